@@ -1,0 +1,28 @@
+#!/usr/bin/env bash
+# Installs matbake's build and test dependencies from Debian (bookworm). Safe to re-run: when every
+# package is already installed it does nothing, not even `apt-get update`.
+set -euo pipefail
+
+packages=(
+  cmake ninja-build g++ pkg-config git
+  libopenimageio-dev openimageio-tools
+  libopencolorio-dev opencolorio-tools
+  libopenexr-dev libimath-dev libglm-dev libtinygltf-dev libembree-dev
+  libcli11-dev nlohmann-json3-dev libtbb-dev
+  libgtest-dev libbenchmark-dev
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q 'install ok installed' || missing+=("$p")
+done
+[ ${#missing[@]} -eq 0 ] && exit 0
+
+if [ "$(id -u)" -ne 0 ]; then
+  echo "matbake: missing packages: ${missing[*]} (run this script as root, or install them)" >&2
+  exit 1
+fi
+echo "matbake: installing ${missing[*]}" >&2
+export DEBIAN_FRONTEND=noninteractive
+apt-get update -qq
+apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null

@@ -1,0 +1,16 @@
+#!/usr/bin/env bash
+# README command 2: installs what is missing, builds matbake and runs the whole test suite twice:
+# a release build (build/) and an AddressSanitizer + UndefinedBehaviorSanitizer build
+# (build-asan/), where any sanitizer report fails the run.
+set -euo pipefail
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+jobs=$(nproc)
+
+bash "$root/scripts/build.sh" "$root/build" -DMATBAKE_WERROR=ON
+ctest --test-dir "$root/build" --output-on-failure -j "$jobs"
+
+bash "$root/scripts/build.sh" "$root/build-asan" -DMATBAKE_WERROR=ON -DMATBAKE_SANITIZE=ON
+export ASAN_OPTIONS=abort_on_error=1:detect_leaks=1:strict_string_checks=1
+export LSAN_OPTIONS=suppressions=$root/tests/lsan.supp:print_suppressions=0
+export UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1
+ctest --test-dir "$root/build-asan" --output-on-failure -j "$jobs"
