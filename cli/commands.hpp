@@ -1,0 +1,41 @@
+#pragma once
+// Each command: setup_<name>() declares its options on the CLI11 app, run_<name>() calls the
+// library and prints. Exit codes: 0 ok, 1 bad input or failed work, 2 bad usage.
+#include <CLI/CLI.hpp>
+
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include "matbake/convert.hpp"
+#include "matbake/result.hpp"
+
+namespace matbake::cli {
+
+enum ExitCode { kOk = 0, kFailed = 1, kUsage = 2 };
+
+struct GlobalOptions {
+  bool json = false;
+  bool quiet = false;
+  int jobs = 0;  // 0: all cores
+  std::string ocio_config;
+};
+
+// Prints `matbake: error: <path>: <problem>` and returns the exit code the error calls for.
+inline int report_error(const Error& error) {
+  std::cerr << "matbake: error: " << error.to_string() << "\n";
+  return error.usage ? kUsage : kFailed;
+}
+
+struct ConvertSettings {
+  std::vector<std::string> inputs;
+  std::string output;
+  std::string out_dir;
+  std::string format;
+  std::string bits;
+  ConvertOptions options;
+};
+CLI::App* setup_convert(CLI::App& app, ConvertSettings& settings);
+int run_convert(const ConvertSettings& settings, const GlobalOptions& global);
+
+}  // namespace matbake::cli

@@ -1,0 +1,42 @@
+#include <tbb/global_control.h>
+
+#include <memory>
+
+#include "commands.hpp"
+#include "matbake/image.hpp"
+#include "matbake/version.hpp"
+
+int main(int argc, char** argv) {
+  using namespace matbake::cli;
+  CLI::App app{"matbake: material authoring and texture baking", "matbake"};
+  app.set_version_flag("--version", std::string("matbake ") + matbake::version);
+  app.require_subcommand(1, 1);
+  app.fallthrough();  // global flags may also follow the command
+  GlobalOptions global;
+  app.add_flag("--json", global.json, "Print a machine-readable result on stdout");
+  app.add_flag("-q,--quiet", global.quiet, "Print nothing but errors");
+  app.add_option("-j,--jobs", global.jobs, "Worker threads (default: all cores)")->check(CLI::NonNegativeNumber);
+  app.add_option("--ocio-config", global.ocio_config,
+                 "OpenColorIO config for colour-space names (default: $OCIO, else the shipped presets/ocio/config.ocio)");
+
+  ConvertSettings convert;
+  CLI::App* convert_app = setup_convert(app, convert);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
+    std::string message = e.what();
+    message = message.substr(0, message.find('\n'));
+    return report_error(matbake::Error{"", message + " (see matbake --help)", true});
+  }
+
+  std::unique_ptr<tbb::global_control> threads;
+  if (global.jobs > 0) {
+    threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, global.jobs);
+  }
+  matbake::image::set_thread_count(global.jobs);
+
+  if (convert_app->parsed()) return run_convert(convert, global);
+  return kUsage;
+}

@@ -1,0 +1,13 @@
+# Every dependency comes from Debian (scripts/deps.sh). See ../shared/design/DEBIAN-NOTES.md for
+# why OpenImageIO and OpenColorIO are found through pkg-config rather than their CMake packages.
+find_package(PkgConfig REQUIRED)
+pkg_check_modules(OIIO REQUIRED IMPORTED_TARGET OpenImageIO)
+pkg_check_modules(OCIO REQUIRED IMPORTED_TARGET OpenColorIO)
+find_package(OpenEXR CONFIG REQUIRED)
+find_package(Imath CONFIG REQUIRED)
+find_package(glm CONFIG REQUIRED)
+find_package(TinyGLTF CONFIG REQUIRED)
+find_package(embree 3 CONFIG REQUIRED)
+find_package(CLI11 CONFIG REQUIRED)
+find_package(TBB CONFIG REQUIRED)
+find_package(nlohmann_json CONFIG REQUIRED)

@@ -1,0 +1,31 @@
+#pragma once
+// Outputs are written to a temporary file in the target's folder and renamed over the target only
+// when complete, so a failure leaves nothing half-written and never touches an existing output.
+#include <filesystem>
+
+#include "matbake/result.hpp"
+
+namespace matbake {
+
+class AtomicFile {
+ public:
+  // Fails when the target's folder does not exist or is not writable.
+  static Result<AtomicFile> create(const std::filesystem::path& target);
+
+  AtomicFile(AtomicFile&& other) noexcept;
+  AtomicFile& operator=(AtomicFile&&) = delete;
+  AtomicFile(const AtomicFile&) = delete;
+  ~AtomicFile();  // removes the temporary file unless committed
+
+  // Same folder and extension as the target (writers pick their format by extension).
+  const std::filesystem::path& temp_path() const { return temp_; }
+  Status commit();
+
+ private:
+  AtomicFile(std::filesystem::path target, std::filesystem::path temp);
+  std::filesystem::path target_;
+  std::filesystem::path temp_;
+  bool done_ = false;
+};
+
+}  // namespace matbake

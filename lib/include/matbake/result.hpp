@@ -1,0 +1,42 @@
+#pragma once
+// Errors that user input can cause are values, not exceptions or prints: the library returns them
+// and only the CLI prints `matbake: error: <path>: <problem>` and picks the exit code.
+#include <string>
+#include <utility>
+#include <variant>
+
+namespace matbake {
+
+struct Error {
+  std::string path;     // the file the problem is about; empty when it is about no file
+  std::string message;  // one line, lower case, no trailing period
+  bool usage = false;   // the command was called wrongly (exit 2), rather than given bad input (exit 1)
+
+  std::string to_string() const { return path.empty() ? message : path + ": " + message; }
+};
+
+template <class T>
+class [[nodiscard]] Result {
+ public:
+  Result(T value) : state_(std::move(value)) {}
+  Result(Error error) : state_(std::move(error)) {}
+
+  bool ok() const { return state_.index() == 0; }
+  explicit operator bool() const { return ok(); }
+  T& value() { return std::get<0>(state_); }
+  const T& value() const { return std::get<0>(state_); }
+  T& operator*() { return value(); }
+  const T& operator*() const { return value(); }
+  T* operator->() { return &value(); }
+  const T* operator->() const { return &value(); }
+  const Error& error() const { return std::get<1>(state_); }
+
+ private:
+  std::variant<T, Error> state_;
+};
+
+// For operations that produce nothing but can fail.
+using Status = Result<std::monostate>;
+inline Status success() { return std::monostate{}; }
+
+}  // namespace matbake

@@ -1,0 +1,106 @@
+#include "matbake/pixels.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <array>
+#include <cassert>
+#include <cmath>
+
+namespace matbake::color {
+namespace {
+
+// Pixels per task: large enough that scheduling costs nothing next to the work.
+constexpr std::size_t kGrainPixels = 16384;
+
+// Calls kernel(pixel_begin, pixel_end) over all pixels in parallel.
+template <class Kernel>
+void for_pixel_ranges(std::size_t pixels, Kernel&& kernel) {
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pixels, kGrainPixels),
+                    [&](const tbb::blocked_range<std::size_t>& r) { kernel(r.begin(), r.end()); });
+}
+
+// out[i] = table_c[in[i]] with one table per channel; the channel count is a template parameter so
+// the inner loop has no modulo and unrolls.
+template <int Channels, class Code>
+void lookup(const Code* in, float* out, std::size_t begin, std::size_t end,
+            const std::array<const float*, 4>& table) {
+  for (std::size_t p = begin; p < end; ++p) {
+    for (int c = 0; c < Channels; ++c) {
+      out[p * Channels + c] = table[c][in[p * Channels + c]];
+    }
+  }
+}
+
+template <class Code>
+void lookup_pixels(std::span<const Code> in, std::span<float> out, const std::array<const float*, 4>& table,
+                   int channels) {
+  assert(in.size() == out.size());
+  const std::size_t pixels = in.size() / channels;
+  for_pixel_ranges(pixels, [&](std::size_t b, std::size_t e) {
+    switch (channels) {
+      case 1: lookup<1>(in.data(), out.data(), b, e, table); break;
+      case 2: lookup<2>(in.data(), out.data(), b, e, table); break;
+      case 3: lookup<3>(in.data(), out.data(), b, e, table); break;
+      default: lookup<4>(in.data(), out.data(), b, e, table); break;
+    }
+  });
+}
+
+template <class TableOf>
+std::array<const float*, 4> tables_for(ChannelTransfers transfers, TableOf&& table_of) {
+  std::array<const float*, 4> tables{};
+  for (std::size_t c = 0; c < transfers.size(); ++c) tables[c] = table_of(transfers[c]).data();
+  return tables;
+}
+
+// out[i] = sample_c(in[i]) with a per-channel function, for the paths without tables.
+template <class In, class Out, class Sample>
+void map_pixels(std::span<const In> in, std::span<Out> out, ChannelTransfers transfers, Sample&& sample) {
+  assert(in.size() == out.size());
+  const std::size_t channels = transfers.size();
+  for_pixel_ranges(in.size() / channels, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b * channels; i < e * channels; ++i) {
+      out[i] = sample(transfers[i % channels], in[i]);
+    }
+  });
+}
+
+}  // namespace
+
+void decode_pixels(std::span<const uint8_t> in, std::span<float> out, ChannelTransfers transfers) {
+  lookup_pixels(in, out, tables_for(transfers, [](Transfer t) { return decode_table(t, 8); }),
+                int(transfers.size()));
+}
+
+void decode_pixels(std::span<const uint16_t> in, std::span<float> out, ChannelTransfers transfers) {
+  lookup_pixels(in, out, tables_for(transfers, [](Transfer t) { return decode_table(t, 16); }),
+                int(transfers.size()));
+}
+
+void decode_half_pixels(std::span<const uint16_t> in, std::span<float> out, ChannelTransfers transfers) {
+  lookup_pixels(in, out, tables_for(transfers, [](Transfer t) { return decode_table_half(t); }),
+                int(transfers.size()));
+}
+
+void decode_pixels(std::span<const float> in, std::span<float> out, ChannelTransfers transfers) {
+  map_pixels(in, out, transfers, [](Transfer t, float v) {
+    return t == Transfer::linear ? v : linear_from_encoded_fast(t, v);
+  });
+}
+
+void encode_pixels(std::span<const float> in, std::span<uint8_t> out, ChannelTransfers transfers) {
+  map_pixels(in, out, transfers, [](Transfer t, float v) { return uint8_t(quantize(t, 8, v)); });
+}
+
+void encode_pixels(std::span<const float> in, std::span<uint16_t> out, ChannelTransfers transfers) {
+  map_pixels(in, out, transfers, [](Transfer t, float v) { return quantize(t, 16, v); });
+}
+
+void encode_pixels(std::span<const float> in, std::span<float> out, ChannelTransfers transfers) {
+  map_pixels(in, out, transfers, [](Transfer t, float v) {
+    return t == Transfer::linear ? v : encoded_from_linear_fast(t, v);
+  });
+}
+
+}  // namespace matbake::color

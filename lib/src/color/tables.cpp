@@ -1,0 +1,101 @@
+// Exact tables: decode of every 8-bit, 16-bit and half code, and the decision thresholds that make
+// quantize() equal to rounding the float64 formula. Built in float64 on first use, once per process.
+#include <Imath/half.h>
+
+#include <array>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "matbake/color.hpp"
+
+namespace matbake::color {
+namespace {
+
+constexpr std::array<Transfer, 3> kTransfers = {Transfer::linear, Transfer::srgb, Transfer::gamma22};
+
+int max_code(int bits) { return (1 << bits) - 1; }
+
+std::vector<float> build_decode_table(Transfer transfer, int bits) {
+  const int max = max_code(bits);
+  std::vector<float> table(std::size_t(max) + 1);
+  for (int code = 0; code <= max; ++code) {
+    table[code] = float(linear_from_encoded(transfer, double(code) / max));
+  }
+  return table;
+}
+
+std::vector<float> build_half_table(Transfer transfer) {
+  std::vector<float> table(65536);
+  for (unsigned bits = 0; bits < 65536; ++bits) {
+    Imath::half h;
+    h.setBits(static_cast<unsigned short>(bits));
+    table[bits] = float(linear_from_encoded(transfer, double(float(h))));
+  }
+  return table;
+}
+
+template <int Bits>
+const std::vector<float>& decode_table_of(Transfer transfer) {
+  static const std::array<std::vector<float>, 3> tables = {build_decode_table(kTransfers[0], Bits),
+                                                           build_decode_table(kTransfers[1], Bits),
+                                                           build_decode_table(kTransfers[2], Bits)};
+  return tables[std::size_t(transfer)];
+}
+
+// threshold[k] is the smallest float x with quantize_reference(x) >= k, for k in 1..max; found
+// from the inverse formula and then walked float by float until the reference rule agrees.
+std::vector<float> build_thresholds(Transfer transfer, int bits) {
+  const int max = max_code(bits);
+  std::vector<float> threshold(std::size_t(max) + 1, 0.0f);
+  constexpr float kInf = std::numeric_limits<float>::infinity();
+  for (int k = 1; k <= max; ++k) {
+    float x = float(linear_from_encoded(transfer, (k - 0.5) / max));
+    while (quantize_reference(transfer, bits, x) >= k) x = std::nextafter(x, -kInf);
+    while (quantize_reference(transfer, bits, x) < k) x = std::nextafter(x, kInf);
+    threshold[k] = x;
+  }
+  return threshold;
+}
+
+template <int Bits>
+const std::vector<float>& thresholds_of(Transfer transfer) {
+  static const std::array<std::vector<float>, 3> tables = {build_thresholds(kTransfers[0], Bits),
+                                                           build_thresholds(kTransfers[1], Bits),
+                                                           build_thresholds(kTransfers[2], Bits)};
+  return tables[std::size_t(transfer)];
+}
+
+}  // namespace
+
+std::span<const float> decode_table(Transfer transfer, int bits) {
+  return bits == 16 ? decode_table_of<16>(transfer) : decode_table_of<8>(transfer);
+}
+
+std::span<const float> decode_table_half(Transfer transfer) {
+  static const std::array<std::vector<float>, 3> tables = {
+      build_half_table(kTransfers[0]), build_half_table(kTransfers[1]), build_half_table(kTransfers[2])};
+  return tables[std::size_t(transfer)];
+}
+
+uint16_t quantize_reference(Transfer transfer, int bits, double linear) {
+  const int max = max_code(bits);
+  const double code = std::floor(encoded_from_linear(transfer, linear) * max + 0.5);
+  if (!(code > 0)) return 0;  // also NaN
+  return code >= max ? uint16_t(max) : uint16_t(code);
+}
+
+uint16_t quantize(Transfer transfer, int bits, float linear) {
+  const std::vector<float>& threshold = bits == 16 ? thresholds_of<16>(transfer) : thresholds_of<8>(transfer);
+  const int max = max_code(bits);
+  if (!(linear >= threshold[1])) return 0;  // also NaN
+  if (linear >= threshold[max]) return uint16_t(max);
+  // The fast encode lands on the right code or next to it; the thresholds settle it exactly.
+  const double guess = double(encoded_from_linear_fast(transfer, linear)) * max + 0.5;
+  int code = guess < 1 ? 1 : guess >= max ? max - 1 : int(guess);
+  while (linear >= threshold[code + 1]) ++code;
+  while (linear < threshold[code]) --code;
+  return uint16_t(code);
+}
+
+}  // namespace matbake::color

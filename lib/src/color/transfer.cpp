@@ -1,0 +1,109 @@
+#include <cmath>
+
+#include "matbake/color.hpp"
+#include "power_function.hpp"
+
+namespace matbake::color {
+namespace {
+
+// IEC 61966-2-1 constants.
+constexpr double kSrgbDecodeThreshold = 0.04045;
+constexpr double kSrgbEncodeThreshold = 0.0031308;
+constexpr double kSrgbSlope = 12.92;
+constexpr double kSrgbOffset = 0.055;
+constexpr double kSrgbScale = 1.055;
+constexpr double kSrgbGamma = 2.4;
+// Schüler's display gamma.
+constexpr double kGamma22 = 2.2;
+
+const PowerFunction& srgb_decode_power() {
+  static const PowerFunction f(kSrgbGamma);
+  return f;
+}
+const PowerFunction& srgb_encode_power() {
+  static const PowerFunction f(1.0 / kSrgbGamma);
+  return f;
+}
+const PowerFunction& gamma22_decode_power() {
+  static const PowerFunction f(kGamma22);
+  return f;
+}
+const PowerFunction& gamma22_encode_power() {
+  static const PowerFunction f(1.0 / kGamma22);
+  return f;
+}
+
+// The two formulas share their shape; `power` is std::pow in the reference and a PowerFunction on
+// the fast path, so both paths evaluate the same float64 expression.
+template <class Power>
+double decode_magnitude(Transfer transfer, double v, const Power& power) {
+  switch (transfer) {
+    case Transfer::linear: return v;
+    case Transfer::srgb:
+      return v <= kSrgbDecodeThreshold ? v / kSrgbSlope : power((v + kSrgbOffset) / kSrgbScale);
+    case Transfer::gamma22: return power(v);
+  }
+  return v;
+}
+
+template <class Power>
+double encode_magnitude(Transfer transfer, double l, const Power& power) {
+  switch (transfer) {
+    case Transfer::linear: return l;
+    case Transfer::srgb:
+      return l <= kSrgbEncodeThreshold ? l * kSrgbSlope : kSrgbScale * power(l) - kSrgbOffset;
+    case Transfer::gamma22: return power(l);
+  }
+  return l;
+}
+
+struct StdPow {
+  double exponent;
+  double operator()(double x) const { return std::pow(x, exponent); }
+};
+
+double decode_exponent(Transfer transfer) { return transfer == Transfer::srgb ? kSrgbGamma : kGamma22; }
+
+}  // namespace
+
+std::optional<Transfer> transfer_from_name(std::string_view name) {
+  if (name == "linear") return Transfer::linear;
+  if (name == "srgb") return Transfer::srgb;
+  if (name == "gamma2.2") return Transfer::gamma22;
+  return std::nullopt;
+}
+
+std::string_view transfer_name(Transfer transfer) {
+  switch (transfer) {
+    case Transfer::linear: return "linear";
+    case Transfer::srgb: return "srgb";
+    case Transfer::gamma22: return "gamma2.2";
+  }
+  return "?";
+}
+
+double linear_from_encoded(Transfer transfer, double encoded) {
+  const StdPow power{decode_exponent(transfer)};
+  return std::copysign(decode_magnitude(transfer, std::fabs(encoded), power), encoded);
+}
+
+double encoded_from_linear(Transfer transfer, double linear) {
+  const StdPow power{1.0 / decode_exponent(transfer)};
+  return std::copysign(encode_magnitude(transfer, std::fabs(linear), power), linear);
+}
+
+float linear_from_encoded_fast(Transfer transfer, float encoded) {
+  const PowerFunction& power =
+      transfer == Transfer::srgb ? srgb_decode_power() : gamma22_decode_power();
+  const double v = encoded;
+  return float(std::copysign(decode_magnitude(transfer, std::fabs(v), power), v));
+}
+
+float encoded_from_linear_fast(Transfer transfer, float linear) {
+  const PowerFunction& power =
+      transfer == Transfer::srgb ? srgb_encode_power() : gamma22_encode_power();
+  const double l = linear;
+  return float(std::copysign(encode_magnitude(transfer, std::fabs(l), power), l));
+}
+
+}  // namespace matbake::color

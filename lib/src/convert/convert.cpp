@@ -1,0 +1,117 @@
+#include "matbake/convert.hpp"
+
+#include <algorithm>
+#include <cctype>
+
+namespace fs = std::filesystem;
+
+namespace matbake {
+namespace {
+
+std::string lower_extension(const fs::path& path) {
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  return ext;
+}
+
+bool is_exr(const fs::path& path) { return lower_extension(path) == ".exr"; }
+bool is_png(const fs::path& path) { return lower_extension(path) == ".png"; }
+
+// EXR stores half or float; PNG 8 or 16 bits; TIFF all four.
+bool format_stores(const fs::path& output, image::SampleType type) {
+  if (is_exr(output)) return !image::is_integer(type);
+  if (is_png(output)) return image::is_integer(type);
+  return true;
+}
+
+// The tag OIIO writes into the file (PNG sRGB/gAMA chunks, an EXR/TIFF attribute).
+std::string colorspace_tag(const ConversionPlan& plan, const ConvertOptions& options) {
+  if (plan.ocio) return options.to;
+  switch (plan.encode) {
+    case color::Transfer::linear: return "Linear";
+    case color::Transfer::srgb: return "sRGB";
+    case color::Transfer::gamma22: return "Gamma2.2";
+  }
+  return {};
+}
+
+}  // namespace
+
+Result<ConversionPlan> plan_conversion(const ConvertOptions& options) {
+  const auto from = color::transfer_from_name(options.from);
+  const auto to = color::transfer_from_name(options.to);
+  ConversionPlan plan;
+  if (from && to) {
+    plan.decode = *from;
+    plan.encode = *to;
+    plan.target_is_linear = *to == color::Transfer::linear;
+    return plan;
+  }
+  if (from || to) {
+    // A built-in name says nothing of primaries, so it cannot be matched to an OCIO colour space.
+    return Error{"",
+                 "--from and --to mix a built-in transfer with an OCIO colour space; name both from the OCIO "
+                 "config (e.g. 'sRGB - Texture' and 'Linear Rec.709 (sRGB)') or neither",
+                 true};
+  }
+  auto config = color::OcioConfig::load(options.ocio_config);
+  if (!config) return config.error();
+  auto processor = config->processor(options.from, options.to);
+  if (!processor) return Error{processor.error().path, processor.error().message, true};
+  plan.ocio = processor.value();
+  plan.target_is_linear = config->is_scene_linear(options.to);
+  plan.ocio_source = config->source();
+  return plan;
+}
+
+bool is_supported_output_extension(const fs::path& path) {
+  const std::string ext = lower_extension(path);
+  return ext == ".exr" || ext == ".png" || ext == ".tif" || ext == ".tiff";
+}
+
+image::SampleType default_sample_type(const fs::path& output, bool target_is_linear, image::SampleType input_type) {
+  if (is_exr(output)) return image::SampleType::half;
+  if (target_is_linear || !image::is_integer(input_type)) return image::SampleType::u16;
+  return input_type;
+}
+
+fs::path output_path_in_folder(const fs::path& input, const fs::path& folder, const std::string& format,
+                               bool target_is_linear) {
+  const std::string ext = format.empty() ? (target_is_linear ? "exr" : "png") : format;
+  return folder / (input.stem().string() + "." + ext);
+}
+
+Result<ConvertReport> convert_file(const ConversionPlan& plan, const fs::path& input, const fs::path& output,
+                                   const ConvertOptions& options) {
+  if (!is_supported_output_extension(output)) {
+    return Error{output.string(), "unsupported output format (matbake writes .exr, .png, .tif)", true};
+  }
+  if (options.type && !format_stores(output, *options.type)) {
+    return Error{output.string(),
+                 "this format cannot store " + std::string(image::sample_type_name(*options.type)) +
+                     " samples (EXR: half or float; PNG: 8 or 16)",
+                 true};
+  }
+  std::error_code ec;
+  if (fs::exists(output, ec) && fs::equivalent(input, output, ec)) {
+    return Error{output.string(), "output is the input file; matbake never overwrites an input"};
+  }
+
+  image::ReadInfo info;
+  auto image = image::read_image(input, plan.decode, &info);
+  if (!image) return image.error();
+  if (plan.ocio) {
+    if (image->channels < 3) {
+      return Error{input.string(), "OCIO colour spaces need RGB or RGBA; this image has " +
+                                       std::to_string(image->channels) + " channel(s)"};
+    }
+    plan.ocio->apply(image->pixels, image->channels);
+  }
+
+  const image::SampleType type = options.type.value_or(default_sample_type(output, plan.target_is_linear, info.stored_type));
+  const image::WriteOptions write{plan.encode, type, options.compression, colorspace_tag(plan, options)};
+  if (Status written = image::write_image(*image, output, write); !written) return written.error();
+  return ConvertReport{input, output, image->width, image->height, image->channels, info.stored_type, type};
+}
+
+}  // namespace matbake

@@ -1,0 +1,240 @@
+// `matbake convert` end to end: the built binary on generated inputs; exit codes, the one-line
+// error format, outputs compared by value, and nothing left behind on failure.
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+#include <unistd.h>
+
+#include <algorithm>
+#include <filesystem>
+
+#include "support/files.hpp"
+#include "support/run.hpp"
+#include "support/temp_dir.hpp"
+
+namespace matbake::test {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Exactly one line on stderr, in the documented form.
+void expect_one_error_line(const RunResult& r, const std::string& path, const std::string& problem) {
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  const std::string expected = "matbake: error: " + (path.empty() ? "" : path + ": ") + problem;
+  EXPECT_EQ(r.err.rfind(expected, 0), 0u) << "stderr: " << r.err << "expected: " << expected;
+}
+
+TEST(CliConvert, HelpAndVersion) {
+  const auto help = matbake({"--help"});
+  EXPECT_EQ(help.exit_code, 0);
+  EXPECT_NE(help.out.find("convert"), std::string::npos);
+  const auto convert_help = matbake({"convert", "--help"});
+  EXPECT_EQ(convert_help.exit_code, 0);
+  EXPECT_NE(convert_help.out.find("--out-dir"), std::string::npos);
+  const auto version = matbake({"--version"});
+  EXPECT_EQ(version.exit_code, 0);
+  EXPECT_EQ(version.out.rfind("matbake 0.", 0), 0u) << version.out;
+}
+
+TEST(CliConvert, UsageErrorsExitTwo) {
+  TempDir dir;
+  write_raw(dir / "a.png", 1, 1, 3, "uint8", {1, 2, 3});
+  const std::string a = (dir / "a.png").string();
+  const std::vector<std::vector<std::string>> cases = {
+      {},
+      {"frobnicate"},
+      {"convert"},
+      {"convert", a},
+      {"convert", a, a, "-o", (dir / "x.exr").string()},
+      {"convert", a, "-o", (dir / "x.exr").string(), "--bits", "12"},
+      {"convert", a, "-o", (dir / "x.exr").string(), "--from", "srgb", "--to", "Linear Rec.709 (sRGB)"},
+      {"convert", a, "-o", (dir / "x.exr").string(), "--from", "sRGB - Texture", "--to", "nonsense"},
+      {"convert", a, "-o", (dir / "x.jpg")},
+      {"convert", a, "-o", (dir / "x.exr").string(), "--bits", "8"},
+      {"convert", a, "-o", (dir / "x.exr").string(), "--out-dir", dir.path().string()},
+  };
+  for (const auto& args : cases) {
+    const auto r = matbake(args);
+    EXPECT_EQ(r.exit_code, 2) << testing::PrintToString(args) << r.err;
+    EXPECT_EQ(r.err.rfind("matbake: error: ", 0), 0u) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  }
+  EXPECT_EQ(list_folder(dir.path()), std::vector<std::string>{"a.png"});
+}
+
+TEST(CliConvert, RgbaPngToLinearExrAndBackIsBitExact) {
+  TempDir dir;
+  write_raw(dir / "in.png", 1, 1, 4, "uint8", {255, 128, 64, 128});
+  const auto to_linear = matbake({"convert", (dir / "in.png").string(), "-o", (dir / "lin.exr").string()});
+  ASSERT_EQ(to_linear.exit_code, 0) << to_linear.err;
+  const auto exr = read_raw(dir / "lin.exr");
+  EXPECT_EQ(exr.format, "half");
+  EXPECT_EQ(exr.samples[0], 1.0);
+  EXPECT_NEAR(exr.samples[1], 0.2158605, 1e-4);  // half of the sRGB decode of 128
+  EXPECT_EQ(exr.samples[3], 0.501953125);        // half(128/255): alpha linear, not divided
+  const auto back = matbake({"convert", (dir / "lin.exr").string(), "-o", (dir / "back.png").string(), "--from",
+                             "linear", "--to", "srgb", "--bits", "8"});
+  ASSERT_EQ(back.exit_code, 0) << back.err;
+  EXPECT_EQ(read_raw(dir / "back.png").samples, (std::vector<double>{255, 128, 64, 128}));
+}
+
+TEST(CliConvert, InputFormatsAndLayouts) {
+  TempDir dir;
+  write_raw(dir / "gray_alpha.png", 3, 3, 2, "uint8", std::vector<double>(18, 100));
+  write_raw(dir / "rgb16.tif", 5, 1, 3, "uint16", std::vector<double>(15, 40000));
+  write_raw(dir / "photo.jpg", 8, 8, 3, "uint8", std::vector<double>(192, 180));
+  write_raw(dir / "half.exr", 2, 1, 1, "half", {0.5, 2.0});
+  const auto r = matbake({"convert", (dir / "gray_alpha.png").string(), (dir / "rgb16.tif").string(),
+                          (dir / "photo.jpg").string(), (dir / "half.exr").string(), "--out-dir",
+                          (dir / "out").string(), "--format", "tif", "--bits", "float"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto gray = read_raw(dir / "out/gray_alpha.tif");
+  EXPECT_EQ(gray.channels, 2);
+  EXPECT_FLOAT_EQ(float(gray.samples[0]), float(std::pow((100 / 255.0 + 0.055) / 1.055, 2.4)));
+  EXPECT_FLOAT_EQ(float(gray.samples[1]), float(100 / 255.0));
+  EXPECT_FLOAT_EQ(float(read_raw(dir / "out/rgb16.tif").samples[0]), float(std::pow((40000 / 65535.0 + 0.055) / 1.055, 2.4)));
+  EXPECT_EQ(read_raw(dir / "out/photo.tif").width, 8);
+  const auto hdr = read_raw(dir / "out/half.tif");
+  EXPECT_FLOAT_EQ(float(hdr.samples[1]), float(std::pow(2.055 / 1.055, 2.4)));
+}
+
+TEST(CliConvert, JsonAndQuiet) {
+  TempDir dir;
+  write_raw(dir / "a.png", 4, 2, 3, "uint8", std::vector<double>(24, 9));
+  const auto json = matbake({"convert", (dir / "a.png").string(), "-o", (dir / "a.exr").string(), "--json"});
+  ASSERT_EQ(json.exit_code, 0) << json.err;
+  const auto parsed = nlohmann::json::parse(json.out);
+  EXPECT_EQ(parsed["command"], "convert");
+  ASSERT_EQ(parsed["results"].size(), 1u);
+  EXPECT_EQ(parsed["results"][0]["width"], 4);
+  EXPECT_EQ(parsed["results"][0]["output_type"], "half");
+  EXPECT_EQ(parsed["results"][0]["output"], (dir / "a.exr").string());
+
+  const auto quiet = matbake({"--quiet", "convert", (dir / "a.png").string(), "-o", (dir / "b.exr").string()});
+  EXPECT_EQ(quiet.exit_code, 0);
+  EXPECT_EQ(quiet.out, "");
+  EXPECT_EQ(quiet.err, "");
+  const auto loud = matbake({"convert", (dir / "a.png").string(), "-o", (dir / "c.exr").string()});
+  EXPECT_NE(loud.out.find("-> "), std::string::npos);
+}
+
+TEST(CliConvert, BadInputsExitOneWithOneLineNamingTheFile) {
+  TempDir dir;
+  write_raw(dir / "good.png", 64, 64, 3, "uint8", std::vector<double>(64 * 64 * 3, 120));
+  const std::string good = read_bytes(dir / "good.png");
+  write_bytes(dir / "truncated.png", good.substr(0, good.size() / 2));
+  write_bytes(dir / "text.png", "not an image\n");
+  write_raw(dir / "five.exr", 2, 2, 5, "half", std::vector<double>(20, 0.5));
+  write_raw(dir / "nan.exr", 2, 1, 1, "float", {std::nan(""), 0.5});
+  write_bytes(dir / "previous.exr", "previous good output");
+  const auto files_before = list_folder(dir.path());
+
+  struct Case {
+    std::string input;
+    std::string problem;
+  };
+  const std::vector<Case> cases = {
+      {(dir / "missing.png").string(), "no such file"},
+      {(dir / "text.png").string(), "not a readable image"},
+      {(dir / "truncated.png").string(), "cannot read pixels"},
+      {(dir / "five.exr").string(), "5 channels; matbake reads 1 to 4"},
+      {(dir / "nan.exr").string(), "contains 1 NaN and 0 Inf samples"},
+  };
+  for (const Case& c : cases) {
+    const auto r = matbake({"convert", c.input, "-o", (dir / "previous.exr").string()});
+    EXPECT_EQ(r.exit_code, 1) << c.input;
+    expect_one_error_line(r, c.input, c.problem);
+  }
+  // The existing output is untouched and no temporary file is left.
+  EXPECT_EQ(read_bytes(dir / "previous.exr"), "previous good output");
+  EXPECT_EQ(list_folder(dir.path()), files_before);
+
+  // Output path equal to the input.
+  const auto same = matbake({"convert", (dir / "good.png").string(), "-o", (dir / "good.png").string()});
+  EXPECT_EQ(same.exit_code, 1);
+  expect_one_error_line(same, (dir / "good.png").string(), "output is the input file");
+  // Output folder missing, or a file.
+  const auto no_folder = matbake({"convert", (dir / "good.png").string(), "-o", (dir / "none/x.exr").string()});
+  EXPECT_EQ(no_folder.exit_code, 1);
+  expect_one_error_line(no_folder, (dir / "none/x.exr").string(), "output folder does not exist");
+  EXPECT_EQ(read_bytes(dir / "good.png"), good);
+}
+
+TEST(CliConvert, UnwritableOutputFolder) {
+  TempDir dir;
+  write_raw(dir / "in.png", 2, 2, 3, "uint8", std::vector<double>(12, 1));
+  fs::create_directory(dir / "locked");
+  fs::permissions(dir / "locked", fs::perms::owner_read | fs::perms::owner_exec | fs::perms::group_read |
+                                      fs::perms::group_exec | fs::perms::others_read | fs::perms::others_exec);
+  fs::permissions(dir.path(), fs::perms::others_read | fs::perms::others_exec, fs::perm_options::add);
+  const std::vector<std::string> args = {"convert", (dir / "in.png").string(), "-o", (dir / "locked/out.exr").string()};
+  RunResult r;
+  if (geteuid() == 0) {
+    // Root writes anywhere: run as nobody, for whom the folder is read-only.
+    std::vector<std::string> as_nobody = {"--reuid=65534", "--regid=65534", "--clear-groups", MATBAKE_EXE};
+    as_nobody.insert(as_nobody.end(), args.begin(), args.end());
+    if (!fs::exists("/usr/bin/setpriv")) GTEST_SKIP() << "running as root without setpriv";
+    r = run("/usr/bin/setpriv", as_nobody);
+  } else {
+    r = matbake(args);
+  }
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  expect_one_error_line(r, (dir / "locked/out.exr").string(), "cannot write in the output folder: Permission denied");
+  EXPECT_TRUE(fs::is_empty(dir / "locked"));
+}
+
+TEST(CliConvert, BatchFinishesPastABadFileAndSummarises) {
+  TempDir dir;
+  write_raw(dir / "a.png", 2, 2, 3, "uint8", std::vector<double>(12, 1));
+  write_bytes(dir / "b.png", "garbage");
+  write_raw(dir / "c.png", 2, 2, 3, "uint8", std::vector<double>(12, 2));
+  const auto r = matbake({"convert", (dir / "a.png").string(), (dir / "b.png").string(), (dir / "c.png").string(),
+                          "--out-dir", (dir / "out").string()});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_EQ(list_folder(dir / "out"), (std::vector<std::string>{"a.exr", "c.exr"}));
+  EXPECT_NE(r.err.find("matbake: error: " + (dir / "b.png").string() + ": not a readable image"), std::string::npos);
+  EXPECT_NE(r.err.find("matbake: 1 of 3 conversions failed"), std::string::npos);
+}
+
+TEST(CliConvert, OutDirCollisionIsRefusedBeforeAnyWork) {
+  TempDir dir;
+  fs::create_directories(dir / "x");
+  write_raw(dir / "a.png", 1, 1, 3, "uint8", {1, 2, 3});
+  write_raw(dir / "x/a.png", 1, 1, 3, "uint8", {1, 2, 3});
+  const auto r = matbake({"convert", (dir / "a.png").string(), (dir / "x/a.png").string(), "--out-dir",
+                          (dir / "out").string()});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_FALSE(fs::exists(dir / "out"));
+}
+
+TEST(CliConvert, OutputIsByteIdenticalAcrossRunsAndThreadCounts) {
+  TempDir dir;
+  std::vector<double> codes(300 * 200 * 4);
+  for (std::size_t i = 0; i < codes.size(); ++i) codes[i] = double((i * 2654435761u) % 256);
+  write_raw(dir / "in.png", 300, 200, 4, "uint8", codes);
+  for (const char* name : {"a", "b"}) {
+    const auto r = matbake({"convert", (dir / "in.png").string(), "-o", (dir / (std::string(name) + ".exr")).string(),
+                            "--jobs", std::string(name) == "a" ? "1" : "2"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+  }
+  EXPECT_EQ(read_bytes(dir / "a.exr"), read_bytes(dir / "b.exr"));
+}
+
+TEST(CliConvert, OcioConfigOptionAndVariable) {
+  TempDir dir;
+  write_raw(dir / "in.png", 2, 1, 3, "uint8", {10, 128, 255, 0, 1, 2});
+  const std::vector<std::string> args = {"convert", (dir / "in.png").string(), "-o", (dir / "o.exr").string(),
+                                         "--from", "sRGB - Texture", "--to", "Linear Rec.709 (sRGB)"};
+  const auto builtin = matbake(args, {"OCIO="});
+  ASSERT_EQ(builtin.exit_code, 0) << builtin.err;
+  const auto missing_env = matbake(args, {"OCIO=" + (dir / "none.ocio").string()});
+  EXPECT_EQ(missing_env.exit_code, 1);
+  expect_one_error_line(missing_env, (dir / "none.ocio").string(), "OCIO config not found");
+  auto with_option = args;
+  with_option.insert(with_option.begin(), {"--ocio-config", (dir / "none2.ocio").string()});
+  const auto missing_option = matbake(with_option);
+  EXPECT_EQ(missing_option.exit_code, 1);
+  expect_one_error_line(missing_option, (dir / "none2.ocio").string(), "OCIO config not found");
+}
+
+}  // namespace
+}  // namespace matbake::test

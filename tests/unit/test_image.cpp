@@ -1,0 +1,167 @@
+// Image I/O: decode at read, encode at write, alpha unassociated on both sides, every layout and
+// odd size, non-finite input rejected, atomic writes.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "matbake/image.hpp"
+#include "support/files.hpp"
+#include "support/temp_dir.hpp"
+
+namespace matbake::image {
+namespace {
+
+using color::Transfer;
+using test::list_folder;
+using test::read_raw;
+using test::TempDir;
+using test::write_raw;
+
+TEST(ImageIo, AlphaIsUnassociatedAndNeverTransferred) {
+  // DEBIAN-NOTES: OIIO's default would premultiply (255,128,64,128) on read and divide on write.
+  TempDir dir;
+  write_raw(dir / "in.png", 1, 1, 4, "uint8", {255, 128, 64, 128});
+  auto image = read_image(dir / "in.png", Transfer::srgb);
+  ASSERT_TRUE(image) << image.error().to_string();
+  EXPECT_EQ(image->alpha_channel, 3);
+  EXPECT_EQ(image->pixels[0], 1.0f);
+  EXPECT_EQ(image->pixels[1], color::decode_table(Transfer::srgb, 8)[128]);
+  EXPECT_EQ(image->pixels[2], color::decode_table(Transfer::srgb, 8)[64]);
+  EXPECT_EQ(image->pixels[3], float(128.0 / 255.0));
+
+  ASSERT_TRUE(write_image(*image, dir / "linear.exr", {Transfer::linear, SampleType::f32, "", "Linear"}));
+  const auto exr = read_raw(dir / "linear.exr");
+  EXPECT_EQ(exr.samples, (std::vector<double>{1.0, image->pixels[1], image->pixels[2], image->pixels[3]}));
+
+  auto linear = read_image(dir / "linear.exr", Transfer::linear);
+  ASSERT_TRUE(linear);
+  ASSERT_TRUE(write_image(*linear, dir / "back.png", {Transfer::srgb, SampleType::u8, "", "sRGB"}));
+  EXPECT_EQ(read_raw(dir / "back.png").samples, (std::vector<double>{255, 128, 64, 128}));
+}
+
+TEST(ImageIo, EveryLayoutAndOddSizeRoundTripsThroughLinearHalf) {
+  TempDir dir;
+  const std::vector<std::vector<std::string>> names = {{"Y"}, {"Y", "A"}, {"R", "G", "B"}, {"R", "G", "B", "A"}};
+  for (int channels = 1; channels <= 4; ++channels) {
+    for (auto [w, h] : {std::pair{1, 1}, std::pair{7, 5}, std::pair{3, 1}}) {
+      std::vector<double> codes(std::size_t(w) * h * channels);
+      for (std::size_t i = 0; i < codes.size(); ++i) codes[i] = double((i * 37 + 11) % 256);
+      const auto in = dir / ("in" + std::to_string(channels) + ".png");
+      write_raw(in, w, h, channels, "uint8", codes, names[channels - 1]);
+      auto image = read_image(in, Transfer::srgb);
+      ASSERT_TRUE(image);
+      EXPECT_EQ(image->width, w);
+      EXPECT_EQ(image->height, h);
+      EXPECT_EQ(image->channel_names, names[channels - 1]);
+      // Half keeps 11 significant bits: enough for every 8-bit sRGB code to come back.
+      ASSERT_TRUE(write_image(*image, dir / "mid.exr", {Transfer::linear, SampleType::half, "", ""}));
+      EXPECT_EQ(read_raw(dir / "mid.exr").channel_names, names[channels - 1]);
+      auto mid = read_image(dir / "mid.exr", Transfer::linear);
+      ASSERT_TRUE(mid);
+      ASSERT_TRUE(write_image(*mid, dir / "out.png", {Transfer::srgb, SampleType::u8, "", ""}));
+      const auto out = read_raw(dir / "out.png");
+      EXPECT_EQ(out.samples, codes) << channels << " channels, " << w << "x" << h;
+    }
+  }
+}
+
+TEST(ImageIo, SixteenBitCodesRoundTripThroughFloat) {
+  TempDir dir;
+  std::vector<double> codes;
+  for (int i = 0; i < 65536; i += 13) codes.push_back(i);
+  codes.resize(codes.size() / 3 * 3);
+  const int w = int(codes.size() / 3);
+  write_raw(dir / "in.png", w, 1, 3, "uint16", codes);
+  auto image = read_image(dir / "in.png", Transfer::srgb);
+  ASSERT_TRUE(image);
+  ASSERT_TRUE(write_image(*image, dir / "mid.tif", {Transfer::linear, SampleType::f32, "", ""}));
+  auto mid = read_image(dir / "mid.tif", Transfer::linear);
+  ASSERT_TRUE(mid);
+  ASSERT_TRUE(write_image(*mid, dir / "out.png", {Transfer::srgb, SampleType::u16, "", ""}));
+  EXPECT_EQ(read_raw(dir / "out.png").samples, codes);
+}
+
+TEST(ImageIo, NonFiniteSamplesAreRejectedAndCounted) {
+  TempDir dir;
+  const double nan = std::nan(""), inf = std::numeric_limits<double>::infinity();
+  for (const char* format : {"float", "half"}) {
+    const auto path = dir / (std::string(format) + ".exr");
+    write_raw(path, 3, 1, 3, format, {0.5, nan, inf, -inf, 0.25, nan, nan, 1.0, 0.0});
+    auto image = read_image(path, Transfer::srgb);
+    ASSERT_FALSE(image);
+    EXPECT_EQ(image.error().path, path.string());
+    EXPECT_EQ(image.error().message, "contains 3 NaN and 2 Inf samples; matbake rejects non-finite texels");
+  }
+}
+
+TEST(ImageIo, DecodeOverflowIsRejectedButHdrAndNegativesPass) {
+  TempDir dir;
+  write_raw(dir / "huge.exr", 2, 1, 1, "float", {1e30, 2.0});
+  auto huge = read_image(dir / "huge.exr", Transfer::srgb);
+  ASSERT_FALSE(huge);
+  EXPECT_EQ(huge.error().message, "1 samples overflow float when decoded from srgb (inputs above about 1e16)");
+  EXPECT_TRUE(read_image(dir / "huge.exr", Transfer::linear));  // nothing to decode: fine
+
+  write_raw(dir / "hdr.exr", 2, 1, 1, "float", {4.0, -0.5});
+  auto hdr = read_image(dir / "hdr.exr", Transfer::srgb);
+  ASSERT_TRUE(hdr);
+  EXPECT_FLOAT_EQ(hdr->pixels[0], float(std::pow(4.055 / 1.055, 2.4)));
+  EXPECT_FLOAT_EQ(hdr->pixels[1], -float(std::pow(0.555 / 1.055, 2.4)));
+}
+
+TEST(ImageIo, UnsupportedChannelCountIsAnError) {
+  TempDir dir;
+  write_raw(dir / "five.exr", 2, 2, 5, "half", std::vector<double>(20, 0.5));
+  auto image = read_image(dir / "five.exr", Transfer::linear);
+  ASSERT_FALSE(image);
+  EXPECT_EQ(image.error().message, "5 channels; matbake reads 1 to 4 (gray, gray+alpha, RGB, RGBA)");
+}
+
+TEST(ImageIo, MissingAndNonImageFilesAreErrors) {
+  TempDir dir;
+  auto missing = read_image(dir / "nope.png", Transfer::srgb);
+  ASSERT_FALSE(missing);
+  EXPECT_EQ(missing.error().message, "no such file");
+  test::write_bytes(dir / "text.png", "this is not a PNG\n");
+  auto text = read_image(dir / "text.png", Transfer::srgb);
+  ASSERT_FALSE(text);
+  EXPECT_EQ(text.error().message.rfind("not a readable image", 0), 0u) << text.error().message;
+  EXPECT_EQ(text.error().message.find('\n'), std::string::npos);
+}
+
+TEST(ImageIo, FailedWriteLeavesTheExistingOutputAndNoTemporaryFile) {
+  TempDir dir;
+  write_raw(dir / "in.png", 2, 2, 3, "uint8", std::vector<double>(12, 200));
+  test::write_bytes(dir / "out.xyz", "previous good output");
+  auto image = read_image(dir / "in.png", Transfer::srgb);
+  ASSERT_TRUE(image);
+  // No writer for the extension: fails after the temporary file was reserved.
+  Status s = write_image(*image, dir / "out.xyz", {Transfer::linear, SampleType::half, "", ""});
+  ASSERT_FALSE(s);
+  EXPECT_EQ(s.error().path, (dir / "out.xyz").string());
+  EXPECT_EQ(s.error().message.rfind("no image writer for this extension", 0), 0u) << s.error().message;
+  EXPECT_EQ(test::read_bytes(dir / "out.xyz"), "previous good output");
+  EXPECT_EQ(list_folder(dir.path()), (std::vector<std::string>{"in.png", "out.xyz"}));
+
+  // A folder that does not exist: a clean error, nothing created.
+  Status missing = write_image(*image, dir / "no" / "out.exr", {});
+  ASSERT_FALSE(missing);
+  EXPECT_EQ(missing.error().message, "output folder does not exist");
+}
+
+TEST(ImageIo, WritesAreDeterministic) {
+  TempDir dir;
+  write_raw(dir / "in.png", 5, 3, 4, "uint8", std::vector<double>(60, 77));
+  auto image = read_image(dir / "in.png", Transfer::srgb);
+  ASSERT_TRUE(image);
+  for (const char* ext : {".exr", ".png", ".tif"}) {
+    const SampleType type = std::string(ext) == ".png" ? SampleType::u16 : SampleType::half;
+    ASSERT_TRUE(write_image(*image, dir / (std::string("a") + ext), {Transfer::linear, type, "", "Linear"}));
+    ASSERT_TRUE(write_image(*image, dir / (std::string("b") + ext), {Transfer::linear, type, "", "Linear"}));
+    EXPECT_EQ(test::read_bytes(dir / (std::string("a") + ext)), test::read_bytes(dir / (std::string("b") + ext))) << ext;
+  }
+}
+
+}  // namespace
+}  // namespace matbake::image
