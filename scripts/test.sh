@@ -10,7 +10,8 @@ bash "$root/scripts/build.sh" "$root/build" -DMATBAKE_WERROR=ON
 ctest --test-dir "$root/build" --output-on-failure -j "$jobs"
 
 bash "$root/scripts/build.sh" "$root/build-asan" -DMATBAKE_WERROR=ON -DMATBAKE_SANITIZE=ON
-export ASAN_OPTIONS=abort_on_error=1:detect_leaks=1:strict_string_checks=1
+# Full unwinding on malloc so leak suppressions can name the third-party frame.
+export ASAN_OPTIONS=abort_on_error=1:detect_leaks=1:strict_string_checks=1:fast_unwind_on_malloc=0
 export LSAN_OPTIONS=suppressions=$root/tests/lsan.supp:print_suppressions=0
 export UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1
 ctest --test-dir "$root/build-asan" --output-on-failure -j "$jobs"
