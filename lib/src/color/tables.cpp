@@ -3,11 +3,13 @@
 #include <Imath/half.h>
 
 #include <array>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <vector>
 
 #include "matbake/color.hpp"
+#include "quantizer.hpp"
 
 namespace matbake::color {
 namespace {
@@ -43,27 +45,31 @@ const std::vector<float>& decode_table_of(Transfer transfer) {
   return tables[std::size_t(transfer)];
 }
 
-// threshold[k] is the smallest float x with quantize_reference(x) >= k, for k in 1..max; found
-// from the inverse formula and then walked float by float until the reference rule agrees.
-std::vector<float> build_thresholds(Transfer transfer, int bits) {
+Quantizer build_quantizer(Transfer transfer, int bits) {
   const int max = max_code(bits);
-  std::vector<float> threshold(std::size_t(max) + 1, 0.0f);
+  Quantizer q;
+  q.max = max;
+  q.threshold.assign(std::size_t(max) + 1, 0.0f);
   constexpr float kInf = std::numeric_limits<float>::infinity();
   for (int k = 1; k <= max; ++k) {
     float x = float(linear_from_encoded(transfer, (k - 0.5) / max));
     while (quantize_reference(transfer, bits, x) >= k) x = std::nextafter(x, -kInf);
     while (quantize_reference(transfer, bits, x) < k) x = std::nextafter(x, kInf);
-    threshold[k] = x;
+    q.threshold[k] = x;
   }
-  return threshold;
+  const uint32_t last_bucket = std::bit_cast<uint32_t>(1.0f) >> QuantizerView::kBucketShift;
+  for (uint32_t b = 0; b <= last_bucket; ++b) {
+    q.bucket_code.push_back(quantize_reference(transfer, bits, std::bit_cast<float>(b << QuantizerView::kBucketShift)));
+  }
+  return q;
 }
 
 template <int Bits>
-const std::vector<float>& thresholds_of(Transfer transfer) {
-  static const std::array<std::vector<float>, 3> tables = {build_thresholds(kTransfers[0], Bits),
-                                                           build_thresholds(kTransfers[1], Bits),
-                                                           build_thresholds(kTransfers[2], Bits)};
-  return tables[std::size_t(transfer)];
+const Quantizer& quantizer_of(Transfer transfer) {
+  static const std::array<Quantizer, 3> quantizers = {build_quantizer(kTransfers[0], Bits),
+                                                      build_quantizer(kTransfers[1], Bits),
+                                                      build_quantizer(kTransfers[2], Bits)};
+  return quantizers[std::size_t(transfer)];
 }
 
 }  // namespace
@@ -85,17 +91,10 @@ uint16_t quantize_reference(Transfer transfer, int bits, double linear) {
   return code >= max ? uint16_t(max) : uint16_t(code);
 }
 
-uint16_t quantize(Transfer transfer, int bits, float linear) {
-  const std::vector<float>& threshold = bits == 16 ? thresholds_of<16>(transfer) : thresholds_of<8>(transfer);
-  const int max = max_code(bits);
-  if (!(linear >= threshold[1])) return 0;  // also NaN
-  if (linear >= threshold[max]) return uint16_t(max);
-  // The fast encode lands on the right code or next to it; the thresholds settle it exactly.
-  const double guess = double(encoded_from_linear_fast(transfer, linear)) * max + 0.5;
-  int code = guess < 1 ? 1 : guess >= max ? max - 1 : int(guess);
-  while (linear >= threshold[code + 1]) ++code;
-  while (linear < threshold[code]) --code;
-  return uint16_t(code);
+const Quantizer& quantizer(Transfer transfer, int bits) {
+  return bits == 16 ? quantizer_of<16>(transfer) : quantizer_of<8>(transfer);
 }
+
+uint16_t quantize(Transfer transfer, int bits, float linear) { return quantizer(transfer, bits).view().code_of(linear); }
 
 }  // namespace matbake::color
