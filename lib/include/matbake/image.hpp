@@ -3,6 +3,8 @@
 // alpha unassociated: OIIO is told so on both sides (../shared/design/DEBIAN-NOTES.md).
 #include <cstddef>
 #include <filesystem>
+#include <functional>
+#include <span>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -19,21 +21,25 @@ std::optional<SampleType> sample_type_from_name(std::string_view name);  // "8",
 std::string_view sample_type_name(SampleType type);
 bool is_integer(SampleType type);
 
-struct Image {
+// Size and channel layout of an image, without its pixels.
+struct ImageLayout {
   int width = 0;
   int height = 0;
   int channels = 0;                        // 1 gray, 2 gray+alpha, 3 RGB, 4 RGBA
   std::vector<std::string> channel_names;  // as stored ("R", "G", "B", "A", "Y", ...)
   int alpha_channel = -1;                  // index into channels, or -1
-  std::vector<float> pixels;               // width * height * channels, row-major, interleaved
 
   std::size_t sample_count() const {
     return std::size_t(width) * std::size_t(height) * std::size_t(channels);
   }
 };
 
+struct Image : ImageLayout {
+  std::vector<float> pixels;  // width * height * channels, row-major, interleaved
+};
+
 // Per-channel transfers: `colour` for colour channels, linear for alpha.
-std::vector<color::Transfer> channel_transfers(const Image& image, color::Transfer colour);
+std::vector<color::Transfer> channel_transfers(const ImageLayout& layout, color::Transfer colour);
 
 struct ReadInfo {
   SampleType stored_type = SampleType::u8;  // the closest of ours to what the file holds
@@ -46,6 +52,9 @@ struct ReadInfo {
 Result<Image> read_image(const std::filesystem::path& path, color::Transfer colour,
                          ReadInfo* info = nullptr);
 
+// Opens the file's header only: what it stores, without reading pixels.
+Result<ReadInfo> probe_image(const std::filesystem::path& path);
+
 struct WriteOptions {
   color::Transfer colour = color::Transfer::linear;  // applied to colour channels, never alpha
   SampleType type = SampleType::half;
@@ -55,7 +64,19 @@ struct WriteOptions {
 
 // Writes atomically: a temporary file in the target folder, renamed over `path` when complete.
 // The format follows the extension. Output bytes depend only on the inputs (no timestamps).
+// Errors: unwritable folder, unknown extension, half output beyond the half range (±65504).
 Status write_image(const Image& image, const std::filesystem::path& path, const WriteOptions& options);
+
+// Reads `input` and writes `output` band by band (rows), `transform` applied to each decoded band
+// in between: reading, transforming and writing overlap on the cores, and memory stays a few bands
+// whatever the image size. Same checks and guarantees as read_image and write_image.
+struct BandTransform {
+  std::function<Status(const ImageLayout&)> accept;  // once, before any band: may refuse the input
+  std::function<void(std::span<float> band, const ImageLayout&)> apply;  // each band, in parallel
+};
+Status stream_image(const std::filesystem::path& input, color::Transfer decode, const std::filesystem::path& output,
+                    const WriteOptions& options, const BandTransform& transform = {}, ReadInfo* info = nullptr,
+                    ImageLayout* layout = nullptr);
 
 // Threads OIIO may use (EXR compression above all); 0: one per core.
 void set_thread_count(int threads);

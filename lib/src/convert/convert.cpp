@@ -97,21 +97,32 @@ Result<ConvertReport> convert_file(const ConversionPlan& plan, const fs::path& i
     return Error{output.string(), "output is the input file; matbake never overwrites an input"};
   }
 
+  // Without --bits the output type depends on the input's, known only once the input is open.
   image::ReadInfo info;
-  auto image = image::read_image(input, plan.decode, &info);
-  if (!image) return image.error();
-  if (plan.ocio) {
-    if (image->channels < 3) {
+  image::ImageLayout layout;
+  image::WriteOptions write{plan.encode, options.type.value_or(image::SampleType::half), options.compression,
+                            colorspace_tag(plan, options)};
+  image::BandTransform transform;
+  transform.accept = [&](const image::ImageLayout& l) -> Status {
+    if (plan.ocio && l.channels < 3) {
       return Error{input.string(), "OCIO colour spaces need RGB or RGBA; this image has " +
-                                       std::to_string(image->channels) + " channel(s)"};
+                                       std::to_string(l.channels) + " channel(s)"};
     }
-    plan.ocio->apply(image->pixels, image->channels);
+    return success();
+  };
+  if (plan.ocio) {
+    transform.apply = [&](std::span<float> band, const image::ImageLayout& l) { plan.ocio->apply(band, l.channels); };
   }
-
-  const image::SampleType type = options.type.value_or(default_sample_type(output, plan.target_is_linear, info.stored_type));
-  const image::WriteOptions write{plan.encode, type, options.compression, colorspace_tag(plan, options)};
-  if (Status written = image::write_image(*image, output, write); !written) return written.error();
-  return ConvertReport{input, output, image->width, image->height, image->channels, info.stored_type, type};
+  if (!options.type) {
+    // Peek at the stored type first (opening is cheap: the header only).
+    auto probe = image::probe_image(input);
+    if (!probe) return probe.error();
+    write.type = default_sample_type(output, plan.target_is_linear, probe->stored_type);
+  }
+  if (Status s = image::stream_image(input, plan.decode, output, write, transform, &info, &layout); !s) {
+    return s.error();
+  }
+  return ConvertReport{input, output, layout.width, layout.height, layout.channels, info.stored_type, write.type};
 }
 
 }  // namespace matbake

@@ -1,9 +1,14 @@
-// All image file I/O goes through OpenImageIO here, and only here.
+// All image file I/O goes through OpenImageIO here, and only here. Reading and writing work in
+// bands of rows (RowReader, RowWriter); whole-image reads and writes are one band.
 #include <OpenImageIO/imageio.h>
+#include <tbb/parallel_pipeline.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <memory>
 #include <string>
+#include <thread>
 
 #include "matbake/atomic_file.hpp"
 #include "matbake/image.hpp"
@@ -40,48 +45,218 @@ TypeDesc type_desc(SampleType type) {
   return TypeDesc::FLOAT;
 }
 
-template <class T>
-Status read_samples(OIIO::ImageInput& in, const ImageSpec& spec, SampleType type, std::vector<T>& samples,
-                    const fs::path& path) {
-  samples.resize(std::size_t(spec.width) * spec.height * spec.nchannels);
-  if (!in.read_image(0, 0, 0, spec.nchannels, type_desc(type), samples.data())) {
-    return Error{path.string(), "cannot read pixels: " + first_line(in.geterror())};
-  }
-  return success();
-}
-
-// Non-finite samples are rejected before decoding (they are bad input, not something to convert),
-// and so are finite ones that the decode overflows (sRGB/gamma 2.2 of values above about 1e16).
 struct NonFinite {
   std::size_t nan = 0;
   std::size_t inf = 0;
+  bool any() const { return nan + inf > 0; }
+  void add(float v) {
+    nan += std::isnan(v);
+    inf += std::isinf(v);
+  }
 };
 
-NonFinite count_non_finite(std::span<const float> samples) {
-  NonFinite n;
-  for (float v : samples) {
-    n.nan += std::isnan(v);
-    n.inf += std::isinf(v);
-  }
-  return n;
-}
-
-NonFinite count_non_finite_half(std::span<const uint16_t> bits) {
+void count_half(std::span<const uint16_t> bits, NonFinite& n) {
   constexpr uint16_t kExponent = 0x7c00, kMantissa = 0x03ff;  // all-ones exponent: Inf or NaN
-  NonFinite n;
   for (uint16_t b : bits) {
     const bool special = (b & kExponent) == kExponent;
     n.nan += special && (b & kMantissa) != 0;
     n.inf += special && (b & kMantissa) == 0;
   }
-  return n;
 }
 
-Status reject_non_finite(NonFinite n, const std::string& what, const fs::path& path) {
-  if (n.nan == 0 && n.inf == 0) return success();
-  return Error{path.string(), what + std::to_string(n.nan) + " NaN and " + std::to_string(n.inf) +
-                                  " Inf samples; matbake rejects non-finite texels"};
-}
+// Decodes bands of rows in order. Non-finite samples are bad input and finite ones the decode
+// overflows (sRGB/gamma 2.2 of values above about 1e16) are too; both are counted over the whole
+// file, so the error gives the totals, and reported by finish().
+class RowReader {
+ public:
+  static Result<RowReader> open(const fs::path& path, color::Transfer colour) {
+    std::error_code ec;
+    if (!fs::exists(path, ec)) return Error{path.string(), "no such file"};
+    if (fs::is_directory(path, ec)) return Error{path.string(), "is a folder, not an image"};
+    ImageSpec config;
+    config.attribute("oiio:UnassociatedAlpha", 1);
+    auto in = OIIO::ImageInput::open(path.string(), &config);
+    if (!in) return Error{path.string(), "not a readable image: " + first_line(OIIO::geterror())};
+    const ImageSpec& spec = in->spec();
+    if (spec.nchannels < 1 || spec.nchannels > 4) {
+      return Error{path.string(), std::to_string(spec.nchannels) +
+                                      " channels; matbake reads 1 to 4 (gray, gray+alpha, RGB, RGBA)"};
+    }
+    if (spec.depth > 1) return Error{path.string(), "volume images are not supported"};
+    return RowReader(path, std::move(in), colour);
+  }
+
+  const ImageLayout& layout() const { return layout_; }
+  ReadInfo info() const { return {stored_, in_->format_name()}; }
+
+  // Rows [y, y + rows) into `out`, decoded.
+  Status read_rows(int y, int rows, std::span<float> out) {
+    switch (stored_) {
+      case SampleType::u8: return read_and_decode<uint8_t>(y, rows, out);
+      case SampleType::u16: return read_and_decode<uint16_t>(y, rows, out);
+      case SampleType::half: return read_and_decode<uint16_t>(y, rows, out);  // bit patterns
+      case SampleType::f32: return read_and_decode<float>(y, rows, out);
+    }
+    return success();
+  }
+
+  Status finish() const {
+    if (bad_.any()) {
+      return Error{path_.string(), "contains " + std::to_string(bad_.nan) + " NaN and " + std::to_string(bad_.inf) +
+                                       " Inf samples; matbake rejects non-finite texels"};
+    }
+    if (overflow_ > 0) {
+      return Error{path_.string(), std::to_string(overflow_) + " samples overflow float when decoded from " +
+                                       std::string(color::transfer_name(colour_)) + " (inputs above about 1e16)"};
+    }
+    return success();
+  }
+
+  bool failed() const { return bad_.any() || overflow_ > 0; }
+
+ private:
+  RowReader(fs::path path, std::unique_ptr<OIIO::ImageInput> in, color::Transfer colour)
+      : path_(std::move(path)), in_(std::move(in)), colour_(colour) {
+    const ImageSpec& spec = in_->spec();
+    layout_.width = spec.width;
+    layout_.height = spec.height;
+    layout_.channels = spec.nchannels;
+    layout_.channel_names = spec.channelnames;
+    layout_.alpha_channel = spec.alpha_channel;
+    transfers_ = channel_transfers(layout_, colour);
+    stored_ = stored_type_of(spec);
+  }
+
+  template <class T>
+  Status read_and_decode(int y, int rows, std::span<float> out) {
+    raw_.resize(out.size() * sizeof(T));
+    T* samples = reinterpret_cast<T*>(raw_.data());
+    const ImageSpec& spec = in_->spec();
+    if (!in_->read_scanlines(0, 0, spec.y + y, spec.y + y + rows, 0, 0, spec.nchannels, type_desc(stored_), samples)) {
+      return Error{path_.string(), "cannot read pixels: " + first_line(in_->geterror())};
+    }
+    const std::span<const T> in(samples, out.size());
+    if constexpr (std::is_same_v<T, float>) {
+      for (float v : in) bad_.add(v);
+      color::decode_pixels(in, out, transfers_);
+    } else if constexpr (std::is_same_v<T, uint16_t>) {
+      if (stored_ == SampleType::half) {
+        count_half(in, bad_);
+        color::decode_half_pixels(in, out, transfers_);
+      } else {
+        color::decode_pixels(in, out, transfers_);
+      }
+    } else {
+      color::decode_pixels(in, out, transfers_);
+    }
+    if (colour_ != color::Transfer::linear && !bad_.any()) {
+      overflow_ += std::size_t(std::count_if(out.begin(), out.end(), [](float v) { return std::isinf(v); }));
+    }
+    return success();
+  }
+
+  fs::path path_;
+  std::unique_ptr<OIIO::ImageInput> in_;
+  color::Transfer colour_;
+  ImageLayout layout_;
+  std::vector<color::Transfer> transfers_;
+  SampleType stored_ = SampleType::u8;
+  std::vector<std::byte> raw_;
+  NonFinite bad_;
+  std::size_t overflow_ = 0;
+};
+
+// Encodes and writes bands of rows in order into a temporary file; commit() renames it over the
+// target. Half output beyond the half range is refused (it would round to Inf), counted over all
+// bands.
+class RowWriter {
+ public:
+  static Result<RowWriter> open(const fs::path& path, const ImageLayout& layout, const WriteOptions& options) {
+    auto file = AtomicFile::create(path);
+    if (!file) return file.error();
+    auto out = OIIO::ImageOutput::create(file->temp_path().string());
+    if (!out) return Error{path.string(), "no image writer for this extension: " + first_line(OIIO::geterror())};
+
+    ImageSpec spec(layout.width, layout.height, layout.channels, type_desc(options.type));
+    if (layout.channel_names.size() == std::size_t(layout.channels)) spec.channelnames = layout.channel_names;
+    spec.alpha_channel = layout.alpha_channel;
+    spec.attribute("oiio:UnassociatedAlpha", 1);  // write colour as given, never divided by alpha
+    // OIIO stamps the current time (EXR capDate, TIFF DateTime) unless told a value; an empty one
+    // keeps output bytes a function of the inputs alone.
+    spec.attribute("DateTime", "");
+    if (!options.colorspace.empty()) spec.attribute("oiio:ColorSpace", options.colorspace);
+    std::string compression = options.compression;
+    if (compression.empty() && std::string_view(out->format_name()) == "openexr") compression = "zip";
+    if (!compression.empty()) spec.attribute("compression", compression);
+    if (!out->open(file->temp_path().string(), spec)) {
+      return Error{path.string(), "cannot write: " + first_line(out->geterror())};
+    }
+    return RowWriter(path, std::move(file.value()), std::move(out), layout, options);
+  }
+
+  Status write_rows(int y, int rows, std::span<const float> pixels) {
+    switch (options_.type) {
+      case SampleType::u8: return encode_and_write<uint8_t>(y, rows, pixels);
+      case SampleType::u16: return encode_and_write<uint16_t>(y, rows, pixels);
+      case SampleType::half:
+      case SampleType::f32: return encode_and_write<float>(y, rows, pixels);  // OIIO rounds to half, nearest even
+    }
+    return success();
+  }
+
+  Status commit() {
+    if (beyond_half_ > 0) {
+      return Error{path_.string(),
+                   std::to_string(beyond_half_) + " samples exceed the half-float range (65504); use float samples"};
+    }
+    if (!out_->close()) return Error{path_.string(), "cannot write: " + first_line(out_->geterror())};
+    return file_.commit();
+  }
+
+ private:
+  RowWriter(fs::path path, AtomicFile file, std::unique_ptr<OIIO::ImageOutput> out, const ImageLayout& layout,
+            const WriteOptions& options)
+      : path_(std::move(path)), file_(std::move(file)), out_(std::move(out)), options_(options),
+        transfers_(channel_transfers(layout, options.colour)) {}
+
+  template <class T>
+  Status encode_and_write(int y, int rows, std::span<const float> pixels) {
+    encoded_.resize(pixels.size() * sizeof(T));
+    const std::span<T> samples(reinterpret_cast<T*>(encoded_.data()), pixels.size());
+    color::encode_pixels(pixels, samples, transfers_);
+    if constexpr (std::is_same_v<T, float>) {
+      if (options_.type == SampleType::half) {
+        constexpr float kHalfOverflow = 65520.0f;  // from here on, rounding to half gives Inf
+        beyond_half_ += std::size_t(
+            std::count_if(samples.begin(), samples.end(), [](float v) { return std::abs(v) >= kHalfOverflow; }));
+      }
+    }
+    if (beyond_half_ > 0) return success();  // keep counting; commit() refuses
+    if (!out_->write_scanlines(y, y + rows, 0, scanline_type<T>(), samples.data())) {
+      return Error{path_.string(), "cannot write: " + first_line(out_->geterror())};
+    }
+    return success();
+  }
+
+  template <class T>
+  static TypeDesc scanline_type() {
+    if constexpr (std::is_same_v<T, uint8_t>) return TypeDesc::UINT8;
+    else if constexpr (std::is_same_v<T, uint16_t>) return TypeDesc::UINT16;
+    else return TypeDesc::FLOAT;
+  }
+
+  fs::path path_;
+  AtomicFile file_;
+  std::unique_ptr<OIIO::ImageOutput> out_;
+  WriteOptions options_;
+  std::vector<color::Transfer> transfers_;
+  std::vector<std::byte> encoded_;
+  std::size_t beyond_half_ = 0;
+};
+
+// Rows per band: a few hundred KB of floats for a 2K-wide RGBA image, and a multiple of the 16
+// scanlines OpenEXR compresses together.
+constexpr int kBandRows = 64;
 
 }  // namespace
 
@@ -105,78 +280,31 @@ std::string_view sample_type_name(SampleType type) {
 
 bool is_integer(SampleType type) { return type == SampleType::u8 || type == SampleType::u16; }
 
-std::vector<color::Transfer> channel_transfers(const Image& image, color::Transfer colour) {
-  std::vector<color::Transfer> transfers(std::size_t(image.channels), colour);
-  if (image.alpha_channel >= 0 && image.alpha_channel < image.channels) {
-    transfers[image.alpha_channel] = color::Transfer::linear;
+std::vector<color::Transfer> channel_transfers(const ImageLayout& layout, color::Transfer colour) {
+  std::vector<color::Transfer> transfers(std::size_t(layout.channels), colour);
+  if (layout.alpha_channel >= 0 && layout.alpha_channel < layout.channels) {
+    transfers[layout.alpha_channel] = color::Transfer::linear;
   }
   return transfers;
 }
 
 void set_thread_count(int threads) { OIIO::attribute("threads", threads); }
 
+Result<ReadInfo> probe_image(const fs::path& path) {
+  auto reader = RowReader::open(path, color::Transfer::linear);
+  if (!reader) return reader.error();
+  return reader->info();
+}
+
 Result<Image> read_image(const fs::path& path, color::Transfer colour, ReadInfo* info) {
-  std::error_code ec;
-  if (!fs::exists(path, ec)) return Error{path.string(), "no such file"};
-  if (fs::is_directory(path, ec)) return Error{path.string(), "is a folder, not an image"};
-
-  ImageSpec config;
-  config.attribute("oiio:UnassociatedAlpha", 1);
-  auto in = OIIO::ImageInput::open(path.string(), &config);
-  if (!in) return Error{path.string(), "not a readable image: " + first_line(OIIO::geterror())};
-  const ImageSpec spec = in->spec();
-  if (spec.nchannels < 1 || spec.nchannels > 4) {
-    return Error{path.string(), std::to_string(spec.nchannels) +
-                                    " channels; matbake reads 1 to 4 (gray, gray+alpha, RGB, RGBA)"};
-  }
-  if (spec.depth > 1) return Error{path.string(), "volume images are not supported"};
-
+  auto reader = RowReader::open(path, colour);
+  if (!reader) return reader.error();
+  if (info != nullptr) *info = reader->info();
   Image image;
-  image.width = spec.width;
-  image.height = spec.height;
-  image.channels = spec.nchannels;
-  image.channel_names = spec.channelnames;
-  image.alpha_channel = spec.alpha_channel;
+  static_cast<ImageLayout&>(image) = reader->layout();
   image.pixels.resize(image.sample_count());
-  const std::vector<color::Transfer> transfers = channel_transfers(image, colour);
-
-  const SampleType stored = stored_type_of(spec);
-  if (info != nullptr) *info = ReadInfo{stored, in->format_name()};
-  switch (stored) {
-    case SampleType::u8: {
-      std::vector<uint8_t> samples;
-      if (Status s = read_samples(*in, spec, stored, samples, path); !s) return s.error();
-      color::decode_pixels(std::span<const uint8_t>(samples), image.pixels, transfers);
-      break;
-    }
-    case SampleType::u16: {
-      std::vector<uint16_t> samples;
-      if (Status s = read_samples(*in, spec, stored, samples, path); !s) return s.error();
-      color::decode_pixels(std::span<const uint16_t>(samples), image.pixels, transfers);
-      break;
-    }
-    case SampleType::half: {
-      std::vector<uint16_t> samples;  // half bit patterns, decoded by table
-      if (Status s = read_samples(*in, spec, stored, samples, path); !s) return s.error();
-      if (Status s = reject_non_finite(count_non_finite_half(samples), "contains ", path); !s) return s.error();
-      color::decode_half_pixels(samples, image.pixels, transfers);
-      break;
-    }
-    case SampleType::f32: {
-      std::vector<float> samples;
-      if (Status s = read_samples(*in, spec, stored, samples, path); !s) return s.error();
-      if (Status s = reject_non_finite(count_non_finite(samples), "contains ", path); !s) return s.error();
-      color::decode_pixels(std::span<const float>(samples), image.pixels, transfers);
-      break;
-    }
-  }
-  if (colour != color::Transfer::linear) {
-    const std::size_t overflow = count_non_finite(image.pixels).inf;
-    if (overflow > 0) {
-      return Error{path.string(), std::to_string(overflow) + " samples overflow float when decoded from " +
-                                      std::string(color::transfer_name(colour)) + " (inputs above about 1e16)"};
-    }
-  }
+  if (Status s = reader->read_rows(0, image.height, image.pixels); !s) return s.error();
+  if (Status s = reader->finish(); !s) return s.error();
   return image;
 }
 
@@ -184,60 +312,75 @@ Status write_image(const Image& image, const fs::path& path, const WriteOptions&
   if (image.channels < 1 || image.channels > 4 || image.pixels.size() != image.sample_count()) {
     return Error{path.string(), "internal: inconsistent image"};
   }
-  auto file = AtomicFile::create(path);
-  if (!file) return file.error();
+  auto writer = RowWriter::open(path, image, options);
+  if (!writer) return writer.error();
+  if (Status s = writer->write_rows(0, image.height, image.pixels); !s) return s;
+  return writer->commit();
+}
 
-  auto out = OIIO::ImageOutput::create(file->temp_path().string());
-  if (!out) return Error{path.string(), "no image writer for this extension: " + first_line(OIIO::geterror())};
-
-  ImageSpec spec(image.width, image.height, image.channels, type_desc(options.type));
-  if (image.channel_names.size() == std::size_t(image.channels)) spec.channelnames = image.channel_names;
-  spec.alpha_channel = image.alpha_channel;
-  spec.attribute("oiio:UnassociatedAlpha", 1);  // write colour as given, never divided by alpha
-  if (!options.colorspace.empty()) spec.attribute("oiio:ColorSpace", options.colorspace);
-  std::string compression = options.compression;
-  if (compression.empty() && std::string_view(out->format_name()) == "openexr") compression = "zip";
-  if (!compression.empty()) spec.attribute("compression", compression);
-
-  if (!out->open(file->temp_path().string(), spec)) {
-    return Error{path.string(), "cannot write: " + first_line(out->geterror())};
+Status stream_image(const fs::path& input, color::Transfer decode, const fs::path& output, const WriteOptions& options,
+                    const BandTransform& transform, ReadInfo* info, ImageLayout* layout_out) {
+  auto reader = RowReader::open(input, decode);
+  if (!reader) return reader.error();
+  const ImageLayout& layout = reader->layout();
+  if (info != nullptr) *info = reader->info();
+  if (layout_out != nullptr) *layout_out = layout;
+  if (transform.accept) {
+    if (Status s = transform.accept(layout); !s) return s;
   }
-  const std::vector<color::Transfer> transfers = channel_transfers(image, options.colour);
-  bool written = false;
-  switch (options.type) {
-    case SampleType::u8: {
-      std::vector<uint8_t> samples(image.pixels.size());
-      color::encode_pixels(image.pixels, samples, transfers);
-      written = out->write_image(TypeDesc::UINT8, samples.data());
-      break;
-    }
-    case SampleType::u16: {
-      std::vector<uint16_t> samples(image.pixels.size());
-      color::encode_pixels(image.pixels, samples, transfers);
-      written = out->write_image(TypeDesc::UINT16, samples.data());
-      break;
-    }
-    case SampleType::half:
-    case SampleType::f32: {
-      // OIIO rounds float to half to nearest even.
-      std::vector<float> samples(image.pixels.size());
-      color::encode_pixels(std::span<const float>(image.pixels), samples, transfers);
-      if (options.type == SampleType::half) {
-        // Finite values from 65520 on would round to Inf: refuse rather than write non-finite texels.
-        constexpr float kHalfOverflow = 65520.0f;
-        const auto beyond = std::count_if(samples.begin(), samples.end(),
-                                          [](float v) { return std::abs(v) >= kHalfOverflow; });
-        if (beyond > 0) {
-          return Error{path.string(), std::to_string(beyond) +
-                                          " samples exceed the half-float range (65504); use float samples"};
-        }
-      }
-      written = out->write_image(TypeDesc::FLOAT, samples.data());
-      break;
-    }
-  }
-  if (!written || !out->close()) return Error{path.string(), "cannot write: " + first_line(out->geterror())};
-  return file->commit();
+  auto writer = RowWriter::open(output, layout, options);
+  if (!writer) return writer.error();
+
+  struct Band {
+    int y = 0;
+    int rows = 0;
+    std::vector<float> pixels;
+  };
+  // Stage 1 alone touches the reader and read_error, stage 3 alone the writer and write_error; the
+  // atomic flag is all they share. After bad input the rest is still read (so the error counts it
+  // all) but nothing more is transformed or written.
+  std::optional<Error> read_error, write_error;
+  std::atomic<bool> stop{false};
+  int next_row = 0;
+  const std::size_t row_samples = std::size_t(layout.width) * layout.channels;
+  // Read in order, transform in parallel, write in order: decoding, OCIO and compression overlap.
+  const std::size_t tokens = 2 * std::max(1u, std::thread::hardware_concurrency());
+  tbb::parallel_pipeline(
+      tokens,
+      tbb::make_filter<void, std::shared_ptr<Band>>(
+          tbb::filter_mode::serial_in_order,
+          [&](tbb::flow_control& fc) -> std::shared_ptr<Band> {
+            if (read_error || next_row >= layout.height) {
+              fc.stop();
+              return nullptr;
+            }
+            auto band = std::make_shared<Band>();
+            band->y = next_row;
+            band->rows = std::min(kBandRows, layout.height - next_row);
+            band->pixels.resize(row_samples * band->rows);
+            next_row += band->rows;
+            if (Status s = reader->read_rows(band->y, band->rows, band->pixels); !s) read_error = s.error();
+            if (read_error || reader->failed()) stop = true;
+            return band;
+          }) &
+          tbb::make_filter<std::shared_ptr<Band>, std::shared_ptr<Band>>(
+              tbb::filter_mode::parallel,
+              [&](std::shared_ptr<Band> band) {
+                if (transform.apply && !stop) transform.apply(band->pixels, layout);
+                return band;
+              }) &
+          tbb::make_filter<std::shared_ptr<Band>, void>(
+              tbb::filter_mode::serial_in_order, [&](std::shared_ptr<Band> band) {
+                if (stop) return;
+                if (Status s = writer->write_rows(band->y, band->rows, band->pixels); !s) {
+                  write_error = s.error();
+                  stop = true;
+                }
+              }));
+  if (read_error) return *read_error;
+  if (write_error) return *write_error;
+  if (Status s = reader->finish(); !s) return s;
+  return writer->commit();
 }
 
 }  // namespace matbake::image
