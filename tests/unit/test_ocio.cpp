@@ -42,6 +42,14 @@ std::vector<float> decode_codes_with(const OcioProcessor& processor) {
   return rgb;
 }
 
+OcioProcessor builtin_processor(const char* from, const char* to) {
+  auto config = OcioConfig::load_builtin();
+  EXPECT_TRUE(config);
+  auto processor = config->processor(from, to);
+  EXPECT_TRUE(processor);
+  return processor.value();
+}
+
 TEST(Ocio, BuiltinConfigHasTheTextureSpaces) {
   ScopedOcioVariable unset(nullptr);
   auto config = OcioConfig::load();
@@ -55,11 +63,7 @@ TEST(Ocio, BuiltinConfigHasTheTextureSpaces) {
 
 TEST(Ocio, SrgbCurveDiffersFromIecInTheToeOnly) {
   // OCIO 2.1 uses the C1-continuous break (0.03928, slope 12.9232) instead of IEC's 0.04045 / 12.92.
-  auto config = OcioConfig::load_builtin();
-  ASSERT_TRUE(config);
-  auto processor = config->processor(kSrgb, kLinear);
-  ASSERT_TRUE(processor);
-  const auto ocio = decode_codes_with(*processor);
+  const auto ocio = decode_codes_with(builtin_processor(kSrgb, kLinear));
   double worst = 0;
   int worst_code = 0;
   for (int code = 1; code < 256; ++code) {
@@ -76,21 +80,14 @@ TEST(Ocio, SrgbCurveDiffersFromIecInTheToeOnly) {
 }
 
 TEST(Ocio, GammaSpaceMatchesTheBuiltinCurve) {
-  auto config = OcioConfig::load_builtin();
-  ASSERT_TRUE(config);
-  auto processor = config->processor(kGamma22, kLinear);
-  ASSERT_TRUE(processor);
-  const auto ocio = decode_codes_with(*processor);
+  const auto ocio = decode_codes_with(builtin_processor(kGamma22, kLinear));
   for (int code = 1; code < 256; ++code) {
     EXPECT_NEAR(ocio[code * 3], decode_table(Transfer::gamma22, 8)[code], 2e-6 * ocio[code * 3]) << code;
   }
 }
 
 TEST(Ocio, EightBitPathAgreesWithFloatPathAndKeepsAlpha) {
-  auto config = OcioConfig::load_builtin();
-  ASSERT_TRUE(config);
-  auto processor = config->processor(kSrgb, kLinear);
-  ASSERT_TRUE(processor);
+  const OcioProcessor processor = builtin_processor(kSrgb, kLinear);
   std::vector<uint8_t> codes(256 * 4);
   std::vector<float> values(codes.size());
   for (std::size_t i = 0; i < codes.size(); ++i) {
@@ -98,8 +95,8 @@ TEST(Ocio, EightBitPathAgreesWithFloatPathAndKeepsAlpha) {
     values[i] = float(codes[i] / 255.0);
   }
   std::vector<float> from_codes(codes.size());
-  processor->apply(std::span<const uint8_t>(codes), from_codes, 4);
-  processor->apply(values, 4);
+  processor.apply(std::span<const uint8_t>(codes), from_codes, 4);
+  processor.apply(values, 4);
   for (std::size_t i = 0; i < codes.size(); ++i) {
     EXPECT_NEAR(from_codes[i], values[i], 1e-6) << i;
     if (i % 4 == 3) {

@@ -16,21 +16,12 @@ constexpr double kSrgbGamma = 2.4;
 // Schüler's display gamma.
 constexpr double kGamma22 = 2.2;
 
-const PowerFunction& srgb_decode_power() {
-  static const PowerFunction f(kSrgbGamma);
-  return f;
-}
-const PowerFunction& srgb_encode_power() {
-  static const PowerFunction f(1.0 / kSrgbGamma);
-  return f;
-}
-const PowerFunction& gamma22_decode_power() {
-  static const PowerFunction f(kGamma22);
-  return f;
-}
-const PowerFunction& gamma22_encode_power() {
-  static const PowerFunction f(1.0 / kGamma22);
-  return f;
+// The four power functions the fast path needs, built once.
+const PowerFunction& power_function(Transfer transfer, bool decode) {
+  static const PowerFunction srgb_decode(kSrgbGamma), srgb_encode(1.0 / kSrgbGamma);
+  static const PowerFunction gamma22_decode(kGamma22), gamma22_encode(1.0 / kGamma22);
+  if (transfer == Transfer::srgb) return decode ? srgb_decode : srgb_encode;
+  return decode ? gamma22_decode : gamma22_encode;
 }
 
 // The two formulas share their shape; `power` is std::pow in the reference and a PowerFunction on
@@ -93,15 +84,13 @@ double encoded_from_linear(Transfer transfer, double linear) {
 }
 
 float linear_from_encoded_fast(Transfer transfer, float encoded) {
-  const PowerFunction& power =
-      transfer == Transfer::srgb ? srgb_decode_power() : gamma22_decode_power();
+  const PowerFunction& power = power_function(transfer, true);
   const double v = encoded;
   return float(std::copysign(decode_magnitude(transfer, std::fabs(v), power), v));
 }
 
 float encoded_from_linear_fast(Transfer transfer, float linear) {
-  const PowerFunction& power =
-      transfer == Transfer::srgb ? srgb_encode_power() : gamma22_encode_power();
+  const PowerFunction& power = power_function(transfer, false);
   const double l = linear;
   return float(std::copysign(encode_magnitude(transfer, std::fabs(l), power), l));
 }
