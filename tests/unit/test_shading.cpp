@@ -7,10 +7,10 @@
 #include <functional>
 #include <numbers>
 #include <random>
-#include <string>
 #include <vector>
 
 #include "matbake/shading.hpp"
+#include "matbake/shading_catalog.hpp"
 
 namespace matbake::shading {
 namespace {
@@ -185,40 +185,6 @@ TEST(Models, SlightlyUnnormalizedInputsGiveTheSameValues) {
   EXPECT_NEAR(schuler_optimized(exact, 0.04, 0.7), schuler_optimized(scaled, 0.04, 0.7), 1e-12);
 }
 
-// Every model under test, as a BRDF in 1/sr with parameters from (ks, gloss), for the property
-// tests below. `reciprocal` marks the models where f(l, v) = f(v, l) should hold.
-struct NamedBrdf {
-  std::string name;
-  bool reciprocal;
-  std::function<double(const Geometry&, double ks, double gloss)> f;
-};
-
-std::vector<NamedBrdf> all_brdfs() {
-  const auto e = [](double gloss) { return schuler_exponent(gloss); };
-  const auto m = [&](double gloss) { return beckmann_m_from_exponent(e(gloss)); };
-  std::vector<NamedBrdf> list = {
-      {"lambert", true, [](const Geometry&, double ks, double) { return lambert_brdf(ks); }},
-      {"phong", false, [&](const Geometry& g, double ks, double gl) { return phong_brdf(g, ks, e(gl)); }},
-      {"blinn_phong", false, [&](const Geometry& g, double ks, double gl) { return blinn_phong_brdf(g, ks, e(gl)); }},
-      {"blinn_phong_normalized", true,
-       [&](const Geometry& g, double ks, double gl) { return blinn_phong_normalized_brdf(g, ks, e(gl)); }},
-      {"phong_plausible", true, [&](const Geometry& g, double ks, double gl) { return phong_plausible_brdf(g, ks, e(gl)); }},
-      {"cook_torrance", true,
-       [&](const Geometry& g, double ks, double gl) { return cook_torrance_brdf(g, ior_from_f0(ks), m(gl)); }},
-      {"ggx", true, [&](const Geometry& g, double ks, double gl) { return ggx_brdf(g, ks, m(gl)); }},
-      {"oren_nayar", true, [&](const Geometry& g, double ks, double gl) { return oren_nayar_brdf(g, ks, 1.0 - gl); }},
-      {"strauss", false,
-       [](const Geometry& g, double ks, double gl) { return strauss_brdf(g, {ks, gl, 0.0, 0.0}); }},
-  };
-  for (auto variant : {SchulerVariant::full, SchulerVariant::simplified, SchulerVariant::kelemen_szirmay_kalos,
-                       SchulerVariant::optimized}) {
-    list.push_back({"schuler_" + std::to_string(int(variant)), true, [variant](const Geometry& g, double ks, double gl) {
-                      return schuler_specular_brdf(variant, g, ks, gl);
-                    }});
-  }
-  return list;
-}
-
 // Unit vector at polar angle theta (from z) and azimuth phi.
 Vec3 direction(double theta, double phi) {
   return {std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta)};
@@ -228,13 +194,13 @@ TEST(Models, FiniteNonNegativeAndZeroBelowTheHorizon) {
   std::mt19937 rng(9);
   std::uniform_real_distribution<double> u(0, 1);
   const double grazing = kPi / 2 - 1e-9;
-  for (const NamedBrdf& brdf : all_brdfs()) {
+  for (const ModelInfo& brdf : models()) {
     for (double gloss : {0.0, 0.5, 1.0}) {
       for (double ks : {0.0, 0.04, 1.0}) {
         for (int i = 0; i < 2000; ++i) {
           const Geometry g = make_geometry(kZ, direction(std::acos(u(rng)), 2 * kPi * u(rng)),
                                            direction(std::acos(u(rng)), 2 * kPi * u(rng)));
-          const double f = brdf.f(g, ks, gloss);
+          const double f = brdf.brdf(g, {ks, ks, gloss});
           ASSERT_TRUE(std::isfinite(f) && f >= 0) << brdf.name << " f=" << f;
         }
         // Hard cases: n·l → 0⁺, n·v → 0⁺, l·h → 0 (l and v nearly opposite, both grazing).
@@ -246,13 +212,13 @@ TEST(Models, FiniteNonNegativeAndZeroBelowTheHorizon) {
             make_geometry(kZ, kZ, kZ),
         };
         for (const Geometry& g : hard) {
-          const double f = brdf.f(g, ks, gloss);
+          const double f = brdf.brdf(g, {ks, ks, gloss});
           ASSERT_TRUE(std::isfinite(f) && f >= 0) << brdf.name << " g=" << gloss << " ks=" << ks << " f=" << f;
         }
         // Light or view below the horizon: nothing (except Lambert's constant, which has no l).
         if (brdf.name != "lambert") {
-          EXPECT_EQ(brdf.f(make_geometry(kZ, direction(2.0, 0), kZ), ks, gloss), 0.0) << brdf.name;
-          EXPECT_EQ(brdf.f(make_geometry(kZ, kZ, direction(1.7, 1)), ks, gloss), 0.0) << brdf.name;
+          EXPECT_EQ(brdf.brdf(make_geometry(kZ, direction(2.0, 0), kZ), {ks, ks, gloss}), 0.0) << brdf.name;
+          EXPECT_EQ(brdf.brdf(make_geometry(kZ, kZ, direction(1.7, 1)), {ks, ks, gloss}), 0.0) << brdf.name;
         }
       }
     }
@@ -262,12 +228,13 @@ TEST(Models, FiniteNonNegativeAndZeroBelowTheHorizon) {
 TEST(Models, ReciprocityWhereItShouldHold) {
   std::mt19937 rng(10);
   std::uniform_real_distribution<double> u(0.05, 0.95);
-  for (const NamedBrdf& brdf : all_brdfs()) {
+  for (const ModelInfo& brdf : models()) {
     if (!brdf.reciprocal) continue;
     for (int i = 0; i < 500; ++i) {
       const Vec3 l = direction(std::acos(u(rng)), 2 * kPi * u(rng)), v = direction(std::acos(u(rng)), 2 * kPi * u(rng));
       const double ks = u(rng), gloss = u(rng);
-      const double a = brdf.f(make_geometry(kZ, l, v), ks, gloss), b = brdf.f(make_geometry(kZ, v, l), ks, gloss);
+      const MaterialSample material{ks, ks, gloss};
+      const double a = brdf.brdf(make_geometry(kZ, l, v), material), b = brdf.brdf(make_geometry(kZ, v, l), material);
       ASSERT_NEAR(a, b, 1e-10 * std::max(1.0, a)) << brdf.name;
     }
   }
