@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "matbake/convert.hpp"
+#include "matbake/preview.hpp"
 #include "matbake/result.hpp"
 
 namespace matbake::cli {
@@ -37,5 +38,21 @@ struct ConvertSettings {
 };
 CLI::App* setup_convert(CLI::App& app, ConvertSettings& settings);
 int run_convert(const ConvertSettings& settings, const GlobalOptions& global);
+
+struct PreviewSettings {
+  std::string output;
+  std::string kd = "0.5";
+  std::string ks = "0.04";
+  double gloss = 0.5;
+  std::string base_color;
+  double metallic = 0;
+  double roughness = 0.5;
+  std::string materials;
+  std::vector<double> gloss_sweep;
+  std::string model = "schuler-optimized";
+  int size = 128;
+};
+CLI::App* setup_preview(CLI::App& app, PreviewSettings& settings);
+int run_preview(const PreviewSettings& settings, const GlobalOptions& global);
 
 }  // namespace matbake::cli

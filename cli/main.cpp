@@ -21,6 +21,8 @@ int main(int argc, char** argv) {
 
   ConvertSettings convert;
   CLI::App* convert_app = setup_convert(app, convert);
+  PreviewSettings preview;
+  CLI::App* preview_app = setup_preview(app, preview);
 
   try {
     app.parse(argc, argv);
@@ -38,5 +40,6 @@ int main(int argc, char** argv) {
   matbake::image::set_thread_count(global.jobs);
 
   if (convert_app->parsed()) return run_convert(convert, global);
+  if (preview_app->parsed()) return run_preview(preview, global);
   return kUsage;
 }

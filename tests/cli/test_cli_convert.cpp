@@ -252,3 +252,40 @@ TEST(CliConvert, OcioConfigOptionAndVariable) {
 
 }  // namespace
 }  // namespace matbake::test
+
+namespace matbake::test {
+namespace {
+
+TEST(CliPreview, WritesPngAndSidecarAndRefusesBadParameters) {
+  TempDir dir;
+  const auto ok = matbake({"preview", "-o", (dir / "ball.png").string(), "--kd", "0.8,0.2,0.1", "--gloss-sweep",
+                           "0.25,1", "--size", "32"});
+  ASSERT_EQ(ok.exit_code, 0) << ok.err;
+  const auto png = read_raw(dir / "ball.png");
+  EXPECT_EQ(png.width, 64);
+  EXPECT_EQ(png.height, 32);
+  EXPECT_EQ(png.format, "uint8");
+  const auto sidecar = nlohmann::json::parse(read_bytes(dir / "ball.json"));
+  EXPECT_EQ(sidecar["cells"].size(), 2u);
+  EXPECT_EQ(sidecar["cells"][1]["gloss"], 1.0);
+
+  const std::vector<std::vector<std::string>> usage = {
+      {"preview", "-o", (dir / "x.png").string(), "--gloss", "1.2"},
+      {"preview", "-o", (dir / "x.png").string(), "--kd", "-0.5"},
+      {"preview", "-o", (dir / "x.png").string(), "--ks", "0.1,0.2"},
+      {"preview", "-o", (dir / "x.png").string(), "--model", "nope"},
+      {"preview", "-o", (dir / "x.exr").string()},
+  };
+  for (const auto& args : usage) {
+    const auto r = matbake(args);
+    EXPECT_EQ(r.exit_code, 2) << testing::PrintToString(args) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  }
+  write_bytes(dir / "bad.json", "not json");
+  const auto bad = matbake({"preview", "-o", (dir / "x.png").string(), "--materials", (dir / "bad.json").string()});
+  EXPECT_EQ(bad.exit_code, 1);
+  EXPECT_FALSE(fs::exists(dir / "x.png"));
+}
+
+}  // namespace
+}  // namespace matbake::test

@@ -18,8 +18,11 @@ struct MaterialSample {
   double gloss = 0.5;
 };
 
+enum class Lobe { diffuse, specular, both };
+
 struct ModelInfo {
   std::string_view name;
+  Lobe lobe;
   std::string_view description;
   bool reciprocal;          // f(l, v) = f(v, l) holds by construction
   bool conserves_energy;    // directional albedo ≤ 1 by construction (for kd, ks ≤ 1)
