@@ -2,7 +2,6 @@
 #include <cmath>
 #include <numbers>
 
-#include "lobe_power.hpp"
 #include "matbake/shading.hpp"
 
 namespace matbake::shading {
@@ -19,10 +18,7 @@ double beckmann_d(double n_dot_h, double m) {
   // exp(−tan²/m²) underflows long before cos⁴θ does; stop before 0/0.
   if (c2 < 1e-150) return 0.0;
   const double tan2 = (1.0 - c2) / c2;
-  // exp(−tan²/m²) as 2^(−tan²/(m² ln 2)): the same exp2 as the Phong-family lobes, so comparisons of
-  // the models' speed compare the models, not two maths libraries.
-  constexpr double kLog2e = 1.442695040888963407360;
-  return LobePower::instance().exp2(-tan2 / (m * m) * kLog2e) / (std::numbers::pi * m * m * c2 * c2);
+  return std::exp(-tan2 / (m * m)) / (std::numbers::pi * m * m * c2 * c2);
 }
 
 double torrance_sparrow_g(const Geometry& g) {

@@ -5,7 +5,6 @@
 #include <cmath>
 #include <numbers>
 
-#include "lobe_power.hpp"
 #include "matbake/shading.hpp"
 
 namespace matbake::shading {
@@ -18,11 +17,11 @@ bool lit_and_seen(const Geometry& g) { return g.n_dot_l > 0.0 && g.n_dot_v > 0.0
 }  // namespace
 
 double phong_lobe(const Geometry& g, double m) {
-  return g.n_dot_l > 0.0 ? LobePower::instance().pow(g.r_dot_v, m) : 0.0;
+  return g.n_dot_l > 0.0 ? std::pow(std::max(g.r_dot_v, 0.0), m) : 0.0;
 }
 
 double blinn_phong_lobe(const Geometry& g, double m) {
-  return g.n_dot_l > 0.0 ? LobePower::instance().pow(g.n_dot_h, m) : 0.0;
+  return g.n_dot_l > 0.0 ? std::pow(std::max(g.n_dot_h, 0.0), m) : 0.0;
 }
 
 double phong_illumination(const Geometry& g, double emitted, double ambient, double incident, double ka, double kd,

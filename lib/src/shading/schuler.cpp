@@ -6,7 +6,6 @@
 #include <cmath>
 #include <numbers>
 
-#include "lobe_power.hpp"
 #include "matbake/shading.hpp"
 
 namespace matbake::shading {
@@ -15,13 +14,13 @@ namespace {
 constexpr double kPi = std::numbers::pi;
 
 // Normalized Blinn-Phong in Schüler's units: (1 + e)/2 (n·h)^e (appendix).
-double schuler_d(const Geometry& g, double e) { return (1.0 + e) / 2.0 * LobePower::instance().pow(g.n_dot_h, e); }
+double schuler_d(const Geometry& g, double e) { return (1.0 + e) / 2.0 * std::pow(std::max(g.n_dot_h, 0.0), e); }
 
 double lerp(double a, double b, double t) { return a + t * (b - a); }
 
 }  // namespace
 
-double schuler_exponent(double gloss) { return LobePower::instance().exp2(12.0 * gloss); }
+double schuler_exponent(double gloss) { return std::exp2(12.0 * gloss); }
 
 double beckmann_m_from_exponent(double e) { return std::sqrt(2.0 / (e + 2.0)); }
 
@@ -52,7 +51,7 @@ double schuler_optimized(const Geometry& g, double ks, double gloss) {
   if (g.n_dot_l <= 0.0 || g.n_dot_v <= 0.0) return 0.0;
   const double e = schuler_exponent(gloss);
   const double l_dot_h3 = g.l_dot_h * g.l_dot_h * g.l_dot_h;
-  return ks * (1.0 + e) / (8.0 * l_dot_h3) * LobePower::instance().pow(g.n_dot_h, e) * g.n_dot_l;
+  return ks * (1.0 + e) / (8.0 * l_dot_h3) * std::pow(std::max(g.n_dot_h, 0.0), e) * g.n_dot_l;
 }
 
 double schuler_specular(SchulerVariant variant, const Geometry& g, double ks, double gloss) {

@@ -4,7 +4,6 @@
 #include <cmath>
 #include <numbers>
 
-#include "lobe_power.hpp"
 #include "matbake/shading.hpp"
 
 namespace matbake::shading {
@@ -40,7 +39,7 @@ double strauss_intensity(const Geometry& g, const StraussMaterial& m) {
   const double diffuse = g.n_dot_l * r_d * (1.0 - m.metalness * s) * m.color;
   const double r_n = 1.0 - m.transparency - r_d;
   const double r_j = std::min(1.0, r_n + (r_n + kJ) * strauss_f(x_i) * strauss_g(x_i) * strauss_g(x_r));
-  const double r_s = LobePower::instance().pow(g.r_dot_v, 3.0 / (1.0 - s)) * r_j;
+  const double r_s = std::pow(std::max(g.r_dot_v, 0.0), 3.0 / (1.0 - s)) * r_j;
   // Specular colour: white, shifted towards the surface colour for metals away from grazing.
   const double c_s = 1.0 + m.metalness * (1.0 - strauss_f(x_i)) * (m.color - 1.0);
   return diffuse + r_s * c_s;
