@@ -19,7 +19,7 @@ struct Material {
 };
 
 // The metalness workflow's relation (PBR notes): kd = base (1 − m), ks = lerp(0.04, base, m);
-// gloss from glTF roughness r through α = r², e = 2/α² − 2 (Walter), g = log2(e)/12, clamped.
+// gloss from glTF roughness by the Walter mapping (workflow::gloss_from_roughness).
 Material from_metal_rough(std::string name, shading::Vec3 base_color, double metallic, double roughness);
 
 // Refuses what no renderer should take: colours outside [0, 1] or NaN, gloss outside [0, 1].

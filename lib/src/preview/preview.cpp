@@ -1,4 +1,5 @@
 #include "matbake/preview.hpp"
+#include "matbake/workflow.hpp"
 
 #include <glm/common.hpp>
 #include <glm/exponential.hpp>
@@ -53,14 +54,9 @@ const std::vector<DirectionalLight>& lights() {
 }
 
 Material from_metal_rough(std::string name, Vec3 base_color, double metallic, double roughness) {
-  Material m;
-  m.name = std::move(name);
-  m.kd = base_color * (1.0 - metallic);
-  m.ks = glm::mix(Vec3(0.04), base_color, metallic);
-  const double alpha = std::max(roughness * roughness, 1e-4);
-  const double e = std::max(2.0 / (alpha * alpha) - 2.0, 1.0);
-  m.gloss = std::clamp(std::log2(e) / 12.0, 0.0, 1.0);
-  return m;
+  const workflow::SpecGloss sg =
+      workflow::spec_gloss_from_metal_rough({base_color, metallic, roughness}, workflow::RoughnessMapping::walter);
+  return {std::move(name), sg.kd, sg.ks, sg.gloss};
 }
 
 Status check(const Material& m) {
