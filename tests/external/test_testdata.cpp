@@ -109,13 +109,21 @@ TEST(OpenExrImages, NonFiniteSamplesAreCountedExactly) {
   for (const char* name : {"AllHalfValues.exr", "BrightRingsNanInf.exr"}) {
     const fs::path in = kTestdata / "images/openexr/TestImages" / name;
     // Count independently, through OIIO.
-    std::size_t nan = 0, inf = 0;
-    for (double v : test::read_raw(in).samples) nan += std::isnan(v), inf += std::isinf(v);
+    std::size_t nan = 0, inf = 0, first = SIZE_MAX, index = 0;
+    const auto raw = test::read_raw(in);
+    for (double v : raw.samples) {
+      nan += std::isnan(v), inf += std::isinf(v);
+      if (!std::isfinite(v) && first == SIZE_MAX) first = index;
+      ++index;
+    }
     ASSERT_GT(nan + inf, 0u);
     auto r = convert(in, dir / "out.exr", "linear", "srgb");
     expect_clean_error(r, in);
+    const std::size_t row = std::size_t(raw.width) * raw.channels;
     EXPECT_EQ(r.error().message, "contains " + std::to_string(nan) + " NaN and " + std::to_string(inf) +
-                                     " Inf samples; matbake rejects non-finite texels");
+                                     " Inf samples (the first at x " + std::to_string(first % row / raw.channels) +
+                                     ", y " + std::to_string(first / row) + ", channel " +
+                                     std::to_string(first % raw.channels) + "); matbake rejects non-finite texels");
   }
   EXPECT_FALSE(fs::exists(dir / "out.exr"));
 }

@@ -45,22 +45,28 @@ TypeDesc type_desc(SampleType type) {
   return TypeDesc::FLOAT;
 }
 
+// Non-finite samples, counted, and where the first one is (its sample index in the file).
 struct NonFinite {
   std::size_t nan = 0;
   std::size_t inf = 0;
+  std::size_t first = SIZE_MAX;
   bool any() const { return nan + inf > 0; }
-  void add(float v) {
-    nan += std::isnan(v);
-    inf += std::isinf(v);
+  void add(bool is_nan, bool is_inf, std::size_t index) {
+    nan += is_nan;
+    inf += is_inf;
+    if ((is_nan || is_inf) && index < first) first = index;
   }
 };
 
-void count_half(std::span<const uint16_t> bits, NonFinite& n) {
+void count_float(std::span<const float> samples, std::size_t first_index, NonFinite& n) {
+  for (std::size_t i = 0; i < samples.size(); ++i) n.add(std::isnan(samples[i]), std::isinf(samples[i]), first_index + i);
+}
+
+void count_half(std::span<const uint16_t> bits, std::size_t first_index, NonFinite& n) {
   constexpr uint16_t kExponent = 0x7c00, kMantissa = 0x03ff;  // all-ones exponent: Inf or NaN
-  for (uint16_t b : bits) {
-    const bool special = (b & kExponent) == kExponent;
-    n.nan += special && (b & kMantissa) != 0;
-    n.inf += special && (b & kMantissa) == 0;
+  for (std::size_t i = 0; i < bits.size(); ++i) {
+    const bool special = (bits[i] & kExponent) == kExponent;
+    n.add(special && (bits[i] & kMantissa) != 0, special && (bits[i] & kMantissa) == 0, first_index + i);
   }
 }
 
@@ -102,8 +108,12 @@ class RowReader {
 
   Status finish() const {
     if (bad_.any()) {
+      const std::size_t channels = std::size_t(layout_.channels), row = std::size_t(layout_.width) * channels;
+      const std::size_t x = bad_.first % row / channels, y = bad_.first / row, c = bad_.first % channels;
       return Error{path_.string(), "contains " + std::to_string(bad_.nan) + " NaN and " + std::to_string(bad_.inf) +
-                                       " Inf samples; matbake rejects non-finite texels"};
+                                       " Inf samples (the first at x " + std::to_string(x) + ", y " +
+                                       std::to_string(y) + ", channel " + std::to_string(c) +
+                                       "); matbake rejects non-finite texels"};
     }
     if (overflow_ > 0) {
       return Error{path_.string(), std::to_string(overflow_) + " samples overflow float when decoded from " +
@@ -136,12 +146,13 @@ class RowReader {
       return Error{path_.string(), "cannot read pixels: " + first_line(in_->geterror())};
     }
     const std::span<const T> in(samples, out.size());
+    const std::size_t first_index = std::size_t(y) * std::size_t(layout_.width) * std::size_t(layout_.channels);
     if constexpr (std::is_same_v<T, float>) {
-      for (float v : in) bad_.add(v);
+      count_float(in, first_index, bad_);
       color::decode_pixels(in, out, transfers_);
     } else if constexpr (std::is_same_v<T, uint16_t>) {
       if (stored_ == SampleType::half) {
-        count_half(in, bad_);
+        count_half(in, first_index, bad_);
         color::decode_half_pixels(in, out, transfers_);
       } else {
         color::decode_pixels(in, out, transfers_);
