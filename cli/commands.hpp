@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "material_sources.hpp"
 #include "matbake/convert.hpp"
 #include "matbake/preview.hpp"
 #include "matbake/result.hpp"
@@ -54,5 +55,34 @@ struct PreviewSettings {
 };
 CLI::App* setup_preview(CLI::App& app, PreviewSettings& settings);
 int run_preview(const PreviewSettings& settings, const GlobalOptions& global);
+
+struct PackSettings {
+  std::string layout = "schuler";
+  SourceSettings sources;
+  OutputSettings output;
+};
+CLI::App* setup_pack(CLI::App& app, PackSettings& settings);
+int run_pack(const PackSettings& settings, const GlobalOptions& global);
+
+struct UnpackSettings {
+  std::string layout = "schuler";
+  std::vector<std::string> inputs;
+  std::string out_dir;
+  std::string format = "png";
+  std::string bits;
+  std::string transfer = "srgb";
+};
+CLI::App* setup_unpack(CLI::App& app, UnpackSettings& settings);
+int run_unpack(const UnpackSettings& settings, const GlobalOptions& global);
+
+struct WorkflowSettings {
+  std::string to;  // target layout
+  std::string mapping = "fitted";
+  std::string report;  // JSON file
+  SourceSettings sources;
+  OutputSettings output;
+};
+CLI::App* setup_workflow(CLI::App& app, WorkflowSettings& settings);
+int run_workflow(const WorkflowSettings& settings, const GlobalOptions& global);
 
 }  // namespace matbake::cli

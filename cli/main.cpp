@@ -23,6 +23,12 @@ int main(int argc, char** argv) {
   CLI::App* convert_app = setup_convert(app, convert);
   PreviewSettings preview;
   CLI::App* preview_app = setup_preview(app, preview);
+  PackSettings pack;
+  CLI::App* pack_app = setup_pack(app, pack);
+  UnpackSettings unpack;
+  CLI::App* unpack_app = setup_unpack(app, unpack);
+  WorkflowSettings workflow;
+  CLI::App* workflow_app = setup_workflow(app, workflow);
 
   try {
     app.parse(argc, argv);
@@ -41,5 +47,8 @@ int main(int argc, char** argv) {
 
   if (convert_app->parsed()) return run_convert(convert, global);
   if (preview_app->parsed()) return run_preview(preview, global);
+  if (pack_app->parsed()) return run_pack(pack, global);
+  if (unpack_app->parsed()) return run_unpack(unpack, global);
+  if (workflow_app->parsed()) return run_workflow(workflow, global);
   return kUsage;
 }

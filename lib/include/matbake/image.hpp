@@ -78,6 +78,10 @@ Status stream_image(const std::filesystem::path& input, color::Transfer decode, 
                     const WriteOptions& options, const BandTransform& transform = {}, ReadInfo* info = nullptr,
                     ImageLayout* layout = nullptr);
 
+// Resampled to width × height with OIIO's default filter for the direction (e.g. Lanczos 3 when
+// shrinking), on the values as they are: pass linear data to filter in linear light.
+Image resize_image(const Image& image, int width, int height);
+
 // Threads OIIO may use (EXR compression above all); 0: one per core.
 void set_thread_count(int threads);
 

@@ -1,0 +1,147 @@
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cstdio>
+#include <fstream>
+
+#include "commands.hpp"
+#include "matbake/atomic_file.hpp"
+#include "matbake/workflow_maps.hpp"
+
+namespace matbake::cli {
+namespace {
+
+using workflow::ErrorStats;
+
+bool uses_any(const pack::Layout& layout, std::initializer_list<std::string_view> names) {
+  const auto used = pack::layout_sources(layout);
+  return std::any_of(names.begin(), names.end(),
+                     [&](std::string_view n) { return std::find(used.begin(), used.end(), n) != used.end(); });
+}
+
+nlohmann::json to_json(const ErrorStats& s) {
+  return {{"mean", s.mean}, {"max", s.max}, {"max_at", {s.max_x, s.max_y}}, {"texels", s.count}};
+}
+
+nlohmann::json to_json(const workflow::ConversionErrors& e) {
+  return {{"diffuse_delta_e_ab", to_json(e.diffuse_delta_e)}, {"specular_f0_abs", to_json(e.specular)},
+          {"lobe_relative_rms", to_json(e.lobe)}};
+}
+
+std::string line(const char* label, const ErrorStats& s, double scale, const char* unit) {
+  char buffer[160];
+  std::snprintf(buffer, sizeof buffer, "  %-22s mean %.4g%s  max %.4g%s at (%d, %d)\n", label, s.mean * scale, unit,
+                s.max * scale, unit, s.max_x, s.max_y);
+  return buffer;
+}
+
+std::string describe(const workflow::ConversionErrors& e) {
+  return line("diffuse ΔE*ab", e.diffuse_delta_e, 1, "") + line("specular |ΔF0|", e.specular, 1, "") +
+         line("lobe error (rel. RMS)", e.lobe, 100, "%");
+}
+
+Status write_report(const std::string& path, const nlohmann::json& doc) {
+  auto file = AtomicFile::create(path);
+  if (!file) return file.error();
+  {
+    std::ofstream out(file->temp_path());
+    out << doc.dump(2) << "\n";
+    if (!out) return Error{path, "cannot write"};
+  }
+  return file->commit();
+}
+
+}  // namespace
+
+CLI::App* setup_workflow(CLI::App& app, WorkflowSettings& s) {
+  CLI::App* cmd = app.add_subcommand(
+      "workflow",
+      "Convert between Schüler's specular workflow (Kd, Ks, gloss) and the metalness workflow (base colour,\n"
+      "metallic, roughness), write the target layout's textures and report the error of the conversion\n"
+      "(and, to metal-rough, of the Khronos spec-gloss converter on the same texels).\n"
+      "Example: matbake workflow --from schuler A.png B.png --to gltf-orm -o out/brick_{texture}.png");
+  cmd->add_option("--to", s.to, "Target layout: a preset or a layout JSON file")->required();
+  cmd->add_option("--mapping", s.mapping, "Gloss <-> roughness: fitted (least squares over the lobe) or walter")
+      ->capture_default_str();
+  cmd->add_option("--report", s.report, "Also write the error report as JSON to this file");
+  add_source_options(*cmd, s.sources);
+  add_output_options(*cmd, s.output, "textures");
+  return cmd;
+}
+
+int run_workflow(const WorkflowSettings& s, const GlobalOptions& global) {
+  workflow::RoughnessMapping mapping;
+  if (!workflow::roughness_mapping_from_name(s.mapping, mapping)) {
+    return report_error(Error{"", "--mapping '" + s.mapping + "': use fitted or walter", true});
+  }
+  auto layout = pack::find_layout(s.to);
+  if (!layout) return report_error(layout.error());
+  auto sources = gather_sources(s.sources);
+  if (!sources) return report_error(sources.error());
+
+  const bool has_spec_gloss = sources->find("kd") || sources->find("ks") || sources->find("gloss");
+  const bool has_metal_rough = sources->find("base_color") || sources->find("metallic") || sources->find("roughness");
+  const bool to_metal_rough = uses_any(*layout, {"base_color", "metallic", "roughness"});
+  const bool to_spec_gloss = uses_any(*layout, {"kd", "ks", "gloss"});
+  workflow::ConversionReport report;
+  Result<pack::SourceMaps> converted = Error{"", "", true};
+  std::string direction;
+  if (to_metal_rough && has_spec_gloss && !has_metal_rough) {
+    direction = "spec-gloss to metal-rough";
+    converted = workflow::metal_rough_from_spec_gloss(*sources, mapping, report);
+  } else if (to_spec_gloss && has_metal_rough && !has_spec_gloss) {
+    direction = "metal-rough to spec-gloss";
+    converted = workflow::spec_gloss_from_metal_rough(*sources, mapping, report);
+  } else {
+    return report_error(Error{"", "nothing to convert: give Schüler sources (--kd, --ks, --gloss) for a metal-rough "
+                                  "layout or metal-rough ones (--base-color, --metallic, --roughness) for schuler; "
+                                  "`matbake pack` packs without converting",
+                              true});
+  }
+  if (!converted) return report_error(converted.error());
+  auto written = write_textures(*layout, *converted, s.output, s.sources);
+  if (!written) return report_error(written.error());
+
+  nlohmann::json doc = {{"command", "workflow"}, {"direction", direction}, {"layout", layout->name},
+                        {"mapping", s.mapping}, {"outputs", *written}, {"texels", report.texels},
+                        {"errors", to_json(report.errors)}};
+  const bool spec_gloss_source = direction.starts_with("spec-gloss");
+  if (spec_gloss_source) {
+    doc["khronos_converter_errors"] = to_json(report.khronos_errors);
+    const auto& d = report.dielectric;
+    doc["dielectric_f0"] = {{"texels", d.texels},
+                            {"mean_f0", d.mean_f0},
+                            {"KHR_materials_ior", {{"ior", d.ior}}},
+                            {"KHR_materials_specular", {{"specularColorFactor", d.specular_color_factor}}},
+                            {"error_without_extensions", to_json(d.error_without_extensions)},
+                            {"error_with_extensions", to_json(d.error_with_extensions)}};
+  }
+  if (!s.report.empty()) {
+    if (Status st = write_report(s.report, doc); !st) return report_error(st.error());
+  }
+  if (global.json) {
+    std::cout << doc.dump(2) << "\n";
+  } else if (!global.quiet) {
+    for (const std::string& p : *written) std::cout << p << "\n";
+    std::cout << direction << ", " << converted->width << "x" << converted->height << ", roughness mapping "
+              << s.mapping << "; errors of what the result renders against the source:\n"
+              << describe(report.errors);
+    if (spec_gloss_source) {
+      std::cout << "Khronos spec-gloss converter (roughness = 1 - gloss) on the same texels:\n"
+                << describe(report.khronos_errors);
+      const auto& d = report.dielectric;
+      if (d.texels > 0) {
+        char buffer[300];
+        std::snprintf(buffer, sizeof buffer,
+                      "%zu dielectric texels have F0 != 0.04 (mean %.4f): KHR_materials_ior %.4f or "
+                      "KHR_materials_specular specularColorFactor %.4f; |ΔF0| mean %.4f without them, %.4f with\n",
+                      d.texels, d.mean_f0, d.ior, d.specular_color_factor, d.error_without_extensions.mean,
+                      d.error_with_extensions.mean);
+        std::cout << buffer;
+      }
+    }
+  }
+  return kOk;
+}
+
+}  // namespace matbake::cli

@@ -1,0 +1,205 @@
+#include "material_sources.hpp"
+
+#include <filesystem>
+#include <sstream>
+
+#include "commands.hpp"
+#include "silenced_stderr.hpp"
+
+namespace fs = std::filesystem;
+
+namespace matbake::cli {
+namespace {
+
+std::string option_of(std::string_view source) {
+  std::string name(source);
+  std::replace(name.begin(), name.end(), '_', '-');
+  return "--" + name;
+}
+
+// The output type: --bits, else half for EXR and 8-bit for the rest.
+Result<image::SampleType> output_type(const std::string& bits, const fs::path& path) {
+  if (bits.empty()) return path.extension() == ".exr" ? image::SampleType::half : image::SampleType::u8;
+  auto type = image::sample_type_from_name(bits);
+  if (!type) return Error{"", "--bits '" + bits + "': use 8, 16, half or float", true};
+  return *type;
+}
+
+}  // namespace
+
+std::optional<std::vector<double>> parse_numbers(const std::string& text) {
+  std::vector<double> values;
+  std::stringstream in(text);
+  std::string part;
+  while (std::getline(in, part, ',')) {
+    try {
+      std::size_t used = 0;
+      values.push_back(std::stod(part, &used));
+      if (used != part.size()) return std::nullopt;
+    } catch (const std::exception&) {
+      return std::nullopt;
+    }
+  }
+  if (values.empty()) return std::nullopt;
+  return values;
+}
+
+Result<color::Transfer> parse_transfer(const std::string& name, const char* option) {
+  auto t = color::transfer_from_name(name);
+  if (!t) return Error{"", std::string(option) + " '" + name + "': use srgb, gamma2.2 or linear", true};
+  return *t;
+}
+
+void add_source_options(CLI::App& cmd, SourceSettings& s) {
+  const auto sources = pack::sources();
+  for (std::size_t i = 0; i < sources.size(); ++i) {
+    const bool colour = sources[i].kind == pack::SourceKind::color;
+    cmd.add_option(option_of(sources[i].name), s.values[i],
+                   std::string(sources[i].description) + (colour ? ": image, or linear grey / r,g,b" : ": image, or a value"))
+        ->group("Sources");
+  }
+  cmd.add_option("--from", s.from, "Layout of packed input textures (the positional inputs), e.g. schuler")
+      ->group("Sources");
+  cmd.add_option("inputs", s.inputs, "Packed input textures, one per texture of --from")->group("Sources");
+  cmd.add_option("--transfer", s.transfer, "Curve of 8-bit colour channels, read and written: srgb or gamma2.2")
+      ->capture_default_str();
+  cmd.add_option("--input-transfer", s.input_transfer,
+                 "Curve of every colour input, overriding the rule (8-bit: --transfer; 16-bit, half, float: linear)");
+  cmd.add_flag("--resize", s.resize, "Resample sources of different sizes to the largest (in linear light)");
+  cmd.add_option("--size", s.size, "WxH of the output when every source is a constant (default 1x1)");
+}
+
+Result<pack::SourceMaps> gather_sources(const SourceSettings& s) {
+  auto transfer = parse_transfer(s.transfer, "--transfer");
+  if (!transfer) return transfer.error();
+  pack::LoadOptions options;
+  options.authored = *transfer;
+  options.resize = s.resize;
+  if (!s.input_transfer.empty()) {
+    auto t = parse_transfer(s.input_transfer, "--input-transfer");
+    if (!t) return t.error();
+    options.input = *t;
+  }
+  if (!s.size.empty()) {
+    char x = 0;
+    std::stringstream in(s.size);
+    if (!(in >> options.width >> x >> options.height) || x != 'x' || options.width < 1 || options.height < 1 ||
+        !in.eof()) {
+      return Error{"", "--size '" + s.size + "': use WxH, e.g. 256x256", true};
+    }
+  }
+  std::vector<pack::SourceInput> inputs;
+  const auto sources = pack::sources();
+  for (std::size_t i = 0; i < sources.size(); ++i) {
+    const std::string& text = s.values[i];
+    if (text.empty()) continue;
+    pack::SourceInput input{std::string(sources[i].name), {}, {}};
+    std::error_code ec;
+    auto numbers = parse_numbers(text);
+    if (numbers && !fs::exists(text, ec)) {
+      for (double v : *numbers) {
+        if (!(v >= 0.0 && v <= 1.0)) {
+          return Error{"", option_of(sources[i].name) + " '" + text + "': values are in [0, 1]", true};
+        }
+      }
+      input.constant = *numbers;
+    } else {
+      input.file = text;
+    }
+    inputs.push_back(std::move(input));
+  }
+  pack::SourceMaps maps;
+  {
+    SilencedStderr quiet;
+    auto loaded = pack::load_sources(inputs, options);
+    if (!loaded) return loaded.error();
+    maps = std::move(loaded.value());
+  }
+  if (s.from.empty()) {
+    if (!s.inputs.empty()) return Error{"", "input textures need --from LAYOUT to say what they hold", true};
+    return maps;
+  }
+  // Packed inputs: unpack, then the per-source options take precedence.
+  auto layout = pack::find_layout(s.from);
+  if (!layout) return layout.error();
+  if (s.inputs.size() != layout->textures.size()) {
+    return Error{"", "--from " + s.from + " takes " + std::to_string(layout->textures.size()) + " textures, got " +
+                         std::to_string(s.inputs.size()), true};
+  }
+  std::vector<image::Image> textures;
+  {
+    SilencedStderr quiet;
+    for (std::size_t t = 0; t < s.inputs.size(); ++t) {
+      color::Transfer decode = color::Transfer::linear;
+      if (layout->textures[t].color) {
+        auto d = options.input ? Result<color::Transfer>(*options.input) : pack::decode_transfer(s.inputs[t], *transfer);
+        if (!d) return d.error();
+        decode = *d;
+      }
+      auto image = image::read_image(s.inputs[t], decode);
+      if (!image) return image.error();
+      textures.push_back(std::move(image.value()));
+    }
+  }
+  auto unpacked = pack::unpack(*layout, textures, s.inputs);
+  if (!unpacked) return unpacked.error();
+  if (!maps.maps.empty() && (maps.width != unpacked->width || maps.height != unpacked->height)) {
+    return Error{s.inputs[0], "size differs from the other sources"};
+  }
+  for (auto& [name, map] : maps.maps) unpacked->maps[name] = std::move(map);
+  return unpacked;
+}
+
+void add_output_options(CLI::App& cmd, OutputSettings& o, const std::string& what) {
+  cmd.add_option("-o,--output", o.outputs,
+                 "Output " + what + ": one per texture of the layout, in order, or one path with {texture}, "
+                 "e.g. out/brick_{texture}.png")
+      ->required();
+  cmd.add_option("--bits", o.bits, "8, 16, half or float (default: 8; half for .exr). Colour is encoded with "
+                                   "--transfer in 8-bit and linear otherwise");
+}
+
+Result<std::vector<std::string>> write_textures(const pack::Layout& layout, const pack::SourceMaps& sources,
+                                                const OutputSettings& o, const SourceSettings& inputs) {
+  auto transfer = parse_transfer(inputs.transfer, "--transfer");
+  if (!transfer) return transfer.error();
+  std::vector<std::string> paths;
+  if (o.outputs.size() == 1 && o.outputs[0].find("{texture}") != std::string::npos) {
+    for (const pack::Texture& t : layout.textures) {
+      std::string p = o.outputs[0];
+      p.replace(p.find("{texture}"), 9, t.name);
+      paths.push_back(p);
+    }
+  } else if (o.outputs.size() == layout.textures.size()) {
+    paths = o.outputs;
+  } else {
+    std::string names;
+    for (const pack::Texture& t : layout.textures) names += (names.empty() ? "" : ", ") + t.name;
+    return Error{"", "layout " + layout.name + " writes " + std::to_string(layout.textures.size()) + " textures (" +
+                         names + "): give as many -o, or one with {texture}", true};
+  }
+  std::vector<std::string> input_files = inputs.inputs;
+  for (const std::string& v : inputs.values) {
+    if (!v.empty() && !parse_numbers(v)) input_files.push_back(v);
+  }
+  for (const std::string& out : paths) {
+    for (const std::string& in : input_files) {
+      std::error_code ec;
+      if (fs::equivalent(out, in, ec)) return Error{out, "is an input; matbake never overwrites its inputs", true};
+    }
+  }
+  auto images = pack::pack(layout, sources);
+  if (!images) return images.error();
+  for (std::size_t t = 0; t < paths.size(); ++t) {
+    auto type = output_type(o.bits, paths[t]);
+    if (!type) return type.error();
+    SilencedStderr quiet;
+    if (Status st = image::write_image((*images)[t], paths[t], pack::write_options(layout.textures[t].color, {*type, *transfer}));
+        !st) {
+      return st.error();
+    }
+  }
+  return paths;
+}
+
+}  // namespace matbake::cli

@@ -1,0 +1,39 @@
+#pragma once
+// What pack, unpack and workflow share: source maps given as options (--kd FILE or --kd 0.5,0.4,0.3)
+// or as packed textures of a layout (--from LAYOUT IN...), and writing a layout's textures.
+#include <CLI/CLI.hpp>
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include "matbake/pack.hpp"
+
+namespace matbake::cli {
+
+struct SourceSettings {
+  std::array<std::string, 9> values;  // by pack::sources() index: a file, or numbers
+  std::string from;                   // layout of the packed inputs
+  std::vector<std::string> inputs;    // packed inputs, one per texture of `from`
+  std::string transfer = "srgb";      // 8-bit colour, read and written
+  std::string input_transfer;         // overrides the rule for colour inputs
+  bool resize = false;
+  std::string size;                   // WxH when every source is a constant
+};
+void add_source_options(CLI::App& cmd, SourceSettings& s);
+Result<pack::SourceMaps> gather_sources(const SourceSettings& s);
+
+struct OutputSettings {
+  std::vector<std::string> outputs;  // one per layout texture, or one with {texture}
+  std::string bits;                  // 8, 16, half, float; default 8 (half for .exr)
+};
+void add_output_options(CLI::App& cmd, OutputSettings& o, const std::string& what);
+// Writes the layout's textures; returns the paths written. An output that is one of the inputs
+// is refused before anything is written.
+Result<std::vector<std::string>> write_textures(const pack::Layout& layout, const pack::SourceMaps& sources,
+                                                const OutputSettings& o, const SourceSettings& inputs);
+Result<color::Transfer> parse_transfer(const std::string& name, const char* option);
+// "0.5" or "0.9,0.6,0.2": the numbers, or nothing when `text` is not a list of numbers.
+std::optional<std::vector<double>> parse_numbers(const std::string& text);
+
+}  // namespace matbake::cli

@@ -1,0 +1,102 @@
+#pragma once
+// Packing source maps (diffuse colour, gloss, roughness, ...) into the textures a renderer samples,
+// and back. What goes where is data: a layout (presets/layouts/*.json, or a user's file) lists
+// each output texture's channels, each taken from a source map's component, optionally as 1 − x.
+// docs/pack.md has the format and the presets.
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "matbake/image.hpp"
+#include "matbake/result.hpp"
+
+namespace matbake::pack {
+
+// Colour sources are RGB and authored with a transfer (sRGB or gamma 2.2 in 8/16-bit files);
+// scalar sources are one linear channel.
+enum class SourceKind { color, scalar };
+struct Source {
+  std::string_view name;  // as layouts and the CLI (--kd, --base-color, ...) name it
+  SourceKind kind;
+  std::string_view description;
+};
+std::span<const Source> sources();
+const Source* find_source(std::string_view name);
+
+enum class Transform { identity, one_minus };
+
+struct Channel {
+  std::string source;              // empty: the constant `fallback`
+  int component = 0;               // 0–2 of a colour source; 0 for a scalar one
+  Transform transform = Transform::identity;
+  std::optional<double> fallback;  // used when the source is not given (a constant when source is empty)
+};
+
+struct Texture {
+  std::string name;
+  bool color = false;  // channels 0–2 are colour (encoded with the output transfer); others linear
+  std::vector<Channel> channels;  // 1 to 4; the fourth is alpha (unassociated)
+};
+
+struct Layout {
+  std::string name;
+  std::string description;
+  std::vector<Texture> textures;
+};
+
+// The presets compiled into the library (from presets/layouts/), by name.
+std::vector<std::string> builtin_layout_names();
+// A preset name, or else a path to a layout JSON file.
+Result<Layout> find_layout(const std::string& name_or_path);
+Result<Layout> parse_layout(std::string_view json_text, const std::string& origin);
+
+// Source maps in memory: linear float, colour sources with 3 channels, scalar ones with 1, all
+// the same size.
+struct SourceMaps {
+  int width = 0;
+  int height = 0;
+  std::map<std::string, image::Image, std::less<>> maps;
+  const image::Image* find(std::string_view name) const;
+};
+
+struct SourceInput {
+  std::string name;             // a sources() name
+  std::filesystem::path file;   // an image, or
+  std::vector<double> constant; // linear values: 1 (scalar, or grey) or 3 (colour)
+};
+
+struct LoadOptions {
+  color::Transfer authored = color::Transfer::srgb;  // how 8-bit colour sources were encoded
+  std::optional<color::Transfer> input;              // for every colour file, overriding the rule below
+  bool resize = false;  // else sources of different sizes are an error
+  int width = 0;        // size when every source is a constant (0: 1×1)
+  int height = 0;
+};
+// Reads every file (colour files: 8-bit ones decoded with `authored`, 16-bit, half and float ones
+// as linear, which is how pack writes them, unless `input` says otherwise; a colour source from a grey
+// file is grey, from RGB(A) its RGB; a scalar source is a file's first channel), resizes to the
+// largest (by pixel count) when asked, in linear light with OIIO's default filter, and fills the
+// constants.
+Result<SourceMaps> load_sources(const std::vector<SourceInput>& inputs, const LoadOptions& options);
+
+// The sources a layout reads, and which of them it cannot do without (no fallback).
+std::vector<std::string> layout_sources(const Layout& layout);
+Result<std::vector<image::Image>> pack(const Layout& layout, const SourceMaps& sources);
+// The inverse: source maps from decoded textures (one per layout texture, same size).
+Result<SourceMaps> unpack(const Layout& layout, std::span<const image::Image> textures,
+                          std::span<const std::string> texture_paths);
+
+struct OutputOptions {
+  image::SampleType type = image::SampleType::u8;
+  color::Transfer transfer = color::Transfer::srgb;  // for colour channels of 8-bit output; else linear
+};
+image::WriteOptions write_options(bool color, const OutputOptions& options);
+// How to decode a file holding colour: `authored` for 8-bit files, linear for 16-bit and float
+// ones (the rule write_options follows).
+Result<color::Transfer> decode_transfer(const std::filesystem::path& path, color::Transfer authored);
+
+}  // namespace matbake::pack

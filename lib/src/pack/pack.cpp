@@ -1,0 +1,334 @@
+#include "matbake/pack.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <array>
+#include <fstream>
+#include <sstream>
+
+#include "builtin_layouts.hpp"
+
+namespace matbake::pack {
+namespace fs = std::filesystem;
+namespace {
+
+constexpr std::array<Source, 9> kSources = {{
+    {"kd", SourceKind::color, "Schüler: diffuse colour"},
+    {"ks", SourceKind::color, "Schüler: specular colour, F0"},
+    {"mask", SourceKind::scalar, "mask / opacity (alpha of pair A and of base colour maps)"},
+    {"gloss", SourceKind::scalar, "Schüler: gloss g, Blinn-Phong exponent 2^(12 g)"},
+    {"base_color", SourceKind::color, "metalness workflow: base colour"},
+    {"metallic", SourceKind::scalar, "metalness workflow: metallic"},
+    {"roughness", SourceKind::scalar, "metalness workflow: perceptual roughness (GGX alpha = roughness^2)"},
+    {"occlusion", SourceKind::scalar, "ambient occlusion"},
+    {"detail_mask", SourceKind::scalar, "Unity HDRP detail mask"},
+}};
+
+int component_count(SourceKind kind) { return kind == SourceKind::color ? 3 : 1; }
+
+double apply(Transform transform, double x) { return transform == Transform::one_minus ? 1.0 - x : x; }
+
+Result<Channel> parse_channel(const nlohmann::json& j, const std::string& origin, const std::string& where) {
+  const auto bad = [&](const std::string& what) { return Error{origin, where + ": " + what}; };
+  if (!j.is_object()) return bad("a channel must be an object");
+  Channel c;
+  for (const auto& [key, value] : j.items()) {
+    if (key == "source") {
+      if (!value.is_string()) return bad("\"source\" must be a string");
+      c.source = value.get<std::string>();
+      if (!find_source(c.source)) return bad("unknown source \"" + c.source + "\"");
+    } else if (key == "component") {
+      if (!value.is_number_integer()) return bad("\"component\" must be 0, 1 or 2");
+      c.component = value.get<int>();
+    } else if (key == "transform") {
+      const std::string t = value.is_string() ? value.get<std::string>() : "";
+      if (t == "identity") {
+        c.transform = Transform::identity;
+      } else if (t == "one_minus") {
+        c.transform = Transform::one_minus;
+      } else {
+        return bad("\"transform\" must be \"identity\" or \"one_minus\"");
+      }
+    } else if (key == "default" || key == "value") {
+      if (!value.is_number()) return bad("\"" + key + "\" must be a number");
+      c.fallback = value.get<double>();
+    } else {
+      return bad("unknown key \"" + key + "\"");
+    }
+  }
+  if (c.source.empty() && !c.fallback) return bad("needs a \"source\" or a \"value\"");
+  if (j.contains("value") && !c.source.empty()) return bad("\"value\" is a constant channel: use \"default\" with a source");
+  if (!c.source.empty()) {
+    const int components = component_count(find_source(c.source)->kind);
+    if (c.component < 0 || c.component >= components) {
+      return bad("component " + std::to_string(c.component) + " of \"" + c.source + "\", which has " +
+                 std::to_string(components));
+    }
+  }
+  return c;
+}
+
+Result<Texture> parse_texture(const nlohmann::json& j, const std::string& origin, std::size_t index) {
+  const std::string where = "texture " + std::to_string(index);
+  if (!j.is_object() || !j.contains("name") || !j["name"].is_string() || !j.contains("channels") ||
+      !j["channels"].is_array()) {
+    return Error{origin, where + ": needs \"name\" (string) and \"channels\" (array)"};
+  }
+  Texture t;
+  t.name = j["name"].get<std::string>();
+  t.color = j.value("color", false);
+  const auto& channels = j["channels"];
+  if (channels.empty() || channels.size() > 4) return Error{origin, t.name + ": 1 to 4 channels"};
+  if (t.color && channels.size() < 3) return Error{origin, t.name + ": a colour texture has RGB (3 or 4 channels)"};
+  for (std::size_t i = 0; i < channels.size(); ++i) {
+    auto c = parse_channel(channels[i], origin, t.name + " channel " + std::to_string(i));
+    if (!c) return c.error();
+    t.channels.push_back(std::move(c.value()));
+  }
+  return t;
+}
+
+image::Image blank(int width, int height, int channels) {
+  image::Image image;
+  image.width = width;
+  image.height = height;
+  image.channels = channels;
+  static const std::array<std::vector<std::string>, 5> kNames = {
+      {{}, {"Y"}, {"Y", "A"}, {"R", "G", "B"}, {"R", "G", "B", "A"}}};
+  image.channel_names = kNames[std::size_t(channels)];
+  image.alpha_channel = channels == 2 ? 1 : channels == 4 ? 3 : -1;
+  image.pixels.assign(image.sample_count(), 0.0f);
+  return image;
+}
+
+// A source as a map: its components from a file's channels (grey → RGB repeats it).
+image::Image source_from_file(const image::Image& file, SourceKind kind) {
+  const int components = component_count(kind);
+  image::Image map = blank(file.width, file.height, components);
+  const bool grey = file.channels < 3;
+  const std::size_t texels = std::size_t(file.width) * std::size_t(file.height);
+  for (std::size_t i = 0; i < texels; ++i) {
+    for (int c = 0; c < components; ++c) {
+      map.pixels[i * std::size_t(components) + std::size_t(c)] =
+          file.pixels[i * std::size_t(file.channels) + std::size_t(grey ? 0 : c)];
+    }
+  }
+  return map;
+}
+
+std::string option_name(std::string_view source) {
+  std::string option = "--" + std::string(source);
+  std::replace(option.begin(), option.end(), '_', '-');
+  return option;
+}
+
+}  // namespace
+
+std::span<const Source> sources() { return kSources; }
+
+const Source* find_source(std::string_view name) {
+  for (const Source& s : kSources) {
+    if (s.name == name) return &s;
+  }
+  return nullptr;
+}
+
+std::vector<std::string> builtin_layout_names() {
+  std::vector<std::string> names;
+  for (const BuiltinLayout& b : builtin_layouts()) names.emplace_back(b.name);
+  return names;
+}
+
+Result<Layout> parse_layout(std::string_view json_text, const std::string& origin) {
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(json_text);
+  } catch (const nlohmann::json::parse_error& e) {
+    return Error{origin, "not a valid layout (JSON): " + std::string(e.what())};
+  }
+  if (!j.is_object() || !j.contains("textures") || !j["textures"].is_array() || j["textures"].empty()) {
+    return Error{origin, "a layout needs a non-empty \"textures\" array"};
+  }
+  Layout layout;
+  layout.name = j.value("name", fs::path(origin).stem().string());
+  layout.description = j.value("description", "");
+  for (std::size_t i = 0; i < j["textures"].size(); ++i) {
+    auto t = parse_texture(j["textures"][i], origin, i);
+    if (!t) return t.error();
+    layout.textures.push_back(std::move(t.value()));
+  }
+  return layout;
+}
+
+Result<Layout> find_layout(const std::string& name_or_path) {
+  for (const BuiltinLayout& b : builtin_layouts()) {
+    if (b.name == name_or_path) return parse_layout(b.json, "presets/layouts/" + std::string(b.name) + ".json");
+  }
+  std::error_code ec;
+  if (!fs::is_regular_file(name_or_path, ec)) {
+    std::string names;
+    for (const std::string& n : builtin_layout_names()) names += (names.empty() ? "" : ", ") + n;
+    return Error{name_or_path, "no such layout file, and not a preset (" + names + ")", true};
+  }
+  std::ifstream in(name_or_path);
+  std::stringstream text;
+  text << in.rdbuf();
+  if (!in) return Error{name_or_path, "cannot read"};
+  return parse_layout(text.str(), name_or_path);
+}
+
+const image::Image* SourceMaps::find(std::string_view name) const {
+  const auto it = maps.find(name);
+  return it == maps.end() ? nullptr : &it->second;
+}
+
+Result<color::Transfer> decode_transfer(const fs::path& path, color::Transfer authored) {
+  auto info = image::probe_image(path);
+  if (!info) return info.error();
+  return info->stored_type == image::SampleType::u8 ? authored : color::Transfer::linear;
+}
+
+Result<SourceMaps> load_sources(const std::vector<SourceInput>& inputs, const LoadOptions& options) {
+  SourceMaps result;
+  std::map<std::string, std::string> origin;  // source → file, for size errors
+  for (const SourceInput& input : inputs) {
+    const Source* source = find_source(input.name);
+    if (!source) return Error{"", "unknown source \"" + input.name + "\"", true};
+    if (input.file.empty()) continue;
+    color::Transfer decode = color::Transfer::linear;
+    if (source->kind == SourceKind::color) {
+      if (options.input) {
+        decode = *options.input;
+      } else {
+        auto t = decode_transfer(input.file, options.authored);
+        if (!t) return t.error();
+        decode = *t;
+      }
+    }
+    auto file = image::read_image(input.file, decode);
+    if (!file) return file.error();
+    result.maps[input.name] = source_from_file(*file, source->kind);
+    origin[input.name] = input.file.string();
+  }
+  // One size for all: the largest by pixel count, the others resized to it or refused.
+  const image::Image* largest = nullptr;
+  for (const auto& [name, map] : result.maps) {
+    if (!largest || std::size_t(map.width) * map.height > std::size_t(largest->width) * largest->height) largest = &map;
+  }
+  if (largest) {
+    result.width = largest->width;
+    result.height = largest->height;
+    for (auto& [name, map] : result.maps) {
+      if (map.width == result.width && map.height == result.height) continue;
+      if (!options.resize) {
+        const auto& first = *std::find_if(result.maps.begin(), result.maps.end(), [&](const auto& m) {
+          return m.second.width == result.width && m.second.height == result.height;
+        });
+        return Error{origin[name], std::to_string(map.width) + "x" + std::to_string(map.height) + ", but " +
+                                       origin[first.first] + " is " + std::to_string(result.width) + "x" +
+                                       std::to_string(result.height) + " (--resize resamples to the largest)"};
+      }
+      map = image::resize_image(map, result.width, result.height);
+    }
+  } else {
+    result.width = options.width > 0 ? options.width : 1;
+    result.height = options.height > 0 ? options.height : 1;
+  }
+  for (const SourceInput& input : inputs) {
+    if (!input.file.empty()) continue;
+    const Source* source = find_source(input.name);
+    const int components = component_count(source->kind);
+    const std::size_t n = input.constant.size();
+    if (!(n == 1 || (n == 3 && source->kind == SourceKind::color))) {
+      return Error{"", option_name(input.name) + ": " + (source->kind == SourceKind::color ? "1 or 3 values" : "one value") +
+                           " expected, got " + std::to_string(n), true};
+    }
+    image::Image map = blank(result.width, result.height, components);
+    for (std::size_t i = 0; i < map.pixels.size(); ++i) {
+      map.pixels[i] = float(input.constant[n == 1 ? 0 : i % std::size_t(components)]);
+    }
+    result.maps[input.name] = std::move(map);
+  }
+  return result;
+}
+
+std::vector<std::string> layout_sources(const Layout& layout) {
+  std::vector<std::string> names;
+  for (const Texture& t : layout.textures) {
+    for (const Channel& c : t.channels) {
+      if (!c.source.empty() && std::find(names.begin(), names.end(), c.source) == names.end()) names.push_back(c.source);
+    }
+  }
+  return names;
+}
+
+Result<std::vector<image::Image>> pack(const Layout& layout, const SourceMaps& sources) {
+  std::vector<image::Image> textures;
+  for (const Texture& t : layout.textures) {
+    image::Image out = blank(sources.width, sources.height, int(t.channels.size()));
+    const std::size_t texels = std::size_t(out.width) * std::size_t(out.height), stride = t.channels.size();
+    for (std::size_t c = 0; c < stride; ++c) {
+      const Channel& channel = t.channels[c];
+      const image::Image* map = channel.source.empty() ? nullptr : sources.find(channel.source);
+      if (!map && !channel.fallback) {
+        return Error{"", "layout " + layout.name + " needs " + channel.source + " (" + option_name(channel.source) + ")",
+                     true};
+      }
+      for (std::size_t i = 0; i < texels; ++i) {
+        const double x = map ? map->pixels[i * std::size_t(map->channels) + std::size_t(channel.component)]
+                             : *channel.fallback;
+        out.pixels[i * stride + c] = float(apply(channel.transform, x));
+      }
+    }
+    textures.push_back(std::move(out));
+  }
+  return textures;
+}
+
+Result<SourceMaps> unpack(const Layout& layout, std::span<const image::Image> textures,
+                          std::span<const std::string> texture_paths) {
+  if (textures.size() != layout.textures.size()) {
+    return Error{"", "layout " + layout.name + " has " + std::to_string(layout.textures.size()) + " textures, got " +
+                         std::to_string(textures.size()), true};
+  }
+  SourceMaps result;
+  result.width = textures[0].width;
+  result.height = textures[0].height;
+  for (std::size_t t = 0; t < textures.size(); ++t) {
+    const image::Image& in = textures[t];
+    const Texture& spec = layout.textures[t];
+    if (in.width != result.width || in.height != result.height) {
+      return Error{texture_paths[t], std::to_string(in.width) + "x" + std::to_string(in.height) + ", but " +
+                                         texture_paths[0] + " is " + std::to_string(result.width) + "x" +
+                                         std::to_string(result.height)};
+    }
+    if (in.channels < int(spec.channels.size())) {
+      return Error{texture_paths[t], std::to_string(in.channels) + " channels; layout " + layout.name + " texture " +
+                                         spec.name + " has " + std::to_string(spec.channels.size())};
+    }
+    const std::size_t texels = std::size_t(in.width) * std::size_t(in.height);
+    for (std::size_t c = 0; c < spec.channels.size(); ++c) {
+      const Channel& channel = spec.channels[c];
+      if (channel.source.empty()) continue;
+      const SourceKind kind = find_source(channel.source)->kind;
+      auto [it, inserted] = result.maps.try_emplace(channel.source);
+      if (inserted) it->second = blank(in.width, in.height, component_count(kind));
+      image::Image& map = it->second;
+      for (std::size_t i = 0; i < texels; ++i) {
+        map.pixels[i * std::size_t(map.channels) + std::size_t(channel.component)] =
+            float(apply(channel.transform, in.pixels[i * std::size_t(in.channels) + c]));
+      }
+    }
+  }
+  return result;
+}
+
+image::WriteOptions write_options(bool color, const OutputOptions& options) {
+  image::WriteOptions w;
+  w.type = options.type;
+  w.colour = color && options.type == image::SampleType::u8 ? options.transfer : color::Transfer::linear;
+  return w;
+}
+
+}  // namespace matbake::pack
