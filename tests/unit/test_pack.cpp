@@ -1,0 +1,181 @@
+// Layouts: the presets' channel assignments value by value, parse errors, pack/unpack inverses,
+// source loading (sizes, resize, constants).
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "matbake/pack.hpp"
+#include "support/files.hpp"
+#include "support/temp_dir.hpp"
+
+namespace matbake::pack {
+namespace {
+
+using test::TempDir;
+
+// Two texels, every source with different values (and texel 1 different from texel 0).
+SourceMaps all_sources() {
+  std::vector<SourceInput> inputs = {
+      {"kd", {}, {0.11, 0.12, 0.13}}, {"ks", {}, {0.21, 0.22, 0.23}}, {"mask", {}, {0.9}},
+      {"gloss", {}, {0.35}},          {"base_color", {}, {0.41, 0.42, 0.43}}, {"metallic", {}, {0.7}},
+      {"roughness", {}, {0.25}},      {"occlusion", {}, {0.6}},               {"detail_mask", {}, {0.4}}};
+  auto maps = load_sources(inputs, {color::Transfer::srgb, {}, false, 2, 1});
+  EXPECT_TRUE(maps) << maps.error().to_string();
+  for (auto& [name, map] : maps->maps) {
+    for (std::size_t i = std::size_t(map.channels); i < map.pixels.size(); ++i) map.pixels[i] *= 0.5f;
+  }
+  return *maps;
+}
+
+std::vector<float> texel(const image::Image& image, int i) {
+  return {image.pixels.begin() + i * image.channels, image.pixels.begin() + (i + 1) * image.channels};
+}
+
+void expect_texel(const image::Image& image, int i, std::vector<double> expected, const std::string& what) {
+  const auto got = texel(image, i);
+  ASSERT_EQ(got.size(), expected.size()) << what;
+  for (std::size_t c = 0; c < got.size(); ++c) EXPECT_NEAR(got[c], expected[c], 1e-6) << what << " channel " << c;
+}
+
+TEST(Layouts, EveryPresetParses) {
+  const auto names = builtin_layout_names();
+  for (const char* name : {"schuler", "gltf-metal-rough", "gltf-orm", "unreal-orm", "unity-hdrp", "unity-urp"}) {
+    EXPECT_NE(std::find(names.begin(), names.end(), name), names.end()) << name;
+    auto layout = find_layout(name);
+    ASSERT_TRUE(layout) << layout.error().to_string();
+    EXPECT_EQ(layout->name, name);
+  }
+}
+
+TEST(Layouts, PresetChannelsValueByValue) {
+  const SourceMaps s = all_sources();
+  const auto packed = [&](const char* name) {
+    auto images = pack(*find_layout(name), s);
+    EXPECT_TRUE(images) << name;
+    return *images;
+  };
+  for (int i : {0, 1}) {
+    const double h = i ? 0.5 : 1.0;  // texel 1 holds half of texel 0's values
+    auto schuler = packed("schuler");
+    expect_texel(schuler[0], i, {0.11 * h, 0.12 * h, 0.13 * h, 0.9 * h}, "schuler A");
+    expect_texel(schuler[1], i, {0.21 * h, 0.22 * h, 0.23 * h, 0.35 * h}, "schuler B");
+    auto gltf = packed("gltf-metal-rough");
+    expect_texel(gltf[0], i, {0.41 * h, 0.42 * h, 0.43 * h, 0.9 * h}, "glTF base colour");
+    expect_texel(gltf[1], i, {0, 0.25 * h, 0.7 * h}, "glTF metallicRoughness");
+    expect_texel(packed("gltf-orm")[1], i, {0.6 * h, 0.25 * h, 0.7 * h}, "glTF ORM");
+    auto unreal = packed("unreal-orm");
+    expect_texel(unreal[0], i, {0.41 * h, 0.42 * h, 0.43 * h}, "Unreal base colour");
+    expect_texel(unreal[1], i, {0.6 * h, 0.25 * h, 0.7 * h}, "Unreal ORM");
+    expect_texel(packed("unity-hdrp")[1], i, {0.7 * h, 0.6 * h, 0.4 * h, 1 - 0.25 * h}, "HDRP mask map");
+    expect_texel(packed("unity-urp")[1], i, {0.7 * h, 0, 0, 1 - 0.25 * h}, "URP metallic gloss");
+  }
+  EXPECT_EQ(packed("schuler")[0].alpha_channel, 3);
+  EXPECT_EQ(packed("gltf-orm")[1].alpha_channel, -1);
+}
+
+TEST(Layouts, DefaultsAndMissingSources) {
+  SourceMaps s = all_sources();
+  s.maps.erase("occlusion");
+  s.maps.erase("mask");
+  auto orm = pack(*find_layout("gltf-orm"), s);
+  ASSERT_TRUE(orm);
+  expect_texel((*orm)[0], 0, {0.41, 0.42, 0.43, 1.0}, "mask defaults to 1");
+  expect_texel((*orm)[1], 0, {1.0, 0.25, 0.7}, "occlusion defaults to 1");
+  s.maps.erase("roughness");
+  auto missing = pack(*find_layout("gltf-orm"), s);
+  ASSERT_FALSE(missing);
+  EXPECT_TRUE(missing.error().usage);
+  EXPECT_EQ(missing.error().message, "layout gltf-orm needs roughness (--roughness)");
+}
+
+TEST(Layouts, UnpackInvertsPackIncludingOneMinus) {
+  const SourceMaps s = all_sources();
+  for (const std::string& name : builtin_layout_names()) {
+    const Layout layout = *find_layout(name);
+    auto textures = pack(layout, s);
+    ASSERT_TRUE(textures);
+    const std::vector<std::string> paths(textures->size(), "t");
+    auto back = unpack(layout, *textures, paths);
+    ASSERT_TRUE(back) << name;
+    for (const std::string& source : layout_sources(layout)) {
+      const image::Image* got = back->find(source);
+      ASSERT_NE(got, nullptr) << name << " " << source;
+      const image::Image* want = s.find(source);
+      for (std::size_t i = 0; i < got->pixels.size(); ++i) {
+        EXPECT_NEAR(got->pixels[i], want->pixels[i], 1e-7) << name << " " << source;
+      }
+    }
+  }
+}
+
+TEST(Layouts, ParseErrorsNameTheFileAndTheProblem) {
+  const std::pair<const char*, const char*> cases[] = {
+      {"{", "not a valid layout (JSON)"},
+      {R"({"textures": []})", "a layout needs a non-empty \"textures\" array"},
+      {R"({"textures": [{"name": "t", "channels": [{"source": "albedo"}]}]})", "unknown source \"albedo\""},
+      {R"({"textures": [{"name": "t", "channels": [{"source": "gloss", "component": 1}]}]})",
+       "component 1 of \"gloss\", which has 1"},
+      {R"({"textures": [{"name": "t", "channels": [{"source": "gloss", "transform": "square"}]}]})",
+       "\"transform\" must be \"identity\" or \"one_minus\""},
+      {R"({"textures": [{"name": "t", "channels": [{}]}]})", "needs a \"source\" or a \"value\""},
+      {R"({"textures": [{"name": "t", "color": true, "channels": [{"value": 0}]}]})", "a colour texture has RGB"},
+      {R"({"textures": [{"name": "t", "channels": [{"value": 0}, {"value": 0}, {"value": 0}, {"value": 0}, {"value": 0}]}]})",
+       "1 to 4 channels"},
+      {R"({"textures": [{"name": "t", "channels": [{"source": "gloss", "gain": 2}]}]})", "unknown key \"gain\""},
+  };
+  for (const auto& [json, message] : cases) {
+    auto layout = parse_layout(json, "mine.json");
+    ASSERT_FALSE(layout) << json;
+    EXPECT_EQ(layout.error().path, "mine.json");
+    EXPECT_NE(layout.error().message.find(message), std::string::npos) << layout.error().message;
+  }
+  auto missing = find_layout("no-such-layout");
+  ASSERT_FALSE(missing);
+  EXPECT_TRUE(missing.error().usage);
+}
+
+TEST(Sources, ConstantsFillTheSizeOfTheFiles) {
+  TempDir dir;
+  test::write_raw(dir / "gloss.png", 3, 2, 1, "uint8", {0, 51, 102, 153, 204, 255});
+  auto maps = load_sources({{"gloss", dir / "gloss.png", {}}, {"kd", {}, {0.5}}}, {});
+  ASSERT_TRUE(maps) << maps.error().to_string();
+  EXPECT_EQ(maps->width, 3);
+  EXPECT_EQ(maps->height, 2);
+  EXPECT_EQ(maps->find("kd")->pixels, std::vector<float>(18, 0.5f));
+  EXPECT_FLOAT_EQ(maps->find("gloss")->pixels[1], 0.2f);  // scalar sources are linear
+  // A single constant with no file: 1×1.
+  auto one = load_sources({{"gloss", {}, {0.5}}}, {});
+  ASSERT_TRUE(one);
+  EXPECT_EQ(one->width * one->height, 1);
+}
+
+TEST(Sources, ColourFilesDecodeBy8BitRuleGreyRepeats) {
+  TempDir dir;
+  test::write_raw(dir / "grey.png", 1, 1, 1, "uint8", {188});
+  test::write_raw(dir / "rgb16.png", 1, 1, 3, "uint16", {0, 32768, 65535});
+  auto maps = load_sources({{"kd", dir / "grey.png", {}}, {"ks", dir / "rgb16.png", {}}}, {color::Transfer::gamma22, {}, false, 0, 0});
+  ASSERT_TRUE(maps);
+  const float grey = float(std::pow(188 / 255.0, 2.2));
+  EXPECT_EQ(maps->find("kd")->pixels, std::vector<float>(3, grey));
+  EXPECT_FLOAT_EQ(maps->find("ks")->pixels[1], 32768 / 65535.0f);  // 16-bit: linear
+}
+
+TEST(Sources, DifferentSizesAreAnErrorUnlessResized) {
+  TempDir dir;
+  test::write_raw(dir / "big.png", 4, 4, 1, "uint8", std::vector<double>(16, 128));
+  test::write_raw(dir / "small.png", 2, 2, 1, "uint8", std::vector<double>(4, 51));
+  const std::vector<SourceInput> inputs = {{"gloss", dir / "big.png", {}}, {"mask", dir / "small.png", {}}};
+  auto refused = load_sources(inputs, {});
+  ASSERT_FALSE(refused);
+  EXPECT_EQ(refused.error().path, (dir / "small.png").string());
+  EXPECT_EQ(refused.error().message, "2x2, but " + (dir / "big.png").string() +
+                                         " is 4x4 (--resize resamples to the largest)");
+  LoadOptions resize;
+  resize.resize = true;
+  auto resized = load_sources(inputs, resize);
+  ASSERT_TRUE(resized);
+  for (float v : resized->find("mask")->pixels) EXPECT_NEAR(v, 0.2f, 1e-6);  // a constant stays constant
+}
+
+}  // namespace
+}  // namespace matbake::pack
