@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <filesystem>
 
+#include "support/expect_error.hpp"
 #include "support/files.hpp"
 #include "support/run.hpp"
 #include "support/temp_dir.hpp"
@@ -15,13 +16,6 @@ namespace matbake::test {
 namespace {
 
 namespace fs = std::filesystem;
-
-// Exactly one line on stderr, in the documented form.
-void expect_one_error_line(const RunResult& r, const std::string& path, const std::string& problem) {
-  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
-  const std::string expected = "matbake: error: " + (path.empty() ? "" : path + ": ") + problem;
-  EXPECT_EQ(r.err.rfind(expected, 0), 0u) << "stderr: " << r.err << "expected: " << expected;
-}
 
 TEST(CliConvert, HelpAndVersion) {
   const auto help = matbake({"--help"});

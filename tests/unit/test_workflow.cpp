@@ -30,34 +30,46 @@ TEST(RoughnessMapping, WalterValuesOfTheIssue) {
 
 TEST(RoughnessMapping, BothMappingsDecreaseAndInvert) {
   for (RoughnessMapping mapping : {RoughnessMapping::walter, RoughnessMapping::fitted}) {
-    double previous = 2;
-    for (int i = 0; i <= 1000; ++i) {
-      const double g = i / 1000.0;
-      const double r = roughness_from_gloss(g, mapping);
-      EXPECT_LT(r, previous);
-      previous = r;
-      EXPECT_NEAR(gloss_from_roughness(r, mapping), g, 1e-9) << roughness_mapping_name(mapping) << " g " << g;
+    for (double f0 : {0.0, 0.04, 0.1, 0.33, 0.9, 1.0}) {
+      double previous = 2;
+      for (int i = 0; i <= 1000; ++i) {
+        const double g = i / 1000.0;
+        const double r = roughness_from_gloss(g, mapping, f0);
+        EXPECT_LT(r, previous);
+        previous = r;
+        EXPECT_NEAR(gloss_from_roughness(r, mapping, f0), g, 1e-9) << roughness_mapping_name(mapping) << " g " << g;
+      }
+      EXPECT_EQ(gloss_from_roughness(1.0, mapping, f0), 0.0);  // rougher than any Schüler surface
+      EXPECT_EQ(gloss_from_roughness(0.0, mapping, f0), 1.0);  // a mirror: the glossiest we have
     }
-    EXPECT_EQ(gloss_from_roughness(1.0, mapping), 0.0);  // rougher than any Schüler surface
-    EXPECT_EQ(gloss_from_roughness(0.0, mapping), 1.0);  // a mirror: the glossiest we have
   }
+  // Between rows the fitted mapping interpolates in F0.
+  const double r0 = roughness_from_gloss(0.5, RoughnessMapping::fitted, 0.2);
+  const double r1 = roughness_from_gloss(0.5, RoughnessMapping::fitted, 0.5);
+  EXPECT_NEAR(roughness_from_gloss(0.5, RoughnessMapping::fitted, 0.35), (r0 + r1) / 2, 1e-12);
 }
 
 TEST(RoughnessMapping, FittedIsTheLeastSquaresOptimumAndBeatsWalter) {
   const LobeQuadrature q = make_lobe_quadrature(24);
   const LobeQuadrature fine = make_lobe_quadrature(48);
-  for (int i = 0; i <= 32; i += 4) {
-    const double g = i / 32.0;
-    const double walter = lobe_error(q, kDielectricF0, g, kDielectricF0, roughness_from_gloss(g, RoughnessMapping::walter));
-    const double fitted = lobe_error(q, kDielectricF0, g, kDielectricF0, roughness_from_gloss(g, RoughnessMapping::fitted));
-    EXPECT_LT(fitted, walter) << "g " << g;
+  for (double f0 : {0.04, 0.3, 0.9}) {
+    for (int i = 0; i <= 32; i += 4) {
+      const double g = i / 32.0;
+      const double walter = lobe_error(q, f0, g, f0, roughness_from_gloss(g, RoughnessMapping::walter));
+      const double fitted = lobe_error(q, f0, g, f0, roughness_from_gloss(g, RoughnessMapping::fitted, f0));
+      const double khronos = lobe_error(q, f0, g, f0, 1 - g);
+      EXPECT_LT(fitted, walter) << "F0 " << f0 << " g " << g;
+      EXPECT_LT(fitted, khronos) << "F0 " << f0 << " g " << g;
+    }
   }
-  // The shipped table is what the fit gives (bench/fit_gloss_roughness regenerates it).
-  for (int i : {0, 16, 32}) {
-    EXPECT_NEAR(fitted_roughness_table()[i], best_roughness(fine, kDielectricF0, i / 32.0), 1e-6) << i;
+  // The shipped table is what the fit gives (bench/fit_gloss_roughness regenerates it)…
+  for (std::size_t row : {std::size_t(1), std::size_t(5)}) {
+    for (int i : {0, 16, 32}) {
+      EXPECT_NEAR(fitted_roughness_table(row)[i], best_roughness(fine, kFittedF0[row], i / 32.0), 1e-6) << i;
+    }
   }
-  // …and the quadrature has converged: twice the resolution moves the optimum by < 0.005.
-  EXPECT_NEAR(best_roughness(q, kDielectricF0, 0.5), fitted_roughness_table()[16], 0.005);
+  // …and the quadrature has converged: half the resolution moves the optimum by < 0.005.
+  EXPECT_NEAR(best_roughness(q, kDielectricF0, 0.5), fitted_roughness_table(1)[16], 0.005);
 }
 
 TEST(LobeQuadrature, WeightsCoverTheHemispherePerView) {
@@ -148,8 +160,12 @@ TEST(Workflow, MetalRoughToSpecGlossAndBack) {
   for (RoughnessMapping mapping : {RoughnessMapping::walter, RoughnessMapping::fitted}) {
     for (int i = 0; i < 500; ++i) {
       // Within the range a Schüler gloss can say (the mapping's roughness at g = 1 and 0).
-      const double r = roughness_from_gloss(1, mapping) + u(rng) * (roughness_from_gloss(0, mapping) - roughness_from_gloss(1, mapping));
-      const MetalRough mr{{u(rng), u(rng), u(rng)}, i % 2 ? 1.0 : u(rng), r};
+      const Vec3 base(u(rng), u(rng), u(rng));
+      const double metallic = i % 2 ? 1.0 : u(rng);
+      const double f0 = mean_f0(specular_from_metal_rough(base, metallic));
+      // Within the range a Schüler gloss can say for this F0 (the roughness at g = 1 and 0).
+      const double lo = roughness_from_gloss(1, mapping, f0), hi = roughness_from_gloss(0, mapping, f0);
+      const MetalRough mr{base, metallic, lo + u(rng) * (hi - lo)};
       const SpecGloss sg = spec_gloss_from_metal_rough(mr, mapping);
       const MetalRough back = metal_rough_from_spec_gloss(sg, mapping);
       EXPECT_NEAR(back.roughness, mr.roughness, 1e-9);

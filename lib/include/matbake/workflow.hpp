@@ -35,18 +35,22 @@ Vec3 specular_from_metal_rough(const Vec3& base, double metallic);
 enum class RoughnessMapping {
   // e = 2^(12 g) → Beckmann α = sqrt(2/(e + 2)) (Walter et al. 2007) → roughness = sqrt(α).
   walter,
-  // Per g, the roughness whose GGX lobe is nearest to Schüler's CookTorranceSimplified lobe in
-  // least squares (lobe_error below), tabulated at 33 glosses and interpolated linearly
-  // (bench/fit_gloss_roughness prints the table and both mappings' errors).
+  // Per (g, F0), the roughness whose GGX lobe is nearest to Schüler's CookTorranceSimplified lobe
+  // in least squares (lobe_error below), tabulated at 33 glosses × the F0 values of
+  // kFittedF0 and interpolated linearly in both (bench/fit_gloss_roughness prints the table and
+  // both mappings' errors). The best roughness grows with F0 (Schüler's Fresnel and Schlick's
+  // differ most for dielectrics), up to 0.14 at g = 0.
   fitted,
 };
+inline constexpr double kFittedF0[] = {0.02, 0.04, 0.2, 0.5, 0.8, 1.0};
 std::string_view roughness_mapping_name(RoughnessMapping mapping);
 bool roughness_mapping_from_name(std::string_view name, RoughnessMapping& mapping);
-// g in [0, 1] (clamped); both mappings are strictly decreasing, so each has an inverse.
-double roughness_from_gloss(double gloss, RoughnessMapping mapping);
-double gloss_from_roughness(double roughness, RoughnessMapping mapping);  // clamped to [0, 1]
-// The fitted table: roughness at g = i / 32.
-std::span<const double> fitted_roughness_table();
+// g in [0, 1] (clamped); both mappings are strictly decreasing in g, so each has an inverse for a
+// given F0 (the mean of the specular colour's channels; walter ignores it).
+double roughness_from_gloss(double gloss, RoughnessMapping mapping, double f0 = kDielectricF0);
+double gloss_from_roughness(double roughness, RoughnessMapping mapping, double f0 = kDielectricF0);  // in [0, 1]
+// The fitted table's row for kFittedF0[row]: roughness at g = i / 32.
+std::span<const double> fitted_roughness_table(std::size_t row);
 
 // --- Colour: (Kd, Ks) ⇄ (base, metallic) --------------------------------------------------------
 struct BaseMetallic {
@@ -62,6 +66,8 @@ BaseMetallic base_metallic_from_spec_gloss(const Vec3& kd, const Vec3& ks);
 // brightness, base from a metallic²-weighted blend), for comparison.
 BaseMetallic khronos_base_metallic(const Vec3& kd, const Vec3& ks);
 
+// The mean of the channels: the F0 the fitted mapping is looked up with.
+double mean_f0(const Vec3& specular);
 MetalRough metal_rough_from_spec_gloss(const SpecGloss& material, RoughnessMapping mapping);
 SpecGloss spec_gloss_from_metal_rough(const MetalRough& material, RoughnessMapping mapping);
 

@@ -150,7 +150,7 @@ Result<pack::SourceMaps> metal_rough_from_spec_gloss(const pack::SourceMaps& in,
     const BaseMetallic bm = base_metallic_from_spec_gloss(d, s);
     store_colour(base, i, bm.base);
     metallic.pixels[i] = float(bm.metallic);
-    roughness.pixels[i] = float(roughness_from_gloss((*gloss)->pixels[i], mapping));
+    roughness.pixels[i] = float(roughness_from_gloss((*gloss)->pixels[i], mapping, mean_f0(s)));
     const BaseMetallic k = khronos_base_metallic(d, s);
     store_colour(khronos_base, i, k.base);
     khronos_metallic.pixels[i] = float(k.metallic);

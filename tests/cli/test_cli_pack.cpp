@@ -1,0 +1,182 @@
+// `matbake pack`, `unpack` and `workflow` end to end: every 8-bit code through pack and unpack,
+// preset channels read back from the files, bad inputs, and the workflow report.
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <filesystem>
+
+#include "support/expect_error.hpp"
+#include "support/files.hpp"
+#include "support/run.hpp"
+#include "support/temp_dir.hpp"
+
+namespace matbake::test {
+namespace {
+
+namespace fs = std::filesystem;
+
+// 256×1 maps whose texel i holds different codes in every channel, all 256 codes in each.
+void write_code_sources(const fs::path& dir) {
+  std::vector<double> kd, ks, mask, gloss;
+  for (int i = 0; i < 256; ++i) {
+    kd.insert(kd.end(), {double(i), double(255 - i), double((i * 7) % 256)});
+    ks.insert(ks.end(), {double((i * 5) % 256), double(i), double(255 - i)});
+    mask.push_back((i * 3) % 256);
+    gloss.push_back(i);
+  }
+  write_raw(dir / "kd.png", 256, 1, 3, "uint8", kd);
+  write_raw(dir / "ks.png", 256, 1, 3, "uint8", ks);
+  write_raw(dir / "mask.png", 256, 1, 1, "uint8", mask);
+  write_raw(dir / "gloss.png", 256, 1, 1, "uint8", gloss);
+}
+
+std::vector<std::string> sources_from(const fs::path& dir) {
+  return {"--kd", (dir / "kd.png").string(), "--ks", (dir / "ks.png").string(),
+          "--mask", (dir / "mask.png").string(), "--gloss", (dir / "gloss.png").string()};
+}
+
+std::vector<std::string> concat(std::vector<std::string> a, const std::vector<std::string>& b) {
+  a.insert(a.end(), b.begin(), b.end());
+  return a;
+}
+
+TEST(CliPack, EveryEightBitCodeSurvivesPackAndUnpack) {
+  for (const char* transfer : {"srgb", "gamma2.2"}) {
+    TempDir dir;
+    write_code_sources(dir.path());
+    const auto packed = matbake(concat({"pack", "--transfer", transfer, "-o", (dir / "A.png").string(), "-o",
+                                        (dir / "B.png").string()},
+                                       sources_from(dir.path())));
+    ASSERT_EQ(packed.exit_code, 0) << packed.err;
+    // The pair holds the sources' codes: colour encoded with the same curve, alpha as stored.
+    const RawImage a = read_raw(dir / "A.png"), b = read_raw(dir / "B.png"), kd = read_raw(dir / "kd.png");
+    ASSERT_EQ(a.channels, 4);
+    for (int i = 0; i < 256; ++i) {
+      EXPECT_EQ(a.samples[i * 4 + 0], kd.samples[i * 3 + 0]) << transfer << " " << i;
+      EXPECT_EQ(a.samples[i * 4 + 2], kd.samples[i * 3 + 2]) << transfer << " " << i;
+      EXPECT_EQ(a.samples[i * 4 + 3], (i * 3) % 256);
+      EXPECT_EQ(b.samples[i * 4 + 3], i);
+    }
+    // unpack ∘ pack = identity on the sources' codes.
+    const auto unpacked = matbake({"unpack", "--transfer", transfer, (dir / "A.png").string(),
+                                   (dir / "B.png").string(), "-o", (dir / "back").string()});
+    ASSERT_EQ(unpacked.exit_code, 0) << unpacked.err;
+    for (const char* name : {"kd.png", "ks.png", "mask.png", "gloss.png"}) {
+      EXPECT_EQ(read_raw(dir / "back" / name).samples, read_raw(dir / name).samples) << transfer << " " << name;
+    }
+    // pack ∘ unpack = identity on the pair's codes.
+    const auto repacked = matbake(concat({"pack", "--transfer", transfer, "-o", (dir / "A2.png").string(), "-o",
+                                          (dir / "B2.png").string()},
+                                         sources_from(dir / "back")));
+    ASSERT_EQ(repacked.exit_code, 0) << repacked.err;
+    EXPECT_EQ(read_raw(dir / "A2.png").samples, a.samples);
+    EXPECT_EQ(read_raw(dir / "B2.png").samples, b.samples);
+  }
+}
+
+TEST(CliPack, PresetChannelsInTheFiles) {
+  TempDir dir;
+  std::vector<double> roughness;
+  for (int i = 0; i < 256; ++i) roughness.push_back(i);
+  write_raw(dir / "roughness.png", 256, 1, 1, "uint8", roughness);
+  const auto r = matbake({"pack", "--layout", "unity-hdrp", "--base-color", "0.5,0.25,1", "--metallic", "1",
+                          "--roughness", (dir / "roughness.png").string(), "--occlusion", "0.2", "-o",
+                          (dir / "hdrp_{texture}.png").string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const RawImage mask_map = read_raw(dir / "hdrp_mask_map.png");
+  ASSERT_EQ(mask_map.channels, 4);
+  for (int i = 0; i < 256; ++i) {
+    EXPECT_EQ(mask_map.samples[i * 4 + 0], 255);      // metallic
+    EXPECT_EQ(mask_map.samples[i * 4 + 1], 51);       // occlusion 0.2, linear
+    EXPECT_EQ(mask_map.samples[i * 4 + 2], 255);      // detail mask default 1
+    EXPECT_EQ(mask_map.samples[i * 4 + 3], 255 - i);  // smoothness = 1 − roughness, every code exact
+  }
+  const RawImage base = read_raw(dir / "hdrp_base_color.png");
+  EXPECT_EQ(base.samples[0], 188);  // 0.5 linear in sRGB 8-bit
+  EXPECT_EQ(base.samples[1], 137);  // 0.25
+  EXPECT_EQ(base.samples[3], 255);  // mask default 1
+  // 16-bit output: colour is written linear.
+  const auto wide = matbake({"pack", "--layout", "gltf-orm", "--base-color", "0.5", "--metallic", "0",
+                             "--roughness", "0.5", "--bits", "16", "-o", (dir / "w_{texture}.png").string()});
+  ASSERT_EQ(wide.exit_code, 0) << wide.err;
+  EXPECT_EQ(read_raw(dir / "w_base_color.png").samples[0], 32768);
+  EXPECT_EQ(read_raw(dir / "w_orm.png").samples, std::vector<double>({65535, 32768, 0}));
+}
+
+TEST(CliPack, BadInputsAndUsage) {
+  TempDir dir;
+  write_raw(dir / "big.png", 4, 4, 1, "uint8", std::vector<double>(16, 10));
+  write_raw(dir / "small.png", 2, 2, 3, "uint8", std::vector<double>(12, 10));
+  write_raw(dir / "nan.exr", 3, 2, 1, "float", {0.5, 0.5, 0.5, 0.5, std::nan(""), 0.5});
+  const std::string big = (dir / "big.png").string(), small = (dir / "small.png").string();
+  const std::string out = (dir / "o_{texture}.png").string();
+  const auto before = list_folder(dir.path());
+
+  struct Case {
+    std::vector<std::string> args;
+    int exit_code;
+    std::string path, problem;
+  };
+  const std::vector<Case> cases = {
+      {{"--kd", (dir / "none.png").string(), "--ks", "0.04", "--gloss", "0.5"}, 1, (dir / "none.png").string(), "no such file"},
+      {{"--kd", "0.5", "--ks", "0.04", "--gloss", (dir / "nan.exr").string()}, 1, (dir / "nan.exr").string(),
+       "contains 1 NaN and 0 Inf samples (the first at x 1, y 1, channel 0)"},
+      {{"--kd", small, "--ks", "0.04", "--gloss", big}, 1, small, "2x2, but " + big + " is 4x4"},
+      {{"--kd", "1.5", "--ks", "0.04", "--gloss", "0.5"}, 2, "", "--kd '1.5': values are in [0, 1]"},
+      {{"--kd", "0.5", "--ks", "0.04"}, 2, "", "layout schuler needs gloss (--gloss)"},
+      {{"--kd", "0.5,0.5", "--ks", "0.04", "--gloss", "0.5"}, 2, "", "--kd: 1 or 3 values expected, got 2"},
+      {{"--layout", "nope", "--kd", "0.5"}, 2, "nope", "no such layout file, and not a preset"},
+  };
+  for (const Case& c : cases) {
+    const auto r = matbake(concat(concat({"pack"}, c.args), {"-o", out}));
+    EXPECT_EQ(r.exit_code, c.exit_code) << c.problem << "\n" << r.err;
+    expect_one_error_line(r, c.path, c.problem);
+  }
+  EXPECT_EQ(list_folder(dir.path()), before);  // nothing written, no temporary left
+  // Two outputs wanted, one given; an output that is an input.
+  const auto count = matbake({"pack", "--kd", "0.5", "--ks", "0.04", "--gloss", "0.5", "-o", (dir / "x.png").string()});
+  EXPECT_EQ(count.exit_code, 2);
+  expect_one_error_line(count, "", "layout schuler writes 2 textures (a, b): give as many -o, or one with {texture}");
+  const std::string bytes = read_bytes(dir / "big.png");
+  const auto clobber = matbake({"pack", "--kd", "0.5", "--ks", "0.04", "--gloss", big, "-o", big, "-o",
+                                (dir / "b.png").string()});
+  EXPECT_EQ(clobber.exit_code, 2);
+  expect_one_error_line(clobber, big, "is an input; matbake never overwrites its inputs");
+  EXPECT_EQ(read_bytes(dir / "big.png"), bytes);
+}
+
+TEST(CliWorkflow, ReportsBothConversionsAndConvertsBack) {
+  TempDir dir;
+  // Schüler pair: a gold texel (Kd 0, Ks gold) and a plastic one (Kd red, Ks 0.04).
+  const auto packed = matbake({"pack", "--kd", "0", "--ks", "1,0.78,0.34", "--gloss", "0.75", "-o",
+                               (dir / "gold_{texture}.png").string()});
+  ASSERT_EQ(packed.exit_code, 0) << packed.err;
+  const auto r = matbake({"--json", "workflow", "--from", "schuler", (dir / "gold_a.png").string(),
+                          (dir / "gold_b.png").string(), "--to", "gltf-orm", "-o", (dir / "mr_{texture}.png").string(),
+                          "--report", (dir / "report.json").string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto doc = nlohmann::json::parse(r.out);
+  EXPECT_EQ(doc, nlohmann::json::parse(read_bytes(dir / "report.json")));
+  EXPECT_EQ(doc["direction"], "spec-gloss to metal-rough");
+  EXPECT_LT(doc["errors"]["specular_f0_abs"]["max"].get<double>(), 1e-6);
+  EXPECT_GT(doc["khronos_converter_errors"]["lobe_relative_rms"]["mean"].get<double>(),
+            doc["errors"]["lobe_relative_rms"]["mean"].get<double>());
+  const RawImage orm = read_raw(dir / "mr_orm.png");
+  EXPECT_EQ(orm.samples[0], 255);  // occlusion default
+  EXPECT_EQ(orm.samples[2], 255);  // metallic 1
+  // And back to Schüler's pair: gold's Ks codes again.
+  const auto back = matbake({"workflow", "--from", "gltf-orm", (dir / "mr_base_color.png").string(),
+                             (dir / "mr_orm.png").string(), "--to", "schuler", "-o", (dir / "sg_{texture}.png").string()});
+  ASSERT_EQ(back.exit_code, 0) << back.err;
+  const RawImage b = read_raw(dir / "sg_b.png"), b0 = read_raw(dir / "gold_b.png");
+  for (int c = 0; c < 3; ++c) EXPECT_EQ(b.samples[c], b0.samples[c]) << c;
+  EXPECT_NEAR(b.samples[3], b0.samples[3], 1);  // gloss through the 8-bit roughness
+  // Nothing to convert.
+  const auto none = matbake({"workflow", "--kd", "0.5", "--ks", "0.04", "--gloss", "0.5", "--to", "schuler", "-o",
+                             (dir / "n_{texture}.png").string()});
+  EXPECT_EQ(none.exit_code, 2);
+}
+
+}  // namespace
+}  // namespace matbake::test
