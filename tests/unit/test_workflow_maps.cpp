@@ -81,6 +81,26 @@ TEST(WorkflowMaps, HardCasesStayFinite) {
   }
 }
 
+TEST(WorkflowMaps, MetalRoughHardCases) {
+  // Base colour 0 and 1, metallic 0 and 1, roughness at and beyond the ends of what gloss can say.
+  for (double base : {0.0, 1.0}) {
+    for (double metallic : {0.0, 1.0}) {
+      for (double roughness : {0.0, 0.04, 1.0}) {
+        ConversionReport report;
+        auto sg = spec_gloss_from_metal_rough(
+            maps({{"base_color", {}, {base}}, {"metallic", {}, {metallic}}, {"roughness", {}, {roughness}}}),
+            RoughnessMapping::fitted, report);
+        ASSERT_TRUE(sg);
+        EXPECT_NEAR(colour(*sg, "kd").r, base * (1 - metallic), 1e-7);
+        EXPECT_NEAR(colour(*sg, "ks").r, 0.04 + metallic * (base - 0.04), 1e-7);
+        const float g = sg->find("gloss")->pixels[0];
+        EXPECT_EQ(g, roughness == 1.0 ? 0.0f : 1.0f);  // beyond the ends: clamped
+        EXPECT_TRUE(std::isfinite(report.errors.lobe.max));
+      }
+    }
+  }
+}
+
 TEST(WorkflowMaps, MetalRoughToSchulerAndBack) {
   const std::vector<pack::SourceInput> mr = {{"base_color", {}, {0.8, 0.5, 0.2}}, {"metallic", {}, {0.6}},
                                              {"roughness", {}, {0.4}}, {"occlusion", {}, {0.7}}};
