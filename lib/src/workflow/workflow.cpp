@@ -145,7 +145,7 @@ BaseMetallic base_metallic_from_spec_gloss(const Vec3& kd, const Vec3& ks) {
   if (all_at_most(glm::abs(ks - Vec3(kDielectricF0)), kF0Tolerance)) return {glm::clamp(kd, 0.0, 1.0), 0.0};
   // The residual in m can have two local minima (a dielectric and a metal reading of the same
   // colours): scan, then refine around the best sample.
-  constexpr int kScan = 32;
+  constexpr int kScan = 16;
   int best = 0;
   double best_residual = metal_residual(kd, ks, 0, nullptr);
   for (int i = 1; i <= kScan; ++i) {
@@ -156,7 +156,7 @@ BaseMetallic base_metallic_from_spec_gloss(const Vec3& kd, const Vec3& ks) {
     }
   }
   const double lo = std::max(best - 1, 0) / double(kScan), hi = std::min(best + 1, kScan) / double(kScan);
-  double m = golden_minimum([&](double x) { return metal_residual(kd, ks, x, nullptr); }, lo, hi, 40);
+  double m = golden_minimum([&](double x) { return metal_residual(kd, ks, x, nullptr); }, lo, hi, 28);
   // The ends are exact candidates (m = 0 or 1) that the interior search only approaches.
   for (double end : {0.0, 1.0}) {
     if (metal_residual(kd, ks, end, nullptr) <= metal_residual(kd, ks, m, nullptr)) m = end;
