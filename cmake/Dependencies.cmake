@@ -11,3 +11,5 @@ find_package(embree 3 CONFIG REQUIRED)
 find_package(CLI11 CONFIG REQUIRED)
 find_package(TBB CONFIG REQUIRED)
 find_package(nlohmann_json CONFIG REQUIRED)
+# toml++ 3.3 (libtomlplusplus-dev): the material table and, later, build manifests are TOML.
+find_package(tomlplusplus CONFIG REQUIRED)

@@ -8,7 +8,7 @@ packages=(
   libopenimageio-dev openimageio-tools
   libopencolorio-dev opencolorio-tools
   libopenexr-dev libimath-dev libglm-dev libtinygltf-dev libembree-dev
-  libcli11-dev nlohmann-json3-dev libtbb-dev
+  libcli11-dev nlohmann-json3-dev libtbb-dev libtomlplusplus-dev
   libgtest-dev libbenchmark-dev
 )
 
