@@ -14,7 +14,8 @@
 
 namespace matbake::cli {
 
-enum ExitCode { kOk = 0, kFailed = 1, kUsage = 2 };
+// kViolations: validate found more flagged texels than --max-violations allows (a build can gate on it).
+enum ExitCode { kOk = 0, kFailed = 1, kUsage = 2, kViolations = 3 };
 
 struct GlobalOptions {
   bool json = false;
@@ -84,5 +85,23 @@ struct WorkflowSettings {
 };
 CLI::App* setup_workflow(CLI::App& app, WorkflowSettings& settings);
 int run_workflow(const WorkflowSettings& settings, const GlobalOptions& global);
+
+struct MaterialsSettings {
+  std::string table;
+};
+CLI::App* setup_materials(CLI::App& app, MaterialsSettings& settings);
+int run_materials(const MaterialsSettings& settings, const GlobalOptions& global);
+
+struct ValidateSettings {
+  SourceSettings sources;
+  std::string material;
+  std::string table;
+  double tolerance = 0.1;
+  double max_violations = 0;
+  std::string heatmap;
+  int worst = 10;
+};
+CLI::App* setup_validate(CLI::App& app, ValidateSettings& settings);
+int run_validate(const ValidateSettings& settings, const GlobalOptions& global);
 
 }  // namespace matbake::cli

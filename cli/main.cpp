@@ -29,6 +29,10 @@ int main(int argc, char** argv) {
   CLI::App* unpack_app = setup_unpack(app, unpack);
   WorkflowSettings workflow;
   CLI::App* workflow_app = setup_workflow(app, workflow);
+  MaterialsSettings materials;
+  CLI::App* materials_app = setup_materials(app, materials);
+  ValidateSettings validate;
+  CLI::App* validate_app = setup_validate(app, validate);
 
   try {
     app.parse(argc, argv);
@@ -50,5 +54,7 @@ int main(int argc, char** argv) {
   if (pack_app->parsed()) return run_pack(pack, global);
   if (unpack_app->parsed()) return run_unpack(unpack, global);
   if (workflow_app->parsed()) return run_workflow(workflow, global);
+  if (materials_app->parsed()) return run_materials(materials, global);
+  if (validate_app->parsed()) return run_validate(validate, global);
   return kUsage;
 }

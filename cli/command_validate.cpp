@@ -1,0 +1,220 @@
+#include <nlohmann/json.hpp>
+
+#include <cstdio>
+#include <filesystem>
+
+#include "commands.hpp"
+#include "matbake/materials.hpp"
+#include "matbake/validate.hpp"
+#include "silenced_stderr.hpp"
+
+namespace fs = std::filesystem;
+
+namespace matbake::cli {
+namespace {
+
+Result<std::vector<materials::Material>> table_from(const std::string& path) {
+  if (path.empty()) return materials::builtin_table();
+  return materials::load_table(path);
+}
+
+nlohmann::json rgb(const glm::dvec3& v) { return {v.r, v.g, v.b}; }
+
+std::vector<int> codes(const glm::dvec3& f0, color::Transfer transfer) {
+  std::vector<int> c;
+  for (int i = 0; i < 3; ++i) c.push_back(color::quantize(transfer, 8, float(f0[i])));
+  if (c[0] == c[1] && c[1] == c[2]) c.resize(1);
+  return c;
+}
+
+std::string join(const std::vector<int>& v) {
+  std::string s;
+  for (int x : v) s += (s.empty() ? "" : ";") + std::to_string(x);
+  return s;
+}
+
+std::string flag_list(std::uint8_t flags) {
+  std::string s;
+  for (int bit = 0; bit < validate::kFlagCount; ++bit) {
+    if (flags & (1 << bit)) s += (s.empty() ? "" : ",") + std::string(validate::flag_name(bit));
+  }
+  return s;
+}
+
+nlohmann::json stats_json(const std::array<validate::ChannelStats, 3>& s) {
+  nlohmann::json j = nlohmann::json::array();
+  for (const auto& c : s) j.push_back({{"min", c.min}, {"max", c.max}, {"mean", c.mean}});
+  return j;
+}
+
+}  // namespace
+
+CLI::App* setup_materials(CLI::App& app, MaterialsSettings& s) {
+  CLI::App* cmd = app.add_subcommand(
+      "materials",
+      "List the material table (presets/materials.toml): F0 linear, as 8-bit codes via gamma 2.2 and via sRGB,\n"
+      "IOR, source.");
+  cmd->add_option("--table", s.table, "Another table file in the same TOML format");
+  return cmd;
+}
+
+int run_materials(const MaterialsSettings& s, const GlobalOptions& global) {
+  auto table = table_from(s.table);
+  if (!table) return report_error(table.error());
+  nlohmann::json list = nlohmann::json::array();
+  for (const materials::Material& m : *table) {
+    nlohmann::json j = {{"name", m.name},
+                        {"class", materials::class_name(m.material_class)},
+                        {"f0_linear", rgb(m.f0)},
+                        {"code_gamma22", codes(m.f0, color::Transfer::gamma22)},
+                        {"code_srgb", codes(m.f0, color::Transfer::srgb)},
+                        {"source", m.source}};
+    if (m.f0_range) j["f0_range"] = *m.f0_range;
+    if (!m.table_code.empty()) j["table_code"] = m.table_code;
+    if (m.ior) j["ior"] = *m.ior;
+    if (m.ior_n) j["ior_n"] = rgb(*m.ior_n), j["ior_k"] = rgb(*m.ior_k);
+    list.push_back(std::move(j));
+  }
+  if (global.json) {
+    std::cout << nlohmann::json{{"command", "materials"}, {"materials", list}}.dump(2) << "\n";
+    return kOk;
+  }
+  std::printf("%-16s %-13s %-22s %-12s %-12s %s\n", "name", "class", "F0 (linear)", "8-bit g2.2", "8-bit sRGB", "IOR");
+  for (const materials::Material& m : *table) {
+    char f0[64];
+    if (m.f0.r == m.f0.g && m.f0.g == m.f0.b) {
+      std::snprintf(f0, sizeof f0, "%.4f", m.f0.r);
+    } else {
+      std::snprintf(f0, sizeof f0, "%.3f %.3f %.3f", m.f0.r, m.f0.g, m.f0.b);
+    }
+    char ior[64] = "";
+    if (m.ior) std::snprintf(ior, sizeof ior, "%.4f", *m.ior);
+    if (m.ior_n) std::snprintf(ior, sizeof ior, "n %.2f %.2f %.2f, k %.2f %.2f %.2f", m.ior_n->r, m.ior_n->g, m.ior_n->b,
+                               m.ior_k->r, m.ior_k->g, m.ior_k->b);
+    std::printf("%-16s %-13s %-22s %-12s %-12s %s\n", m.name.c_str(), std::string(materials::class_name(m.material_class)).c_str(),
+                f0, join(codes(m.f0, color::Transfer::gamma22)).c_str(), join(codes(m.f0, color::Transfer::srgb)).c_str(),
+                ior);
+  }
+  return kOk;
+}
+
+CLI::App* setup_validate(CLI::App& app, ValidateSettings& s) {
+  CLI::App* cmd = app.add_subcommand(
+      "validate",
+      "Check every texel's F0 (and diffuse colour) against physics: below any real material (< 0.02),\n"
+      "dielectric, gem, semiconductor gap (0.2-0.45, flagged), metal (>= 0.45, flagged with a diffuse colour);\n"
+      "coloured dielectric specular, implausible albedo. Inputs: a Schüler pair (--from schuler A.png B.png),\n"
+      "pair B alone (--ks B.png), or metal-rough maps (--from gltf-metal-rough base.png mr.png, or --base-color\n"
+      "and --metallic). Exit 0 clean, 3 when the flagged share exceeds --max-violations, 1 bad input.");
+  add_source_options(*cmd, s.sources);
+  cmd->add_option("--material", s.material, "Also compare with a table entry (see `matbake materials`)");
+  cmd->add_option("--materials-table", s.table, "Another table file in the TOML format of presets/materials.toml");
+  cmd->add_option("--tolerance", s.tolerance, "With --material: relative tolerance per channel")->capture_default_str();
+  cmd->add_option("--max-violations", s.max_violations, "Flagged share of unmasked texels allowed before exit 3")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0));
+  cmd->add_option("--heatmap", s.heatmap, "Write a false-colour class map (.png; legend in the README)");
+  cmd->add_option("--worst", s.worst, "How many of the worst texels to list")->capture_default_str();
+  return cmd;
+}
+
+int run_validate(const ValidateSettings& s, const GlobalOptions& global) {
+  auto table = table_from(s.table);
+  if (!table) return report_error(table.error());
+  validate::Options options;
+  options.tolerance = s.tolerance;
+  options.worst_count = std::size_t(std::max(s.worst, 0));
+  options.class_map = !s.heatmap.empty();
+  if (!s.material.empty()) {
+    options.material = materials::find(*table, s.material);
+    if (!options.material) {
+      std::string near;
+      for (const std::string& n : materials::near_names(*table, s.material)) near += (near.empty() ? "" : ", ") + n;
+      return report_error(Error{"", "unknown material '" + s.material + "'" +
+                                        (near.empty() ? " (`matbake materials` lists them)" : "; near: " + near),
+                                true});
+    }
+  }
+  auto sources = gather_sources(s.sources);
+  if (!sources) return report_error(sources.error());
+  validate::Inputs inputs;
+  inputs.mask = sources->find("mask");
+  validate::SpecularDiffuse from_metal_rough;
+  if (sources->find("ks")) {
+    inputs.specular = sources->find("ks");
+    inputs.diffuse = sources->find("kd");
+  } else if (sources->find("base_color") && sources->find("metallic")) {
+    auto sd = validate::from_metal_rough(*sources->find("base_color"), *sources->find("metallic"));
+    if (!sd) return report_error(sd.error());
+    from_metal_rough = std::move(sd.value());
+    inputs.specular = &from_metal_rough.specular;
+    inputs.diffuse = &from_metal_rough.diffuse;
+  } else {
+    return report_error(Error{"", "validate needs a specular map (--ks, or --from schuler A.png B.png) or metal-rough "
+                                  "maps (--base-color and --metallic)",
+                              true});
+  }
+  auto report = validate::validate(inputs, options);
+  if (!report) return report_error(report.error());
+  if (!s.heatmap.empty()) {
+    if (fs::path(s.heatmap).extension() != ".png") return report_error(Error{s.heatmap, "the heatmap is a .png", true});
+    SilencedStderr quiet;
+    const image::WriteOptions png{color::Transfer::srgb, image::SampleType::u8, "", "sRGB"};
+    if (Status st = image::write_image(validate::heatmap(*report), s.heatmap, png); !st) return report_error(st.error());
+  }
+  const bool failed = report->violation_fraction() > s.max_violations;
+  const int exit_code = failed ? kViolations : kOk;
+
+  nlohmann::json classes, flags, worst = nlohmann::json::array();
+  for (std::size_t c = 0; c < 5; ++c) classes[std::string(materials::f0_class_name(materials::F0Class(c)))] = report->class_counts[c];
+  for (int b = 0; b < validate::kFlagCount; ++b) flags[std::string(validate::flag_name(b))] = report->flag_counts[std::size_t(b)];
+  for (const validate::Texel& t : report->worst) {
+    worst.push_back({{"x", t.x}, {"y", t.y}, {"class", materials::f0_class_name(t.f0_class)},
+                     {"flags", flag_list(t.flags)}, {"severity", t.severity}, {"f0", rgb(t.f0)},
+                     {"diffuse", rgb(t.diffuse)}});
+  }
+  nlohmann::json doc = {{"command", "validate"},       {"width", report->width},
+                        {"height", report->height},    {"texels", report->texels},
+                        {"masked", report->masked},    {"checked", report->checked},
+                        {"classes", classes},          {"flags", flags},
+                        {"violations", report->violations}, {"violation_fraction", report->violation_fraction()},
+                        {"max_violations", s.max_violations}, {"passed", !failed},
+                        {"worst", worst},              {"f0_stats", stats_json(report->f0_stats)}};
+  if (inputs.diffuse) doc["diffuse_stats"] = stats_json(report->diffuse_stats);
+  if (options.material) {
+    doc["material"] = {{"name", options.material->name},
+                       {"tolerance", s.tolerance},
+                       {"within", report->material_within},
+                       {"share_within", report->checked ? double(report->material_within) / double(report->checked) : 0.0}};
+  }
+  if (!s.heatmap.empty()) doc["heatmap"] = s.heatmap;
+  if (global.json) {
+    std::cout << doc.dump(2) << "\n";
+  } else if (!global.quiet) {
+    std::printf("%d x %d: %zu texels checked, %zu masked\n", report->width, report->height, report->checked,
+                report->masked);
+    std::printf("  classes: below %zu · dielectric %zu · gem %zu · semiconductor gap %zu · metal %zu\n",
+                report->class_counts[0], report->class_counts[1], report->class_counts[2], report->class_counts[3],
+                report->class_counts[4]);
+    if (options.material) {
+      std::printf("  %s within %.0f%%: %zu texels (%.2f%%)\n", options.material->name.c_str(), 100 * s.tolerance,
+                  report->material_within,
+                  report->checked ? 100.0 * double(report->material_within) / double(report->checked) : 0.0);
+    }
+    std::printf("  flagged: %zu texels (%.4f%%, allowed %.4f%%)%s\n", report->violations,
+                100 * report->violation_fraction(), 100 * s.max_violations, failed ? ": FAILED" : "");
+    for (int b = 0; b < validate::kFlagCount; ++b) {
+      if (report->flag_counts[std::size_t(b)]) {
+        std::printf("    %-22s %zu\n", std::string(validate::flag_name(b)).c_str(), report->flag_counts[std::size_t(b)]);
+      }
+    }
+    for (const validate::Texel& t : report->worst) {
+      std::printf("    at (%d, %d): %s, F0 %.4f %.4f %.4f: %s\n", t.x, t.y,
+                  std::string(materials::f0_class_name(t.f0_class)).c_str(), t.f0.r, t.f0.g, t.f0.b,
+                  flag_list(t.flags).c_str());
+    }
+  }
+  return exit_code;
+}
+
+}  // namespace matbake::cli
