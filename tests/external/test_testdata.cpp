@@ -5,7 +5,12 @@
 #include <cmath>
 #include <filesystem>
 
+#include <nlohmann/json.hpp>
+
+#include <fstream>
+
 #include "matbake/convert.hpp"
+#include "matbake/materials.hpp"
 #include "support/files.hpp"
 #include "support/temp_dir.hpp"
 
@@ -154,6 +159,40 @@ TEST(OpenExrImages, WideRangesAndDamagedFiles) {
     if (damaged.extension() == ".rst") continue;
     expect_clean_error(convert(damaged, dir / "out.exr"), damaged);
   }
+}
+
+// Every table entry citing physicallybased.info matches that database: F0 from its IOR or
+// complex IOR (srgb-linear), recomputed here from the JSON itself.
+TEST(PhysicallyBased, TableEntriesMatchTheDatabase) {
+  REQUIRE_TESTDATA("materials/physicallybased");
+  std::ifstream in(kTestdata / "materials/physicallybased/materials.json");
+  const auto db = nlohmann::json::parse(in)["data"];
+  int checked = 0;
+  for (const materials::Material& m : materials::builtin_table()) {
+    const auto quote = m.source.find("entry '");
+    if (m.source.rfind("physicallybased.info", 0) != 0 || quote == std::string::npos) continue;
+    const std::string name = m.source.substr(quote + 7, m.source.rfind('\'') - quote - 7);
+    const auto entry = std::find_if(db.begin(), db.end(), [&](const auto& e) { return e["name"] == name; });
+    ASSERT_NE(entry, db.end()) << name;
+    for (int c = 0; c < 3; ++c) {
+      double f0 = 0;
+      if (entry->contains("ior") && (*entry)["ior"].is_number()) {
+        const double n = (*entry)["ior"];
+        f0 = std::pow((n - 1) / (n + 1), 2);
+      } else {
+        const auto& complex = (*entry)["complexIor"][0];
+        ASSERT_EQ(complex["colorSpace"], "srgb-linear");
+        const double n = complex["n"][c], k = complex["k"][c];
+        f0 = ((n - 1) * (n - 1) + k * k) / ((n + 1) * (n + 1) + k * k);
+      }
+      EXPECT_NEAR(m.f0[c], f0, 5e-5) << m.name;
+    }
+    ++checked;
+  }
+  EXPECT_EQ(checked, 22);
+  // The database's gold base colour is above 1 in linear red (a colour, not F0).
+  const auto gold = std::find_if(db.begin(), db.end(), [](const auto& e) { return e["name"] == "Gold"; });
+  EXPECT_GT((*gold)["color"][0]["color"][0].get<double>(), 1.0);
 }
 
 }  // namespace
