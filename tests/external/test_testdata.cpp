@@ -11,6 +11,7 @@
 
 #include "matbake/convert.hpp"
 #include "matbake/materials.hpp"
+#include "matbake/scene.hpp"
 #include "support/files.hpp"
 #include "support/temp_dir.hpp"
 
@@ -193,6 +194,37 @@ TEST(PhysicallyBased, TableEntriesMatchTheDatabase) {
   // The database's gold base colour is above 1 in linear red (a colour, not F0).
   const auto gold = std::find_if(db.begin(), db.end(), [](const auto& e) { return e["name"] == "Gold"; });
   EXPECT_GT((*gold)["color"][0]["color"][0].get<double>(), 1.0);
+}
+
+// Every Khronos sample model loads; counts checked where the model's README states them.
+TEST(KhronosModels, EveryModelLoadsWithItsTriangleAndInstanceCounts) {
+  REQUIRE_TESTDATA("gltf");
+  int loaded = 0;
+  for (const auto& model : fs::directory_iterator(kTestdata / "gltf")) {
+    if (!model.is_directory()) continue;
+    for (const char* variant : {"glTF", "glTF-Embedded", "glTF-Binary"}) {
+      const fs::path folder = model.path() / variant;
+      if (!fs::is_directory(folder)) continue;
+      for (const auto& f : fs::directory_iterator(folder)) {
+        const std::string ext = f.path().extension().string();
+        if (ext != ".gltf" && ext != ".glb") continue;
+        auto s = scene::load_scene(f.path());
+        ASSERT_TRUE(s) << s.error().to_string();
+        ++loaded;
+      }
+    }
+  }
+  EXPECT_GE(loaded, 19);
+  const auto load = [](const char* relative) { return *scene::load_scene(kTestdata / "gltf" / relative); };
+  const scene::Scene box = load("Box/glTF-Embedded/Box.gltf");
+  ASSERT_EQ(box.instances.size(), 1u);
+  EXPECT_EQ(box.instances[0].triangles.size(), 12u);
+  EXPECT_EQ(load("SimpleMeshes/glTF-Embedded/SimpleMeshes.gltf").instances.size(), 2u);  // one mesh, two nodes
+  EXPECT_EQ(load("TriangleWithoutIndices/glTF-Embedded/TriangleWithoutIndices.gltf").instances[0].triangles.size(), 1u);
+  const scene::Scene modes = load("MeshPrimitiveModes/glTF-Embedded/MeshPrimitiveModes.gltf");
+  EXPECT_EQ(modes.instances.size(), 3u);  // triangles, strip, fan
+  ASSERT_EQ(modes.notes.size(), 1u);
+  EXPECT_EQ(modes.notes[0], "4 point or line primitives ignored");
 }
 
 }  // namespace

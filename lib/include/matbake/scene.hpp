@@ -1,0 +1,57 @@
+#pragma once
+// A glTF scene flattened for ray casting: every triangle primitive reachable from the default
+// scene's node graph, in world space. Only what the scene references is read: nodes outside it,
+// images and animations are not loaded.
+#include <glm/mat4x4.hpp>
+#include <glm/vec3.hpp>
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "matbake/result.hpp"
+
+namespace matbake::scene {
+
+using Vec3 = glm::vec3;
+
+// One primitive placed by one node (a mesh instanced by two nodes gives two).
+struct Instance {
+  int node = -1, mesh = -1, primitive = -1;
+  glm::dmat4 world{1.0};                          // node to world
+  std::vector<Vec3> positions;                    // world space, one per vertex of the primitive
+  std::vector<Vec3> normals;                      // world space, unit; empty when the file has none
+  std::vector<std::array<std::uint32_t, 3>> triangles;  // strips and fans converted; facing kept
+                                                         // under mirroring transforms
+};
+
+struct Scene {
+  std::vector<Instance> instances;
+  std::vector<std::string> notes;  // what was skipped and why (points, lines, ...)
+  Vec3 bounds_min{0}, bounds_max{0};
+  float radius() const;            // half the bounding box diagonal
+};
+
+// Reads .gltf or .glb. Errors name the file: malformed JSON or GLB, accessors or buffer views out
+// of range, indices beyond the vertex count, sparse accessors (refused), buffer or image URIs that
+// leave the file's folder (absolute or with ..), node cycles, no default scene, no triangles.
+Result<Scene> load_scene(const std::filesystem::path& path);
+
+// Vertex normals from faces (ch. 12): the sum over the faces around a vertex of the face normal
+// weighted equally (12.31), by face area (12.32) or by the face's angle at the vertex (12.33).
+// Degenerate faces (zero area) are skipped. A vertex in no valid face keeps its normal from the
+// file when there is one, else takes the area-weighted normal of the whole primitive, else +z;
+// fallbacks are counted.
+enum class NormalWeighting { equal, area, angle };
+struct NormalResult {
+  std::vector<Vec3> normals;
+  std::size_t fallbacks = 0;
+  std::size_t degenerate_faces = 0;
+};
+NormalResult vertex_normals(const std::vector<Vec3>& positions,
+                            const std::vector<std::array<std::uint32_t, 3>>& triangles, NormalWeighting weighting,
+                            const std::vector<Vec3>& original = {});
+
+}  // namespace matbake::scene
