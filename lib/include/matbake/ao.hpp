@@ -1,0 +1,52 @@
+#pragma once
+// Per-vertex ambient obscurance (ch. 12, eq. 12.72) ray-cast with Embree 3:
+//   w(p) = (1/π) ∫ μ(d(ω)) cos θ dω
+// over the hemisphere around the vertex normal, d the distance to the first surface along ω.
+// μ is normalized to the range d_max so that it reaches 1 there and open sky gives w = 1:
+//   exponential: μ(x) = (1 − e^(−τx)) / (1 − e^(−τ d_max)) for x < d_max, 1 beyond;
+//   none (binary AO): μ = 0 for a hit within d_max, 1 beyond.
+// With cosine-weighted directions (pdf cos θ / π) the estimator is the mean of μ over the rays.
+#include <cstdint>
+#include <vector>
+
+#include "matbake/result.hpp"
+#include "matbake/scene.hpp"
+
+namespace matbake::ao {
+
+enum class Falloff { exponential, none };
+enum class Sampler {
+  sobol,   // (0, 2)-sequence in base 2, XOR-scrambled per vertex: low discrepancy
+  random,  // independent uniform pairs per vertex: for comparison
+};
+
+struct Options {
+  int samples = 64;                // rays per vertex
+  double max_distance = 0.25;      // d_max: absolute, or × the scene radius when relative_distance
+  bool relative_distance = true;
+  double tau = 4.0;                // τ in units of 1/d_max (so e^(−τ d_max) = e^(−4) by default)
+  Falloff falloff = Falloff::exponential;
+  double bias = 1e-5;  // origin offset along the normal, × the vertex's mean edge length, capped at
+                       // 1e-4 × the scene radius, at least 1e-6 × the coordinates' magnitude
+  bool two_sided = true;           // false: surfaces seen from behind do not occlude
+  std::uint64_t seed = 0;
+  Sampler sampler = Sampler::sobol;
+};
+
+struct Bake {
+  std::vector<std::vector<float>> values;  // per scene instance, per vertex: w in [0, 1]
+  std::uint64_t rays = 0;
+  double max_distance = 0;                 // d_max as used (absolute)
+};
+
+// Normals: the instance's own where present, else area-weighted from its faces. Identical for a
+// given seed whatever the thread count (each vertex has its own sample stream).
+Result<Bake> bake(const scene::Scene& scene, const Options& options);
+
+// Sample i of the per-vertex sequence, in [0, 1)².
+struct Sample2 {
+  float u, v;
+};
+Sample2 sample(Sampler sampler, std::uint32_t i, std::uint64_t vertex_key);
+
+}  // namespace matbake::ao

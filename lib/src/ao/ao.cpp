@@ -1,0 +1,232 @@
+#include "matbake/ao.hpp"
+
+#include <embree3/rtcore.h>
+#include <glm/geometric.hpp>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <numbers>
+
+namespace matbake::ao {
+namespace {
+
+using scene::Vec3;
+
+// --- Sequences -------------------------------------------------------------------------------------
+std::uint64_t mix(std::uint64_t x) {  // splitmix64's finalizer: a well-spread 64-bit hash
+  x += 0x9e3779b97f4a7c15ull;
+  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
+  x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
+  return x ^ (x >> 31);
+}
+
+std::uint32_t reverse_bits(std::uint32_t x) {
+  x = ((x >> 1) & 0x55555555u) | ((x & 0x55555555u) << 1);
+  x = ((x >> 2) & 0x33333333u) | ((x & 0x33333333u) << 2);
+  x = ((x >> 4) & 0x0f0f0f0fu) | ((x & 0x0f0f0f0fu) << 4);
+  x = ((x >> 8) & 0x00ff00ffu) | ((x & 0x00ff00ffu) << 8);
+  return (x >> 16) | (x << 16);
+}
+
+// Sobol's second dimension (primitive polynomial x + 1): with the van der Corput first dimension
+// a (0, 2)-sequence in base 2.
+std::uint32_t sobol_second(std::uint32_t i) {
+  std::uint32_t r = 0;
+  for (std::uint32_t v = 1u << 31; i; i >>= 1, v ^= v >> 1) {
+    if (i & 1) r ^= v;
+  }
+  return r;
+}
+
+constexpr float kTwoToMinus32 = 2.3283064365386963e-10f;
+
+float unit(std::uint32_t bits) { return std::min(float(bits) * kTwoToMinus32, 0x1.fffffep-1f); }
+
+// --- Geometry --------------------------------------------------------------------------------------
+// An orthonormal basis around n (Duff et al. 2017, branchless).
+void basis(const Vec3& n, Vec3& t, Vec3& b) {
+  const float sign = std::copysign(1.0f, n.z);
+  const float a = -1.0f / (sign + n.z);
+  const float c = n.x * n.y * a;
+  t = Vec3(1.0f + sign * n.x * n.x * a, sign * c, -sign * n.x);
+  b = Vec3(c, sign + n.y * n.y * a, -n.y);
+}
+
+struct Mesh {
+  std::vector<Vec3> normals;       // per vertex, unit
+  std::vector<float> edge_length;  // per vertex: mean length of its edges (the bias scale)
+  std::vector<Vec3> face_normals;  // for one-sided occlusion
+};
+
+Mesh prepare(const scene::Instance& inst) {
+  Mesh m;
+  m.normals = scene::vertex_normals(inst.positions, inst.triangles, scene::NormalWeighting::area, inst.normals).normals;
+  if (!inst.normals.empty()) {
+    for (std::size_t v = 0; v < m.normals.size(); ++v) {
+      if (glm::length(inst.normals[v]) > 0) m.normals[v] = inst.normals[v];
+    }
+  }
+  std::vector<double> sum(inst.positions.size(), 0.0);
+  std::vector<int> count(inst.positions.size(), 0);
+  for (const auto& t : inst.triangles) {
+    for (int k = 0; k < 3; ++k) {
+      const std::uint32_t a = t[std::size_t(k)], b = t[std::size_t((k + 1) % 3)];
+      const double length = glm::length(inst.positions[a] - inst.positions[b]);
+      sum[a] += length, sum[b] += length;
+      ++count[a], ++count[b];
+    }
+    const Vec3 n = glm::cross(inst.positions[t[1]] - inst.positions[t[0]], inst.positions[t[2]] - inst.positions[t[0]]);
+    m.face_normals.push_back(n);
+  }
+  m.edge_length.resize(inst.positions.size());
+  for (std::size_t v = 0; v < sum.size(); ++v) m.edge_length[v] = count[v] ? float(sum[v] / count[v]) : 0.0f;
+  return m;
+}
+
+// One-sided occlusion: a hit on the back of a face (its normal along the ray) is not a hit.
+void reject_back_faces(const RTCFilterFunctionNArguments* args) {
+  const auto* faces = static_cast<const std::vector<Vec3>*>(args->geometryUserPtr);
+  for (unsigned i = 0; i < args->N; ++i) {
+    if (args->valid[i] != -1) continue;
+    const Vec3& n = (*faces)[RTCHitN_primID(args->hit, args->N, i)];
+    const Vec3 d(RTCRayN_dir_x(args->ray, args->N, i), RTCRayN_dir_y(args->ray, args->N, i),
+                 RTCRayN_dir_z(args->ray, args->N, i));
+    if (glm::dot(n, d) > 0) args->valid[i] = 0;
+  }
+}
+
+// The ray-origin offset along the normal: bias × the vertex's mean edge length (local geometry),
+// capped at 1e-4 of the scene radius (a huge triangle must not lift the origin through nearby
+// geometry) and at least 1e-6 of the coordinates' magnitude (float precision: below it a ray can
+// hit the surface it leaves).
+float origin_offset(const Vec3& p, float edge_length, float radius, double bias) {
+  const float magnitude = std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z), radius});
+  return std::max(std::min(float(bias) * edge_length, 1e-4f * radius), 1e-6f * magnitude);
+}
+
+struct DeviceDeleter {
+  void operator()(RTCDevice d) const { rtcReleaseDevice(d); }
+};
+struct SceneDeleter {
+  void operator()(RTCScene s) const { rtcReleaseScene(s); }
+};
+using Device = std::unique_ptr<RTCDeviceTy, DeviceDeleter>;
+using RtcScene = std::unique_ptr<RTCSceneTy, SceneDeleter>;
+
+}  // namespace
+
+Sample2 sample(Sampler sampler, std::uint32_t i, std::uint64_t key) {
+  if (sampler == Sampler::sobol) {
+    const std::uint64_t scramble = mix(key);
+    return {unit(reverse_bits(i) ^ std::uint32_t(scramble)), unit(sobol_second(i) ^ std::uint32_t(scramble >> 32))};
+  }
+  const std::uint64_t bits = mix(key ^ mix(i));
+  return {unit(std::uint32_t(bits)), unit(std::uint32_t(bits >> 32))};
+}
+
+Result<Bake> bake(const scene::Scene& scene, const Options& options) {
+  if (options.samples < 1) return Error{"", "--samples must be at least 1", true};
+  if (!(options.max_distance > 0) || !(options.tau > 0) || !(options.bias >= 0)) {
+    return Error{"", "--max-distance and --tau must be positive, --bias not negative", true};
+  }
+  Device device(rtcNewDevice(nullptr));
+  if (!device) return Error{"", "Embree could not start (rtcNewDevice failed)"};
+  RtcScene rtc(rtcNewScene(device.get()));
+  std::vector<Mesh> meshes;
+  meshes.reserve(scene.instances.size());
+  for (const scene::Instance& inst : scene.instances) {
+    meshes.push_back(prepare(inst));
+    RTCGeometry g = rtcNewGeometry(device.get(), RTC_GEOMETRY_TYPE_TRIANGLE);
+    // Embree reads vertex buffers in 16-byte loads: rtcSetNewGeometryBuffer pads for us.
+    auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                                                  3 * sizeof(float), inst.positions.size()));
+    for (std::size_t v = 0; v < inst.positions.size(); ++v) {
+      vertices[3 * v] = inst.positions[v].x, vertices[3 * v + 1] = inst.positions[v].y, vertices[3 * v + 2] = inst.positions[v].z;
+    }
+    auto* indices = static_cast<std::uint32_t*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                                         3 * sizeof(std::uint32_t), inst.triangles.size()));
+    for (std::size_t t = 0; t < inst.triangles.size(); ++t) {
+      for (int k = 0; k < 3; ++k) indices[3 * t + std::size_t(k)] = inst.triangles[t][std::size_t(k)];
+    }
+    if (!options.two_sided) {
+      rtcSetGeometryUserData(g, &meshes.back().face_normals);
+      rtcSetGeometryIntersectFilterFunction(g, reject_back_faces);
+      rtcSetGeometryOccludedFilterFunction(g, reject_back_faces);
+    }
+    rtcCommitGeometry(g);
+    rtcAttachGeometry(rtc.get(), g);
+    rtcReleaseGeometry(g);
+  }
+  rtcCommitScene(rtc.get());
+  if (rtcGetDeviceError(device.get()) != RTC_ERROR_NONE) return Error{"", "Embree could not build the scene"};
+
+  Bake result;
+  const double d_max = options.relative_distance ? options.max_distance * scene.radius() : options.max_distance;
+  result.max_distance = d_max;
+  const float far = float(d_max);
+  const double tau = options.tau / d_max;
+  const double normalization = 1.0 / (1.0 - std::exp(-tau * d_max));
+  const bool binary = options.falloff == Falloff::none;
+  const float radius = scene.radius();
+
+  // Every vertex of every instance, flattened, so the parallel loop balances across instances.
+  std::vector<std::size_t> first(scene.instances.size() + 1, 0);
+  for (std::size_t k = 0; k < scene.instances.size(); ++k) first[k + 1] = first[k] + scene.instances[k].positions.size();
+  result.values.resize(scene.instances.size());
+  for (std::size_t k = 0; k < scene.instances.size(); ++k) result.values[k].resize(scene.instances[k].positions.size());
+
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, first.back(), 64), [&](const tbb::blocked_range<std::size_t>& range) {
+    RTCIntersectContext context;
+    std::size_t k = std::size_t(std::upper_bound(first.begin(), first.end(), range.begin()) - first.begin()) - 1;
+    for (std::size_t flat = range.begin(); flat != range.end(); ++flat) {
+      while (flat >= first[k + 1]) ++k;
+      const std::size_t v = flat - first[k];
+      const Vec3 n = meshes[k].normals[v];
+      const Vec3 p = scene.instances[k].positions[v];
+      const Vec3 origin = p + n * origin_offset(p, meshes[k].edge_length[v], radius, options.bias);
+      Vec3 t, b;
+      basis(n, t, b);
+      const std::uint64_t key = options.seed * 0x100000001b3ull ^ (std::uint64_t(k) << 40) ^ v;
+      double sum = 0;
+      for (int s0 = 0; s0 < options.samples; s0 += 8) {
+        alignas(32) int valid[8];
+        RTCRayHit8 rh;
+        for (int j = 0; j < 8; ++j) {
+          const int s = s0 + j;
+          valid[j] = s < options.samples ? -1 : 0;
+          const Sample2 u = sample(options.sampler, std::uint32_t(s), key);
+          // Cosine-weighted: r = √u, φ = 2π v.
+          const float r = std::sqrt(u.u), phi = 2 * std::numbers::pi_v<float> * u.v;
+          const Vec3 d = t * (r * std::cos(phi)) + b * (r * std::sin(phi)) + n * std::sqrt(std::max(0.0f, 1 - u.u));
+          rh.ray.org_x[j] = origin.x, rh.ray.org_y[j] = origin.y, rh.ray.org_z[j] = origin.z;
+          rh.ray.dir_x[j] = d.x, rh.ray.dir_y[j] = d.y, rh.ray.dir_z[j] = d.z;
+          rh.ray.tnear[j] = 0, rh.ray.tfar[j] = far, rh.ray.time[j] = 0;
+          rh.ray.mask[j] = ~0u, rh.ray.id[j] = unsigned(j), rh.ray.flags[j] = 0;
+          rh.hit.geomID[j] = RTC_INVALID_GEOMETRY_ID;
+        }
+        rtcInitIntersectContext(&context);
+        if (binary) {
+          rtcOccluded8(valid, rtc.get(), &context, &rh.ray);
+          for (int j = 0; j < 8; ++j) {
+            if (valid[j]) sum += rh.ray.tfar[j] >= 0 ? 1.0 : 0.0;  // occluded rays come back with tfar = −inf
+          }
+        } else {
+          rtcIntersect8(valid, rtc.get(), &context, &rh);
+          for (int j = 0; j < 8; ++j) {
+            if (!valid[j]) continue;
+            sum += rh.hit.geomID[j] == RTC_INVALID_GEOMETRY_ID
+                       ? 1.0
+                       : std::min(1.0, (1.0 - std::exp(-tau * rh.ray.tfar[j])) * normalization);
+          }
+        }
+      }
+      result.values[k][v] = float(sum / options.samples);
+    }
+  });
+  result.rays = std::uint64_t(first.back()) * std::uint64_t(options.samples);
+  return result;
+}
+
+}  // namespace matbake::ao

@@ -1,0 +1,206 @@
+// Ambient obscurance against closed forms (tolerance: 3σ of the binary estimator at the sample
+// count, or tighter where the answer is exact), scale invariance, determinism, and the gain of the
+// low-discrepancy sampler.
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include <glm/geometric.hpp>
+
+#include <cmath>
+#include <numbers>
+
+#include "matbake/ao.hpp"
+
+namespace matbake::ao {
+namespace {
+
+using scene::Instance;
+using scene::Vec3;
+
+// A square of half-size `half` in the plane through `center` spanned by u and v, facing u × v, as a
+// fan of 4 triangles around its centre vertex (vertex 0).
+Instance square(const Vec3& center, const Vec3& u, const Vec3& v, float half) {
+  Instance inst;
+  inst.positions = {center, center + half * (-u - v), center + half * (u - v), center + half * (u + v),
+                    center + half * (-u + v)};
+  inst.triangles = {{0, 1, 2}, {0, 2, 3}, {0, 3, 4}, {0, 4, 1}};
+  return inst;
+}
+
+scene::Scene scene_of(std::vector<Instance> instances) {
+  scene::Scene s;
+  s.instances = std::move(instances);
+  bool first = true;
+  for (const Instance& inst : s.instances) {
+    for (const Vec3& p : inst.positions) {
+      s.bounds_min = first ? p : glm::min(s.bounds_min, p);
+      s.bounds_max = first ? p : glm::max(s.bounds_max, p);
+      first = false;
+    }
+  }
+  return s;
+}
+
+const Vec3 kX(1, 0, 0), kY(0, 1, 0), kZ(0, 0, 1);
+constexpr float kHalf = 1000;
+
+Options binary(int samples) {
+  Options o;
+  o.samples = samples;
+  o.falloff = Falloff::none;
+  o.relative_distance = false;
+  o.max_distance = 1e5;
+  return o;
+}
+
+double three_sigma(double p, int samples) { return 3 * std::sqrt(p * (1 - p) / samples) + 1e-6; }
+
+float centre_value(const scene::Scene& s, const Options& o, std::size_t instance = 0) {
+  auto r = bake(s, o);
+  EXPECT_TRUE(r) << r.error().to_string();
+  return r->values[instance][0];
+}
+
+TEST(AmbientOcclusion, IsolatedPlaneAndConvexMeshAreExactlyOpen) {
+  for (Falloff f : {Falloff::none, Falloff::exponential}) {
+    Options o = binary(256);
+    o.falloff = f;
+    auto open = bake(scene_of({square({0, 0, 0}, kX, kY, 1)}), o);
+    ASSERT_TRUE(open);
+    for (float w : open->values[0]) EXPECT_EQ(w, 1.0f);
+    // A cube with outward faces: no vertex may see its own mesh (the self-intersection test).
+    std::vector<Instance> faces = {square({0, 0, 1}, kX, kY, 1),  square({0, 0, -1}, kY, kX, 1),
+                                   square({1, 0, 0}, kY, kZ, 1),  square({-1, 0, 0}, kZ, kY, 1),
+                                   square({0, 1, 0}, kZ, kX, 1),  square({0, -1, 0}, kX, kZ, 1)};
+    auto cube = bake(scene_of(faces), o);
+    ASSERT_TRUE(cube);
+    for (const auto& face : cube->values) EXPECT_EQ(face[0], 1.0f);
+  }
+}
+
+TEST(AmbientOcclusion, PlaneUnderAParallelPlaneIsOneMinusTwoE3) {
+  const double h = 1, tau = 1;  // τh = 1
+  // E3(z) = ∫_0^1 e^(−z/μ) μ dμ, midpoint rule in float64.
+  double e3 = 0;
+  constexpr int kSteps = 200000;
+  for (int i = 0; i < kSteps; ++i) {
+    const double mu = (i + 0.5) / kSteps;
+    e3 += std::exp(-tau * h / mu) * mu / kSteps;
+  }
+  const double expected = 1 - 2 * e3;  // 0.7806
+  Options o;
+  o.samples = 4096;
+  o.relative_distance = false;
+  o.max_distance = 1e4;  // effectively unbounded: μ(x) = 1 − e^(−τx)
+  o.tau = tau * o.max_distance;
+  const auto s = scene_of({square({0, 0, 0}, kX, kY, kHalf), square({0, 0, float(h)}, kY, kX, kHalf)});
+  // μ is continuous: σ ≤ 0.5/√N; the large quads lose at most e^(−τ·1000)-ish of the integral.
+  EXPECT_NEAR(centre_value(s, o), expected, 3 * 0.5 / std::sqrt(4096.0));
+}
+
+TEST(AmbientOcclusion, FootOfAWallAndCorners) {
+  const int n = 4096;
+  const float gap = 1e-3f;  // the walls stand just behind the probe, off its plane
+  const Instance floor = square({0, 0, 0}, kX, kY, kHalf);
+  const Instance wall_x = square({-gap, 0, kHalf}, kY, kZ, kHalf);
+  const Instance wall_y = square({0, -gap, kHalf}, kZ, kX, kHalf);
+  EXPECT_NEAR(centre_value(scene_of({floor, wall_x}), binary(n)), 0.5, three_sigma(0.5, n));
+  EXPECT_NEAR(centre_value(scene_of({floor, wall_x, wall_y}), binary(n)), 0.25, three_sigma(0.25, n));
+  // The same corner seen with the normal (1, 1, 1)/√3: cosine weighting gives √3/4.
+  Instance probe;
+  const Vec3 diagonal = glm::normalize(Vec3(1, 1, 1));
+  probe.positions = {{gap, gap, gap}, Vec3(gap) + 1e-4f * glm::normalize(Vec3(1, -1, 0)),
+                     Vec3(gap) + 1e-4f * glm::normalize(Vec3(1, 1, -2))};
+  probe.triangles = {{0, 1, 2}};
+  probe.normals = {diagonal, diagonal, diagonal};
+  Instance floor_low = square({0, 0, -gap}, kX, kY, kHalf);
+  EXPECT_NEAR(centre_value(scene_of({probe, floor_low, wall_x, wall_y}), binary(n)), std::sqrt(3.0) / 4,
+              three_sigma(0.433, n));
+}
+
+TEST(AmbientOcclusion, InsideAClosedSphereIsDark) {
+  // A UV sphere wound inwards: its vertices look at its inside.
+  Instance sphere;
+  constexpr int kRings = 16, kSegments = 32;
+  for (int i = 0; i <= kRings; ++i) {
+    for (int j = 0; j < kSegments; ++j) {
+      const float theta = std::numbers::pi_v<float> * float(i) / kRings, phi = 2 * std::numbers::pi_v<float> * float(j) / kSegments;
+      sphere.positions.push_back({std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta)});
+    }
+  }
+  for (int i = 0; i < kRings; ++i) {
+    for (int j = 0; j < kSegments; ++j) {
+      const auto at = [](int r, int s) { return std::uint32_t(r * kSegments + (s % kSegments)); };
+      sphere.triangles.push_back({at(i, j), at(i, j + 1), at(i + 1, j)});
+      sphere.triangles.push_back({at(i, j + 1), at(i + 1, j + 1), at(i + 1, j)});
+    }
+  }
+  Options o = binary(256);
+  o.max_distance = 10;
+  auto r = bake(scene_of({sphere}), o);
+  ASSERT_TRUE(r);
+  for (std::size_t v = kSegments; v < sphere.positions.size() - kSegments; ++v) EXPECT_EQ(r->values[0][v], 0.0f) << v;
+}
+
+TEST(AmbientOcclusion, ScaleInvariantWithARelativeRange) {
+  const auto make = [](float scale) {
+    return scene_of({square({0, 0, 0}, kX, kY, 10 * scale), square({-0.5f * scale, 0, 5 * scale}, kY, kZ, 5 * scale)});
+  };
+  Options o;
+  o.samples = 256;
+  o.max_distance = 0.3;  // relative to the scene radius
+  const auto reference = bake(make(1), o);
+  ASSERT_TRUE(reference);
+  for (float scale : {1e-3f, 1e3f}) {
+    const auto scaled = bake(make(scale), o);
+    ASSERT_TRUE(scaled);
+    for (std::size_t k = 0; k < 2; ++k) {
+      for (std::size_t v = 0; v < scaled->values[k].size(); ++v) {
+        EXPECT_NEAR(scaled->values[k][v], reference->values[k][v], 1e-4) << scale;
+      }
+    }
+  }
+}
+
+TEST(AmbientOcclusion, SameValuesWhateverTheThreadCount) {
+  std::vector<Instance> grid;
+  for (int i = 0; i < 40; ++i) grid.push_back(square({float(i), 0, float(i % 3)}, kX, kY, 0.7f));
+  const auto s = scene_of(grid);
+  Options o;
+  o.samples = 64;
+  o.seed = 7;
+  Bake one;
+  {
+    tbb::global_control c(tbb::global_control::max_allowed_parallelism, 1);
+    one = *bake(s, o);
+  }
+  EXPECT_EQ(one.values, bake(s, o)->values);
+  o.seed = 8;
+  EXPECT_NE(one.values, bake(s, o)->values);
+}
+
+TEST(AmbientOcclusion, LowDiscrepancyBeatsRandomAtEqualSamples) {
+  const auto s = scene_of({square({0, 0, 0}, kX, kY, kHalf), square({-1e-3f, 0, kHalf}, kY, kZ, kHalf)});
+  double sobol = 0, random = 0;
+  for (std::uint64_t seed = 0; seed < 64; ++seed) {
+    Options o = binary(64);
+    o.seed = seed;
+    sobol += std::pow(centre_value(s, o) - 0.5, 2);
+    o.sampler = Sampler::random;
+    random += std::pow(centre_value(s, o) - 0.5, 2);
+  }
+  EXPECT_LT(std::sqrt(sobol / 64), 0.5 * std::sqrt(random / 64));
+}
+
+TEST(AmbientOcclusion, BadOptions) {
+  const auto s = scene_of({square({0, 0, 0}, kX, kY, 1)});
+  Options o;
+  o.samples = 0;
+  EXPECT_FALSE(bake(s, o));
+  o = Options{};
+  o.max_distance = -1;
+  EXPECT_FALSE(bake(s, o));
+}
+
+}  // namespace
+}  // namespace matbake::ao
