@@ -31,10 +31,11 @@ struct Options {
   bool two_sided = true;           // false: surfaces seen from behind do not occlude
   std::uint64_t seed = 0;
   Sampler sampler = Sampler::sobol;
+  std::vector<bool> targets;  // per instance: bake it (all occlude either way); empty: all
 };
 
 struct Bake {
-  std::vector<std::vector<float>> values;  // per scene instance, per vertex: w in [0, 1]
+  std::vector<std::vector<float>> values;  // per scene instance, per vertex: w in [0, 1] (empty: not a target)
   std::uint64_t rays = 0;
   double max_distance = 0;                 // d_max as used (absolute)
 };

@@ -171,11 +171,18 @@ Result<Bake> bake(const scene::Scene& scene, const Options& options) {
   const bool binary = options.falloff == Falloff::none;
   const float radius = scene.radius();
 
-  // Every vertex of every instance, flattened, so the parallel loop balances across instances.
+  if (!options.targets.empty() && options.targets.size() != scene.instances.size()) {
+    return Error{"", "internal: targets must have one entry per instance"};
+  }
+  // Every vertex of every target instance, flattened, so the parallel loop balances across them.
+  const auto target = [&](std::size_t k) { return options.targets.empty() || options.targets[k]; };
   std::vector<std::size_t> first(scene.instances.size() + 1, 0);
-  for (std::size_t k = 0; k < scene.instances.size(); ++k) first[k + 1] = first[k] + scene.instances[k].positions.size();
   result.values.resize(scene.instances.size());
-  for (std::size_t k = 0; k < scene.instances.size(); ++k) result.values[k].resize(scene.instances[k].positions.size());
+  for (std::size_t k = 0; k < scene.instances.size(); ++k) {
+    const std::size_t n = target(k) ? scene.instances[k].positions.size() : 0;
+    first[k + 1] = first[k] + n;
+    result.values[k].resize(n);
+  }
 
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, first.back(), 64), [&](const tbb::blocked_range<std::size_t>& range) {
     RTCIntersectContext context;
