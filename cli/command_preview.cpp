@@ -15,20 +15,10 @@ namespace {
 
 // "0.5" (gray) or "0.9,0.6,0.2".
 Result<shading::Vec3> parse_colour(const std::string& text, const char* option) {
-  std::vector<double> values;
-  std::stringstream in(text);
-  std::string part;
-  while (std::getline(in, part, ',')) {
-    try {
-      std::size_t used = 0;
-      values.push_back(std::stod(part, &used));
-      if (used != part.size()) throw std::invalid_argument(part);
-    } catch (const std::exception&) {
-      return Error{"", std::string(option) + " '" + text + "' is not a number or r,g,b", true};
-    }
-  }
-  if (values.size() == 1) return shading::Vec3(values[0]);
-  if (values.size() == 3) return shading::Vec3(values[0], values[1], values[2]);
+  const auto values = parse_numbers(text);
+  if (!values) return Error{"", std::string(option) + " '" + text + "' is not a number or r,g,b", true};
+  if (values->size() == 1) return shading::Vec3((*values)[0]);
+  if (values->size() == 3) return shading::Vec3((*values)[0], (*values)[1], (*values)[2]);
   return Error{"", std::string(option) + " '" + text + "' needs 1 or 3 values", true};
 }
 
