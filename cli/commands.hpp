@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "material_sources.hpp"
+#include "matbake/ao.hpp"
 #include "matbake/convert.hpp"
 #include "matbake/preview.hpp"
 #include "matbake/result.hpp"
@@ -103,5 +104,19 @@ struct ValidateSettings {
 };
 CLI::App* setup_validate(CLI::App& app, ValidateSettings& settings);
 int run_validate(const ValidateSettings& settings, const GlobalOptions& global);
+
+struct BakeAoSettings {
+  std::string scene;
+  std::string dump;
+  ao::Options options;
+  double relative_distance = 0.25;
+  double absolute_distance = 0;
+  std::string falloff = "exponential";
+  std::string sampler = "sobol";
+  bool two_sided = false;
+  std::string recompute_normals;
+};
+CLI::App* setup_bake_ao(CLI::App& app, BakeAoSettings& settings);
+int run_bake_ao(const BakeAoSettings& settings, const GlobalOptions& global);
 
 }  // namespace matbake::cli

@@ -33,6 +33,8 @@ int main(int argc, char** argv) {
   CLI::App* materials_app = setup_materials(app, materials);
   ValidateSettings validate;
   CLI::App* validate_app = setup_validate(app, validate);
+  BakeAoSettings bake_ao;
+  CLI::App* bake_ao_app = setup_bake_ao(app, bake_ao);
 
   try {
     app.parse(argc, argv);
@@ -56,5 +58,6 @@ int main(int argc, char** argv) {
   if (workflow_app->parsed()) return run_workflow(workflow, global);
   if (materials_app->parsed()) return run_materials(materials, global);
   if (validate_app->parsed()) return run_validate(validate, global);
+  if (bake_ao_app->parsed()) return run_bake_ao(bake_ao, global);
   return kUsage;
 }

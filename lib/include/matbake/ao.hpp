@@ -7,6 +7,7 @@
 //   none (binary AO): μ = 0 for a hit within d_max, 1 beyond.
 // With cosine-weighted directions (pdf cos θ / π) the estimator is the mean of μ over the rays.
 #include <cstdint>
+#include <filesystem>
 #include <vector>
 
 #include "matbake/result.hpp"
@@ -43,6 +44,10 @@ struct Bake {
 // Normals: the instance's own where present, else area-weighted from its faces. Identical for a
 // given seed whatever the thread count (each vertex has its own sample stream).
 Result<Bake> bake(const scene::Scene& scene, const Options& options);
+
+// Raw values: `.csv` (a header, then node,mesh,primitive,vertex,x,y,z,ao per baked vertex, world
+// positions) or `.bin` (the float32 values, little-endian, in the same order). Written atomically.
+Status write_dump(const std::filesystem::path& path, const scene::Scene& scene, const Bake& bake);
 
 // Sample i of the per-vertex sequence, in [0, 1)².
 struct Sample2 {

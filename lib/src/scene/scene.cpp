@@ -37,7 +37,10 @@ std::string expand_path(const std::string& path, void* user) {
   auto* folder = static_cast<Folder*>(user);
   if (!inside(folder->base, path) || path.find("://") != std::string::npos) {
     if (folder->refused.empty()) {
-      folder->refused = "URI '" + path + "' is outside the glTF's folder; only files beside it are read";
+      // Said as written in the file where possible (tinygltf hands over the joined path).
+      const fs::path relative = fs::path(path).lexically_relative(folder->base);
+      folder->refused = "URI '" + (relative.empty() ? path : relative.string()) +
+                        "' is outside the glTF's folder; only files beside it are read";
     }
     return {};
   }

@@ -1,0 +1,102 @@
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+#include <cstdio>
+
+#include "commands.hpp"
+#include "matbake/ao.hpp"
+#include "matbake/scene.hpp"
+
+namespace matbake::cli {
+
+CLI::App* setup_bake_ao(CLI::App& app, BakeAoSettings& s) {
+  CLI::App* cmd = app.add_subcommand(
+      "bake-ao",
+      "Bake per-vertex ambient obscurance (ch. 12, eq. 12.72) of a glTF scene's triangles with Embree: cosine-\n"
+      "weighted scrambled-Sobol rays over each vertex's hemisphere, against all scene geometry. This release\n"
+      "writes the raw values (--dump); writing them into the glTF is the next step.");
+  cmd->add_option("scene", s.scene, "Input .gltf or .glb")->required();
+  cmd->add_option("--dump", s.dump, "Raw values: .csv (node,mesh,primitive,vertex,x,y,z,ao) or .bin (float32)")->required();
+  cmd->add_option("--samples", s.options.samples, "Rays per vertex")->capture_default_str();
+  cmd->add_option("--relative-distance", s.relative_distance, "d_max as a fraction of the scene radius")
+      ->capture_default_str();
+  cmd->add_option("--max-distance", s.absolute_distance, "d_max in scene units (instead of --relative-distance)");
+  cmd->add_option("--tau", s.options.tau, "Falloff rate τ in units of 1/d_max")->capture_default_str();
+  cmd->add_option("--falloff", s.falloff, "exponential (1 − e^(−τx), normalized to 1 at d_max) or none (binary AO)")
+      ->capture_default_str();
+  cmd->add_option("--bias", s.options.bias, "Ray-origin offset along the normal × the vertex's mean edge length")
+      ->capture_default_str();
+  cmd->add_flag("--two-sided", s.two_sided, "Surfaces seen from behind occlude too");
+  cmd->add_option("--seed", s.options.seed, "Sample scrambling seed (same seed, same values, any --jobs)")
+      ->capture_default_str();
+  cmd->add_option("--sampler", s.sampler, "sobol or random")->capture_default_str();
+  cmd->add_option("--recompute-normals", s.recompute_normals, "Replace the file's normals: equal, area or angle");
+  return cmd;
+}
+
+int run_bake_ao(const BakeAoSettings& s, const GlobalOptions& global) {
+  ao::Options options = s.options;
+  if (s.falloff == "exponential") {
+    options.falloff = ao::Falloff::exponential;
+  } else if (s.falloff == "none") {
+    options.falloff = ao::Falloff::none;
+  } else {
+    return report_error(Error{"", "--falloff '" + s.falloff + "': use exponential or none", true});
+  }
+  if (s.sampler == "sobol") {
+    options.sampler = ao::Sampler::sobol;
+  } else if (s.sampler == "random") {
+    options.sampler = ao::Sampler::random;
+  } else {
+    return report_error(Error{"", "--sampler '" + s.sampler + "': use sobol or random", true});
+  }
+  options.two_sided = s.two_sided;
+  options.relative_distance = s.absolute_distance <= 0;
+  options.max_distance = options.relative_distance ? s.relative_distance : s.absolute_distance;
+
+  auto scene = scene::load_scene(s.scene);
+  if (!scene) return report_error(scene.error());
+  if (!s.recompute_normals.empty()) {
+    scene::NormalWeighting weighting;
+    if (s.recompute_normals == "equal") {
+      weighting = scene::NormalWeighting::equal;
+    } else if (s.recompute_normals == "area") {
+      weighting = scene::NormalWeighting::area;
+    } else if (s.recompute_normals == "angle") {
+      weighting = scene::NormalWeighting::angle;
+    } else {
+      return report_error(Error{"", "--recompute-normals '" + s.recompute_normals + "': use equal, area or angle", true});
+    }
+    for (scene::Instance& inst : scene->instances) {
+      inst.normals = scene::vertex_normals(inst.positions, inst.triangles, weighting, inst.normals).normals;
+    }
+  }
+  const auto start = std::chrono::steady_clock::now();
+  auto baked = ao::bake(*scene, options);
+  if (!baked) return report_error(baked.error());
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (Status st = ao::write_dump(s.dump, *scene, *baked); !st) return report_error(st.error());
+
+  std::size_t vertices = 0;
+  double sum = 0;
+  for (const auto& values : baked->values) {
+    vertices += values.size();
+    for (float w : values) sum += w;
+  }
+  if (global.json) {
+    std::cout << nlohmann::json{{"command", "bake-ao"}, {"scene", s.scene}, {"dump", s.dump},
+                                {"instances", scene->instances.size()}, {"vertices", vertices},
+                                {"rays", baked->rays}, {"seconds", seconds}, {"max_distance", baked->max_distance},
+                                {"mean_ao", vertices ? sum / double(vertices) : 0.0}, {"notes", scene->notes}}
+                     .dump(2)
+              << "\n";
+  } else if (!global.quiet) {
+    for (const std::string& note : scene->notes) std::cout << "note: " << note << "\n";
+    std::printf("%s: %zu instances, %zu vertices, %.3g rays in %.2f s (%.1f M rays/s), d_max %.4g, mean %.4f\n",
+                s.dump.c_str(), scene->instances.size(), vertices, double(baked->rays), seconds,
+                double(baked->rays) / seconds / 1e6, baked->max_distance, vertices ? sum / double(vertices) : 0.0);
+  }
+  return kOk;
+}
+
+}  // namespace matbake::cli
