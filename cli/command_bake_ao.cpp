@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 
 #include "commands.hpp"
 #include "matbake/ao.hpp"
@@ -13,10 +14,17 @@ CLI::App* setup_bake_ao(CLI::App& app, BakeAoSettings& s) {
   CLI::App* cmd = app.add_subcommand(
       "bake-ao",
       "Bake per-vertex ambient obscurance (ch. 12, eq. 12.72) of a glTF scene's triangles with Embree: cosine-\n"
-      "weighted scrambled-Sobol rays over each vertex's hemisphere, against all scene geometry. This release\n"
-      "writes the raw values (--dump); writing them into the glTF is the next step.");
+      "weighted scrambled-Sobol rays over each vertex's hemisphere, against all scene geometry. Writes the\n"
+      "scene again with the values as COLOR_0 or _AO (-o), and/or the raw values (--dump).");
   cmd->add_option("scene", s.scene, "Input .gltf or .glb")->required();
-  cmd->add_option("--dump", s.dump, "Raw values: .csv (node,mesh,primitive,vertex,x,y,z,ao) or .bin (float32)")->required();
+  cmd->add_option("-o,--output", s.output,
+                  "Output .gltf (+ .bin beside it) or .glb; everything but the baked attribute is kept as written");
+  cmd->add_option("--into", s.into, "COLOR_0 (multiplies the base colour in any viewer) or _AO (a float attribute)")
+      ->capture_default_str();
+  cmd->add_option("--existing-colors", s.existing_colors,
+                  "With --into COLOR_0, a primitive's own COLOR_0: multiply (kept, times AO; alpha kept) or replace")
+      ->capture_default_str();
+  cmd->add_option("--dump", s.dump, "Raw values: .csv (node,mesh,primitive,vertex,x,y,z,ao) or .bin (float32)");
   cmd->add_option("--samples", s.options.samples, "Rays per vertex")->capture_default_str();
   cmd->add_option("--relative-distance", s.relative_distance, "d_max as a fraction of the scene radius")
       ->capture_default_str();
@@ -50,6 +58,19 @@ int run_bake_ao(const BakeAoSettings& s, const GlobalOptions& global) {
   } else {
     return report_error(Error{"", "--sampler '" + s.sampler + "': use sobol or random", true});
   }
+  if (s.output.empty() && s.dump.empty()) return report_error(Error{"", "bake-ao writes -o FILE, --dump FILE or both", true});
+  if (const auto ext = std::filesystem::path(s.output).extension(); !s.output.empty() && ext != ".gltf" && ext != ".glb") {
+    return report_error(Error{s.output, "the output is .gltf or .glb", true});
+  }
+  ao::Into into = ao::Into::attribute;
+  if (s.into == "COLOR_0") {
+    if (s.existing_colors != "multiply" && s.existing_colors != "replace") {
+      return report_error(Error{"", "--existing-colors '" + s.existing_colors + "': use multiply or replace", true});
+    }
+    into = s.existing_colors == "multiply" ? ao::Into::color_multiply : ao::Into::color;
+  } else if (s.into != "_AO") {
+    return report_error(Error{"", "--into '" + s.into + "': use COLOR_0 or _AO", true});
+  }
   options.two_sided = s.two_sided;
   options.relative_distance = s.absolute_distance <= 0;
   options.max_distance = options.relative_distance ? s.relative_distance : s.absolute_distance;
@@ -75,7 +96,12 @@ int run_bake_ao(const BakeAoSettings& s, const GlobalOptions& global) {
   auto baked = ao::bake(*scene, options);
   if (!baked) return report_error(baked.error());
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (Status st = ao::write_dump(s.dump, *scene, *baked); !st) return report_error(st.error());
+  if (!s.dump.empty()) {
+    if (Status st = ao::write_dump(s.dump, *scene, *baked); !st) return report_error(st.error());
+  }
+  if (!s.output.empty()) {
+    if (Status st = ao::write_gltf(s.scene, *scene, *baked, into, s.output); !st) return report_error(st.error());
+  }
 
   std::size_t vertices = 0;
   double sum = 0;
@@ -84,7 +110,7 @@ int run_bake_ao(const BakeAoSettings& s, const GlobalOptions& global) {
     for (float w : values) sum += w;
   }
   if (global.json) {
-    std::cout << nlohmann::json{{"command", "bake-ao"}, {"scene", s.scene}, {"dump", s.dump},
+    std::cout << nlohmann::json{{"command", "bake-ao"}, {"scene", s.scene}, {"output", s.output}, {"dump", s.dump},
                                 {"instances", scene->instances.size()}, {"vertices", vertices},
                                 {"rays", baked->rays}, {"seconds", seconds}, {"max_distance", baked->max_distance},
                                 {"mean_ao", vertices ? sum / double(vertices) : 0.0}, {"notes", scene->notes}}
@@ -93,7 +119,7 @@ int run_bake_ao(const BakeAoSettings& s, const GlobalOptions& global) {
   } else if (!global.quiet) {
     for (const std::string& note : scene->notes) std::cout << "note: " << note << "\n";
     std::printf("%s: %zu instances, %zu vertices, %.3g rays in %.2f s (%.1f M rays/s), d_max %.4g, mean %.4f\n",
-                s.dump.c_str(), scene->instances.size(), vertices, double(baked->rays), seconds,
+                (s.output.empty() ? s.dump : s.output).c_str(), scene->instances.size(), vertices, double(baked->rays), seconds,
                 double(baked->rays) / seconds / 1e6, baked->max_distance, vertices ? sum / double(vertices) : 0.0);
   }
   return kOk;

@@ -107,6 +107,9 @@ int run_validate(const ValidateSettings& settings, const GlobalOptions& global);
 
 struct BakeAoSettings {
   std::string scene;
+  std::string output;
+  std::string into = "COLOR_0";
+  std::string existing_colors = "multiply";
   std::string dump;
   ao::Options options;
   double relative_distance = 0.25;

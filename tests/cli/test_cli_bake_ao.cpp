@@ -9,6 +9,7 @@
 #include "support/expect_error.hpp"
 #include "support/files.hpp"
 #include "support/gltf_files.hpp"
+#include "support/gltf_validator.hpp"
 #include "support/run.hpp"
 #include "support/temp_dir.hpp"
 
@@ -51,6 +52,26 @@ TEST(CliBakeAo, FootOfAWallAndDeterministicDumps) {
   EXPECT_EQ(read_bytes(dir / "ao1.bin").size(), 9 * sizeof(float));
 }
 
+// The written scene passes the Khronos glTF-Validator with no error and no warning, in both
+// containers and both attributes, and the input is left as it was.
+TEST(CliBakeAo, WrittenScenesAreValidatorClean) {
+  TempDir dir;
+  write_wall_scene(dir / "wall.gltf");
+  const std::string input = read_bytes(dir / "wall.gltf");
+  for (const char* into : {"COLOR_0", "_AO"}) {
+    for (const char* ext : {".gltf", ".glb"}) {
+      const fs::path out = dir / (std::string("wall") + into + ext);
+      const auto r = matbake({"-q", "bake-ao", (dir / "wall.gltf").string(), "-o", out.string(), "--into", into,
+                              "--samples", "64"});
+      ASSERT_EQ(r.exit_code, 0) << r.err;
+      MATBAKE_VALIDATE_OR_SKIP(report, out);
+      EXPECT_EQ(report->errors, 0) << report->summary;
+      EXPECT_EQ(report->warnings, 0) << report->summary;
+    }
+  }
+  EXPECT_EQ(read_bytes(dir / "wall.gltf"), input);
+}
+
 TEST(CliBakeAo, BadScenesAndUsage) {
   TempDir dir;
   write_wall_scene(dir / "good.gltf");
@@ -74,6 +95,19 @@ TEST(CliBakeAo, BadScenesAndUsage) {
   EXPECT_EQ(matbake({"bake-ao", good, "--dump", dump, "--falloff", "cubic"}).exit_code, 2);
   EXPECT_EQ(matbake({"bake-ao", good, "--dump", (dir / "out.txt").string()}).exit_code, 2);
   EXPECT_FALSE(fs::exists(dump));
+  const std::string before = read_bytes(dir / "good.gltf");
+  using Case = std::pair<std::vector<std::string>, std::string>;
+  for (const auto& [args, problem] :
+       {Case{{"bake-ao", good}, "bake-ao writes -o FILE, --dump FILE or both"},
+        Case{{"bake-ao", good, "-o", good}, good + ": would overwrite an input"},
+        Case{{"bake-ao", good, "-o", (dir / "out.obj").string()}, (dir / "out.obj").string() + ": the output is .gltf or .glb"},
+        Case{{"bake-ao", good, "-o", (dir / "x.glb").string(), "--into", "COLOR_1"}, "--into 'COLOR_1': use COLOR_0 or _AO"}}) {
+    const auto r = matbake(args);
+    EXPECT_EQ(r.exit_code, 2) << problem;
+    expect_one_error_line(r, "", problem);
+  }
+  EXPECT_EQ(read_bytes(dir / "good.gltf"), before);
+  EXPECT_EQ(list_folder(dir.path()), (std::vector<std::string>{"broken.gltf", "escape.gltf", "good.gltf"}));
 }
 
 }  // namespace

@@ -8,11 +8,15 @@
 #include <nlohmann/json.hpp>
 
 #include <fstream>
+#include <set>
 
+#include "lib/src/gltf/document.hpp"
 #include "matbake/convert.hpp"
 #include "matbake/materials.hpp"
 #include "matbake/scene.hpp"
 #include "support/files.hpp"
+#include "support/gltf_validator.hpp"
+#include "support/run.hpp"
 #include "support/temp_dir.hpp"
 
 namespace matbake {
@@ -32,6 +36,24 @@ Result<ConvertReport> convert(const fs::path& in, const fs::path& out, std::stri
   options.from = std::move(from);
   options.to = std::move(to);
   return convert_file(*plan_conversion(options), in, out, options);
+}
+
+// Every .gltf and .glb of the Khronos sample models.
+std::vector<fs::path> khronos_models() {
+  std::vector<fs::path> files;
+  for (const auto& model : fs::directory_iterator(kTestdata / "gltf")) {
+    if (!model.is_directory()) continue;
+    for (const char* variant : {"glTF", "glTF-Embedded", "glTF-Binary", "glTF-pbrSpecularGlossiness"}) {
+      const fs::path folder = model.path() / variant;
+      if (!fs::is_directory(folder)) continue;
+      for (const auto& f : fs::directory_iterator(folder)) {
+        const std::string ext = f.path().extension().string();
+        if (ext == ".gltf" || ext == ".glb") files.push_back(f.path());
+      }
+    }
+  }
+  std::sort(files.begin(), files.end());
+  return files;
 }
 
 std::vector<fs::path> files_in(const fs::path& folder, const std::string& ext = "") {
@@ -200,19 +222,10 @@ TEST(PhysicallyBased, TableEntriesMatchTheDatabase) {
 TEST(KhronosModels, EveryModelLoadsWithItsTriangleAndInstanceCounts) {
   REQUIRE_TESTDATA("gltf");
   int loaded = 0;
-  for (const auto& model : fs::directory_iterator(kTestdata / "gltf")) {
-    if (!model.is_directory()) continue;
-    for (const char* variant : {"glTF", "glTF-Embedded", "glTF-Binary"}) {
-      const fs::path folder = model.path() / variant;
-      if (!fs::is_directory(folder)) continue;
-      for (const auto& f : fs::directory_iterator(folder)) {
-        const std::string ext = f.path().extension().string();
-        if (ext != ".gltf" && ext != ".glb") continue;
-        auto s = scene::load_scene(f.path());
-        ASSERT_TRUE(s) << s.error().to_string();
-        ++loaded;
-      }
-    }
+  for (const fs::path& file : khronos_models()) {
+    auto s = scene::load_scene(file);
+    ASSERT_TRUE(s) << s.error().to_string();
+    ++loaded;
   }
   EXPECT_GE(loaded, 19);
   const auto load = [](const char* relative) { return *scene::load_scene(kTestdata / "gltf" / relative); };
@@ -225,6 +238,55 @@ TEST(KhronosModels, EveryModelLoadsWithItsTriangleAndInstanceCounts) {
   EXPECT_EQ(modes.instances.size(), 3u);  // triangles, strip, fan
   ASSERT_EQ(modes.notes.size(), 1u);
   EXPECT_EQ(modes.notes[0], "4 point or line primitives ignored");
+}
+
+// The warning codes of a report, without where they are.
+std::set<std::string> codes_of(const test::ValidatorReport& report) {
+  std::set<std::string> codes;
+  for (const std::string& c : report.error_and_warning_codes) codes.insert(c.substr(0, c.find(' ')));
+  return codes;
+}
+
+// bake-ao writes every sample model again, as .gltf and as .glb: the validator finds no error and
+// no warning that the input did not already have (those are the models' own: e.g. the
+// NormalTangent models' generated tangent space, the spec-gloss extension the validator does not
+// know); nodes are kept and a mesh placed by n nodes gains n − 1 copies.
+TEST(KhronosModels, BakedAoScenesStayValidatorClean) {
+  REQUIRE_TESTDATA("gltf");
+  test::TempDir dir;
+  int checked = 0;
+  for (const fs::path& file : khronos_models()) {
+    MATBAKE_VALIDATE_OR_SKIP(in_report, file);
+    ASSERT_EQ(in_report->errors, 0) << in_report->summary;
+    const std::set<std::string> in_codes = codes_of(*in_report);
+    const scene::Scene s = *scene::load_scene(file);
+    std::set<int> meshes, nodes;
+    for (const auto& inst : s.instances) meshes.insert(inst.mesh), nodes.insert(inst.node);
+    const auto in = gltf::read_document(file);
+    ASSERT_TRUE(in) << in.error().to_string();
+    for (const char* ext : {".gltf", ".glb"}) {
+      const fs::path out = dir / (file.stem().string() + "_" + file.parent_path().filename().string() + ext);
+      const auto r = test::matbake({"-q", "bake-ao", file.string(), "-o", out.string(), "--samples", "8"});
+      ASSERT_EQ(r.exit_code, 0) << file << ": " << r.err;
+      MATBAKE_VALIDATE_OR_SKIP(out_report, out);
+      EXPECT_EQ(out_report->errors, 0) << out_report->summary;
+      for (const std::string& code : codes_of(*out_report)) {
+        EXPECT_TRUE(in_codes.contains(code)) << code << " is new in " << out_report->summary;
+      }
+      const auto written = scene::load_scene(out);
+      ASSERT_TRUE(written) << written.error().to_string();
+      ASSERT_EQ(written->instances.size(), s.instances.size()) << out;
+      for (std::size_t k = 0; k < s.instances.size(); ++k) {
+        EXPECT_EQ(written->instances[k].colors.size(), s.instances[k].positions.size()) << out << " instance " << k;
+      }
+      const auto doc = gltf::read_document(out);
+      ASSERT_TRUE(doc);
+      EXPECT_EQ(doc->json["nodes"].size(), in->json["nodes"].size()) << out;
+      EXPECT_EQ(doc->json["meshes"].size(), in->json["meshes"].size() + nodes.size() - meshes.size()) << out;
+      ++checked;
+    }
+  }
+  EXPECT_GE(checked, 40);
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
 #include "support/gltf_files.hpp"
 
+#include <algorithm>
 #include <cstring>
 #include <fstream>
 
@@ -19,14 +20,24 @@ std::string base64(const std::vector<unsigned char>& bytes) {
   return out;
 }
 
-int GltfBuilder::add_vec3(const std::vector<float>& xyz) {
+int GltfBuilder::add_floats(const std::vector<float>& values, const std::string& type, int components) {
   const std::size_t offset = bytes.size();
-  bytes.resize(offset + xyz.size() * 4);
-  std::memcpy(bytes.data() + offset, xyz.data(), xyz.size() * 4);
-  doc["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", offset}, {"byteLength", xyz.size() * 4}});
+  bytes.resize(offset + values.size() * 4);
+  std::memcpy(bytes.data() + offset, values.data(), values.size() * 4);
+  doc["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", offset}, {"byteLength", values.size() * 4}});
   doc["accessors"].push_back({{"bufferView", doc["bufferViews"].size() - 1}, {"componentType", 5126},
-                              {"count", xyz.size() / 3}, {"type", "VEC3"}});
+                              {"count", values.size() / std::size_t(components)}, {"type", type}});
   return int(doc["accessors"].size()) - 1;
+}
+
+int GltfBuilder::add_vec3(const std::vector<float>& xyz) {
+  const int accessor = add_floats(xyz, "VEC3", 3);
+  // POSITION accessors must carry their bounds (glTF 2.0, 3.6.2.4).
+  float lo[3] = {xyz[0], xyz[1], xyz[2]}, hi[3] = {xyz[0], xyz[1], xyz[2]};
+  for (std::size_t i = 0; i < xyz.size(); ++i) lo[i % 3] = std::min(lo[i % 3], xyz[i]), hi[i % 3] = std::max(hi[i % 3], xyz[i]);
+  doc["accessors"][std::size_t(accessor)]["min"] = lo;
+  doc["accessors"][std::size_t(accessor)]["max"] = hi;
+  return accessor;
 }
 
 int GltfBuilder::add_indices(const std::vector<std::uint32_t>& indices) {

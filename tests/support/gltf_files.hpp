@@ -17,6 +17,7 @@ struct GltfBuilder {
                         {"meshes", nlohmann::json::array()}, {"nodes", nlohmann::json::array()}};
   // Appends data and an accessor over it; returns the accessor index.
   int add_vec3(const std::vector<float>& xyz);
+  int add_floats(const std::vector<float>& values, const std::string& type, int components);
   int add_indices(const std::vector<std::uint32_t>& indices);
   // A mesh with one primitive; returns the mesh index.
   int add_mesh(int positions, int indices = -1, int mode = 4, int normals = -1);

@@ -6,6 +6,7 @@
 
 #include <glm/geometric.hpp>
 
+#include <array>
 #include <cmath>
 #include <numbers>
 
@@ -190,6 +191,83 @@ TEST(AmbientOcclusion, LowDiscrepancyBeatsRandomAtEqualSamples) {
     random += std::pow(centre_value(s, o) - 0.5, 2);
   }
   EXPECT_LT(std::sqrt(sobol / 64), 0.5 * std::sqrt(random / 64));
+}
+
+// A box of half-size `half` around `center` as one mesh of 24 vertices, each corner three times, and one more.
+// Outwards: each with its face's own normal (flat shading: same position, different normals).
+// Inwards: each with the corner's diagonal towards the centre (a flat-shaded inner corner would
+// start its rays exactly on the two neighbouring faces' planes, where rounding decides). Two
+// degenerate triangles are added: one with a repeated index, one with three collinear corners.
+Instance flat_box(const Vec3& center, float half, bool inward) {
+  Instance box;
+  const Vec3 axes[3] = {kX, kY, kZ};
+  for (int a = 0; a < 3; ++a) {
+    for (float side : {1.0f, -1.0f}) {
+      const Vec3 n = side * axes[a], u = axes[(a + 1) % 3], v = side * axes[(a + 2) % 3];  // u × v = n
+      const auto first = std::uint32_t(box.positions.size());
+      for (const auto& [su, sv] : {std::pair{-1, -1}, {1, -1}, {1, 1}, {-1, 1}}) {
+        box.positions.push_back(center + half * (n + float(su) * u + float(sv) * v));
+        box.normals.push_back(inward ? glm::normalize(center - box.positions.back()) : n);
+      }
+      const std::array<std::uint32_t, 3> t0 = {first, first + 1, first + 2}, t1 = {first, first + 2, first + 3};
+      box.triangles.push_back(inward ? std::array{t0[0], t0[2], t0[1]} : t0);
+      box.triangles.push_back(inward ? std::array{t1[0], t1[2], t1[1]} : t1);
+    }
+  }
+  box.triangles.push_back({0, 0, 1});
+  box.positions.push_back(0.5f * (box.positions[0] + box.positions[1]));  // on the edge from corner 0 to 1
+  box.normals.push_back(box.normals[0]);
+  box.triangles.push_back({0, 24, 1});
+  return box;
+}
+
+// Meshes 1e-4 and 1e4 across in one scene: the ray origin offset follows each mesh's own edges and
+// coordinates, not the scene's size.
+TEST(AmbientOcclusion, SharedCornersDegenerateFacesAndMixedScales) {
+  Options o = binary(256);
+  o.max_distance = 1e3;  // the boxes, 2.5e4 apart, do not see each other
+  const auto outside = scene_of({flat_box({0, 0, 0}, 5e-5f, false), flat_box({3e4f, 0, 0}, 5e3f, false)});
+  auto open = bake(outside, o);
+  ASSERT_TRUE(open);
+  for (std::size_t k = 0; k < 2; ++k) {
+    for (std::size_t v = 0; v < 25; ++v) EXPECT_EQ(open->values[k][v], 1.0f) << "box " << k << " vertex " << v;
+  }
+  // Inside a closed box nothing is open: no ray may leak out through an edge or a corner.
+  o.max_distance = 1e6;
+  const auto inside = scene_of({flat_box({0, 0, 0}, 5e-5f, true), flat_box({3e4f, 0, 0}, 5e3f, true)});
+  auto closed = bake(inside, o);
+  ASSERT_TRUE(closed);
+  for (std::size_t k = 0; k < 2; ++k) {
+    for (std::size_t v = 0; v < 25; ++v) EXPECT_EQ(closed->values[k][v], 0.0f) << "box " << k << " vertex " << v;
+  }
+}
+
+TEST(AmbientOcclusion, CoplanarOverlapsDoNotOcclude) {
+  // Two copies of the same square, one shifted within the plane, one facing the other way.
+  const auto s = scene_of({square({0, 0, 0}, kX, kY, 1), square({0.3f, 0.2f, 0}, kX, kY, 1), square({0, 0, 0}, kY, kX, 1)});
+  auto r = bake(s, binary(256));
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->values[0][0], 1.0f);
+  EXPECT_EQ(r->values[1][0], 1.0f);
+  EXPECT_EQ(r->values[2][0], 1.0f);  // its hemisphere is below: nothing there either
+}
+
+TEST(AmbientOcclusion, VertexInNoFaceAndOneSidedSurfaces) {
+  // A floor facing +z; below it a mesh with one small triangle far away and one vertex in no face,
+  // which takes the mesh's face normal (+z) and so looks up at the floor's back.
+  Instance below;
+  below.positions = {{0, 0, -1}, {50, 50, -1}, {50.1f, 50, -1}, {50, 50.1f, -1}};
+  below.triangles = {{1, 2, 3}};
+  const auto s = scene_of({square({0, 0, 0}, kX, kY, kHalf), below});
+  Options o = binary(256);
+  o.two_sided = true;
+  auto two = bake(s, o);
+  ASSERT_TRUE(two);
+  EXPECT_EQ(two->values[1][0], 0.0f);  // misses only within 1e-6 of the horizon
+  o.two_sided = false;
+  auto one = bake(s, o);
+  ASSERT_TRUE(one);
+  EXPECT_EQ(one->values[1][0], 1.0f);  // the floor's back does not occlude
 }
 
 TEST(AmbientOcclusion, BadOptions) {

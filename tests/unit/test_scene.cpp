@@ -133,6 +133,19 @@ TEST(SceneLoad, BadFilesAreRefusedWithTheReason) {
   }
   {
     GltfBuilder b;
+    b.write(dir / "nan.gltf", {b.add_node({{"mesh", b.add_mesh(b.add_vec3({0, 0, 0, 1, 0, 0, 0, NAN, 0}))}})});
+    expect_refused(dir / "nan.gltf", "mesh 0 primitive 0: POSITION of vertex 2 is not finite");
+  }
+  {
+    // A GLB whose JSON chunk claims more bytes than the file has.
+    std::string glb = std::string("glTF") + std::string("\x02\0\0\0", 4) + std::string("\x40\0\0\0", 4) +
+                      std::string("\xff\0\0\0", 4) + "JSON{}";
+    glb.resize(64, ' ');
+    std::ofstream(dir / "chunks.glb", std::ios::binary) << glb;
+    expect_refused(dir / "chunks.glb", "not a valid glTF");
+  }
+  {
+    GltfBuilder b;
     const int a = b.add_node({{"children", {1}}});
     b.add_node({{"children", {0}}});
     b.write(dir / "cycle.gltf", {a});

@@ -28,7 +28,7 @@ struct Options {
   double tau = 4.0;                // τ in units of 1/d_max (so e^(−τ d_max) = e^(−4) by default)
   Falloff falloff = Falloff::exponential;
   double bias = 1e-5;  // origin offset along the normal, × the vertex's mean edge length, capped at
-                       // 1e-4 × the scene radius, at least 1e-6 × the coordinates' magnitude
+                       // 1e-4 × the scene radius, at least 1e-6 × the vertex's coordinates' magnitude
   bool two_sided = true;           // false: surfaces seen from behind do not occlude
   std::uint64_t seed = 0;
   Sampler sampler = Sampler::sobol;
@@ -48,6 +48,20 @@ Result<Bake> bake(const scene::Scene& scene, const Options& options);
 // Raw values: `.csv` (a header, then node,mesh,primitive,vertex,x,y,z,ao per baked vertex, world
 // positions) or `.bin` (the float32 values, little-endian, in the same order). Written atomically.
 Status write_dump(const std::filesystem::path& path, const scene::Scene& scene, const Bake& bake);
+
+// Where the values go in a written glTF.
+enum class Into {
+  color,           // COLOR_0 = (w, w, w): the renderer multiplies the base colour by it
+  color_multiply,  // COLOR_0 = the file's COLOR_0 × w (alpha kept); (w, w, w) where there is none
+  attribute,       // `_AO`, one float per vertex (an application-specific attribute)
+};
+
+// Writes the scene file `input` again as `output` (.gltf with a .bin beside it, or .glb; either
+// from either) with each baked primitive's values in it; everything else is kept as written. A
+// mesh placed by several nodes gets a copy per further node (sharing every accessor but the new
+// one), because each placement has its own occlusion. `scene` must be load_scene(input).
+Status write_gltf(const std::filesystem::path& input, const scene::Scene& scene, const Bake& bake, Into into,
+                  const std::filesystem::path& output);
 
 // Sample i of the per-vertex sequence, in [0, 1)².
 struct Sample2 {

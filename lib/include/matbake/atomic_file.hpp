@@ -2,6 +2,7 @@
 // Outputs are written to a temporary file in the target's folder and renamed over the target only
 // when complete, so a failure leaves nothing half-written and never touches an existing output.
 #include <filesystem>
+#include <string_view>
 
 #include "matbake/result.hpp"
 
@@ -27,5 +28,8 @@ class AtomicFile {
   std::filesystem::path temp_;
   bool done_ = false;
 };
+
+// The whole of `bytes` as `target`, through a temporary file and a rename.
+Status write_file_atomically(const std::filesystem::path& target, std::string_view bytes);
 
 }  // namespace matbake

@@ -4,6 +4,7 @@
 // images and animations are not loaded.
 #include <glm/mat4x4.hpp>
 #include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
 
 #include <array>
 #include <cstdint>
@@ -23,6 +24,8 @@ struct Instance {
   glm::dmat4 world{1.0};                          // node to world
   std::vector<Vec3> positions;                    // world space, one per vertex of the primitive
   std::vector<Vec3> normals;                      // world space, unit; empty when the file has none
+  std::vector<glm::vec4> colors;                  // COLOR_0 as floats, alpha 1 when the file's are RGB;
+  bool colors_have_alpha = false;                 // empty when the file has none
   std::vector<std::array<std::uint32_t, 3>> triangles;  // strips and fans converted; facing kept
                                                          // under mirroring transforms
 };

@@ -6,6 +6,7 @@
 #include <atomic>
 #include <cerrno>
 #include <cstring>
+#include <fstream>
 #include <string>
 
 namespace fs = std::filesystem;
@@ -56,6 +57,17 @@ Status AtomicFile::commit() {
   if (ec) return Error{target_.string(), "cannot replace the output: " + ec.message()};
   done_ = true;
   return success();
+}
+
+Status write_file_atomically(const fs::path& target, std::string_view bytes) {
+  auto file = AtomicFile::create(target);
+  if (!file) return file.error();
+  {
+    std::ofstream out(file->temp_path(), std::ios::binary);
+    out.write(bytes.data(), std::streamsize(bytes.size()));
+    if (!out.flush()) return Error{target.string(), "cannot write"};
+  }
+  return file->commit();
 }
 
 }  // namespace matbake

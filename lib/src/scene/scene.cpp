@@ -7,9 +7,10 @@
 #include <glm/gtc/type_ptr.hpp>
 #include <tiny_gltf.h>
 
+#include "../gltf/load_model.hpp"
+
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <functional>
 #include <cstring>
 #include <numeric>
@@ -17,66 +18,6 @@
 namespace matbake::scene {
 namespace fs = std::filesystem;
 namespace {
-
-// --- Files: only inside the input's folder ---------------------------------------------------------
-// tinygltf resolves buffer and image URIs itself; these callbacks refuse any outside the folder of
-// the .gltf (absolute paths, .. above it) and remember why, so the error says so.
-struct Folder {
-  fs::path base;
-  std::string refused;  // the first URI refused, with the reason
-};
-
-bool inside(const fs::path& base, const fs::path& p) {
-  const fs::path b = base.lexically_normal(), q = p.lexically_normal();
-  auto [bi, qi] = std::mismatch(b.begin(), b.end(), q.begin(), q.end());
-  return bi == b.end() || (std::next(bi) == b.end() && bi->empty());  // "dir/" ends in an empty element
-}
-
-// tinygltf passes the URI joined to the folder (or as is, when absolute).
-std::string expand_path(const std::string& path, void* user) {
-  auto* folder = static_cast<Folder*>(user);
-  if (!inside(folder->base, path) || path.find("://") != std::string::npos) {
-    if (folder->refused.empty()) {
-      // Said as written in the file where possible (tinygltf hands over the joined path).
-      const fs::path relative = fs::path(path).lexically_relative(folder->base);
-      folder->refused = "URI '" + (relative.empty() ? path : relative.string()) +
-                        "' is outside the glTF's folder; only files beside it are read";
-    }
-    return {};
-  }
-  return path;
-}
-
-bool file_exists(const std::string& path, void* user) {
-  std::error_code ec;
-  return !path.empty() && inside(static_cast<Folder*>(user)->base, path) && fs::is_regular_file(path, ec);
-}
-
-bool read_file(std::vector<unsigned char>* out, std::string* err, const std::string& path, void* user) {
-  if (!file_exists(path, user)) {
-    if (err) *err += "cannot read " + path + "\n";
-    return false;
-  }
-  std::ifstream in(path, std::ios::binary);
-  out->assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-  return bool(in) || in.eof();
-}
-
-bool refuse_write(std::string* err, const std::string&, const std::vector<unsigned char>&, void*) {
-  if (err) *err += "matbake does not write while loading\n";
-  return false;
-}
-
-// Images are not needed for geometry: keep their bytes undecoded.
-bool skip_image(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int, void*) {
-  return true;
-}
-
-std::string first_line(const std::string& text) {
-  std::string line = text.substr(0, text.find('\n'));
-  while (!line.empty() && (line.back() == '\r' || line.back() == ' ')) line.pop_back();
-  return line.empty() ? "unknown error" : line;
-}
 
 // --- Accessors --------------------------------------------------------------------------------------
 struct Reader {
@@ -227,20 +168,8 @@ float Scene::radius() const { return 0.5f * glm::length(bounds_max - bounds_min)
 
 Result<Scene> load_scene(const fs::path& path) {
   const std::string file = path.string();
-  std::error_code ec;
-  if (!fs::is_regular_file(path, ec)) return Error{file, "no such file"};
-  Folder folder{fs::absolute(path).parent_path(), {}};
-  tinygltf::TinyGLTF loader;
-  loader.SetFsCallbacks({file_exists, expand_path, read_file, refuse_write, &folder});
-  loader.SetImageLoader(skip_image, nullptr);
   tinygltf::Model model;
-  std::string err, warn;
-  const std::string ext = path.extension().string();
-  const std::string absolute = fs::absolute(path).string();
-  const bool ok = ext == ".glb" ? loader.LoadBinaryFromFile(&model, &err, &warn, absolute)
-                                : loader.LoadASCIIFromFile(&model, &err, &warn, absolute);
-  if (!folder.refused.empty()) return Error{file, folder.refused};
-  if (!ok) return Error{file, "not a valid glTF: " + first_line(err)};
+  if (Status loaded = gltf::load_model(path, model); !loaded) return loaded.error();
 
   Scene scene;
   const Reader read{model, file};
@@ -277,6 +206,11 @@ Result<Scene> load_scene(const fs::path& path) {
         auto positions = read.floats(position->second, 3);
         if (!positions) return positions.error();
         const std::size_t vertices = positions->size() / 3;
+        if (const auto bad = std::find_if(positions->begin(), positions->end(), [](float x) { return !std::isfinite(x); });
+            bad != positions->end()) {
+          return Error{file, "mesh " + std::to_string(node.mesh) + " primitive " + std::to_string(p) + ": POSITION of vertex " +
+                                 std::to_string((bad - positions->begin()) / 3) + " is not finite"};
+        }
         std::vector<std::uint32_t> order;
         if (prim.indices >= 0) {
           auto idx = read.indices(prim.indices, vertices);
@@ -313,6 +247,22 @@ Result<Scene> load_scene(const fs::path& path) {
             const glm::dvec3 nv = normal_matrix * glm::dvec3((*normals)[3 * v], (*normals)[3 * v + 1], (*normals)[3 * v + 2]);
             const double length = glm::length(nv);
             inst.normals[v] = length > 0 ? Vec3(nv / length) : Vec3(0);
+          }
+        }
+        if (const auto color = prim.attributes.find("COLOR_0"); color != prim.attributes.end()) {
+          const int components = color->second >= 0 && std::size_t(color->second) < model.accessors.size()
+                                     ? tinygltf::GetNumComponentsInType(std::uint32_t(model.accessors[std::size_t(color->second)].type))
+                                     : 4;
+          auto colors = read.floats(color->second, components == 3 ? 3 : 4);
+          if (!colors) return colors.error();
+          if (colors->size() / std::size_t(components) != vertices) {
+            return Error{file, "mesh " + std::to_string(node.mesh) + " primitive " + std::to_string(p) + ": COLOR_0 and POSITION counts differ"};
+          }
+          inst.colors_have_alpha = components == 4;
+          inst.colors.resize(vertices);
+          for (std::size_t v = 0; v < vertices; ++v) {
+            const float* c = colors->data() + v * std::size_t(components);
+            inst.colors[v] = glm::vec4(c[0], c[1], c[2], components == 4 ? c[3] : 1.0f);
           }
         }
         scene.instances.push_back(std::move(inst));

@@ -1,0 +1,234 @@
+#include "document.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+
+#include "load_model.hpp"
+#include "matbake/atomic_file.hpp"
+
+namespace matbake::gltf {
+namespace fs = std::filesystem;
+namespace {
+
+static_assert(std::endian::native == std::endian::little, "GLB is little-endian; so are the bytes written as is");
+
+std::string read_bytes(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+std::uint32_t u32_at(const std::string& bytes, std::size_t offset) {
+  std::uint32_t v = 0;
+  if (offset + 4 <= bytes.size()) std::memcpy(&v, bytes.data() + offset, 4);
+  return v;
+}
+
+bool is_data_uri(const std::string& uri) { return uri.rfind("data:", 0) == 0; }
+
+void pad(std::string& bytes, std::size_t alignment, char fill) {
+  bytes.resize((bytes.size() + alignment - 1) / alignment * alignment, fill);
+}
+
+// The MIME type glTF wants on an image held in a buffer view.
+std::string mime_type_of(const fs::path& path) {
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  if (ext == ".png") return "image/png";
+  if (ext == ".jpg" || ext == ".jpeg") return "image/jpeg";
+  if (ext == ".webp") return "image/webp";
+  if (ext == ".ktx2") return "image/ktx2";
+  return {};
+}
+
+void append_u32(std::string& out, std::uint32_t v) { out.append(reinterpret_cast<const char*>(&v), 4); }
+
+}  // namespace
+
+std::string decode_uri(const std::string& uri) {
+  std::string out;
+  for (std::size_t i = 0; i < uri.size(); ++i) {
+    if (uri[i] == '%' && i + 2 < uri.size() && std::isxdigit(uri[i + 1]) && std::isxdigit(uri[i + 2])) {
+      out += char(std::stoi(uri.substr(i + 1, 2), nullptr, 16));
+      i += 2;
+    } else {
+      out += uri[i];
+    }
+  }
+  return out;
+}
+
+Result<Document> read_document(const fs::path& path) {
+  tinygltf::Model model;  // tinygltf checks the container, the URIs and the buffer sizes
+  if (Status loaded = load_model(path, model); !loaded) return loaded.error();
+
+  Document doc;
+  doc.file = path.string();
+  doc.folder = fs::absolute(path).parent_path();
+  const std::string bytes = read_bytes(path);
+  std::string text = bytes;
+  if (path.extension() == ".glb") {
+    const std::size_t json_length = u32_at(bytes, 12);
+    if (bytes.size() < 20 || 20 + json_length > bytes.size()) return Error{doc.file, "GLB JSON chunk is truncated"};
+    text = bytes.substr(20, json_length);
+  }
+  doc.json = Json::parse(text, nullptr, false);
+  if (doc.json.is_discarded() || !doc.json.is_object()) return Error{doc.file, "not a valid glTF: the JSON is malformed"};
+  const std::size_t declared = doc.json.contains("buffers") ? doc.json["buffers"].size() : 0;
+  if (declared != model.buffers.size()) return Error{doc.file, "not a valid glTF: buffers could not all be read"};
+  for (std::size_t i = 0; i < model.buffers.size(); ++i) {
+    std::vector<unsigned char> data = std::move(model.buffers[i].data);
+    // A GLB's BIN chunk may carry up to 3 bytes of padding beyond the buffer's byteLength.
+    data.resize(std::min(data.size(), std::size_t(doc.json["buffers"][i].value("byteLength", std::size_t{0}))));
+    doc.buffers.push_back(std::move(data));
+  }
+  return doc;
+}
+
+int add_view(Document& doc, std::span<const unsigned char> bytes, int target) {
+  if (doc.added_buffer < 0) {
+    doc.buffers.emplace_back();
+    doc.json["buffers"].push_back({{"byteLength", 0}});
+    doc.added_buffer = int(doc.buffers.size()) - 1;
+  }
+  std::vector<unsigned char>& buffer = doc.buffers[std::size_t(doc.added_buffer)];
+  buffer.resize((buffer.size() + 3) / 4 * 4, 0);
+  const std::size_t offset = buffer.size();
+  buffer.insert(buffer.end(), bytes.begin(), bytes.end());
+  doc.json["buffers"][std::size_t(doc.added_buffer)]["byteLength"] = buffer.size();
+  Json view = {{"buffer", doc.added_buffer}, {"byteOffset", offset}, {"byteLength", bytes.size()}};
+  if (target) view["target"] = target;
+  doc.json["bufferViews"].push_back(std::move(view));
+  return int(doc.json["bufferViews"].size()) - 1;
+}
+
+int add_float_accessor(Document& doc, const std::vector<float>& values, std::size_t count, const char* type) {
+  const std::span bytes(reinterpret_cast<const unsigned char*>(values.data()), values.size() * sizeof(float));
+  const int view = add_view(doc, bytes, kArrayBuffer);
+  doc.json["accessors"].push_back({{"bufferView", view}, {"componentType", 5126}, {"count", count}, {"type", type}});
+  return int(doc.json["accessors"].size()) - 1;
+}
+
+Status write_document(const Document& doc, const fs::path& output) {
+  const std::string out_name = output.string();
+  const std::string ext = output.extension().string();
+  if (ext != ".gltf" && ext != ".glb") return Error{out_name, "the output is .gltf or .glb", true};
+  const bool glb = ext == ".glb";
+  const fs::path out_folder = fs::absolute(output).parent_path().lexically_normal();
+  const fs::path bin_path = output.parent_path() / (output.stem().string() + ".bin");
+
+  // Every file the document came from, none of which may be written.
+  std::vector<fs::path> inputs = {fs::absolute(doc.file).lexically_normal()};
+  const auto uri_files = [&](const char* array) {
+    if (!doc.json.contains(array)) return;
+    for (const Json& item : doc.json[array]) {
+      const std::string uri = item.value("uri", "");
+      if (!uri.empty() && !is_data_uri(uri)) inputs.push_back((doc.folder / decode_uri(uri)).lexically_normal());
+    }
+  };
+  uri_files("buffers");
+  uri_files("images");
+  const auto is_input = [&](const fs::path& p) {
+    const fs::path a = fs::absolute(p).lexically_normal();
+    return std::find(inputs.begin(), inputs.end(), a) != inputs.end();
+  };
+  if (is_input(output)) return Error{out_name, "would overwrite an input; write somewhere else", true};
+  if (!glb && is_input(bin_path)) {
+    return Error{out_name, "its buffer " + bin_path.filename().string() + " would overwrite an input; name the output differently", true};
+  }
+
+  // All buffers become one: each starts 4-byte aligned, the views move with it.
+  Json json = doc.json;
+  std::string bin;
+  std::vector<std::size_t> base(doc.buffers.size());
+  for (std::size_t i = 0; i < doc.buffers.size(); ++i) {
+    pad(bin, 4, '\0');
+    base[i] = bin.size();
+    bin.append(reinterpret_cast<const char*>(doc.buffers[i].data()), doc.buffers[i].size());
+  }
+  if (json.contains("bufferViews")) {
+    for (Json& view : json["bufferViews"]) {
+      const std::size_t buffer = view.value("buffer", std::size_t{0});
+      if (buffer >= base.size()) return Error{doc.file, "a buffer view names a buffer that does not exist"};
+      view["buffer"] = 0;
+      view["byteOffset"] = base[buffer] + view.value("byteOffset", std::size_t{0});
+    }
+  }
+
+  // Images by URI: embedded in a .glb (a GLB holds no URIs, data: ones included); copied beside a
+  // .gltf written to another folder.
+  std::vector<std::pair<fs::path, fs::path>> copies;
+  if (json.contains("images")) {
+    for (std::size_t i = 0; i < json["images"].size(); ++i) {
+      Json& image = json["images"][i];
+      const std::string uri = image.value("uri", "");
+      if (uri.empty() || (!glb && is_data_uri(uri))) continue;
+      const fs::path source = doc.folder / decode_uri(uri);
+      if (glb) {
+        std::string mime = image.value("mimeType", "");
+        std::string pixels;
+        if (is_data_uri(uri)) {
+          std::vector<unsigned char> decoded;
+          std::string uri_copy = uri, data_mime;
+          if (!tinygltf::DecodeDataURI(&decoded, data_mime, uri_copy, 0, false)) {
+            return Error{doc.file, "image " + std::to_string(i) + ": its data: URI cannot be decoded"};
+          }
+          pixels.assign(decoded.begin(), decoded.end());
+          if (mime.empty()) mime = data_mime;
+        } else {
+          pixels = read_bytes(source);
+          if (mime.empty()) mime = mime_type_of(source);
+        }
+        if (mime.empty()) return Error{doc.file, "image " + std::to_string(i) + ": unknown type, cannot embed it in a GLB"};
+        if (pixels.empty()) return Error{doc.file, "image " + std::to_string(i) + " cannot be read"};
+        pad(bin, 4, '\0');
+        json["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", bin.size()}, {"byteLength", pixels.size()}});
+        bin += pixels;
+        image.erase("uri");
+        image["bufferView"] = json["bufferViews"].size() - 1;
+        image["mimeType"] = mime;
+      } else if (out_folder != doc.folder.lexically_normal()) {
+        const fs::path target = output.parent_path() / decode_uri(uri);
+        if (is_input(target)) return Error{out_name, "copying image '" + uri + "' would overwrite an input", true};
+        copies.emplace_back(source, target);
+      }
+    }
+  }
+  if (bin.empty()) {
+    json.erase("buffers");
+  } else {
+    json["buffers"] = Json::array({{{"byteLength", bin.size()}}});
+    if (!glb) json["buffers"][0]["uri"] = bin_path.filename().string();
+  }
+
+  if (!glb && !bin.empty()) {
+    if (Status s = write_file_atomically(bin_path, bin); !s) return s;
+  }
+  for (const auto& [source, target] : copies) {
+    std::error_code ec;
+    fs::create_directories(target.parent_path().empty() ? fs::path(".") : target.parent_path(), ec);
+    if (Status s = write_file_atomically(target, read_bytes(source)); !s) return s;
+  }
+  if (!glb) return write_file_atomically(output, json.dump(2) + "\n");
+
+  std::string text = json.dump();
+  pad(text, 4, ' ');
+  pad(bin, 4, '\0');
+  std::string file;
+  file += "glTF";
+  append_u32(file, 2);
+  append_u32(file, std::uint32_t(12 + 8 + text.size() + (bin.empty() ? 0 : 8 + bin.size())));
+  append_u32(file, std::uint32_t(text.size()));
+  file += "JSON";
+  file += text;
+  if (!bin.empty()) {
+    append_u32(file, std::uint32_t(bin.size()));
+    file += std::string("BIN\0", 4);
+    file += bin;
+  }
+  return write_file_atomically(output, file);
+}
+
+}  // namespace matbake::gltf

@@ -1,0 +1,50 @@
+#pragma once
+// A glTF file as its JSON plus the bytes of its buffers, for writers that change a few things and
+// keep the rest as it was (node, mesh and material order, names, extras, extensions; key order).
+// tinygltf reads and checks the file (GLB chunks, data: URIs, buffer sizes); the JSON is kept as
+// written rather than rebuilt from tinygltf's model, which would drop what it does not know.
+#include <nlohmann/json.hpp>
+
+#include <cstdint>
+#include <filesystem>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "matbake/result.hpp"
+
+namespace matbake::gltf {
+
+using Json = nlohmann::ordered_json;
+
+struct Document {
+  std::string file;               // as given, for errors
+  std::filesystem::path folder;   // absolute: relative URIs resolve here
+  Json json;
+  std::vector<std::vector<unsigned char>> buffers;  // the bytes of json["buffers"][i]
+  int added_buffer = -1;          // the buffer add_view appends to, once there is one
+};
+
+// .gltf or .glb. Buffer and image URIs must stay inside the file's folder; image files must exist
+// (they are copied or embedded on write).
+Result<Document> read_document(const std::filesystem::path& path);
+
+constexpr int kArrayBuffer = 34962;  // bufferView.target of vertex attributes
+
+// Appends `bytes` (4-byte aligned) as a new buffer view; returns its index. target 0: none.
+int add_view(Document& doc, std::span<const unsigned char> bytes, int target);
+
+// A new float accessor of `count` elements of `type` ("SCALAR", "VEC3", "VEC4") over `values`
+// (count × components floats); returns its index.
+int add_float_accessor(Document& doc, const std::vector<float>& values, std::size_t count, const char* type);
+
+// Writes `doc` as `output`: .gltf (JSON, with every buffer merged into one `<stem>.bin` beside it
+// and images referenced by URI copied beside it when the folder differs) or .glb (one BIN chunk
+// holding every buffer and every image). Each file goes through a temporary file and a rename, the
+// .gltf or .glb last. Refuses to write over any file the document was read from.
+Status write_document(const Document& doc, const std::filesystem::path& output);
+
+// Percent-decoding of a relative URI (RFC 3986), as glTF URIs are written.
+std::string decode_uri(const std::string& uri);
+
+}  // namespace matbake::gltf

@@ -1,0 +1,19 @@
+#pragma once
+// tinygltf behind one call that keeps it inside the folder of the file being loaded: buffer and
+// image URIs that are absolute, climb above the folder with .. or name another scheme are refused,
+// and the error says which URI. Images must exist but are not decoded.
+#include <tiny_gltf.h>
+
+#include <filesystem>
+
+#include "matbake/result.hpp"
+
+namespace matbake::gltf {
+
+// .glb by extension, else .gltf. Errors name `path` as given.
+Status load_model(const std::filesystem::path& path, tinygltf::Model& model);
+
+// Whether `path` lies inside `base`, lexically.
+bool is_inside(const std::filesystem::path& base, const std::filesystem::path& path);
+
+}  // namespace matbake::gltf

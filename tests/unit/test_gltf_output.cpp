@@ -1,0 +1,242 @@
+// Writing glTF again: buffers merged, images copied or embedded, inputs never overwritten, and the
+// baked values read back exactly from COLOR_0 and _AO, per placement of an instanced mesh.
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <fstream>
+
+#include "lib/src/gltf/document.hpp"
+#include "matbake/ao.hpp"
+#include "matbake/scene.hpp"
+#include "support/files.hpp"
+#include "support/gltf_files.hpp"
+#include "support/temp_dir.hpp"
+
+namespace matbake {
+namespace {
+
+namespace fs = std::filesystem;
+using test::GltfBuilder;
+using test::TempDir;
+
+const std::vector<float> kFloor = {0, 0, 0, -1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0};
+const std::vector<std::uint32_t> kFan = {0, 1, 2, 0, 2, 3, 0, 3, 4, 0, 4, 1};
+
+// The floats of a float accessor, read from the written document's own bytes.
+std::vector<float> accessor_floats(const gltf::Document& doc, int index) {
+  const gltf::Json& a = doc.json["accessors"][std::size_t(index)];
+  const gltf::Json& view = doc.json["bufferViews"][a["bufferView"].get<std::size_t>()];
+  EXPECT_EQ(a["componentType"], 5126);
+  const std::size_t components = a["type"] == "SCALAR" ? 1 : a["type"] == "VEC3" ? 3 : 4;
+  std::vector<float> out(a["count"].get<std::size_t>() * components);
+  const auto& buffer = doc.buffers[view["buffer"].get<std::size_t>()];
+  const std::size_t offset = view.value("byteOffset", std::size_t{0}) + a.value("byteOffset", std::size_t{0});
+  EXPECT_LE(offset + out.size() * 4, buffer.size());
+  std::memcpy(out.data(), buffer.data() + offset, out.size() * 4);
+  return out;
+}
+
+// A floor whose buffer is an external .bin and which names an image in a subfolder by an
+// escaped URI.
+fs::path write_external_scene(const fs::path& folder) {
+  GltfBuilder b;
+  b.add_node({{"mesh", b.add_mesh(b.add_vec3(kFloor), b.add_indices(kFan))}});
+  b.doc["images"] = {{{"uri", "tex/a%20b.png"}}};
+  b.write(folder / "scene.gltf", {0});
+  nlohmann::json doc = nlohmann::json::parse(std::ifstream(folder / "scene.gltf"));
+  doc["buffers"][0]["uri"] = "geometry.bin";
+  std::ofstream(folder / "scene.gltf") << doc.dump();
+  test::write_bytes(folder / "geometry.bin", std::string(b.bytes.begin(), b.bytes.end()));
+  fs::create_directories(folder / "tex");
+  test::write_raw(folder / "tex" / "a b.png", 1, 1, 3, "uint8", {10, 20, 30});
+  return folder / "scene.gltf";
+}
+
+TEST(GltfDocument, GltfToAnotherFolderMergesBuffersAndCopiesImages) {
+  TempDir dir;
+  fs::create_directories(dir / "in");
+  fs::create_directories(dir / "out");
+  const fs::path input = write_external_scene(dir / "in");
+  auto doc = gltf::read_document(input);
+  ASSERT_TRUE(doc) << doc.error().to_string();
+  ASSERT_EQ(doc->buffers.size(), 1u);
+  EXPECT_EQ(doc->buffers[0].size(), test::read_bytes(dir / "in" / "geometry.bin").size());
+
+  const int extra = gltf::add_float_accessor(*doc, {0.25f, 0.5f}, 2, "SCALAR");  // a second buffer
+  ASSERT_TRUE(gltf::write_document(*doc, dir / "out" / "copy.gltf"));
+  EXPECT_EQ(test::list_folder(dir / "out"), (std::vector<std::string>{"copy.bin", "copy.gltf", "tex"}));
+  EXPECT_EQ(test::read_bytes(dir / "out" / "tex" / "a b.png"), test::read_bytes(dir / "in" / "tex" / "a b.png"));
+
+  auto back = gltf::read_document(dir / "out" / "copy.gltf");
+  ASSERT_TRUE(back) << back.error().to_string();
+  ASSERT_EQ(back->json["buffers"].size(), 1u);
+  EXPECT_EQ(back->json["buffers"][0]["uri"], "copy.bin");
+  EXPECT_EQ(accessor_floats(*back, extra), (std::vector<float>{0.25f, 0.5f}));
+  for (const auto& view : back->json["bufferViews"]) EXPECT_EQ(view["byteOffset"].get<std::size_t>() % 4, 0u);
+  auto a = scene::load_scene(input), c = scene::load_scene(dir / "out" / "copy.gltf");
+  ASSERT_TRUE(a && c);
+  EXPECT_EQ(a->instances[0].positions, c->instances[0].positions);
+  EXPECT_EQ(a->instances[0].triangles, c->instances[0].triangles);
+}
+
+TEST(GltfDocument, GlbHoldsEveryBufferAndImageInOneChunk) {
+  TempDir dir;
+  const fs::path input = write_external_scene(dir.path());
+  auto doc = gltf::read_document(input);
+  ASSERT_TRUE(doc);
+  ASSERT_TRUE(gltf::write_document(*doc, dir / "one.glb"));
+  const std::string bytes = test::read_bytes(dir / "one.glb");
+  const auto u32 = [&](std::size_t at) {
+    std::uint32_t v;
+    std::memcpy(&v, bytes.data() + at, 4);
+    return v;
+  };
+  ASSERT_GE(bytes.size(), 28u);
+  EXPECT_EQ(bytes.substr(0, 4), "glTF");
+  EXPECT_EQ(u32(4), 2u);
+  EXPECT_EQ(u32(8), bytes.size());
+  const std::uint32_t json_length = u32(12);
+  EXPECT_EQ(json_length % 4, 0u);
+  EXPECT_EQ(bytes.substr(16, 4), "JSON");
+  EXPECT_EQ(bytes.substr(20 + json_length + 4, 4), std::string("BIN\0", 4));
+  EXPECT_EQ(20 + json_length + 8 + u32(20 + json_length), bytes.size());
+
+  auto back = gltf::read_document(dir / "one.glb");
+  ASSERT_TRUE(back) << back.error().to_string();
+  const gltf::Json& image = back->json["images"][0];
+  EXPECT_FALSE(image.contains("uri"));
+  EXPECT_EQ(image["mimeType"], "image/png");
+  const gltf::Json& view = back->json["bufferViews"][image["bufferView"].get<std::size_t>()];
+  const std::string png = test::read_bytes(dir / "tex" / "a b.png");
+  ASSERT_EQ(view["byteLength"].get<std::size_t>(), png.size());
+  EXPECT_EQ(std::memcmp(back->buffers[0].data() + view["byteOffset"].get<std::size_t>(), png.data(), png.size()), 0);
+  auto s = scene::load_scene(dir / "one.glb");
+  ASSERT_TRUE(s) << s.error().to_string();
+  EXPECT_EQ(s->instances[0].triangles.size(), 4u);
+}
+
+TEST(GltfDocument, NeverWritesOverItsInputs) {
+  TempDir dir;
+  const fs::path input = write_external_scene(dir.path());
+  auto doc = gltf::read_document(input);
+  ASSERT_TRUE(doc);
+  const auto before = test::list_folder(dir.path());
+  const std::string original = test::read_bytes(dir / "geometry.bin");
+  for (const fs::path& out : {input, dir / "geometry.gltf", dir / "out.txt", dir / "no-such-folder" / "x.glb"}) {
+    const Status s = gltf::write_document(*doc, out);
+    ASSERT_FALSE(s) << out;
+    EXPECT_EQ(s.error().path, out.string());
+  }
+  EXPECT_EQ(test::list_folder(dir.path()), before);
+  EXPECT_EQ(test::read_bytes(dir / "geometry.bin"), original);
+}
+
+TEST(GltfDocument, PercentDecoding) {
+  EXPECT_EQ(gltf::decode_uri("tex/a%20b%2Fc.png"), "tex/a b/c.png");
+  EXPECT_EQ(gltf::decode_uri("100%"), "100%");
+  EXPECT_EQ(gltf::decode_uri("%zz"), "%zz");
+}
+
+// A quad under a roof and the same mesh placed again in the open; the floor has its own colours.
+fs::path write_instanced_scene(const fs::path& folder) {
+  GltfBuilder b;
+  const int quad = b.add_mesh(b.add_vec3(kFloor), b.add_indices(kFan));
+  const int roof = b.add_mesh(b.add_vec3({0, 0, 1, -9, 9, 1, 9, 9, 1, 9, -9, 1, -9, -9, 1}), b.add_indices(kFan));
+  b.doc["meshes"][std::size_t(quad)]["primitives"][0]["attributes"]["COLOR_0"] =
+      b.add_floats({1, 0.5f, 0.25f, 0.5f, 1, 1, 1, 1, 0, 0, 0, 0, 0.2f, 0.4f, 0.6f, 0.8f, 1, 1, 1, 0}, "VEC4", 4);
+  b.write(folder / "instanced.gltf", {b.add_node({{"mesh", quad}}), b.add_node({{"mesh", roof}}),
+                                      b.add_node({{"mesh", quad}, {"translation", {100, 0, 0}}})});
+  return folder / "instanced.gltf";
+}
+
+ao::Options binary_options() {
+  ao::Options o;
+  o.samples = 64;
+  o.falloff = ao::Falloff::none;
+  o.relative_distance = false;
+  o.max_distance = 1e3;
+  return o;
+}
+
+TEST(AoGltfOutput, EachPlacementKeepsItsOwnValuesAndColoursAreMultiplied) {
+  TempDir dir;
+  const fs::path input = write_instanced_scene(dir.path());
+  auto s = scene::load_scene(input);
+  ASSERT_TRUE(s) << s.error().to_string();
+  ASSERT_EQ(s->instances.size(), 3u);
+  auto baked = ao::bake(*s, binary_options());
+  ASSERT_TRUE(baked);
+  EXPECT_LT(baked->values[0][0], 0.1f);  // under the roof
+  EXPECT_EQ(baked->values[2][0], 1.0f);  // in the open
+
+  ASSERT_TRUE(ao::write_gltf(input, *s, *baked, ao::Into::color_multiply, dir / "multiply.glb"));
+  auto doc = gltf::read_document(dir / "multiply.glb");
+  ASSERT_TRUE(doc);
+  ASSERT_EQ(doc->json["meshes"].size(), 3u);             // the quad, the roof, the quad's copy
+  EXPECT_EQ(doc->json["nodes"][0]["mesh"], 0);
+  EXPECT_EQ(doc->json["nodes"][2]["mesh"], 2);
+  auto out = scene::load_scene(dir / "multiply.glb");
+  ASSERT_TRUE(out) << out.error().to_string();
+  ASSERT_EQ(out->instances.size(), 3u);
+  for (std::size_t k = 0; k < 3; ++k) {
+    const scene::Instance& before = s->instances[k];
+    const scene::Instance& after = out->instances[k];
+    EXPECT_EQ(after.node, before.node);
+    EXPECT_EQ(after.positions, before.positions);
+    ASSERT_EQ(after.colors.size(), before.positions.size()) << k;
+    for (std::size_t v = 0; v < after.colors.size(); ++v) {
+      const float w = baked->values[k][v];
+      const glm::vec4 expected = before.colors.empty() ? glm::vec4(w, w, w, 1)
+                                                       : glm::vec4(glm::vec3(before.colors[v]) * w, before.colors[v].a);
+      EXPECT_EQ(after.colors[v], expected) << "instance " << k << " vertex " << v;
+    }
+    EXPECT_EQ(after.colors_have_alpha, !before.colors.empty());
+  }
+}
+
+TEST(AoGltfOutput, ReplacedColoursAndTheAoAttributeHoldTheValuesExactly) {
+  TempDir dir;
+  const fs::path input = write_instanced_scene(dir.path());
+  auto s = scene::load_scene(input);
+  ASSERT_TRUE(s);
+  auto baked = ao::bake(*s, binary_options());
+  ASSERT_TRUE(baked);
+  ASSERT_TRUE(ao::write_gltf(input, *s, *baked, ao::Into::color, dir / "replace.gltf"));
+  auto replaced = scene::load_scene(dir / "replace.gltf");
+  ASSERT_TRUE(replaced);
+  for (std::size_t k = 0; k < 3; ++k) {
+    EXPECT_FALSE(replaced->instances[k].colors_have_alpha);
+    for (std::size_t v = 0; v < baked->values[k].size(); ++v) {
+      const float w = baked->values[k][v];
+      EXPECT_EQ(replaced->instances[k].colors[v], glm::vec4(w, w, w, 1));
+    }
+  }
+
+  ASSERT_TRUE(ao::write_gltf(input, *s, *baked, ao::Into::attribute, dir / "attribute.gltf"));
+  auto doc = gltf::read_document(dir / "attribute.gltf");
+  ASSERT_TRUE(doc);
+  for (std::size_t k = 0; k < 3; ++k) {
+    const int mesh = doc->json["nodes"][std::size_t(s->instances[k].node)]["mesh"];
+    const gltf::Json& attributes = doc->json["meshes"][std::size_t(mesh)]["primitives"][0]["attributes"];
+    EXPECT_EQ(accessor_floats(*doc, attributes["_AO"].get<int>()), baked->values[k]);
+    EXPECT_EQ(attributes.contains("COLOR_0"), k != 1);  // the file's own colours stay where they were
+  }
+}
+
+TEST(AoGltfOutput, SameBytesEveryTime) {
+  TempDir dir;
+  const fs::path input = write_instanced_scene(dir.path());
+  auto s = scene::load_scene(input);
+  ASSERT_TRUE(s);
+  auto baked = ao::bake(*s, binary_options());
+  ASSERT_TRUE(baked);
+  for (const char* name : {"a.glb", "b.glb", "a.gltf"}) {
+    ASSERT_TRUE(ao::write_gltf(input, *s, *baked, ao::Into::color, dir / name));
+  }
+  EXPECT_EQ(test::read_bytes(dir / "a.glb"), test::read_bytes(dir / "b.glb"));
+  EXPECT_EQ(test::list_folder(dir.path()),
+            (std::vector<std::string>{"a.bin", "a.glb", "a.gltf", "b.glb", "instanced.gltf"}));
+}
+
+}  // namespace
+}  // namespace matbake
