@@ -35,6 +35,8 @@ CLI::App* setup_bake_ao(CLI::App& app, BakeAoSettings& s) {
   cmd->add_option("--bias", s.options.bias, "Ray-origin offset along the normal × the vertex's mean edge length")
       ->capture_default_str();
   cmd->add_flag("--two-sided", s.two_sided, "Surfaces seen from behind occlude too");
+  cmd->add_flag("--fast-traversal", s.fast_traversal,
+                "Embree's non-robust traversal: faster, but a ray may slip between triangles sharing an edge");
   cmd->add_option("--seed", s.options.seed, "Sample scrambling seed (same seed, same values, any --jobs)")
       ->capture_default_str();
   cmd->add_option("--sampler", s.sampler, "sobol or random")->capture_default_str();
@@ -72,6 +74,7 @@ int run_bake_ao(const BakeAoSettings& s, const GlobalOptions& global) {
     return report_error(Error{"", "--into '" + s.into + "': use COLOR_0 or _AO", true});
   }
   options.two_sided = s.two_sided;
+  options.watertight = !s.fast_traversal;
   options.relative_distance = s.absolute_distance <= 0;
   options.max_distance = options.relative_distance ? s.relative_distance : s.absolute_distance;
 

@@ -117,6 +117,7 @@ struct BakeAoSettings {
   std::string falloff = "exponential";
   std::string sampler = "sobol";
   bool two_sided = false;
+  bool fast_traversal = false;
   std::string recompute_normals;
 };
 CLI::App* setup_bake_ao(CLI::App& app, BakeAoSettings& settings);

@@ -33,6 +33,9 @@ struct Options {
   std::uint64_t seed = 0;
   Sampler sampler = Sampler::sobol;
   std::vector<bool> targets;  // per instance: bake it (all occlude either way); empty: all
+  // Embree's robust traversal: no ray slips between two triangles sharing an edge (without it, 1
+  // ray in 256 leaked out of a closed box from its corners). Costs about a third of the speed.
+  bool watertight = true;
 };
 
 struct Bake {

@@ -135,9 +135,8 @@ Result<Bake> bake(const scene::Scene& scene, const Options& options) {
   Device device(rtcNewDevice(nullptr));
   if (!device) return Error{"", "Embree could not start (rtcNewDevice failed)"};
   RtcScene rtc(rtcNewScene(device.get()));
-  // Watertight: without it rays can slip between two triangles sharing an edge (seen: 1 in 256
-  // from inside a closed box at 1e-4 and at 1e4 units).
-  rtcSetSceneFlags(rtc.get(), RTC_SCENE_FLAG_ROBUST);
+  if (options.watertight) rtcSetSceneFlags(rtc.get(), RTC_SCENE_FLAG_ROBUST);
+  rtcSetSceneBuildQuality(rtc.get(), RTC_BUILD_QUALITY_HIGH);
   std::vector<Mesh> meshes;
   meshes.reserve(scene.instances.size());
   for (const scene::Instance& inst : scene.instances) {
