@@ -5,6 +5,7 @@
 #include <fstream>
 
 #include "commands.hpp"
+#include "report_json.hpp"
 #include "matbake/atomic_file.hpp"
 #include "matbake/workflow_maps.hpp"
 
@@ -17,15 +18,6 @@ bool uses_any(const pack::Layout& layout, std::initializer_list<std::string_view
   const auto used = pack::layout_sources(layout);
   return std::any_of(names.begin(), names.end(),
                      [&](std::string_view n) { return std::find(used.begin(), used.end(), n) != used.end(); });
-}
-
-nlohmann::json to_json(const ErrorStats& s) {
-  return {{"mean", s.mean}, {"max", s.max}, {"max_at", {s.max_x, s.max_y}}, {"texels", s.count}};
-}
-
-nlohmann::json to_json(const workflow::ConversionErrors& e) {
-  return {{"diffuse_delta_e_ab", to_json(e.diffuse_delta_e)}, {"specular_f0_abs", to_json(e.specular)},
-          {"lobe_relative_rms", to_json(e.lobe)}};
 }
 
 std::string line(const char* label, const ErrorStats& s, double scale, const char* unit) {
@@ -108,13 +100,7 @@ int run_workflow(const WorkflowSettings& s, const GlobalOptions& global) {
   const bool spec_gloss_source = direction.starts_with("spec-gloss");
   if (spec_gloss_source) {
     doc["khronos_converter_errors"] = to_json(report.khronos_errors);
-    const auto& d = report.dielectric;
-    doc["dielectric_f0"] = {{"texels", d.texels},
-                            {"mean_f0", d.mean_f0},
-                            {"KHR_materials_ior", {{"ior", d.ior}}},
-                            {"KHR_materials_specular", {{"specularColorFactor", d.specular_color_factor}}},
-                            {"error_without_extensions", to_json(d.error_without_extensions)},
-                            {"error_with_extensions", to_json(d.error_with_extensions)}};
+    doc["dielectric_f0"] = to_json(report.dielectric);
   }
   if (!s.report.empty()) {
     if (Status st = write_report(s.report, doc); !st) return report_error(st.error());

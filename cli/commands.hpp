@@ -123,4 +123,18 @@ struct BakeAoSettings {
 CLI::App* setup_bake_ao(CLI::App& app, BakeAoSettings& settings);
 int run_bake_ao(const BakeAoSettings& settings, const GlobalOptions& global);
 
+struct ExportSettings {
+  std::string scene;
+  std::string output;
+  std::vector<std::string> materials;  // NAME=[LAYOUT:]FILE,FILE...
+  std::string transfer = "srgb";       // of 8-bit colour in those files
+  std::string mapping = "fitted";
+  bool no_orm = false;
+  int ao_samples = 0;                  // 0: no AO
+  std::string ao_into = "COLOR_0";
+  std::string report;
+};
+CLI::App* setup_export(CLI::App& app, ExportSettings& settings);
+int run_export(const ExportSettings& settings, const GlobalOptions& global);
+
 }  // namespace matbake::cli

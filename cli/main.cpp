@@ -35,6 +35,8 @@ int main(int argc, char** argv) {
   CLI::App* validate_app = setup_validate(app, validate);
   BakeAoSettings bake_ao;
   CLI::App* bake_ao_app = setup_bake_ao(app, bake_ao);
+  ExportSettings export_settings;
+  CLI::App* export_app = setup_export(app, export_settings);
 
   try {
     app.parse(argc, argv);
@@ -59,5 +61,6 @@ int main(int argc, char** argv) {
   if (materials_app->parsed()) return run_materials(materials, global);
   if (validate_app->parsed()) return run_validate(validate, global);
   if (bake_ao_app->parsed()) return run_bake_ao(bake_ao, global);
+  if (export_app->parsed()) return run_export(export_settings, global);
   return kUsage;
 }

@@ -120,34 +120,39 @@ Result<pack::SourceMaps> gather_sources(const SourceSettings& s) {
     return maps;
   }
   // Packed inputs: unpack, then the per-source options take precedence.
-  auto layout = pack::find_layout(s.from);
-  if (!layout) return layout.error();
-  if (s.inputs.size() != layout->textures.size()) {
-    return Error{"", "--from " + s.from + " takes " + std::to_string(layout->textures.size()) + " textures, got " +
-                         std::to_string(s.inputs.size()), true};
-  }
-  std::vector<image::Image> textures;
-  {
-    SilencedStderr quiet;
-    for (std::size_t t = 0; t < s.inputs.size(); ++t) {
-      color::Transfer decode = color::Transfer::linear;
-      if (layout->textures[t].color) {
-        auto d = options.input ? Result<color::Transfer>(*options.input) : pack::decode_transfer(s.inputs[t], *transfer);
-        if (!d) return d.error();
-        decode = *d;
-      }
-      auto image = image::read_image(s.inputs[t], decode);
-      if (!image) return image.error();
-      textures.push_back(std::move(image.value()));
-    }
-  }
-  auto unpacked = pack::unpack(*layout, textures, s.inputs);
+  auto unpacked = read_packed(s.from, s.inputs, options.input, *transfer);
   if (!unpacked) return unpacked.error();
   if (!maps.maps.empty() && (maps.width != unpacked->width || maps.height != unpacked->height)) {
     return Error{s.inputs[0], "size differs from the other sources"};
   }
   for (auto& [name, map] : maps.maps) unpacked->maps[name] = std::move(map);
   return unpacked;
+}
+
+Result<pack::SourceMaps> read_packed(const std::string& layout_name, const std::vector<std::string>& files,
+                                     std::optional<color::Transfer> input, color::Transfer authored) {
+  auto layout = pack::find_layout(layout_name);
+  if (!layout) return layout.error();
+  if (files.size() != layout->textures.size()) {
+    return Error{"", "layout " + layout_name + " takes " + std::to_string(layout->textures.size()) + " textures, got " +
+                         std::to_string(files.size()), true};
+  }
+  std::vector<image::Image> textures;
+  {
+    SilencedStderr quiet;
+    for (std::size_t t = 0; t < files.size(); ++t) {
+      color::Transfer decode = color::Transfer::linear;
+      if (layout->textures[t].color) {
+        auto d = input ? Result<color::Transfer>(*input) : pack::decode_transfer(files[t], authored);
+        if (!d) return d.error();
+        decode = *d;
+      }
+      auto image = image::read_image(files[t], decode);
+      if (!image) return image.error();
+      textures.push_back(std::move(image.value()));
+    }
+  }
+  return pack::unpack(*layout, textures, files);
 }
 
 void add_output_options(CLI::App& cmd, OutputSettings& o, const std::string& what) {

@@ -4,6 +4,7 @@
 #include <CLI/CLI.hpp>
 
 #include <array>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -22,6 +23,10 @@ struct SourceSettings {
 };
 void add_source_options(CLI::App& cmd, SourceSettings& s);
 Result<pack::SourceMaps> gather_sources(const SourceSettings& s);
+// The source maps in `files`, the textures of layout `layout_name` in order: colour decoded with
+// `input` when given, else `authored` for 8-bit files and linear for the rest.
+Result<pack::SourceMaps> read_packed(const std::string& layout_name, const std::vector<std::string>& files,
+                                     std::optional<color::Transfer> input, color::Transfer authored);
 
 struct OutputSettings {
   std::vector<std::string> outputs;  // one per layout texture, or one with {texture}

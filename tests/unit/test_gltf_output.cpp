@@ -123,7 +123,7 @@ TEST(GltfDocument, NeverWritesOverItsInputs) {
   const auto before = test::list_folder(dir.path());
   const std::string original = test::read_bytes(dir / "geometry.bin");
   for (const fs::path& out : {input, dir / "geometry.gltf", dir / "out.txt", dir / "no-such-folder" / "x.glb"}) {
-    const Status s = gltf::write_document(*doc, out);
+    const auto s = gltf::write_document(*doc, out);
     ASSERT_FALSE(s) << out;
     EXPECT_EQ(s.error().path, out.string());
   }

@@ -60,6 +60,37 @@ std::string decode_uri(const std::string& uri) {
   return out;
 }
 
+Result<std::string> image_bytes(const Document& doc, std::size_t index) {
+  const std::string what = "image " + std::to_string(index);
+  if (!doc.json.contains("images") || index >= doc.json["images"].size()) return Error{doc.file, what + " does not exist"};
+  const Json& image = doc.json["images"][index];
+  if (image.contains("bufferView")) {
+    const std::size_t v = image["bufferView"].get<std::size_t>();
+    if (!doc.json.contains("bufferViews") || v >= doc.json["bufferViews"].size()) return Error{doc.file, what + ": no such buffer view"};
+    const Json& view = doc.json["bufferViews"][v];
+    const std::size_t buffer = view.value("buffer", std::size_t{0}), offset = view.value("byteOffset", std::size_t{0}),
+                      length = view.value("byteLength", std::size_t{0});
+    if (buffer >= doc.buffers.size() || offset + length > doc.buffers[buffer].size()) {
+      return Error{doc.file, what + ": its buffer view reaches beyond its buffer"};
+    }
+    return std::string(reinterpret_cast<const char*>(doc.buffers[buffer].data()) + offset, length);
+  }
+  const std::string uri = image.value("uri", "");
+  if (uri.empty()) return Error{doc.file, what + " has neither a URI nor a buffer view"};
+  if (const auto made = doc.new_files.find(uri); made != doc.new_files.end()) return made->second;
+  if (is_data_uri(uri)) {
+    std::vector<unsigned char> decoded;
+    std::string uri_copy = uri, mime;
+    if (!tinygltf::DecodeDataURI(&decoded, mime, uri_copy, 0, false)) return Error{doc.file, what + ": its data: URI cannot be decoded"};
+    return std::string(decoded.begin(), decoded.end());
+  }
+  const fs::path path = doc.folder / decode_uri(uri);
+  if (!is_inside(doc.folder, path)) return Error{doc.file, what + ": URI '" + uri + "' is outside the glTF's folder"};
+  std::string bytes = read_bytes(path);
+  if (bytes.empty()) return Error{doc.file, what + ": '" + uri + "' cannot be read"};
+  return bytes;
+}
+
 Result<Document> read_document(const fs::path& path) {
   tinygltf::Model model;  // tinygltf checks the container, the URIs and the buffer sizes
   if (Status loaded = load_model(path, model); !loaded) return loaded.error();
@@ -111,7 +142,7 @@ int add_float_accessor(Document& doc, const std::vector<float>& values, std::siz
   return int(doc.json["accessors"].size()) - 1;
 }
 
-Status write_document(const Document& doc, const fs::path& output) {
+Result<std::vector<fs::path>> write_document(const Document& doc, const fs::path& output) {
   const std::string out_name = output.string();
   const std::string ext = output.extension().string();
   if (ext != ".gltf" && ext != ".glb") return Error{out_name, "the output is .gltf or .glb", true};
@@ -157,43 +188,34 @@ Status write_document(const Document& doc, const fs::path& output) {
     }
   }
 
-  // Images by URI: embedded in a .glb (a GLB holds no URIs, data: ones included); copied beside a
-  // .gltf written to another folder.
-  std::vector<std::pair<fs::path, fs::path>> copies;
+  // Images by URI: embedded in a .glb (a GLB holds no URIs, data: ones included); written beside a
+  // .gltf when made here, copied beside it when the folder differs.
+  std::vector<std::pair<fs::path, std::string>> files;  // written beside the output: target, bytes
   if (json.contains("images")) {
     for (std::size_t i = 0; i < json["images"].size(); ++i) {
       Json& image = json["images"][i];
       const std::string uri = image.value("uri", "");
       if (uri.empty() || (!glb && is_data_uri(uri))) continue;
-      const fs::path source = doc.folder / decode_uri(uri);
-      if (glb) {
-        std::string mime = image.value("mimeType", "");
-        std::string pixels;
-        if (is_data_uri(uri)) {
-          std::vector<unsigned char> decoded;
-          std::string uri_copy = uri, data_mime;
-          if (!tinygltf::DecodeDataURI(&decoded, data_mime, uri_copy, 0, false)) {
-            return Error{doc.file, "image " + std::to_string(i) + ": its data: URI cannot be decoded"};
-          }
-          pixels.assign(decoded.begin(), decoded.end());
-          if (mime.empty()) mime = data_mime;
-        } else {
-          pixels = read_bytes(source);
-          if (mime.empty()) mime = mime_type_of(source);
-        }
-        if (mime.empty()) return Error{doc.file, "image " + std::to_string(i) + ": unknown type, cannot embed it in a GLB"};
-        if (pixels.empty()) return Error{doc.file, "image " + std::to_string(i) + " cannot be read"};
-        pad(bin, 4, '\0');
-        json["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", bin.size()}, {"byteLength", pixels.size()}});
-        bin += pixels;
-        image.erase("uri");
-        image["bufferView"] = json["bufferViews"].size() - 1;
-        image["mimeType"] = mime;
-      } else if (out_folder != doc.folder.lexically_normal()) {
+      const bool made = doc.new_files.contains(uri);
+      if (!glb && !made && out_folder == doc.folder.lexically_normal()) continue;
+      auto bytes = image_bytes(doc, i);
+      if (!bytes) return bytes.error();
+      if (!glb) {
         const fs::path target = output.parent_path() / decode_uri(uri);
-        if (is_input(target)) return Error{out_name, "copying image '" + uri + "' would overwrite an input", true};
-        copies.emplace_back(source, target);
+        if (is_input(target)) return Error{out_name, "writing image '" + uri + "' would overwrite an input", true};
+        files.emplace_back(target, std::move(*bytes));
+        continue;
       }
+      std::string mime = image.value("mimeType", "");
+      if (mime.empty() && is_data_uri(uri)) mime = uri.substr(5, uri.find(';') - 5);
+      if (mime.empty()) mime = mime_type_of(decode_uri(uri));
+      if (mime.empty()) return Error{doc.file, "image " + std::to_string(i) + ": unknown type, cannot embed it in a GLB"};
+      pad(bin, 4, '\0');
+      json["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", bin.size()}, {"byteLength", bytes->size()}});
+      bin += *bytes;
+      image.erase("uri");
+      image["bufferView"] = json["bufferViews"].size() - 1;
+      image["mimeType"] = mime;
     }
   }
   if (bin.empty()) {
@@ -203,15 +225,22 @@ Status write_document(const Document& doc, const fs::path& output) {
     if (!glb) json["buffers"][0]["uri"] = bin_path.filename().string();
   }
 
+  std::vector<fs::path> written;
   if (!glb && !bin.empty()) {
-    if (Status s = write_file_atomically(bin_path, bin); !s) return s;
+    if (Status s = write_file_atomically(bin_path, bin); !s) return s.error();
+    written.push_back(bin_path);
   }
-  for (const auto& [source, target] : copies) {
+  for (const auto& [target, bytes] : files) {
     std::error_code ec;
     fs::create_directories(target.parent_path().empty() ? fs::path(".") : target.parent_path(), ec);
-    if (Status s = write_file_atomically(target, read_bytes(source)); !s) return s;
+    if (Status s = write_file_atomically(target, bytes); !s) return s.error();
+    written.push_back(target);
   }
-  if (!glb) return write_file_atomically(output, json.dump(2) + "\n");
+  if (!glb) {
+    if (Status s = write_file_atomically(output, json.dump(2) + "\n"); !s) return s.error();
+    written.push_back(output);
+    return written;
+  }
 
   std::string text = json.dump();
   pad(text, 4, ' ');
@@ -228,7 +257,9 @@ Status write_document(const Document& doc, const fs::path& output) {
     file += std::string("BIN\0", 4);
     file += bin;
   }
-  return write_file_atomically(output, file);
+  if (Status s = write_file_atomically(output, file); !s) return s.error();
+  written.push_back(output);
+  return written;
 }
 
 }  // namespace matbake::gltf

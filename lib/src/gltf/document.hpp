@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <map>
 #include <span>
 #include <string>
 #include <vector>
@@ -23,6 +24,8 @@ struct Document {
   Json json;
   std::vector<std::vector<unsigned char>> buffers;  // the bytes of json["buffers"][i]
   int added_buffer = -1;          // the buffer add_view appends to, once there is one
+  // Files made here, by relative URI (images): written beside a .gltf, embedded in a .glb.
+  std::map<std::string, std::string> new_files;
 };
 
 // .gltf or .glb. Buffer and image URIs must stay inside the file's folder; image files must exist
@@ -41,8 +44,13 @@ int add_float_accessor(Document& doc, const std::vector<float>& values, std::siz
 // Writes `doc` as `output`: .gltf (JSON, with every buffer merged into one `<stem>.bin` beside it
 // and images referenced by URI copied beside it when the folder differs) or .glb (one BIN chunk
 // holding every buffer and every image). Each file goes through a temporary file and a rename, the
-// .gltf or .glb last. Refuses to write over any file the document was read from.
-Status write_document(const Document& doc, const std::filesystem::path& output);
+// .gltf or .glb last. Refuses to write over any file the document was read from. Returns the files
+// written, the .gltf or .glb last.
+Result<std::vector<std::filesystem::path>> write_document(const Document& doc, const std::filesystem::path& output);
+
+// The encoded bytes of image `index`: a file beside the document, a data: URI, a buffer view, or
+// one of new_files.
+Result<std::string> image_bytes(const Document& doc, std::size_t index);
 
 // Percent-decoding of a relative URI (RFC 3986), as glTF URIs are written.
 std::string decode_uri(const std::string& uri);

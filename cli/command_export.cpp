@@ -1,0 +1,136 @@
+#include <nlohmann/json.hpp>
+
+#include <cstdio>
+
+#include "commands.hpp"
+#include "material_sources.hpp"
+#include "matbake/atomic_file.hpp"
+#include "matbake/export.hpp"
+#include "report_json.hpp"
+#include "silenced_stderr.hpp"
+
+namespace matbake::cli {
+namespace {
+
+// "NAME=[LAYOUT:]FILE,FILE..." → the material's name and its maps (layout schuler by default).
+Result<exporter::MaterialMaps> parse_material(const std::string& text, color::Transfer authored) {
+  const std::size_t equals = text.find('=');
+  if (equals == std::string::npos || equals == 0 || equals + 1 == text.size()) {
+    return Error{"", "--material '" + text + "': use NAME=A.png,B.png (a Schüler pair) or NAME=LAYOUT:FILE,...", true};
+  }
+  exporter::MaterialMaps m;
+  m.material = text.substr(0, equals);
+  std::string rest = text.substr(equals + 1), layout = "schuler";
+  // A layout name has no dot or slash; a file path usually has both.
+  if (const std::size_t colon = rest.find(':');
+      colon != std::string::npos && rest.substr(0, colon).find_first_of("./") == std::string::npos) {
+    layout = rest.substr(0, colon);
+    rest = rest.substr(colon + 1);
+  }
+  std::vector<std::string> files;
+  for (std::size_t start = 0; start <= rest.size();) {
+    const std::size_t comma = std::min(rest.find(',', start), rest.size());
+    files.push_back(rest.substr(start, comma - start));
+    start = comma + 1;
+  }
+  auto maps = read_packed(layout, files, std::nullopt, authored);
+  if (!maps) return maps.error();
+  m.maps = std::move(*maps);
+  return m;
+}
+
+nlohmann::json report_to_json(const exporter::Report& r) {
+  nlohmann::json materials = nlohmann::json::array();
+  for (const exporter::MaterialReport& m : r.materials) {
+    nlohmann::json j = {{"index", m.index}, {"name", m.name}, {"action", m.action}, {"alphaMode", m.alpha_mode}};
+    if (m.conversion) {
+      j["texels"] = m.conversion->texels;
+      j["errors"] = to_json(m.conversion->errors);
+      j["khronos_converter_errors"] = to_json(m.conversion->khronos_errors);
+      j["dielectric_f0"] = to_json(m.conversion->dielectric);
+    }
+    if (m.specular_color_factor) j["KHR_materials_specular"] = {{"specularColorFactor", *m.specular_color_factor}};
+    materials.push_back(std::move(j));
+  }
+  return {{"command", "export"},     {"materials", materials},           {"skipped", r.skipped},
+          {"written", r.written},    {"images_decoded", r.images_decoded}, {"textures_made", r.textures_made},
+          {"ao_rays", r.ao_rays}};
+}
+
+}  // namespace
+
+CLI::App* setup_export(CLI::App& app, ExportSettings& s) {
+  CLI::App* cmd = app.add_subcommand(
+      "export",
+      "Write a glTF scene again as glTF 2.0 metal-rough: materials given as Schüler pairs (--material) or in\n"
+      "KHR_materials_pbrSpecularGlossiness converted (error reported; KHR_materials_specular where a dielectric's\n"
+      "F0 is not 0.04), occlusion packed into ORM, per-vertex AO baked in (--ao-samples), and only what the\n"
+      "default scene reaches written.\n"
+      "Example: matbake export scene.gltf -o out/scene.glb --material Brick=brick_a.png,brick_b.png --ao-samples 64");
+  cmd->add_option("scene", s.scene, "Input .gltf or .glb")->required();
+  cmd->add_option("-o,--output", s.output, "Output .gltf (+ .bin and PNGs beside it) or .glb")->required();
+  cmd->add_option("--material", s.materials,
+                  "NAME=A.png,B.png: material NAME (or its index) from a Schüler pair; NAME=LAYOUT:FILE,... from\n"
+                  "any pack layout's textures (e.g. gltf-metal-rough:base.png,mr.png). Repeatable");
+  cmd->add_option("--transfer", s.transfer, "How 8-bit colour in --material files was authored: srgb or gamma2.2")
+      ->capture_default_str();
+  cmd->add_option("--mapping", s.mapping, "Gloss -> roughness: fitted or walter")->capture_default_str();
+  cmd->add_flag("--no-orm", s.no_orm, "Keep occlusion and metallic-roughness textures apart");
+  cmd->add_option("--ao-samples", s.ao_samples, "Bake per-vertex AO with this many rays per vertex (0: none)")
+      ->capture_default_str();
+  cmd->add_option("--ao-into", s.ao_into, "COLOR_0 (times the file's own colours) or _AO")->capture_default_str();
+  cmd->add_option("--report", s.report, "Also write the report as JSON to this file");
+  return cmd;
+}
+
+int run_export(const ExportSettings& s, const GlobalOptions& global) {
+  exporter::Options options;
+  if (!workflow::roughness_mapping_from_name(s.mapping, options.mapping)) {
+    return report_error(Error{"", "--mapping '" + s.mapping + "': use fitted or walter", true});
+  }
+  auto transfer = parse_transfer(s.transfer, "--transfer");
+  if (!transfer) return report_error(transfer.error());
+  options.pack_orm = !s.no_orm;
+  if (s.ao_into != "COLOR_0" && s.ao_into != "_AO") {
+    return report_error(Error{"", "--ao-into '" + s.ao_into + "': use COLOR_0 or _AO", true});
+  }
+  options.ao_into = s.ao_into == "_AO" ? ao::Into::attribute : ao::Into::color_multiply;
+  if (s.ao_samples < 0) return report_error(Error{"", "--ao-samples must not be negative", true});
+  if (s.ao_samples > 0) {
+    options.ao = ao::Options{};
+    options.ao->samples = s.ao_samples;
+  }
+  for (const std::string& text : s.materials) {
+    auto m = parse_material(text, *transfer);
+    if (!m) return report_error(m.error());
+    options.materials.push_back(std::move(*m));
+  }
+  Result<exporter::Report> report = Error{"", ""};
+  {
+    SilencedStderr quiet;  // libpng's own messages on a bad texture: our error line says it
+    report = exporter::export_scene(s.scene, s.output, options);
+  }
+  if (!report) return report_error(report.error());
+  const nlohmann::json doc = report_to_json(*report);
+  if (!s.report.empty()) {
+    if (Status st = write_file_atomically(s.report, doc.dump(2) + "\n"); !st) return report_error(st.error());
+  }
+  if (global.json) {
+    std::cout << doc.dump(2) << "\n";
+  } else if (!global.quiet) {
+    for (const std::string& p : report->written) std::cout << p << "\n";
+    for (const exporter::MaterialReport& m : report->materials) {
+      std::printf("material %d '%s': %s, %s", m.index, m.name.c_str(), m.action.c_str(), m.alpha_mode.c_str());
+      if (m.conversion) {
+        std::printf("; diffuse ΔE*ab mean %.3g, |ΔF0| mean %.3g, lobe error mean %.3g%%", m.conversion->errors.diffuse_delta_e.mean,
+                    m.conversion->errors.specular.mean, 100 * m.conversion->errors.lobe.mean);
+      }
+      if (m.specular_color_factor) std::printf("; KHR_materials_specular %.4g", *m.specular_color_factor);
+      std::printf("\n");
+    }
+    for (const std::string& skipped : report->skipped) std::cout << "left out: " << skipped << "\n";
+  }
+  return kOk;
+}
+
+}  // namespace matbake::cli

@@ -1,0 +1,388 @@
+#include "matbake/export.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <set>
+
+#include "../ao/gltf_output.hpp"
+#include "../gltf/document.hpp"
+#include "../gltf/prune.hpp"
+#include "matbake/scene.hpp"
+#include "texture_files.hpp"
+
+namespace matbake::exporter {
+namespace fs = std::filesystem;
+using gltf::Json;
+namespace {
+
+constexpr const char* kSpecGloss = "KHR_materials_pbrSpecularGlossiness";
+constexpr const char* kSpecular = "KHR_materials_specular";
+constexpr double kCoreF0 = 0.04;
+constexpr double kF0Tolerance = 0.001;  // below an 8-bit sRGB step at F0 0.04 (0.0014)
+
+// A channel of a decoded image read as RGBA: grey spreads to RGB, a missing alpha is 1.
+float rgba(const image::Image& im, std::size_t pixel, int c) {
+  const std::size_t base = pixel * std::size_t(im.channels);
+  if (c == 3) return im.channels == 4 ? im.pixels[base + 3] : im.channels == 2 ? im.pixels[base + 1] : 1.0f;
+  return im.channels >= 3 ? im.pixels[base + std::size_t(c)] : im.pixels[base];
+}
+
+image::Image blank(int width, int height, int channels) {
+  image::Image im;
+  im.width = width, im.height = height, im.channels = channels;
+  im.pixels.assign(im.sample_count(), 0.0f);
+  return im;
+}
+
+image::Image at_size(const image::Image& im, int width, int height) {
+  return im.width == width && im.height == height ? im : image::resize_image(im, width, height);
+}
+
+std::vector<double> numbers(const Json& object, const char* key, std::vector<double> fallback) {
+  if (!object.contains(key) || !object[key].is_array()) return fallback;
+  std::vector<double> out;
+  for (const Json& v : object[key]) out.push_back(v.get<double>());
+  return out.size() == fallback.size() ? out : fallback;
+}
+
+void add_extension_used(Json& json, const char* name) {
+  Json& used = json["extensionsUsed"];
+  if (std::find(used.begin(), used.end(), name) == used.end()) used.push_back(name);
+}
+
+// What the export is doing, shared by the per-material steps.
+struct Exporter {
+  gltf::Document& doc;
+  ImageCache& cache;
+  const Options& options;
+  std::string stem;  // of the output: names of the files made
+  Report& report;
+  std::map<std::string, Json> converted;         // spec-gloss block → the metal-rough it became
+  std::map<std::pair<int, int>, int> orm_made;   // (metallic-roughness, occlusion) texture → ORM texture
+
+  // A new texture over a new PNG file, with the sampler of texture `sampler_of` (none when −1).
+  Result<int> add_texture(const image::Image& img, color::Transfer colour, const std::string& name, int sampler_of) {
+    auto png = cache.encode_png(img, colour);
+    if (!png) return png.error();
+    const std::string uri = stem + "_" + name + ".png";
+    doc.new_files[uri] = std::move(*png);
+    doc.json["images"].push_back({{"uri", uri}, {"mimeType", "image/png"}});
+    Json texture = {{"source", doc.json["images"].size() - 1}};
+    if (sampler_of >= 0 && doc.json["textures"][std::size_t(sampler_of)].contains("sampler")) {
+      texture["sampler"] = doc.json["textures"][std::size_t(sampler_of)]["sampler"];
+    }
+    doc.json["textures"].push_back(std::move(texture));
+    ++report.textures_made;
+    return int(doc.json["textures"].size()) - 1;
+  }
+
+  // The metal-rough maps written into `material`: factors when they are 1×1 (constants), else a
+  // base colour texture (with the mask as alpha) and a metallic-roughness one (ORM with occlusion).
+  Status write_metal_rough(Json& material, const pack::SourceMaps& maps, const std::string& name, Json texture_info,
+                           int sampler_of) {
+    Json& pbr = material["pbrMetallicRoughness"];
+    pbr = Json::object();
+    const image::Image& base = *maps.find("base_color");
+    const image::Image* mask = maps.find("mask");
+    if (maps.width == 1 && maps.height == 1) {
+      pbr["baseColorFactor"] = {base.pixels[0], base.pixels[1], base.pixels[2], mask ? mask->pixels[0] : 1.0f};
+      pbr["metallicFactor"] = maps.find("metallic")->pixels[0];
+      pbr["roughnessFactor"] = maps.find("roughness")->pixels[0];
+      return success();
+    }
+    const bool orm = maps.find("occlusion") != nullptr;
+    auto layout = pack::find_layout(orm ? "gltf-orm" : "gltf-metal-rough");
+    if (!layout) return layout.error();
+    auto images = pack::pack(*layout, maps);
+    if (!images) return images.error();
+    auto base_texture = add_texture((*images)[0], color::Transfer::srgb, name + "_base_color", sampler_of);
+    if (!base_texture) return base_texture.error();
+    auto mr_texture = add_texture((*images)[1], color::Transfer::linear, name + (orm ? "_orm" : "_metallic_roughness"), sampler_of);
+    if (!mr_texture) return mr_texture.error();
+    texture_info["index"] = *base_texture;
+    pbr["baseColorTexture"] = texture_info;
+    texture_info["index"] = *mr_texture;
+    pbr["metallicRoughnessTexture"] = texture_info;
+    if (orm) {
+      Json occlusion = material.value("occlusionTexture", Json::object());
+      occlusion["index"] = *mr_texture;
+      occlusion["texCoord"] = texture_info.value("texCoord", 0);
+      material["occlusionTexture"] = occlusion;
+    }
+    return success();
+  }
+
+  // KHR_materials_specular for dielectric texels whose F0 is not glTF's 0.04.
+  void add_dielectric_f0(Json& material, const workflow::ConversionReport& conversion, MaterialReport& out) {
+    const auto& d = conversion.dielectric;
+    if (d.texels == 0 || std::abs(d.mean_f0 - kCoreF0) <= kF0Tolerance) return;
+    const double f = d.specular_color_factor;
+    material["extensions"][kSpecular] = {{"specularColorFactor", {f, f, f}}};
+    add_extension_used(doc.json, kSpecular);
+    out.specular_color_factor = f;
+  }
+
+  // Alpha from a mask map: none or all 1 → OPAQUE, only 0 and 1 → MASK, else BLEND.
+  void set_alpha_mode(Json& material, const image::Image* mask) {
+    if (!mask) return;
+    const auto& v = mask->pixels;
+    if (std::all_of(v.begin(), v.end(), [](float a) { return a >= 1.0f; })) {
+      material.erase("alphaMode");
+      material.erase("alphaCutoff");
+    } else if (std::all_of(v.begin(), v.end(), [](float a) { return a <= 0.0f || a >= 1.0f; })) {
+      material["alphaMode"] = "MASK";
+      material["alphaCutoff"] = 0.5;
+    } else {
+      material["alphaMode"] = "BLEND";
+      material.erase("alphaCutoff");
+    }
+  }
+
+  // KHR_materials_pbrSpecularGlossiness's factors and textures as Schüler sources (kd, ks, gloss,
+  // and the diffuse alpha as mask), at the size of the larger texture.
+  Result<pack::SourceMaps> spec_gloss_sources(const Json& ext) {
+    const std::vector<double> diffuse = numbers(ext, "diffuseFactor", {1, 1, 1, 1});
+    const std::vector<double> specular = numbers(ext, "specularFactor", {1, 1, 1});
+    const double gloss = ext.value("glossinessFactor", 1.0);
+    const image::Image* textures[2] = {nullptr, nullptr};
+    const char* keys[2] = {"diffuseTexture", "specularGlossinessTexture"};
+    int width = 1, height = 1;
+    for (int t = 0; t < 2; ++t) {
+      if (!ext.contains(keys[t])) continue;
+      // Both store colour sRGB-encoded and alpha (opacity, gloss) linear.
+      auto im = cache.texture(ext[keys[t]].value("index", -1), color::Transfer::srgb);
+      if (!im) return im.error();
+      textures[t] = *im;
+      if (std::size_t((*im)->width) * (*im)->height > std::size_t(width) * height) width = (*im)->width, height = (*im)->height;
+    }
+    const image::Image d = textures[0] ? at_size(*textures[0], width, height) : image::Image{};
+    const image::Image s = textures[1] ? at_size(*textures[1], width, height) : image::Image{};
+    pack::SourceMaps maps;
+    maps.width = width, maps.height = height;
+    image::Image kd = blank(width, height, 3), ks = blank(width, height, 3), g = blank(width, height, 1),
+                 alpha = blank(width, height, 1);
+    for (std::size_t p = 0; p < std::size_t(width) * height; ++p) {
+      for (int c = 0; c < 3; ++c) {
+        kd.pixels[p * 3 + std::size_t(c)] = float(diffuse[std::size_t(c)]) * (textures[0] ? rgba(d, p, c) : 1.0f);
+        ks.pixels[p * 3 + std::size_t(c)] = float(specular[std::size_t(c)]) * (textures[1] ? rgba(s, p, c) : 1.0f);
+      }
+      g.pixels[p] = float(gloss) * (textures[1] ? rgba(s, p, 3) : 1.0f);
+      alpha.pixels[p] = float(diffuse[3]) * (textures[0] ? rgba(d, p, 3) : 1.0f);
+    }
+    maps.maps["kd"] = std::move(kd);
+    maps.maps["ks"] = std::move(ks);
+    maps.maps["gloss"] = std::move(g);
+    maps.maps["mask"] = std::move(alpha);
+    return maps;
+  }
+
+  Status from_spec_gloss(int index, Json& material, MaterialReport& out) {
+    const Json ext = material["extensions"][kSpecGloss];
+    material["extensions"].erase(kSpecGloss);
+    if (material["extensions"].empty()) material.erase("extensions");
+    const std::string key = ext.dump();
+    out.action = "converted from " + std::string(kSpecGloss);
+    if (const auto done = converted.find(key); done != converted.end()) {
+      material["pbrMetallicRoughness"] = done->second["pbr"];
+      if (done->second.contains("specular")) {
+        material["extensions"][kSpecular] = done->second["specular"];
+        out.specular_color_factor = done->second["specular"]["specularColorFactor"][0].get<double>();
+      }
+      out.action += " (same as an earlier material: its textures reused)";
+      return success();
+    }
+    auto sources = spec_gloss_sources(ext);
+    if (!sources) return sources.error();
+    workflow::ConversionReport conversion;
+    auto maps = workflow::metal_rough_from_spec_gloss(*sources, options.mapping, conversion);
+    if (!maps) return Error{doc.file, "material " + std::to_string(index) + ": " + maps.error().message};
+    Json info = ext.contains("diffuseTexture") ? ext["diffuseTexture"] : Json::object();
+    info.erase("index");
+    const int sampler_of = ext.contains("diffuseTexture") ? ext["diffuseTexture"].value("index", -1) : -1;
+    if (Status s = write_metal_rough(material, *maps, "material" + std::to_string(index), info, sampler_of); !s) return s;
+    add_dielectric_f0(material, conversion, out);
+    out.conversion = conversion;
+    Json remembered = {{"pbr", material["pbrMetallicRoughness"]}};
+    if (material.contains("extensions") && material["extensions"].contains(kSpecular)) {
+      remembered["specular"] = material["extensions"][kSpecular];
+    }
+    converted[key] = remembered;
+    return success();
+  }
+
+  Status from_maps(int index, Json& material, const pack::SourceMaps& given, MaterialReport& out) {
+    Json info = Json::object();
+    int sampler_of = -1;
+    if (material.contains("pbrMetallicRoughness") && material["pbrMetallicRoughness"].contains("baseColorTexture")) {
+      info = material["pbrMetallicRoughness"]["baseColorTexture"];
+      sampler_of = info.value("index", -1);
+      info.erase("index");
+    }
+    const std::string name = "material" + std::to_string(index);
+    if (given.find("kd")) {
+      workflow::ConversionReport conversion;
+      auto maps = workflow::metal_rough_from_spec_gloss(given, options.mapping, conversion);
+      if (!maps) return Error{doc.file, "material " + std::to_string(index) + ": " + maps.error().message};
+      if (Status s = write_metal_rough(material, *maps, name, info, sampler_of); !s) return s;
+      add_dielectric_f0(material, conversion, out);
+      out.conversion = conversion;
+      out.action = "from Schüler maps";
+    } else {
+      if (Status s = write_metal_rough(material, given, name, info, sampler_of); !s) return s;
+      out.action = "from metal-rough maps";
+    }
+    set_alpha_mode(material, given.find("mask"));
+    return success();
+  }
+
+  // Occlusion and metallic-roughness in two textures of the same texCoord become one ORM texture.
+  Status pack_orm(Json& material, MaterialReport& out) {
+    if (!material.contains("occlusionTexture") || !material.contains("pbrMetallicRoughness") ||
+        !material["pbrMetallicRoughness"].contains("metallicRoughnessTexture")) {
+      return success();
+    }
+    Json& mr = material["pbrMetallicRoughness"]["metallicRoughnessTexture"];
+    Json& occlusion = material["occlusionTexture"];
+    const int mr_index = mr.value("index", -1), occlusion_index = occlusion.value("index", -1);
+    if (mr_index == occlusion_index || mr.value("texCoord", 0) != occlusion.value("texCoord", 0) ||
+        mr.contains("extensions") || occlusion.contains("extensions")) {
+      return success();  // already one texture, or mapped differently: nothing to pack
+    }
+    int orm = -1;
+    if (const auto found = orm_made.find({mr_index, occlusion_index}); found != orm_made.end()) {
+      orm = found->second;
+    } else {
+      auto mr_image = cache.texture(mr_index, color::Transfer::linear);
+      if (!mr_image) return mr_image.error();
+      auto occlusion_image = cache.texture(occlusion_index, color::Transfer::linear);
+      if (!occlusion_image) return occlusion_image.error();
+      const image::Image& m = **mr_image;
+      const image::Image o = at_size(**occlusion_image, m.width, m.height);
+      image::Image packed = blank(m.width, m.height, 3);
+      for (std::size_t p = 0; p < std::size_t(m.width) * m.height; ++p) {
+        packed.pixels[p * 3] = rgba(o, p, 0);
+        packed.pixels[p * 3 + 1] = rgba(m, p, 1);
+        packed.pixels[p * 3 + 2] = rgba(m, p, 2);
+      }
+      auto texture = add_texture(packed, color::Transfer::linear, "orm" + std::to_string(orm_made.size()), mr_index);
+      if (!texture) return texture.error();
+      orm = orm_made[{mr_index, occlusion_index}] = *texture;
+    }
+    mr["index"] = orm;
+    occlusion["index"] = orm;
+    out.action = (out.action == "kept" ? "" : out.action + "; ") + "occlusion and metallic-roughness packed into ORM";
+    return success();
+  }
+};
+
+// The index of the material named `name` (or given as a number), or an error listing the names.
+Result<int> material_index(const gltf::Document& doc, const std::string& name) {
+  const std::size_t count = doc.json.contains("materials") ? doc.json["materials"].size() : 0;
+  std::string names;
+  for (std::size_t i = 0; i < count; ++i) {
+    const std::string n = doc.json["materials"][i].value("name", "");
+    if (n == name || std::to_string(i) == name) return int(i);
+    names += (names.empty() ? "" : ", ") + (n.empty() ? std::to_string(i) : n);
+  }
+  return Error{doc.file, "no material '" + name + "' in the scene" + (names.empty() ? "" : " (it has: " + names + ")"), true};
+}
+
+// Every texCoord a material's textures use must exist on every primitive drawing with it.
+Status check_texture_coordinates(const gltf::Document& doc) {
+  if (!doc.json.contains("meshes")) return success();
+  for (std::size_t m = 0; m < doc.json["meshes"].size(); ++m) {
+    const Json& mesh = doc.json["meshes"][m];
+    for (std::size_t p = 0; mesh.contains("primitives") && p < mesh["primitives"].size(); ++p) {
+      const Json& primitive = mesh["primitives"][p];
+      if (!primitive.contains("material")) continue;
+      const Json& material = doc.json["materials"][primitive["material"].get<std::size_t>()];
+      std::string missing;
+      const auto check = [&](const Json& info) {
+        const std::string set = "TEXCOORD_" + std::to_string(info.value("texCoord", 0));
+        if (!primitive["attributes"].contains(set)) missing = set;
+      };
+      if (material.contains("pbrMetallicRoughness")) {
+        for (const char* key : {"baseColorTexture", "metallicRoughnessTexture"}) {
+          if (material["pbrMetallicRoughness"].contains(key)) check(material["pbrMetallicRoughness"][key]);
+        }
+      }
+      for (const char* key : {"normalTexture", "occlusionTexture", "emissiveTexture"}) {
+        if (material.contains(key)) check(material[key]);
+      }
+      if (!missing.empty()) {
+        return Error{doc.file, "material " + primitive["material"].dump() + " has textures but mesh " + std::to_string(m) +
+                                   " primitive " + std::to_string(p) + " has no " + missing};
+      }
+    }
+  }
+  return success();
+}
+
+}  // namespace
+
+Result<Report> export_scene(const fs::path& input, const fs::path& output, const Options& options) {
+  const std::string ext = output.extension().string();
+  if (ext != ".gltf" && ext != ".glb") return Error{output.string(), "the output is .gltf or .glb", true};
+  auto scene = scene::load_scene(input);
+  if (!scene) return scene.error();
+  auto doc = gltf::read_document(input);
+  if (!doc) return doc.error();
+
+  Report report;
+  report.skipped = gltf::prune_unreachable(*doc);  // from here on, everything in doc is reachable
+  for (std::string& s : report.skipped) s += ": not reachable from the default scene";
+
+  std::map<int, const pack::SourceMaps*> given;
+  for (const MaterialMaps& m : options.materials) {
+    auto index = material_index(*doc, m.material);
+    if (!index) return index.error();
+    given[*index] = &m.maps;
+  }
+
+  ImageCache cache(*doc);
+  Exporter exporter{*doc, cache, options, output.stem().string(), report, {}, {}};
+  const std::size_t materials = doc->json.contains("materials") ? doc->json["materials"].size() : 0;
+  for (std::size_t i = 0; i < materials; ++i) {
+    Json& material = doc->json["materials"][i];
+    MaterialReport out;
+    out.index = int(i);
+    out.name = material.value("name", "");
+    out.action = "kept";
+    Status done = success();
+    if (const auto maps = given.find(int(i)); maps != given.end()) {
+      done = exporter.from_maps(int(i), material, *maps->second, out);
+    } else if (material.contains("extensions") && material["extensions"].contains(kSpecGloss)) {
+      done = exporter.from_spec_gloss(int(i), material, out);
+    }
+    if (done && options.pack_orm) done = exporter.pack_orm(material, out);
+    if (!done) return done.error();
+    out.alpha_mode = material.value("alphaMode", "OPAQUE");
+    report.materials.push_back(std::move(out));
+  }
+  // The spec-gloss extension is gone from every material that had it.
+  for (const char* list : {"extensionsUsed", "extensionsRequired"}) {
+    if (!doc->json.contains(list)) continue;
+    Json& names = doc->json[list];
+    names.erase(std::remove(names.begin(), names.end(), kSpecGloss), names.end());
+    if (names.empty()) doc->json.erase(list);
+  }
+  if (Status s = check_texture_coordinates(*doc); !s) return s.error();
+
+  if (options.ao) {
+    auto baked = ao::bake(*scene, *options.ao);
+    if (!baked) return baked.error();
+    ao::add_to_document(*doc, *scene, *baked, options.ao_into);
+    report.ao_rays = baked->rays;
+  }
+  // What the conversions replaced (spec-gloss textures, separate occlusion maps, old colours).
+  for (std::string& s : gltf::prune_unreachable(*doc)) report.skipped.push_back(s + ": replaced");
+  report.images_decoded = cache.decoded();
+
+  auto written = gltf::write_document(*doc, output);
+  if (!written) return written.error();
+  for (const fs::path& p : *written) report.written.push_back(p.string());
+  return report;
+}
+
+}  // namespace matbake::exporter

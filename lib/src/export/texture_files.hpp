@@ -1,0 +1,37 @@
+#pragma once
+// A glTF document's images decoded through OIIO (each once per transfer), and images encoded as
+// PNG bytes for the document's new files. OIIO reads and writes files, so both go through a
+// private temporary folder, removed with the cache.
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <string>
+#include <utility>
+
+#include "../gltf/document.hpp"
+#include "matbake/image.hpp"
+
+namespace matbake::exporter {
+
+class ImageCache {
+ public:
+  explicit ImageCache(const gltf::Document& doc);
+  ~ImageCache();
+  ImageCache(const ImageCache&) = delete;
+  ImageCache& operator=(const ImageCache&) = delete;
+
+  // The image of texture `texture`, colour channels decoded with `colour` (alpha stays linear).
+  Result<const image::Image*> texture(int texture, color::Transfer colour);
+  std::size_t decoded() const { return images_.size(); }
+
+  // 8-bit PNG bytes of `img` (colour channels encoded with `colour`).
+  Result<std::string> encode_png(const image::Image& img, color::Transfer colour);
+
+ private:
+  const gltf::Document& doc_;
+  std::filesystem::path folder_;  // private temporary folder
+  int files_ = 0;
+  std::map<std::pair<int, color::Transfer>, image::Image> images_;  // by (image index, transfer)
+};
+
+}  // namespace matbake::exporter

@@ -1,0 +1,240 @@
+#include "prune.hpp"
+
+#include <functional>
+
+namespace matbake::gltf {
+namespace {
+
+std::size_t count_of(const Json& json, const char* key) { return json.contains(key) ? json[key].size() : 0; }
+
+// A valid index into json[key], or −1.
+int index_in(const Json& json, const char* key, const Json& value) {
+  if (!value.is_number_integer()) return -1;
+  const long long i = value.get<long long>();
+  return i >= 0 && std::size_t(i) < count_of(json, key) ? int(i) : -1;
+}
+
+// The reachable-or-not flags of one top-level array.
+struct Marks {
+  const char* key;
+  std::vector<bool> keep;
+  void mark(const Json& json, const Json& value) {
+    if (const int i = index_in(json, key, value); i >= 0) keep[std::size_t(i)] = true;
+  }
+};
+
+// Keeps the marked items of json[key]; returns old index → new index (−1: removed) and says what went.
+std::vector<int> keep_marked(Json& json, const Marks& marks, const char* what, std::vector<std::string>& removed) {
+  std::vector<int> remap(marks.keep.size(), -1);
+  if (!json.contains(marks.key)) return remap;
+  Json kept = Json::array();
+  for (std::size_t i = 0; i < marks.keep.size(); ++i) {
+    Json& item = json[marks.key][i];
+    if (marks.keep[i]) {
+      remap[i] = int(kept.size());
+      kept.push_back(std::move(item));
+    } else {
+      const std::string name = item.is_object() ? item.value("name", "") : "";
+      removed.push_back(std::string(what) + " " + std::to_string(i) + (name.empty() ? "" : " '" + name + "'"));
+    }
+  }
+  if (kept.empty()) {
+    json.erase(marks.key);
+  } else {
+    json[marks.key] = std::move(kept);
+  }
+  return remap;
+}
+
+void remap_field(Json& object, const char* field, const std::vector<int>& remap) {
+  if (!object.is_object() || !object.contains(field) || !object[field].is_number_integer()) return;
+  const long long i = object[field].get<long long>();
+  if (i >= 0 && std::size_t(i) < remap.size() && remap[std::size_t(i)] >= 0) {
+    object[field] = remap[std::size_t(i)];
+  } else {
+    object.erase(field);
+  }
+}
+
+template <class F>
+void for_each_in(Json& json, const char* key, F f) {
+  if (!json.contains(key)) return;
+  for (Json& item : json[key]) f(item);
+}
+
+template <class F>
+void for_each_primitive(Json& json, F f) {
+  for_each_in(json, "meshes", [&](Json& mesh) { for_each_in(mesh, "primitives", f); });
+}
+
+// Every accessor a primitive reads: indices, attributes, morph targets.
+template <class F>
+void for_each_primitive_accessor(Json& primitive, F f) {
+  if (primitive.contains("indices")) f(primitive["indices"]);
+  if (primitive.contains("attributes")) {
+    for (auto& [name, a] : primitive["attributes"].items()) f(a);
+  }
+  for_each_in(primitive, "targets", [&](Json& target) {
+    for (auto& [name, a] : target.items()) f(a);
+  });
+}
+
+// Every accessor that skins and animations read.
+template <class F>
+void for_each_other_accessor(Json& json, F f) {
+  for_each_in(json, "skins", [&](Json& skin) {
+    if (skin.contains("inverseBindMatrices")) f(skin["inverseBindMatrices"]);
+  });
+  for_each_in(json, "animations", [&](Json& animation) {
+    for_each_in(animation, "samplers", [&](Json& sampler) {
+      if (sampler.contains("input")) f(sampler["input"]);
+      if (sampler.contains("output")) f(sampler["output"]);
+    });
+  });
+}
+
+// Image references of a texture: its source and any extension's (KHR_texture_basisu, EXT_texture_webp).
+template <class F>
+void for_each_texture_source(Json& texture, F f) {
+  if (texture.contains("source")) f(texture["source"]);
+  if (texture.contains("extensions")) {
+    for (auto& [name, extension] : texture["extensions"].items()) {
+      if (extension.is_object() && extension.contains("source")) f(extension["source"]);
+    }
+  }
+}
+
+template <class F>
+void for_each_sparse_view(Json& accessor, F f) {
+  if (!accessor.contains("sparse")) return;
+  Json& sparse = accessor["sparse"];
+  if (sparse.contains("indices") && sparse["indices"].contains("bufferView")) f(sparse["indices"]["bufferView"]);
+  if (sparse.contains("values") && sparse["values"].contains("bufferView")) f(sparse["values"]["bufferView"]);
+}
+
+void remap_value(Json& value, const std::vector<int>& remap) {
+  if (!value.is_number_integer()) return;
+  const long long i = value.get<long long>();
+  value = i >= 0 && std::size_t(i) < remap.size() ? remap[std::size_t(i)] : -1;
+}
+
+}  // namespace
+
+void for_each_texture_index(Json& material, const std::function<void(Json&)>& f) {
+  if (material.is_array()) {
+    for (Json& item : material) for_each_texture_index(item, f);
+    return;
+  }
+  if (!material.is_object()) return;
+  for (auto& [key, value] : material.items()) {
+    if (key.ends_with("Texture") && value.is_object() && value.contains("index")) f(value["index"]);
+    for_each_texture_index(value, f);
+  }
+}
+
+std::vector<std::string> prune_unreachable(Document& doc) {
+  Json& json = doc.json;
+  std::vector<std::string> removed;
+
+  // Nodes of the default scene (scene 0 when none is named), depth first; cycles stop.
+  std::vector<bool> in_scene(count_of(json, "nodes"), false);
+  const int scene = json.contains("scene") ? index_in(json, "scenes", json["scene"]) : (count_of(json, "scenes") ? 0 : -1);
+  std::function<void(const Json&)> visit = [&](const Json& n) {
+    const int i = index_in(json, "nodes", n);
+    if (i < 0 || in_scene[std::size_t(i)]) return;
+    in_scene[std::size_t(i)] = true;
+    for_each_in(json["nodes"][std::size_t(i)], "children", [&](Json& child) { visit(child); });
+  };
+  if (scene >= 0) for_each_in(json["scenes"][std::size_t(scene)], "nodes", [&](Json& n) { visit(n); });
+
+  Marks meshes{"meshes", std::vector<bool>(count_of(json, "meshes"))};
+  for (std::size_t n = 0; n < in_scene.size(); ++n) {
+    if (in_scene[n] && json["nodes"][n].contains("mesh")) meshes.mark(json, json["nodes"][n]["mesh"]);
+  }
+  Marks materials{"materials", std::vector<bool>(count_of(json, "materials"))};
+  Marks accessors{"accessors", std::vector<bool>(count_of(json, "accessors"))};
+  for (std::size_t m = 0; m < meshes.keep.size(); ++m) {
+    if (!meshes.keep[m]) continue;
+    for_each_in(json["meshes"][m], "primitives", [&](Json& p) {
+      if (p.contains("material")) materials.mark(json, p["material"]);
+      for_each_primitive_accessor(p, [&](Json& a) { accessors.mark(json, a); });
+    });
+  }
+  for_each_other_accessor(json, [&](Json& a) { accessors.mark(json, a); });
+  Marks textures{"textures", std::vector<bool>(count_of(json, "textures"))};
+  for (std::size_t m = 0; m < materials.keep.size(); ++m) {
+    if (materials.keep[m]) for_each_texture_index(json["materials"][m], [&](Json& t) { textures.mark(json, t); });
+  }
+  Marks images{"images", std::vector<bool>(count_of(json, "images"))};
+  Marks samplers{"samplers", std::vector<bool>(count_of(json, "samplers"))};
+  for (std::size_t t = 0; t < textures.keep.size(); ++t) {
+    if (!textures.keep[t]) continue;
+    Json& texture = json["textures"][t];
+    for_each_texture_source(texture, [&](Json& i) { images.mark(json, i); });
+    if (texture.contains("sampler")) samplers.mark(json, texture["sampler"]);
+  }
+  Marks views{"bufferViews", std::vector<bool>(count_of(json, "bufferViews"))};
+  for (std::size_t a = 0; a < accessors.keep.size(); ++a) {
+    if (!accessors.keep[a]) continue;
+    Json& accessor = json["accessors"][a];
+    if (accessor.contains("bufferView")) views.mark(json, accessor["bufferView"]);
+    for_each_sparse_view(accessor, [&](Json& v) { views.mark(json, v); });
+  }
+  for (std::size_t i = 0; i < images.keep.size(); ++i) {
+    if (images.keep[i] && json["images"][i].contains("bufferView")) views.mark(json, json["images"][i]["bufferView"]);
+  }
+
+  // Remove, then point every reference at the new indices.
+  const auto mesh_remap = keep_marked(json, meshes, "mesh", removed);
+  const auto material_remap = keep_marked(json, materials, "material", removed);
+  const auto texture_remap = keep_marked(json, textures, "texture", removed);
+  const auto image_remap = keep_marked(json, images, "image", removed);
+  const auto sampler_remap = keep_marked(json, samplers, "sampler", removed);
+  const auto accessor_remap = keep_marked(json, accessors, "accessor", removed);
+  const auto view_remap = keep_marked(json, views, "buffer view", removed);
+  for_each_in(json, "nodes", [&](Json& node) { remap_field(node, "mesh", mesh_remap); });
+  for_each_primitive(json, [&](Json& p) {
+    remap_field(p, "material", material_remap);
+    for_each_primitive_accessor(p, [&](Json& a) { remap_value(a, accessor_remap); });
+  });
+  for_each_other_accessor(json, [&](Json& a) { remap_value(a, accessor_remap); });
+  for_each_in(json, "materials", [&](Json& m) { for_each_texture_index(m, [&](Json& t) { remap_value(t, texture_remap); }); });
+  for_each_in(json, "textures", [&](Json& t) {
+    for_each_texture_source(t, [&](Json& i) { remap_value(i, image_remap); });
+    remap_field(t, "sampler", sampler_remap);
+  });
+  for_each_in(json, "accessors", [&](Json& a) {
+    remap_field(a, "bufferView", view_remap);
+    for_each_sparse_view(a, [&](Json& v) { remap_value(v, view_remap); });
+  });
+  for_each_in(json, "images", [&](Json& i) { remap_field(i, "bufferView", view_remap); });
+
+  // One buffer with only the kept views, each 4-byte aligned (no component is larger). A view
+  // beyond its buffer (tinygltf lets some through) leaves the buffers as they are.
+  bool views_ok = true;
+  for_each_in(json, "bufferViews", [&](Json& view) {
+    const std::size_t buffer = view.value("buffer", std::size_t{0});
+    views_ok = views_ok && buffer < doc.buffers.size() &&
+               view.value("byteOffset", std::size_t{0}) + view.value("byteLength", std::size_t{0}) <= doc.buffers[buffer].size();
+  });
+  if (!views_ok) return removed;
+  std::vector<unsigned char> compact;
+  for_each_in(json, "bufferViews", [&](Json& view) {
+    const auto& from = doc.buffers[view.value("buffer", std::size_t{0})];
+    const auto begin = from.begin() + std::ptrdiff_t(view.value("byteOffset", std::size_t{0}));
+    compact.resize((compact.size() + 3) / 4 * 4, 0);
+    view["buffer"] = 0;
+    view["byteOffset"] = compact.size();
+    compact.insert(compact.end(), begin, begin + std::ptrdiff_t(view.value("byteLength", std::size_t{0})));
+  });
+  doc.buffers.clear();
+  json.erase("buffers");
+  if (!compact.empty()) {
+    doc.buffers.push_back(std::move(compact));
+    json["buffers"] = Json::array({{{"byteLength", doc.buffers[0].size()}}});
+  }
+  doc.added_buffer = -1;
+  return removed;
+}
+
+}  // namespace matbake::gltf

@@ -1,0 +1,21 @@
+#pragma once
+// Keeping only what a glTF's default scene reaches, as gltf-transform's prune does: meshes placed
+// by the scene's nodes, the materials their primitives use, the textures those materials name (in
+// the core and in any extension: every `...Texture` object with an index), their images and
+// samplers, and the accessors and buffer views all of these read. Skins and animations keep
+// what they reference. Nodes stay; one outside the scene loses its mesh when that is removed.
+// The buffers are then compacted into one holding only the kept buffer views.
+#include <string>
+#include <vector>
+
+#include "document.hpp"
+
+namespace matbake::gltf {
+
+// Returns one line per removed object ("material 2 'Unused'"), for the report.
+std::vector<std::string> prune_unreachable(Document& doc);
+
+// Calls f(index) for every texture index a material names, core and extensions alike.
+void for_each_texture_index(Json& material, const std::function<void(Json& index)>& f);
+
+}  // namespace matbake::gltf
