@@ -289,5 +289,56 @@ TEST(KhronosModels, BakedAoScenesStayValidatorClean) {
   EXPECT_GE(checked, 40);
 }
 
+// export writes every sample model again: validator-clean with no warning its input did not have,
+// node, mesh and material counts kept, and with --no-orm the texture count too (ORM packing may
+// join two textures into one, so by default the count can only fall). The spec-gloss models come
+// out as metal-rough, with KHR_materials_specular where their dielectric F0 is not 0.04.
+TEST(KhronosModels, ExportedScenesStayValidatorCleanWithTheirCounts) {
+  REQUIRE_TESTDATA("gltf");
+  test::TempDir dir;
+  int checked = 0, converted = 0;
+  const auto count = [](const gltf::Json& json, const char* key) { return json.contains(key) ? json[key].size() : 0; };
+  for (const fs::path& file : khronos_models()) {
+    MATBAKE_VALIDATE_OR_SKIP(in_report, file);
+    const std::set<std::string> in_codes = codes_of(*in_report);
+    const auto in = gltf::read_document(file);
+    ASSERT_TRUE(in) << in.error().to_string();
+    const bool spec_gloss = in->json.contains("extensionsUsed") &&
+                            in->json["extensionsUsed"].dump().find("pbrSpecularGlossiness") != std::string::npos;
+    for (const bool orm : {true, false}) {
+      const fs::path out = dir / (file.stem().string() + "_" + file.parent_path().filename().string() + (orm ? "_orm.glb" : ".gltf"));
+      std::vector<std::string> args = {"--json", "export", file.string(), "-o", out.string()};
+      if (!orm) args.push_back("--no-orm");
+      const auto r = test::matbake(args);
+      ASSERT_EQ(r.exit_code, 0) << file << ": " << r.err;
+      MATBAKE_VALIDATE_OR_SKIP(out_report, out);
+      EXPECT_EQ(out_report->errors, 0) << out_report->summary;
+      for (const std::string& code : codes_of(*out_report)) {
+        EXPECT_TRUE(in_codes.contains(code)) << code << " is new in " << out_report->summary;
+      }
+      const auto doc = gltf::read_document(out);
+      ASSERT_TRUE(doc) << doc.error().to_string();
+      for (const char* key : {"nodes", "meshes", "materials"}) EXPECT_EQ(count(doc->json, key), count(in->json, key)) << out << " " << key;
+      if (orm) {
+        EXPECT_LE(count(doc->json, "textures"), count(in->json, "textures") + (spec_gloss ? count(in->json, "materials") : 0)) << out;
+      } else if (!spec_gloss) {
+        EXPECT_EQ(count(doc->json, "textures"), count(in->json, "textures")) << out;
+      }
+      if (spec_gloss) {
+        EXPECT_EQ(doc->json["materials"].dump().find("pbrSpecularGlossiness"), std::string::npos) << out;
+        EXPECT_EQ(doc->json.value("extensionsUsed", gltf::Json::array()).dump().find("pbrSpecularGlossiness"), std::string::npos);
+        const nlohmann::json report = nlohmann::json::parse(r.out);
+        bool any = false;
+        for (const auto& m : report["materials"]) any = any || m.contains("errors");
+        EXPECT_TRUE(any) << out << ": no conversion error reported";
+        converted += orm;
+      }
+      ++checked;
+    }
+  }
+  EXPECT_GE(checked, 40);
+  EXPECT_GE(converted, 2);  // BoxTextured's spec-gloss variant and SpecGlossVsMetalRough
+}
+
 }  // namespace
 }  // namespace matbake

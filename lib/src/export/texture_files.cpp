@@ -57,6 +57,23 @@ Result<const image::Image*> ImageCache::texture(int texture, color::Transfer col
   return &(images_[{source, colour}] = std::move(*decoded));
 }
 
+Status ImageCache::check(std::size_t index) {
+  auto bytes = gltf::image_bytes(doc_, index);
+  if (!bytes) return bytes.error();
+  const std::string what = "image " + std::to_string(index);
+  if (bytes->rfind("\xabKTX 20\xbb", 0) == 0) return success();
+  const char* extension = extension_of(*bytes);
+  if (!*extension) return Error{doc_.file, what + " is not PNG, JPEG, WebP or KTX2"};
+  std::error_code ec;
+  fs::create_directories(folder_, ec);
+  const fs::path file = folder_ / ("check" + std::to_string(files_++) + extension);
+  if (Status s = write_file_atomically(file, *bytes); !s) return s.error();
+  auto probed = image::probe_image(file);
+  fs::remove(file, ec);
+  if (!probed) return Error{doc_.file, what + ": " + probed.error().message};
+  return success();
+}
+
 Result<std::string> ImageCache::encode_png(const image::Image& img, color::Transfer colour) {
   std::error_code ec;
   fs::create_directories(folder_, ec);

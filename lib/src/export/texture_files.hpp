@@ -24,6 +24,9 @@ class ImageCache {
   Result<const image::Image*> texture(int texture, color::Transfer colour);
   std::size_t decoded() const { return images_.size(); }
 
+  // Image `index` is a PNG, JPEG or WebP whose header reads, or a KTX2 file (passed through).
+  Status check(std::size_t index);
+
   // 8-bit PNG bytes of `img` (colour channels encoded with `colour`).
   Result<std::string> encode_png(const image::Image& img, color::Transfer colour);
 

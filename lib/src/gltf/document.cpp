@@ -156,7 +156,9 @@ Result<std::vector<fs::path>> write_document(const Document& doc, const fs::path
     if (!doc.json.contains(array)) return;
     for (const Json& item : doc.json[array]) {
       const std::string uri = item.value("uri", "");
-      if (!uri.empty() && !is_data_uri(uri)) inputs.push_back((doc.folder / decode_uri(uri)).lexically_normal());
+      if (!uri.empty() && !is_data_uri(uri) && !doc.new_files.contains(uri)) {
+        inputs.push_back((doc.folder / decode_uri(uri)).lexically_normal());
+      }
     }
   };
   uri_files("buffers");

@@ -13,19 +13,25 @@ struct ConfinedFolder {
   std::string refused;   // the first URI refused, with the reason
 };
 
-// tinygltf passes the URI joined to the folder (or as is, when absolute).
+// tinygltf asks for the URI joined to the folder ("folder/" + uri, even when the URI is absolute),
+// then for "./" + uri. The URI as written decides: absolute, climbing above the folder with .., or
+// naming a scheme is refused (and remembered, so the error says which); otherwise the joined path
+// is the file, and the "./" retry finds nothing.
 std::string expand_path(const std::string& path, void* user) {
   auto* folder = static_cast<ConfinedFolder*>(user);
-  if (!is_inside(folder->base, path) || path.find("://") != std::string::npos) {
+  const std::string prefix = folder->base.string() + "/";
+  const bool joined = path.rfind(prefix, 0) == 0;
+  const std::string uri = joined ? path.substr(prefix.size()) : path.rfind("./", 0) == 0 ? path.substr(2) : path;
+  const fs::path normal = fs::path(uri).lexically_normal();
+  const bool outside = fs::path(uri).is_absolute() || uri.find("://") != std::string::npos ||
+                       (!normal.empty() && *normal.begin() == "..");
+  if (outside) {
     if (folder->refused.empty()) {
-      // Said as written in the file where possible (tinygltf hands over the joined path).
-      const fs::path relative = fs::path(path).lexically_relative(folder->base);
-      folder->refused = "URI '" + (relative.empty() ? path : relative.string()) +
-                        "' is outside the glTF's folder; only files beside it are read";
+      folder->refused = "URI '" + uri + "' is outside the glTF's folder; only files beside it are read";
     }
     return {};
   }
-  return path;
+  return joined ? path : std::string();
 }
 
 bool file_exists(const std::string& path, void* user) {

@@ -1,0 +1,283 @@
+// `matbake export` end to end on scenes written here: texel values of converted textures against the
+// exact cases of the workflow (pure dielectric at F0 0.04: base = Kd; pure metal: base = Ks), factors
+// and KHR_materials_specular for constant materials, ORM packing of a texture shared by two
+// materials (made once), alpha modes from the mask, pruning and its report, AO, byte-identical
+// runs, and bad input. Every file written passes the Khronos glTF-Validator.
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <fstream>
+
+#include "lib/src/gltf/document.hpp"
+#include "matbake/color.hpp"
+#include "matbake/workflow.hpp"
+#include "support/expect_error.hpp"
+#include "support/files.hpp"
+#include "support/gltf_files.hpp"
+#include "support/gltf_validator.hpp"
+#include "support/run.hpp"
+#include "support/temp_dir.hpp"
+
+namespace matbake::test {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+// A quad with texture coordinates drawn with material 0 by node 0 (the scene), and a second quad
+// with material 1 placed only by node 1, which is not in the scene.
+GltfBuilder quad_scene(const json& materials) {
+  GltfBuilder b;
+  const int positions = b.add_vec3({0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0});
+  const int uvs = b.add_floats({0, 1, 1, 1, 1, 0, 0, 0}, "VEC2", 2);
+  const int indices = b.add_indices({0, 1, 2, 0, 2, 3});
+  for (int m = 0; m < 2; ++m) {
+    b.doc["meshes"].push_back({{"primitives", {{{"attributes", {{"POSITION", positions}, {"TEXCOORD_0", uvs}}},
+                                                {"indices", indices}, {"material", m}}}}});
+  }
+  b.add_node({{"mesh", 0}});
+  b.add_node({{"mesh", 1}, {"translation", {5, 0, 0}}});
+  b.doc["materials"] = materials;
+  return b;
+}
+
+// The written document (its JSON and buffers), and the pixels of texture `t` as stored (codes).
+gltf::Document read_output(const fs::path& path) {
+  auto doc = gltf::read_document(path);
+  EXPECT_TRUE(doc) << doc.error().to_string();
+  return std::move(*doc);
+}
+
+RawImage texture_pixels(const gltf::Document& doc, int texture, const fs::path& scratch) {
+  const int image = doc.json["textures"][std::size_t(texture)]["source"];
+  auto bytes = gltf::image_bytes(doc, std::size_t(image));
+  EXPECT_TRUE(bytes);
+  write_bytes(scratch, *bytes);
+  return read_raw(scratch);
+}
+
+json export_json(const std::vector<std::string>& args) {
+  std::vector<std::string> all = {"--json", "export"};
+  all.insert(all.end(), args.begin(), args.end());
+  const RunResult r = matbake(all);
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  return r.exit_code == 0 ? json::parse(r.out) : json();
+}
+
+void expect_validator_clean(const fs::path& file) {
+  MATBAKE_VALIDATE_OR_SKIP(report, file);
+  EXPECT_EQ(report->errors, 0) << report->summary;
+  EXPECT_EQ(report->warnings, 0) << report->summary;
+}
+
+double code_to_linear(double code) { return color::linear_from_encoded(color::Transfer::srgb, code / 255.0); }
+
+TEST(CliExport, SpecGlossTexturesConvertTexelByTexel) {
+  TempDir dir;
+  // Texel 0: a dielectric at F0 0.0395 (code 56: within 0.001 of 0.04, the exact case base = Kd);
+  // texel 1: a pure metal (Kd black: base = Ks, metallic 1).
+  write_raw(dir / "diffuse.png", 2, 1, 4, "uint8", {200, 100, 50, 255, 0, 0, 0, 255});
+  write_raw(dir / "specgloss.png", 2, 1, 4, "uint8", {56, 56, 56, 128, 255, 200, 87, 191});
+  GltfBuilder b = quad_scene(json::array(
+      {{{"name", "Painted"},
+        {"extensions", {{"KHR_materials_pbrSpecularGlossiness",
+                         {{"diffuseTexture", {{"index", 0}}}, {"specularGlossinessTexture", {{"index", 1}}}}}}}},
+       {{"name", "Unused"}}}));
+  b.doc["extensionsUsed"] = {"KHR_materials_pbrSpecularGlossiness"};
+  b.doc["textures"] = {{{"source", 0}, {"sampler", 0}}, {{"source", 1}, {"sampler", 0}}};
+  b.doc["samplers"] = {{{"magFilter", 9728}, {"wrapS", 33071}}};
+  b.doc["images"] = {{{"uri", "diffuse.png"}}, {{"uri", "specgloss.png"}}};
+  b.write(dir / "in.gltf", {0});
+  fs::create_directories(dir / "out");
+  const json report = export_json({(dir / "in.gltf").string(), "-o", (dir / "out" / "scene.gltf").string()});
+  ASSERT_FALSE(report.is_null());
+  EXPECT_EQ(report["materials"][0]["action"], "converted from KHR_materials_pbrSpecularGlossiness");
+  EXPECT_EQ(report["images_decoded"], 2);
+
+  const gltf::Document out = read_output(dir / "out" / "scene.gltf");
+  EXPECT_FALSE(out.json.contains("extensionsUsed"));
+  ASSERT_EQ(out.json["materials"].size(), 1u);
+  const auto& pbr = out.json["materials"][0]["pbrMetallicRoughness"];
+  EXPECT_FALSE(out.json["materials"][0].contains("extensions"));  // F0 0.0395: core glTF's 0.04 is close enough
+  ASSERT_EQ(out.json["samplers"].size(), 1u);
+  EXPECT_EQ(out.json["textures"][pbr["baseColorTexture"]["index"].get<std::size_t>()]["sampler"], 0);
+  const RawImage base = texture_pixels(out, pbr["baseColorTexture"]["index"], dir / "base.png");
+  const RawImage mr = texture_pixels(out, pbr["metallicRoughnessTexture"]["index"], dir / "mr.png");
+  ASSERT_EQ(base.channels, 4);
+  EXPECT_EQ(base.samples, (std::vector<double>{200, 100, 50, 255, 255, 200, 87, 255}));
+  ASSERT_EQ(mr.channels, 3);
+  const auto rough = [](double gloss, double f0) {
+    return std::round(255 * workflow::roughness_from_gloss(gloss, workflow::RoughnessMapping::fitted, f0));
+  };
+  const double metal_f0 = (code_to_linear(255) + code_to_linear(200) + code_to_linear(87)) / 3;
+  EXPECT_NEAR(mr.samples[1], rough(128 / 255.0, code_to_linear(56)), 1);
+  EXPECT_EQ(mr.samples[2], 0);  // metallic
+  EXPECT_NEAR(mr.samples[4], rough(191 / 255.0, metal_f0), 1);
+  EXPECT_EQ(mr.samples[5], 255);
+  expect_validator_clean(dir / "out" / "scene.gltf");
+}
+
+TEST(CliExport, ConstantMaterialsBecomeFactorsAndCarryTheirF0) {
+  TempDir dir;
+  // Water-like: F0 0.02, which core glTF cannot say; KHR_materials_specular's factor is 0.02 / 0.04.
+  GltfBuilder b = quad_scene(json::array(
+      {{{"name", "Water"},
+        {"extensions", {{"KHR_materials_pbrSpecularGlossiness",
+                         {{"diffuseFactor", {0.3, 0.4, 0.5, 1}}, {"specularFactor", {0.02, 0.02, 0.02}},
+                          {"glossinessFactor", 0.75}}}}}},
+       {{"name", "Unused"}}}));
+  b.write(dir / "in.gltf", {0});
+  const json report = export_json({(dir / "in.gltf").string(), "-o", (dir / "out.glb").string()});
+  ASSERT_FALSE(report.is_null());
+  const gltf::Document out = read_output(dir / "out.glb");
+  const auto& material = out.json["materials"][0];
+  const auto expected = workflow::metal_rough_from_spec_gloss({{0.3, 0.4, 0.5}, {0.02, 0.02, 0.02}, 0.75},
+                                                               workflow::RoughnessMapping::fitted);
+  const auto& pbr = material["pbrMetallicRoughness"];
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(pbr["baseColorFactor"][c].get<double>(), expected.base[c], 1e-6);
+  EXPECT_NEAR(pbr["metallicFactor"].get<double>(), expected.metallic, 1e-6);
+  EXPECT_NEAR(pbr["roughnessFactor"].get<double>(), expected.roughness, 1e-6);
+  EXPECT_FALSE(pbr.contains("baseColorTexture"));
+  EXPECT_NEAR(material["extensions"]["KHR_materials_specular"]["specularColorFactor"][0].get<double>(), 0.5, 1e-6);
+  EXPECT_EQ(out.json["extensionsUsed"], json::array({"KHR_materials_specular"}));
+  EXPECT_NEAR(report["materials"][0]["dielectric_f0"]["mean_f0"].get<double>(), 0.02, 1e-7);
+  expect_validator_clean(dir / "out.glb");
+}
+
+TEST(CliExport, OcclusionAndMetalRoughPackOnceIntoOrm) {
+  TempDir dir;
+  write_raw(dir / "occlusion.png", 2, 1, 1, "uint8", {10, 240});
+  write_raw(dir / "mr.png", 2, 1, 3, "uint8", {0, 30, 200, 0, 90, 5});
+  const json metal_rough = {{"pbrMetallicRoughness", {{"metallicRoughnessTexture", {{"index", 1}}}}},
+                            {"occlusionTexture", {{"index", 0}, {"strength", 0.8}}}};
+  json first = metal_rough, second = metal_rough;
+  first["name"] = "A";
+  second["name"] = "B";
+  GltfBuilder b = quad_scene(json::array({first, second}));
+  b.doc["textures"] = {{{"source", 0}}, {{"source", 1}}};
+  b.doc["images"] = {{{"uri", "occlusion.png"}}, {{"uri", "mr.png"}}};
+  b.write(dir / "in.gltf", {0, 1});  // both quads in the scene: both materials
+  const json report = export_json({(dir / "in.gltf").string(), "-o", (dir / "orm.glb").string()});
+  ASSERT_FALSE(report.is_null());
+  EXPECT_EQ(report["textures_made"], 1);
+  EXPECT_EQ(report["images_decoded"], 2);
+  const gltf::Document out = read_output(dir / "orm.glb");
+  ASSERT_EQ(out.json["textures"].size(), 1u);  // the two originals are gone, replaced by one
+  for (const auto& m : out.json["materials"]) {
+    EXPECT_EQ(m["occlusionTexture"]["index"], 0);
+    EXPECT_EQ(m["occlusionTexture"]["strength"], 0.8);
+    EXPECT_EQ(m["pbrMetallicRoughness"]["metallicRoughnessTexture"]["index"], 0);
+  }
+  const RawImage orm = texture_pixels(out, 0, dir / "orm.png");
+  EXPECT_EQ(orm.samples, (std::vector<double>{10, 30, 200, 240, 90, 5}));
+  expect_validator_clean(dir / "orm.glb");
+  // --no-orm keeps them apart.
+  const json kept = export_json({(dir / "in.gltf").string(), "-o", (dir / "apart.glb").string(), "--no-orm"});
+  EXPECT_EQ(read_output(dir / "apart.glb").json["textures"].size(), 2u);
+}
+
+TEST(CliExport, SchulerPairsWithMasksAndTheirAlphaModes) {
+  TempDir dir;
+  // Pair A: Kd + mask; pair B: grey Ks at code 56 (F0 0.0395: a pure dielectric, base = Kd) + gloss.
+  // A binary mask gives MASK; a partial one BLEND.
+  write_raw(dir / "a_mask.png", 2, 1, 4, "uint8", {180, 120, 60, 255, 180, 120, 60, 0});
+  write_raw(dir / "a_blend.png", 2, 1, 4, "uint8", {180, 120, 60, 255, 180, 120, 60, 128});
+  write_raw(dir / "b.png", 2, 1, 4, "uint8", {56, 56, 56, 200, 56, 56, 56, 200});
+  GltfBuilder b = quad_scene(json::array({{{"name", "Leaf"}}, {{"name", "Glass"}}}));
+  b.write(dir / "in.gltf", {0, 1});
+  const std::string in = (dir / "in.gltf").string();
+  const json report = export_json({in, "-o", (dir / "out.gltf").string(), "--material",
+                                   "Leaf=" + (dir / "a_mask.png").string() + "," + (dir / "b.png").string(),
+                                   "--material", "1=schuler:" + (dir / "a_blend.png").string() + "," + (dir / "b.png").string()});
+  ASSERT_FALSE(report.is_null());
+  EXPECT_EQ(report["materials"][0]["action"], "from Schüler maps");
+  const gltf::Document out = read_output(dir / "out.gltf");
+  EXPECT_EQ(out.json["materials"][0]["alphaMode"], "MASK");
+  EXPECT_EQ(out.json["materials"][0]["alphaCutoff"], 0.5);
+  EXPECT_EQ(out.json["materials"][1]["alphaMode"], "BLEND");
+  const RawImage base = texture_pixels(out, out.json["materials"][1]["pbrMetallicRoughness"]["baseColorTexture"]["index"],
+                                       dir / "base.png");
+  EXPECT_EQ(base.samples, (std::vector<double>{180, 120, 60, 255, 180, 120, 60, 128}));  // Kd kept, mask in alpha
+  expect_validator_clean(dir / "out.gltf");
+}
+
+TEST(CliExport, OnlyWhatTheSceneReachesAndTheSameBytesEveryTime) {
+  TempDir dir;
+  write_raw(dir / "unused.png", 1, 1, 3, "uint8", {1, 2, 3});
+  GltfBuilder b = quad_scene(json::array({{{"name", "Used"}}, {{"name", "Unused"},
+                                            {"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}}}));
+  b.doc["textures"] = {{{"source", 0}}};
+  b.doc["images"] = {{{"uri", "unused.png"}}};
+  b.write(dir / "in.gltf", {0});
+  const json report = export_json({(dir / "in.gltf").string(), "-o", (dir / "a.glb").string(), "--ao-samples", "16"});
+  ASSERT_FALSE(report.is_null());
+  const std::vector<std::string> skipped = report["skipped"];
+  for (const char* what : {"mesh 1: not reachable from the default scene",
+                           "material 1 'Unused': not reachable from the default scene",
+                           "texture 0: not reachable from the default scene", "image 0: not reachable from the default scene"}) {
+    EXPECT_NE(std::find(skipped.begin(), skipped.end(), what), skipped.end()) << what;
+  }
+  EXPECT_EQ(report["ao_rays"], 4 * 16);
+  const gltf::Document out = read_output(dir / "a.glb");
+  EXPECT_EQ(out.json["nodes"].size(), 2u);
+  EXPECT_FALSE(out.json["nodes"][1].contains("mesh"));
+  EXPECT_EQ(out.json["meshes"].size(), 1u);
+  EXPECT_EQ(out.json["materials"].size(), 1u);
+  EXPECT_FALSE(out.json.contains("textures"));
+  EXPECT_TRUE(out.json["meshes"][0]["primitives"][0]["attributes"].contains("COLOR_0"));
+  expect_validator_clean(dir / "a.glb");
+  ASSERT_EQ(matbake({"-q", "export", (dir / "in.gltf").string(), "-o", (dir / "b.glb").string(), "--ao-samples", "16"}).exit_code, 0);
+  EXPECT_EQ(read_bytes(dir / "a.glb"), read_bytes(dir / "b.glb"));
+}
+
+TEST(CliExport, BadInputIsRefusedAndNothingIsWritten) {
+  TempDir dir;
+  fs::create_directories(dir / "out");
+  const std::string out = (dir / "out" / "x.glb").string();
+  GltfBuilder good = quad_scene(json::array({{{"name", "M"}}, {{"name", "N"}}}));
+  good.write(dir / "good.gltf", {0});
+  std::ofstream(dir / "malformed.gltf") << "{\"asset\": {\"version\": \"2.0\"";
+  {
+    GltfBuilder b = quad_scene(json::array({{{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}}, json::object()}));
+    b.doc["textures"] = {{{"source", 0}}};
+    b.doc["images"] = {{{"uri", "missing.png"}}};
+    b.write(dir / "missing.gltf", {0});
+    b.doc["images"] = {{{"uri", "../../etc/passwd"}}};
+    b.write(dir / "escape.gltf", {0});
+    b.doc["images"] = {{{"uri", "data:image/png;base64," + base64(std::vector<unsigned char>(
+                                                               {0x89, 'P', 'N', 'G', 0, 0, 0, 0}))}}};
+    b.write(dir / "broken-data.gltf", {0});
+  }
+  {
+    GltfBuilder b = quad_scene(json::array({json::object(), json::object()}));
+    b.doc["accessors"][0]["count"] = 400;
+    b.write(dir / "range.gltf", {0});
+  }
+  write_bytes(dir / "chunks.glb", std::string("glTF\x02\0\0\0\x40\0\0\0\xff\0\0\0JSON{}", 22) + std::string(42, ' '));
+  using Case = std::pair<std::string, std::string>;
+  for (const auto& [file, problem] :
+       {Case{"malformed.gltf", "not a valid glTF"}, Case{"missing.gltf", "image 0: 'missing.png' cannot be read"},
+        Case{"escape.gltf", "URI '../../etc/passwd' is outside the glTF's folder"},
+        Case{"broken-data.gltf", "image 0: "}, Case{"range.gltf", "accessor 0 reaches beyond its buffer"},
+        Case{"chunks.glb", "not a valid glTF"}}) {
+    const RunResult r = matbake({"export", (dir / file).string(), "-o", out});
+    EXPECT_EQ(r.exit_code, 1) << file << ": " << r.err;
+    expect_one_error_line(r, (dir / file).string(), problem);
+  }
+  const std::string good_path = (dir / "good.gltf").string();
+  for (const auto& [args, problem] :
+       {Case{"--material", "Nope=a.png,b.png"}, Case{"--material", "no-equals-sign"}, Case{"--ao-into", "COLOR_1"}}) {
+    const RunResult r = matbake({"export", good_path, "-o", out, args, problem});
+    EXPECT_NE(r.exit_code, 0) << problem;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  }
+  const RunResult unknown = matbake({"export", good_path, "-o", out, "--material", "Nope=" + good_path + "," + good_path});
+  EXPECT_EQ(unknown.exit_code, 1);
+  EXPECT_TRUE(list_folder(dir / "out").empty());
+  const RunResult over = matbake({"export", good_path, "-o", good_path});
+  EXPECT_EQ(over.exit_code, 2) << over.err;
+}
+
+}  // namespace
+}  // namespace matbake::test
