@@ -50,6 +50,7 @@ nlohmann::json report_to_json(const exporter::Report& r) {
       j["dielectric_f0"] = to_json(m.conversion->dielectric);
     }
     if (m.specular_color_factor) j["KHR_materials_specular"] = {{"specularColorFactor", *m.specular_color_factor}};
+    if (m.ior) j["KHR_materials_ior"] = {{"ior", *m.ior}};
     materials.push_back(std::move(j));
   }
   return {{"command", "export"},     {"materials", materials},           {"skipped", r.skipped},
@@ -75,6 +76,10 @@ CLI::App* setup_export(CLI::App& app, ExportSettings& s) {
   cmd->add_option("--transfer", s.transfer, "How 8-bit colour in --material files was authored: srgb or gamma2.2")
       ->capture_default_str();
   cmd->add_option("--mapping", s.mapping, "Gloss -> roughness: fitted or walter")->capture_default_str();
+  cmd->add_option("--dielectric-f0", s.dielectric_f0,
+                  "A converted dielectric whose F0 is not 0.04: specular (KHR_materials_specular), ior\n"
+                  "(KHR_materials_ior), or none (core glTF's 0.04)")
+      ->capture_default_str();
   cmd->add_flag("--no-orm", s.no_orm, "Keep occlusion and metallic-roughness textures apart");
   cmd->add_option("--ao-samples", s.ao_samples, "Bake per-vertex AO with this many rays per vertex (0: none)")
       ->capture_default_str();
@@ -91,6 +96,15 @@ int run_export(const ExportSettings& s, const GlobalOptions& global) {
   auto transfer = parse_transfer(s.transfer, "--transfer");
   if (!transfer) return report_error(transfer.error());
   options.pack_orm = !s.no_orm;
+  if (s.dielectric_f0 == "specular") {
+    options.dielectric_f0 = exporter::DielectricF0::specular;
+  } else if (s.dielectric_f0 == "ior") {
+    options.dielectric_f0 = exporter::DielectricF0::ior;
+  } else if (s.dielectric_f0 == "none") {
+    options.dielectric_f0 = exporter::DielectricF0::none;
+  } else {
+    return report_error(Error{"", "--dielectric-f0 '" + s.dielectric_f0 + "': use specular, ior or none", true});
+  }
   if (s.ao_into != "COLOR_0" && s.ao_into != "_AO") {
     return report_error(Error{"", "--ao-into '" + s.ao_into + "': use COLOR_0 or _AO", true});
   }
@@ -126,6 +140,7 @@ int run_export(const ExportSettings& s, const GlobalOptions& global) {
                     m.conversion->errors.specular.mean, 100 * m.conversion->errors.lobe.mean);
       }
       if (m.specular_color_factor) std::printf("; KHR_materials_specular %.4g", *m.specular_color_factor);
+      if (m.ior) std::printf("; KHR_materials_ior %.4g", *m.ior);
       std::printf("\n");
     }
     for (const std::string& skipped : report->skipped) std::cout << "left out: " << skipped << "\n";

@@ -129,6 +129,7 @@ struct ExportSettings {
   std::vector<std::string> materials;  // NAME=[LAYOUT:]FILE,FILE...
   std::string transfer = "srgb";       // of 8-bit colour in those files
   std::string mapping = "fitted";
+  std::string dielectric_f0 = "specular";
   bool no_orm = false;
   int ao_samples = 0;                  // 0: no AO
   std::string ao_into = "COLOR_0";

@@ -121,13 +121,12 @@ TEST(CliExport, SpecGlossTexturesConvertTexelByTexel) {
 TEST(CliExport, ConstantMaterialsBecomeFactorsAndCarryTheirF0) {
   TempDir dir;
   // Water-like: F0 0.02, which core glTF cannot say; KHR_materials_specular's factor is 0.02 / 0.04.
-  GltfBuilder b = quad_scene(json::array(
-      {{{"name", "Water"},
-        {"extensions", {{"KHR_materials_pbrSpecularGlossiness",
-                         {{"diffuseFactor", {0.3, 0.4, 0.5, 1}}, {"specularFactor", {0.02, 0.02, 0.02}},
-                          {"glossinessFactor", 0.75}}}}}},
-       {{"name", "Unused"}}}));
-  b.write(dir / "in.gltf", {0});
+  // Two materials with the same block: the second reuses the first's conversion.
+  const json water = {{"extensions", {{"KHR_materials_pbrSpecularGlossiness",
+                                       {{"diffuseFactor", {0.3, 0.4, 0.5, 1}}, {"specularFactor", {0.02, 0.02, 0.02}},
+                                        {"glossinessFactor", 0.75}}}}}};
+  GltfBuilder b = quad_scene(json::array({water, water}));
+  b.write(dir / "in.gltf", {0, 1});
   const json report = export_json({(dir / "in.gltf").string(), "-o", (dir / "out.glb").string()});
   ASSERT_FALSE(report.is_null());
   const gltf::Document out = read_output(dir / "out.glb");
@@ -142,7 +141,18 @@ TEST(CliExport, ConstantMaterialsBecomeFactorsAndCarryTheirF0) {
   EXPECT_NEAR(material["extensions"]["KHR_materials_specular"]["specularColorFactor"][0].get<double>(), 0.5, 1e-6);
   EXPECT_EQ(out.json["extensionsUsed"], json::array({"KHR_materials_specular"}));
   EXPECT_NEAR(report["materials"][0]["dielectric_f0"]["mean_f0"].get<double>(), 0.02, 1e-7);
+  EXPECT_EQ(out.json["materials"][1], out.json["materials"][0]);
+  EXPECT_EQ(report["materials"][1]["action"],
+            "converted from KHR_materials_pbrSpecularGlossiness (same as an earlier material: its textures reused)");
+  EXPECT_EQ(report["materials"][1]["KHR_materials_specular"], report["materials"][0]["KHR_materials_specular"]);
   expect_validator_clean(dir / "out.glb");
+  // The same F0 as an IOR: ((n − 1)/(n + 1))² = 0.02.
+  ASSERT_FALSE(export_json({(dir / "in.gltf").string(), "-o", (dir / "ior.glb").string(), "--dielectric-f0", "ior"}).is_null());
+  const gltf::Document ior = read_output(dir / "ior.glb");
+  const double n = ior.json["materials"][0]["extensions"]["KHR_materials_ior"]["ior"];
+  EXPECT_NEAR(std::pow((n - 1) / (n + 1), 2), 0.02, 1e-7);
+  EXPECT_FALSE(ior.json["materials"][0]["extensions"].contains("KHR_materials_specular"));
+  expect_validator_clean(dir / "ior.glb");
 }
 
 TEST(CliExport, OcclusionAndMetalRoughPackOnceIntoOrm) {
@@ -225,7 +235,11 @@ TEST(CliExport, OnlyWhatTheSceneReachesAndTheSameBytesEveryTime) {
   EXPECT_EQ(out.json["meshes"].size(), 1u);
   EXPECT_EQ(out.json["materials"].size(), 1u);
   EXPECT_FALSE(out.json.contains("textures"));
-  EXPECT_TRUE(out.json["meshes"][0]["primitives"][0]["attributes"].contains("COLOR_0"));
+  const auto& attributes = out.json["meshes"][0]["primitives"][0]["attributes"];
+  EXPECT_EQ(attributes.size(), 3u);  // POSITION, TEXCOORD_0 as they were, and COLOR_0
+  for (const char* a : {"POSITION", "TEXCOORD_0", "COLOR_0"}) {
+    EXPECT_EQ(out.json["accessors"][attributes[a].get<std::size_t>()]["count"], 4) << a;
+  }
   expect_validator_clean(dir / "a.glb");
   ASSERT_EQ(matbake({"-q", "export", (dir / "in.gltf").string(), "-o", (dir / "b.glb").string(), "--ao-samples", "16"}).exit_code, 0);
   EXPECT_EQ(read_bytes(dir / "a.glb"), read_bytes(dir / "b.glb"));
@@ -245,6 +259,8 @@ TEST(CliExport, BadInputIsRefusedAndNothingIsWritten) {
     b.write(dir / "missing.gltf", {0});
     b.doc["images"] = {{{"uri", "../../etc/passwd"}}};
     b.write(dir / "escape.gltf", {0});
+    b.doc["images"] = {{{"uri", "/etc/passwd"}}};
+    b.write(dir / "absolute.gltf", {0});
     b.doc["images"] = {{{"uri", "data:image/png;base64," + base64(std::vector<unsigned char>(
                                                                {0x89, 'P', 'N', 'G', 0, 0, 0, 0}))}}};
     b.write(dir / "broken-data.gltf", {0});
@@ -259,6 +275,7 @@ TEST(CliExport, BadInputIsRefusedAndNothingIsWritten) {
   for (const auto& [file, problem] :
        {Case{"malformed.gltf", "not a valid glTF"}, Case{"missing.gltf", "image 0: 'missing.png' cannot be read"},
         Case{"escape.gltf", "URI '../../etc/passwd' is outside the glTF's folder"},
+        Case{"absolute.gltf", "URI '/etc/passwd' is outside the glTF's folder"},
         Case{"broken-data.gltf", "image 0: "}, Case{"range.gltf", "accessor 0 reaches beyond its buffer"},
         Case{"chunks.glb", "not a valid glTF"}}) {
     const RunResult r = matbake({"export", (dir / file).string(), "-o", out});

@@ -27,8 +27,14 @@ struct MaterialMaps {
   pack::SourceMaps maps;  // kd, ks, gloss (Schüler) or base_color, metallic, roughness; mask, occlusion optional
 };
 
+// How a converted dielectric whose F0 is not 0.04 says so: KHR_materials_specular's
+// specularColorFactor = F0 / 0.04 (the IOR stays 1.5), or KHR_materials_ior's IOR from F0 =
+// ((n − 1)/(n + 1))² (which also bends refraction, for transmissive materials), or neither.
+enum class DielectricF0 { specular, ior, none };
+
 struct Options {
   std::vector<MaterialMaps> materials;
+  DielectricF0 dielectric_f0 = DielectricF0::specular;
   workflow::RoughnessMapping mapping = workflow::RoughnessMapping::fitted;
   bool pack_orm = true;           // occlusion + metallic-roughness into one texture
   std::optional<ao::Options> ao;  // bake per-vertex AO when set
@@ -42,6 +48,7 @@ struct MaterialReport {
   std::optional<workflow::ConversionReport> conversion;
   std::string alpha_mode;  // as written
   std::optional<double> specular_color_factor;  // KHR_materials_specular, when written
+  std::optional<double> ior;                    // KHR_materials_ior, when written
 };
 
 struct Report {

@@ -18,6 +18,7 @@ namespace {
 
 constexpr const char* kSpecGloss = "KHR_materials_pbrSpecularGlossiness";
 constexpr const char* kSpecular = "KHR_materials_specular";
+constexpr const char* kIor = "KHR_materials_ior";
 constexpr double kCoreF0 = 0.04;
 constexpr double kF0Tolerance = 0.001;  // below an 8-bit sRGB step at F0 0.04 (0.0014)
 
@@ -113,14 +114,20 @@ struct Exporter {
     return success();
   }
 
-  // KHR_materials_specular for dielectric texels whose F0 is not glTF's 0.04.
+  // KHR_materials_specular or KHR_materials_ior for dielectric texels whose F0 is not glTF's 0.04.
   void add_dielectric_f0(Json& material, const workflow::ConversionReport& conversion, MaterialReport& out) {
     const auto& d = conversion.dielectric;
-    if (d.texels == 0 || std::abs(d.mean_f0 - kCoreF0) <= kF0Tolerance) return;
-    const double f = d.specular_color_factor;
-    material["extensions"][kSpecular] = {{"specularColorFactor", {f, f, f}}};
-    add_extension_used(doc.json, kSpecular);
-    out.specular_color_factor = f;
+    if (d.texels == 0 || std::abs(d.mean_f0 - kCoreF0) <= kF0Tolerance || options.dielectric_f0 == DielectricF0::none) return;
+    if (options.dielectric_f0 == DielectricF0::specular) {
+      const double f = d.specular_color_factor;
+      material["extensions"][kSpecular] = {{"specularColorFactor", {f, f, f}}};
+      add_extension_used(doc.json, kSpecular);
+      out.specular_color_factor = f;
+    } else {
+      material["extensions"][kIor] = {{"ior", d.ior}};
+      add_extension_used(doc.json, kIor);
+      out.ior = d.ior;
+    }
   }
 
   // Alpha from a mask map: none or all 1 → OPAQUE, only 0 and 1 → MASK, else BLEND.
@@ -185,9 +192,11 @@ struct Exporter {
     out.action = "converted from " + std::string(kSpecGloss);
     if (const auto done = converted.find(key); done != converted.end()) {
       material["pbrMetallicRoughness"] = done->second["pbr"];
-      if (done->second.contains("specular")) {
-        material["extensions"][kSpecular] = done->second["specular"];
-        out.specular_color_factor = done->second["specular"]["specularColorFactor"][0].get<double>();
+      if (done->second.contains("extensions")) {
+        for (const auto& [name, value] : done->second["extensions"].items()) material["extensions"][name] = value;
+        const Json& extensions = material["extensions"];
+        if (extensions.contains(kSpecular)) out.specular_color_factor = extensions[kSpecular]["specularColorFactor"][0].get<double>();
+        if (extensions.contains(kIor)) out.ior = extensions[kIor]["ior"].get<double>();
       }
       out.action += " (same as an earlier material: its textures reused)";
       return success();
@@ -204,8 +213,11 @@ struct Exporter {
     add_dielectric_f0(material, conversion, out);
     out.conversion = conversion;
     Json remembered = {{"pbr", material["pbrMetallicRoughness"]}};
-    if (material.contains("extensions") && material["extensions"].contains(kSpecular)) {
-      remembered["specular"] = material["extensions"][kSpecular];
+    if (out.specular_color_factor || out.ior) {
+      remembered["extensions"] = Json::object();
+      for (const char* name : {kSpecular, kIor}) {
+        if (material["extensions"].contains(name)) remembered["extensions"][name] = material["extensions"][name];
+      }
     }
     converted[key] = remembered;
     return success();
