@@ -1,8 +1,10 @@
 #include "matbake/validate.hpp"
 
+#include <emmintrin.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <cstring>
 #include <limits>
 
 #include "matbake/workflow.hpp"
@@ -15,26 +17,14 @@ using materials::F0Class;
 constexpr int kRowsPerBlock = 64;
 
 // One block of rows' share of the report; blocks merge in order, so the result does not depend on
-// the thread count.
-// Per-channel sum and range. The hot loop stays in float: a row's sum is kept in float (rows of
-// a few thousand values in [0, 1]: relative error ~1e-6 typically, 1e-4 at worst) and added to the
-// double total at the end of the row.
+// the thread count. Per-channel sums: float within a row (rows of a few thousand values in [0, 1]:
+// relative error ~1e-6 typically, 1e-4 at worst), double across rows.
 struct Accumulator {
   std::array<double, 3> sum{};
-  std::array<float, 3> row_sum{}, lo{}, hi{};
+  std::array<float, 3> lo{}, hi{};
   Accumulator() {
-    lo.fill(std::numeric_limits<float>::infinity());
-    hi.fill(-std::numeric_limits<float>::infinity());
-  }
-  void add(const float* v) {
-    for (std::size_t c = 0; c < 3; ++c) {
-      row_sum[c] += v[c];
-      lo[c] = std::min(lo[c], v[c]);
-      hi[c] = std::max(hi[c], v[c]);
-    }
-  }
-  void end_row() {
-    for (std::size_t c = 0; c < 3; ++c) sum[c] += row_sum[c], row_sum[c] = 0;
+    lo.fill(std::numeric_limits<float>::max());
+    hi.fill(-std::numeric_limits<float>::max());
   }
   void merge(const Accumulator& other) {
     for (std::size_t c = 0; c < 3; ++c) {
@@ -69,99 +59,256 @@ void keep_worst(std::vector<Texel>& worst, const Texel& t, std::size_t count) {
 float min3(const float* v) { return std::min(v[0], std::min(v[1], v[2])); }
 float max3(const float* v) { return std::max(v[0], std::max(v[1], v[2])); }
 
+constexpr float kHuge = std::numeric_limits<float>::max();
+
+// What is the same for every row of one validation.
+struct RowSetup {
+  const float* specular;
+  const float* diffuse;  // or null
+  const float* mask;     // or null
+  const materials::Material* material;
+  // Class boundaries on the channel sum (3 × the mean's), in float like the rest of the loop.
+  float t0, t1, t2, t3;
+  std::array<float, 3> reference{}, allowed{};  // the material's F0 and allowed deviation per channel
+};
+
+// One row's counts and sums from the first pass.
+struct RowPass {
+  int live = 0;                     // texels not masked
+  std::array<int, 4> at_least{};    // texels with sum ≥ t0, t1, t2, t3
+  int material_within = 0;
+  std::array<float, 3> f0_sum{}, f0_lo{}, f0_hi{}, d_sum{}, d_lo{}, d_hi{};
+};
+
+// --- The first pass, 4 texels at a time in SSE2 (x86-64's baseline) --------------------------------
+using V = __m128;
+
+V splat(float v) { return _mm_set1_ps(v); }
+V select(V m, V a, V b) { return _mm_or_ps(_mm_and_ps(m, a), _mm_andnot_ps(m, b)); }
+int count(V m) { return __builtin_popcount(unsigned(_mm_movemask_ps(m))); }
+float horizontal_sum(V v) {
+  alignas(16) float f[4];
+  _mm_store_ps(f, v);
+  return (f[0] + f[1]) + (f[2] + f[3]);
+}
+float horizontal(V v, float (*op)(float, float)) {
+  alignas(16) float f[4];
+  _mm_store_ps(f, v);
+  return op(op(f[0], f[1]), op(f[2], f[3]));
+}
+
+// Four interleaved RGB texels (12 floats) as R, G and B vectors.
+struct Rgb4 {
+  V r, g, b;
+};
+Rgb4 load_rgb4(const float* p) {
+  const V a0 = _mm_loadu_ps(p), a1 = _mm_loadu_ps(p + 4), a2 = _mm_loadu_ps(p + 8);  // r0g0b0r1 g1b1r2g2 b2r3g3b3
+  const V r23 = _mm_shuffle_ps(a1, a2, _MM_SHUFFLE(1, 0, 3, 2));                       // r2 g2 b2 r3
+  const V g01 = _mm_shuffle_ps(a0, a1, _MM_SHUFFLE(0, 0, 1, 1)), g23 = _mm_shuffle_ps(a1, a2, _MM_SHUFFLE(2, 2, 3, 3));
+  const V b01 = _mm_shuffle_ps(a0, a1, _MM_SHUFFLE(1, 1, 2, 2)), b23 = _mm_shuffle_ps(a2, a2, _MM_SHUFFLE(3, 3, 0, 0));
+  return {_mm_shuffle_ps(a0, r23, _MM_SHUFFLE(3, 0, 3, 0)), _mm_shuffle_ps(g01, g23, _MM_SHUFFLE(2, 0, 2, 0)),
+          _mm_shuffle_ps(b01, b23, _MM_SHUFFLE(2, 0, 2, 0))};
+}
+
+struct ChannelAccumulator {
+  V sum[3] = {_mm_setzero_ps(), _mm_setzero_ps(), _mm_setzero_ps()};
+  V lo[3] = {splat(kHuge), splat(kHuge), splat(kHuge)}, hi[3] = {splat(-kHuge), splat(-kHuge), splat(-kHuge)};
+  void add(const Rgb4& c, V live) {
+    const V v[3] = {c.r, c.g, c.b};
+    for (int k = 0; k < 3; ++k) {
+      sum[k] = _mm_add_ps(sum[k], _mm_and_ps(live, v[k]));
+      lo[k] = _mm_min_ps(lo[k], select(live, v[k], splat(kHuge)));
+      hi[k] = _mm_max_ps(hi[k], select(live, v[k], splat(-kHuge)));
+    }
+  }
+  void store(std::array<float, 3>& s, std::array<float, 3>& l, std::array<float, 3>& h) const {
+    for (std::size_t k = 0; k < 3; ++k) {
+      s[k] = horizontal_sum(sum[k]);
+      l[k] = horizontal(lo[k], [](float a, float b) { return std::min(a, b); });
+      h[k] = horizontal(hi[k], [](float a, float b) { return std::max(a, b); });
+    }
+  }
+};
+
+V min3(const Rgb4& c) { return _mm_min_ps(c.r, _mm_min_ps(c.g, c.b)); }
+V max3(const Rgb4& c) { return _mm_max_ps(c.r, _mm_max_ps(c.g, c.b)); }
+V abs(V v) { return _mm_andnot_ps(splat(-0.0f), v); }
+
+// The first pass over a row: classes, counts, sums and ranges of every texel, and whether anything
+// about it could be flagged (suspect); the second pass looks closer at those only. The row's last
+// texels (width not a multiple of 4) are copied into a padded block whose extra texels are masked.
+template <bool kMask, bool kDiffuse, bool kMaterial>
+void first_pass(const RowSetup& r, std::size_t row, int width, std::uint8_t* classes, std::uint8_t* suspect, RowPass& out) {
+  const V all = _mm_castsi128_ps(_mm_set1_epi32(-1));
+  const V t0 = splat(r.t0), t1 = splat(r.t1), t2 = splat(r.t2), t3 = splat(r.t3);
+  ChannelAccumulator f0, diffuse;
+  int live_count = 0, at_least[4] = {}, within_count = 0;
+  const auto block = [&](const float* s, const float* d, V live, std::uint8_t* cls_out, std::uint8_t* suspect_out) {
+    const Rgb4 f = load_rgb4(s);
+    const V sum = _mm_add_ps(_mm_add_ps(f.r, f.g), f.b), lo = min3(f), hi = max3(f);
+    const V g0 = _mm_cmpge_ps(sum, t0), g1 = _mm_cmpge_ps(sum, t1), g2 = _mm_cmpge_ps(sum, t2), g3 = _mm_cmpge_ps(sum, t3);
+    const V zero = _mm_setzero_ps(), one = splat(1.0f);
+    V flagged = _mm_or_ps(_mm_andnot_ps(g0, all), _mm_andnot_ps(g3, g2));  // below; semiconductor gap
+    flagged = _mm_or_ps(flagged, _mm_or_ps(_mm_cmplt_ps(lo, zero), _mm_cmpgt_ps(hi, one)));
+    const V coloured = _mm_cmpgt_ps(_mm_sub_ps(hi, lo), _mm_mul_ps(splat(float(kColouredRatio)), hi));
+    flagged = _mm_or_ps(flagged, _mm_and_ps(_mm_andnot_ps(g2, g0), coloured));  // dielectric or gem
+    live_count += count(live);
+    at_least[0] += count(_mm_and_ps(live, g0)), at_least[1] += count(_mm_and_ps(live, g1));
+    at_least[2] += count(_mm_and_ps(live, g2)), at_least[3] += count(_mm_and_ps(live, g3));
+    f0.add(f, live);
+    if constexpr (kDiffuse) {
+      const Rgb4 c = load_rgb4(d);
+      const V luminance = _mm_add_ps(_mm_add_ps(_mm_mul_ps(splat(0.2126f), c.r), _mm_mul_ps(splat(0.7152f), c.g)),
+                                     _mm_mul_ps(splat(0.0722f), c.b));
+      flagged = _mm_or_ps(flagged, _mm_or_ps(_mm_cmplt_ps(min3(c), zero), _mm_cmpgt_ps(max3(c), one)));
+      flagged = _mm_or_ps(flagged, _mm_and_ps(g3, _mm_cmpge_ps(luminance, splat(float(kMetalDiffuseMax)))));
+      const V implausible = _mm_or_ps(_mm_cmplt_ps(luminance, splat(float(kAlbedoMin))),
+                                      _mm_cmpgt_ps(luminance, splat(float(kAlbedoMax))));
+      flagged = _mm_or_ps(flagged, _mm_andnot_ps(g3, implausible));
+      diffuse.add(c, live);
+    }
+    if constexpr (kMaterial) {
+      const V within = _mm_and_ps(
+          _mm_cmple_ps(abs(_mm_sub_ps(f.r, splat(r.reference[0]))), splat(r.allowed[0])),
+          _mm_and_ps(_mm_cmple_ps(abs(_mm_sub_ps(f.g, splat(r.reference[1]))), splat(r.allowed[1])),
+                     _mm_cmple_ps(abs(_mm_sub_ps(f.b, splat(r.reference[2]))), splat(r.allowed[2]))));
+      within_count += count(_mm_and_ps(live, within));
+      flagged = _mm_or_ps(flagged, _mm_andnot_ps(within, all));
+    }
+    // Class 0–4 (the masks are −1 where true), kMaskedTexel where not live.
+    const __m128i cls = _mm_sub_epi32(_mm_setzero_si128(),
+                                      _mm_add_epi32(_mm_add_epi32(_mm_castps_si128(g0), _mm_castps_si128(g1)),
+                                                    _mm_add_epi32(_mm_castps_si128(g2), _mm_castps_si128(g3))));
+    const __m128i masked = _mm_set1_epi32(kMaskedTexel);
+    const __m128i chosen = _mm_or_si128(_mm_and_si128(_mm_castps_si128(live), cls), _mm_andnot_si128(_mm_castps_si128(live), masked));
+    const int bytes = _mm_cvtsi128_si32(_mm_packus_epi16(_mm_packs_epi32(chosen, chosen), _mm_setzero_si128()));
+    std::memcpy(cls_out, &bytes, 4);
+    const int bits = _mm_movemask_ps(_mm_and_ps(live, flagged));
+    for (int k = 0; k < 4; ++k) suspect_out[k] = std::uint8_t((bits >> k) & 1);
+  };
+  const auto live_of = [&](std::size_t i) { return kMask ? _mm_cmpgt_ps(_mm_loadu_ps(r.mask + i), _mm_setzero_ps()) : all; };
+  int x = 0;
+  for (; x + 4 <= width; x += 4) {
+    const std::size_t i = row + std::size_t(x);
+    block(r.specular + i * 3, kDiffuse ? r.diffuse + i * 3 : nullptr, live_of(i), classes + x, suspect + x);
+  }
+  if (x < width) {
+    const int n = width - x;
+    const std::size_t i = row + std::size_t(x);
+    float s[12] = {}, d[12] = {}, m[4] = {};
+    std::uint8_t cls_tail[4], suspect_tail[4];
+    std::copy_n(r.specular + i * 3, n * 3, s);
+    if (kDiffuse) std::copy_n(r.diffuse + i * 3, n * 3, d);
+    for (int k = 0; k < n; ++k) m[k] = kMask ? r.mask[i + std::size_t(k)] : 1.0f;
+    block(s, d, _mm_cmpgt_ps(_mm_loadu_ps(m), _mm_setzero_ps()), cls_tail, suspect_tail);
+    std::copy_n(cls_tail, n, classes + x);
+    std::copy_n(suspect_tail, n, suspect + x);
+  }
+  out.live += live_count;
+  for (std::size_t k = 0; k < 4; ++k) out.at_least[k] += at_least[k];
+  out.material_within += within_count;
+  f0.store(out.f0_sum, out.f0_lo, out.f0_hi);
+  diffuse.store(out.d_sum, out.d_lo, out.d_hi);
+}
+
+using FirstPass = void (*)(const RowSetup&, std::size_t, int, std::uint8_t*, std::uint8_t*, RowPass&);
+
+FirstPass first_pass_for(bool mask, bool diffuse, bool material) {
+  static constexpr FirstPass kPasses[8] = {
+      first_pass<false, false, false>, first_pass<false, false, true>, first_pass<false, true, false>,
+      first_pass<false, true, true>,   first_pass<true, false, false>,  first_pass<true, false, true>,
+      first_pass<true, true, false>,   first_pass<true, true, true>};
+  return kPasses[int(mask) * 4 + int(diffuse) * 2 + int(material)];
+}
+
+// The second pass, for a suspect texel: its flags and how far off it is (the most of any flag).
+std::uint8_t check_texel(const RowSetup& r, std::size_t i, F0Class cls, double& severity) {
+  const float* s = r.specular + i * 3;
+  const float lo = min3(s), hi = max3(s);
+  const double mean = double(s[0] + s[1] + s[2]) / 3;
+  std::uint8_t flags = 0;
+  severity = 0;
+  const auto flag = [&](Flag f, double how_far) {
+    flags |= f;
+    severity = std::max(severity, how_far);
+  };
+  if (cls == F0Class::below) flag(kBelowReal, materials::kBelowReal - mean);
+  if (cls == F0Class::semiconductor) {
+    flag(kSemiconductorGap, std::min(mean - materials::kSemiconductorFrom, materials::kMetalFrom - mean));
+  }
+  if (lo < 0 || hi > 1) flag(kNotReflectance, std::max(-lo, hi - 1.0f));
+  if ((cls == F0Class::dielectric || cls == F0Class::gem) && hi - lo > float(kColouredRatio) * hi) {
+    flag(kColouredDielectric, hi - lo);
+  }
+  if (r.diffuse) {
+    const float* d = r.diffuse + i * 3;
+    const float luminance = 0.2126f * d[0] + 0.7152f * d[1] + 0.0722f * d[2];
+    const float d_lo = min3(d), d_hi = max3(d);
+    if (d_lo < 0 || d_hi > 1) flag(kNotReflectance, std::max(-d_lo, d_hi - 1.0f));
+    if (cls == F0Class::metal) {
+      if (luminance >= float(kMetalDiffuseMax)) flag(kMetalWithDiffuse, luminance);
+    } else if (luminance < float(kAlbedoMin) || luminance > float(kAlbedoMax)) {
+      flag(kAlbedoOutOfRange, luminance < float(kAlbedoMin) ? kAlbedoMin - luminance : luminance - kAlbedoMax);
+    }
+  }
+  if (r.material) {
+    const float off[3] = {std::abs(s[0] - r.reference[0]), std::abs(s[1] - r.reference[1]), std::abs(s[2] - r.reference[2])};
+    if (off[0] > r.allowed[0] || off[1] > r.allowed[1] || off[2] > r.allowed[2]) flag(kMaterialMismatch, max3(off));
+  }
+  return flags;
+}
+
 void check_rows(const Inputs& in, const Options& options, int y0, int y1, Partial& p, std::uint8_t* class_map) {
   const int width = in.specular->width;
-  const materials::Material* material = options.material;
-  // Counters and sums live in locals, not in `p`: the byte stores to class_map may alias anything
-  // reachable through `p`, which would keep them in memory.
-  const float* const specular = in.specular->pixels.data();
-  const float* const diffuse = in.diffuse ? in.diffuse->pixels.data() : nullptr;
-  const float* const mask = in.mask ? in.mask->pixels.data() : nullptr;
-  std::size_t masked = 0, checked = 0, violations = 0, material_within = 0;
-  std::array<std::size_t, 5> class_counts{};
-  std::array<std::size_t, kFlagCount> flag_counts{};
-  Accumulator f0_stats, diffuse_stats;
-  // Class boundaries on the channel sum (3 × the mean's), in float like the rest of the loop.
-  const float t0 = float(3 * materials::kBelowReal), t1 = float(3 * materials::kGemFrom),
-              t2 = float(3 * materials::kSemiconductorFrom), t3 = float(3 * materials::kMetalFrom);
-  // The material's F0 and allowed deviation per channel.
-  std::array<float, 3> reference{}, allowed{};
-  for (int c = 0; c < 3 && material; ++c) {
-    reference[std::size_t(c)] = float(material->f0[c]);
-    allowed[std::size_t(c)] = float(options.tolerance * material->f0[c]);
+  RowSetup r{in.specular->pixels.data(), in.diffuse ? in.diffuse->pixels.data() : nullptr,
+             in.mask ? in.mask->pixels.data() : nullptr, options.material,
+             float(3 * materials::kBelowReal), float(3 * materials::kGemFrom), float(3 * materials::kSemiconductorFrom),
+             float(3 * materials::kMetalFrom)};
+  for (int c = 0; c < 3 && r.material; ++c) {
+    r.reference[std::size_t(c)] = float(r.material->f0[c]);
+    r.allowed[std::size_t(c)] = float(options.tolerance * r.material->f0[c]);
   }
+  const FirstPass pass = first_pass_for(r.mask != nullptr, r.diffuse != nullptr, r.material != nullptr);
+  std::vector<std::uint8_t> classes(static_cast<std::size_t>(width)), suspect(static_cast<std::size_t>(width));
+  RowPass counts;
   for (int y = y0; y < y1; ++y) {
+    const std::size_t row = std::size_t(y) * std::size_t(width);
+    RowPass sums;
+    pass(r, row, width, classes.data(), suspect.data(), sums);
+    counts.live += sums.live;
+    for (std::size_t k = 0; k < 4; ++k) counts.at_least[k] += sums.at_least[k];
+    counts.material_within += sums.material_within;
+    for (std::size_t c = 0; c < 3; ++c) {
+      p.f0.sum[c] += sums.f0_sum[c], p.diffuse.sum[c] += sums.d_sum[c];
+      p.f0.lo[c] = std::min(p.f0.lo[c], sums.f0_lo[c]), p.f0.hi[c] = std::max(p.f0.hi[c], sums.f0_hi[c]);
+      p.diffuse.lo[c] = std::min(p.diffuse.lo[c], sums.d_lo[c]), p.diffuse.hi[c] = std::max(p.diffuse.hi[c], sums.d_hi[c]);
+    }
     for (int x = 0; x < width; ++x) {
-      const std::size_t i = std::size_t(y) * std::size_t(width) + std::size_t(x);
-      if (mask && mask[i] <= 0.0f) {
-        ++masked;
-        if (class_map) class_map[i] = kMaskedTexel;
-        continue;
-      }
-      ++checked;
-      const float* s = &specular[i * 3];
-      const float lo = min3(s), hi = max3(s);
-      const float sum = s[0] + s[1] + s[2];
-      const double mean = double(sum) / 3;  // only on the (rare) flagged path
-      const F0Class cls = F0Class(int(sum >= t0) + int(sum >= t1) + int(sum >= t2) + int(sum >= t3));
-      ++class_counts[std::size_t(cls)];
-      f0_stats.add(s);
-      std::uint8_t flags = 0;
+      if (!suspect[std::size_t(x)]) continue;
+      const std::size_t i = row + std::size_t(x);
+      const auto cls = F0Class(classes[std::size_t(x)]);
       double severity = 0;
-      const auto flag = [&](Flag f, double how_far) {
-        flags |= f;
-        severity = std::max(severity, how_far);
-      };
-      if (cls == F0Class::below) flag(kBelowReal, materials::kBelowReal - mean);
-      if (cls == F0Class::semiconductor) {
-        flag(kSemiconductorGap, std::min(mean - materials::kSemiconductorFrom, materials::kMetalFrom - mean));
-      }
-      if (lo < 0 || hi > 1) flag(kNotReflectance, std::max(-lo, hi - 1.0f));
-      if ((cls == F0Class::dielectric || cls == F0Class::gem) && hi - lo > float(kColouredRatio) * hi) {
-        flag(kColouredDielectric, hi - lo);
-      }
-      const float* d = diffuse ? &diffuse[i * 3] : nullptr;
-      if (d) {
-        diffuse_stats.add(d);
-        const float luminance = 0.2126f * d[0] + 0.7152f * d[1] + 0.0722f * d[2];
-        const float d_lo = min3(d), d_hi = max3(d);
-        if (d_lo < 0 || d_hi > 1) flag(kNotReflectance, std::max(-d_lo, d_hi - 1.0f));
-        if (cls == F0Class::metal) {
-          if (luminance >= float(kMetalDiffuseMax)) flag(kMetalWithDiffuse, luminance);
-        } else if (luminance < float(kAlbedoMin) || luminance > float(kAlbedoMax)) {
-          flag(kAlbedoOutOfRange, luminance < float(kAlbedoMin) ? kAlbedoMin - luminance : luminance - kAlbedoMax);
-        }
-      }
-      if (material) {
-        const bool within = std::abs(s[0] - reference[0]) <= allowed[0] && std::abs(s[1] - reference[1]) <= allowed[1] &&
-                            std::abs(s[2] - reference[2]) <= allowed[2];
-        if (within) {
-          ++material_within;
-        } else {
-          flag(kMaterialMismatch, std::max({std::abs(s[0] - reference[0]), std::abs(s[1] - reference[1]),
-                                            std::abs(s[2] - reference[2])}));
-        }
-      }
-      if (class_map) class_map[i] = std::uint8_t(std::uint8_t(cls) | (flags ? kFlaggedTexel : 0));
-      if (!flags) continue;
-      ++violations;
-      for (int bit = 0; bit < kFlagCount; ++bit) flag_counts[std::size_t(bit)] += (flags >> bit) & 1;
-      if (p.worst.size() < options.worst_count || severity >= p.worst.back().severity) {
+      const std::uint8_t flags = check_texel(r, i, cls, severity);
+      if (!flags) continue;  // the first pass's float arithmetic can differ at a boundary
+      classes[std::size_t(x)] = std::uint8_t(classes[std::size_t(x)] | kFlaggedTexel);
+      ++p.violations;
+      for (int bit = 0; bit < kFlagCount; ++bit) p.flag_counts[std::size_t(bit)] += (flags >> bit) & 1;
+      // Texels come in (y, x) order and ties rank the earlier first: an equal severity never enters.
+      if (p.worst.size() < options.worst_count || severity > p.worst.back().severity) {
+        const float* s = r.specular + i * 3;
+        const float* d = r.diffuse ? r.diffuse + i * 3 : nullptr;
         Texel t{x, y, cls, flags, severity, Vec3(s[0], s[1], s[2]), d ? Vec3(d[0], d[1], d[2]) : Vec3(0)};
         keep_worst(p.worst, t, options.worst_count);
       }
     }
-    f0_stats.end_row();
-    diffuse_stats.end_row();
+    if (class_map) std::copy(classes.begin(), classes.end(), class_map + row);
   }
-  p.masked = masked;
-  p.checked = checked;
-  p.violations = violations;
-  p.material_within = material_within;
-  p.class_counts = class_counts;
-  p.flag_counts = flag_counts;
-  p.f0 = f0_stats;
-  p.diffuse = diffuse_stats;
+  p.checked = std::size_t(counts.live);
+  p.masked = std::size_t(y1 - y0) * std::size_t(width) - p.checked;
+  p.material_within = std::size_t(counts.material_within);
+  p.class_counts = {std::size_t(counts.live - counts.at_least[0]), std::size_t(counts.at_least[0] - counts.at_least[1]),
+                    std::size_t(counts.at_least[1] - counts.at_least[2]), std::size_t(counts.at_least[2] - counts.at_least[3]),
+                    std::size_t(counts.at_least[3])};
 }
 
 ChannelStats stats(double sum, double lo, double hi, std::size_t n) {
