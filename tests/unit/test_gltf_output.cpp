@@ -149,27 +149,37 @@ fs::path write_instanced_scene(const fs::path& folder) {
   return folder / "instanced.gltf";
 }
 
-ao::Options binary_options() {
+// The instanced scene loaded and baked (binary AO, 64 rays, d_max 1000).
+struct Baked {
+  fs::path input;
+  scene::Scene scene;
+  ao::Bake bake;
+};
+Baked bake_instanced_scene(const fs::path& folder) {
+  Baked b;
+  b.input = write_instanced_scene(folder);
+  auto s = scene::load_scene(b.input);
+  EXPECT_TRUE(s) << s.error().to_string();
+  b.scene = std::move(*s);
   ao::Options o;
   o.samples = 64;
   o.falloff = ao::Falloff::none;
   o.relative_distance = false;
   o.max_distance = 1e3;
-  return o;
+  auto baked = ao::bake(b.scene, o);
+  EXPECT_TRUE(baked);
+  b.bake = std::move(*baked);
+  return b;
 }
 
 TEST(AoGltfOutput, EachPlacementKeepsItsOwnValuesAndColoursAreMultiplied) {
   TempDir dir;
-  const fs::path input = write_instanced_scene(dir.path());
-  auto s = scene::load_scene(input);
-  ASSERT_TRUE(s) << s.error().to_string();
-  ASSERT_EQ(s->instances.size(), 3u);
-  auto baked = ao::bake(*s, binary_options());
-  ASSERT_TRUE(baked);
-  EXPECT_LT(baked->values[0][0], 0.1f);  // under the roof
-  EXPECT_EQ(baked->values[2][0], 1.0f);  // in the open
+  const Baked b = bake_instanced_scene(dir.path());
+  ASSERT_EQ(b.scene.instances.size(), 3u);
+  EXPECT_LT(b.bake.values[0][0], 0.1f);  // under the roof
+  EXPECT_EQ(b.bake.values[2][0], 1.0f);  // in the open
 
-  ASSERT_TRUE(ao::write_gltf(input, *s, *baked, ao::Into::color_multiply, dir / "multiply.glb"));
+  ASSERT_TRUE(ao::write_gltf(b.input, b.scene, b.bake, ao::Into::color_multiply, dir / "multiply.glb"));
   auto doc = gltf::read_document(dir / "multiply.glb");
   ASSERT_TRUE(doc);
   ASSERT_EQ(doc->json["meshes"].size(), 3u);             // the quad, the roof, the quad's copy
@@ -179,13 +189,13 @@ TEST(AoGltfOutput, EachPlacementKeepsItsOwnValuesAndColoursAreMultiplied) {
   ASSERT_TRUE(out) << out.error().to_string();
   ASSERT_EQ(out->instances.size(), 3u);
   for (std::size_t k = 0; k < 3; ++k) {
-    const scene::Instance& before = s->instances[k];
+    const scene::Instance& before = b.scene.instances[k];
     const scene::Instance& after = out->instances[k];
     EXPECT_EQ(after.node, before.node);
     EXPECT_EQ(after.positions, before.positions);
     ASSERT_EQ(after.colors.size(), before.positions.size()) << k;
     for (std::size_t v = 0; v < after.colors.size(); ++v) {
-      const float w = baked->values[k][v];
+      const float w = b.bake.values[k][v];
       const glm::vec4 expected = before.colors.empty() ? glm::vec4(w, w, w, 1)
                                                        : glm::vec4(glm::vec3(before.colors[v]) * w, before.colors[v].a);
       EXPECT_EQ(after.colors[v], expected) << "instance " << k << " vertex " << v;
@@ -196,42 +206,34 @@ TEST(AoGltfOutput, EachPlacementKeepsItsOwnValuesAndColoursAreMultiplied) {
 
 TEST(AoGltfOutput, ReplacedColoursAndTheAoAttributeHoldTheValuesExactly) {
   TempDir dir;
-  const fs::path input = write_instanced_scene(dir.path());
-  auto s = scene::load_scene(input);
-  ASSERT_TRUE(s);
-  auto baked = ao::bake(*s, binary_options());
-  ASSERT_TRUE(baked);
-  ASSERT_TRUE(ao::write_gltf(input, *s, *baked, ao::Into::color, dir / "replace.gltf"));
+  const Baked b = bake_instanced_scene(dir.path());
+  ASSERT_TRUE(ao::write_gltf(b.input, b.scene, b.bake, ao::Into::color, dir / "replace.gltf"));
   auto replaced = scene::load_scene(dir / "replace.gltf");
   ASSERT_TRUE(replaced);
   for (std::size_t k = 0; k < 3; ++k) {
     EXPECT_FALSE(replaced->instances[k].colors_have_alpha);
-    for (std::size_t v = 0; v < baked->values[k].size(); ++v) {
-      const float w = baked->values[k][v];
+    for (std::size_t v = 0; v < b.bake.values[k].size(); ++v) {
+      const float w = b.bake.values[k][v];
       EXPECT_EQ(replaced->instances[k].colors[v], glm::vec4(w, w, w, 1));
     }
   }
 
-  ASSERT_TRUE(ao::write_gltf(input, *s, *baked, ao::Into::attribute, dir / "attribute.gltf"));
+  ASSERT_TRUE(ao::write_gltf(b.input, b.scene, b.bake, ao::Into::attribute, dir / "attribute.gltf"));
   auto doc = gltf::read_document(dir / "attribute.gltf");
   ASSERT_TRUE(doc);
   for (std::size_t k = 0; k < 3; ++k) {
-    const int mesh = doc->json["nodes"][std::size_t(s->instances[k].node)]["mesh"];
+    const int mesh = doc->json["nodes"][std::size_t(b.scene.instances[k].node)]["mesh"];
     const gltf::Json& attributes = doc->json["meshes"][std::size_t(mesh)]["primitives"][0]["attributes"];
-    EXPECT_EQ(accessor_floats(*doc, attributes["_AO"].get<int>()), baked->values[k]);
+    EXPECT_EQ(accessor_floats(*doc, attributes["_AO"].get<int>()), b.bake.values[k]);
     EXPECT_EQ(attributes.contains("COLOR_0"), k != 1);  // the file's own colours stay where they were
   }
 }
 
 TEST(AoGltfOutput, SameBytesEveryTime) {
   TempDir dir;
-  const fs::path input = write_instanced_scene(dir.path());
-  auto s = scene::load_scene(input);
-  ASSERT_TRUE(s);
-  auto baked = ao::bake(*s, binary_options());
-  ASSERT_TRUE(baked);
+  const Baked b = bake_instanced_scene(dir.path());
   for (const char* name : {"a.glb", "b.glb", "a.gltf"}) {
-    ASSERT_TRUE(ao::write_gltf(input, *s, *baked, ao::Into::color, dir / name));
+    ASSERT_TRUE(ao::write_gltf(b.input, b.scene, b.bake, ao::Into::color, dir / name));
   }
   EXPECT_EQ(test::read_bytes(dir / "a.glb"), test::read_bytes(dir / "b.glb"));
   EXPECT_EQ(test::list_folder(dir.path()),
