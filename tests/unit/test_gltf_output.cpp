@@ -6,6 +6,7 @@
 #include <fstream>
 
 #include "lib/src/gltf/document.hpp"
+#include "lib/src/gltf/prune.hpp"
 #include "matbake/ao.hpp"
 #include "matbake/scene.hpp"
 #include "support/files.hpp"
@@ -135,6 +136,39 @@ TEST(GltfDocument, PercentDecoding) {
   EXPECT_EQ(gltf::decode_uri("tex/a%20b%2Fc.png"), "tex/a b/c.png");
   EXPECT_EQ(gltf::decode_uri("100%"), "100%");
   EXPECT_EQ(gltf::decode_uri("%zz"), "%zz");
+}
+
+// What the scene reaches through extensions stays, renumbered: a material named only by
+// KHR_materials_variants, and the per-instance accessor of EXT_mesh_gpu_instancing.
+TEST(GltfPrune, ExtensionReferencesSurviveAndFollowTheirObjects) {
+  TempDir dir;
+  GltfBuilder b;
+  const int unused_positions = b.add_vec3({0, 0, 0, 1, 0, 0, 0, 1, 0});  // accessor 0: read by nothing
+  const int mesh = b.add_mesh(b.add_vec3(kFloor), b.add_indices(kFan));
+  const int offsets = b.add_vec3({0, 0, 0, 5, 0, 0});
+  b.doc["meshes"][std::size_t(mesh)]["primitives"][0]["material"] = 0;
+  b.doc["meshes"][std::size_t(mesh)]["primitives"][0]["extensions"] = {
+      {"KHR_materials_variants", {{"mappings", {{{"material", 2}, {"variants", {0}}}}}}}};
+  b.doc["materials"] = {{{"name", "Base"}}, {{"name", "Unused"}}, {{"name", "Variant"}}};
+  b.doc["extensionsUsed"] = {"KHR_materials_variants", "EXT_mesh_gpu_instancing"};
+  b.doc["extensions"] = {{"KHR_materials_variants", {{"variants", {{{"name", "red"}}}}}}};
+  b.add_node({{"mesh", mesh}, {"extensions", {{"EXT_mesh_gpu_instancing", {{"attributes", {{"TRANSLATION", offsets}}}}}}}});
+  b.write(dir / "in.gltf", {0});
+  auto doc = gltf::read_document(dir / "in.gltf");
+  ASSERT_TRUE(doc) << doc.error().to_string();
+  const std::vector<std::string> removed = gltf::prune_unreachable(*doc);
+  EXPECT_EQ(removed, (std::vector<std::string>{"material 1 'Unused'", "accessor " + std::to_string(unused_positions),
+                                               "buffer view 0"}));
+  const gltf::Json& json = doc->json;
+  ASSERT_EQ(json["materials"].size(), 2u);
+  EXPECT_EQ(json["materials"][1]["name"], "Variant");
+  EXPECT_EQ(json["meshes"][0]["primitives"][0]["extensions"]["KHR_materials_variants"]["mappings"][0]["material"], 1);
+  const int translation = json["nodes"][0]["extensions"]["EXT_mesh_gpu_instancing"]["attributes"]["TRANSLATION"];
+  EXPECT_EQ(accessor_floats(*doc, translation), (std::vector<float>{0, 0, 0, 5, 0, 0}));
+  ASSERT_TRUE(gltf::write_document(*doc, dir / "out.glb"));
+  auto s = scene::load_scene(dir / "out.glb");
+  ASSERT_TRUE(s) << s.error().to_string();
+  EXPECT_EQ(s->instances[0].positions.size(), 5u);
 }
 
 // A quad under a roof and the same mesh placed again in the open; the floor has its own colours.

@@ -146,6 +146,13 @@ TEST(SceneLoad, BadFilesAreRefusedWithTheReason) {
   }
   {
     GltfBuilder b;
+    b.doc["extensionsUsed"] = {"KHR_draco_mesh_compression"};
+    b.doc["extensionsRequired"] = {"KHR_draco_mesh_compression"};
+    b.write(dir / "draco.gltf", {b.add_node({{"mesh", b.add_mesh(b.add_vec3(kTriangle))}})});
+    expect_refused(dir / "draco.gltf", "uses KHR_draco_mesh_compression, which matbake does not decode");
+  }
+  {
+    GltfBuilder b;
     const int a = b.add_node({{"children", {1}}});
     b.add_node({{"children", {0}}});
     b.write(dir / "cycle.gltf", {a});

@@ -88,6 +88,12 @@ Status load_model(const fs::path& path, tinygltf::Model& model) {
                                               : loader.LoadASCIIFromFile(&model, &err, &warn, absolute);
   if (!folder.refused.empty()) return Error{file, folder.refused};
   if (!ok) return Error{file, "not a valid glTF: " + first_line(err)};
+  // Compressed geometry would be read as whatever bytes its accessors point at.
+  for (const std::string& name : model.extensionsRequired) {
+    if (name == "KHR_draco_mesh_compression" || name == "EXT_meshopt_compression") {
+      return Error{file, "uses " + name + ", which matbake does not decode; decompress it first"};
+    }
+  }
   return success();
 }
 

@@ -79,6 +79,24 @@ void for_each_primitive_accessor(Json& primitive, F f) {
   });
 }
 
+// Materials a primitive names in KHR_materials_variants' mappings, besides its own.
+template <class F>
+void for_each_variant_material(Json& primitive, F f) {
+  if (!primitive.contains("extensions") || !primitive["extensions"].contains("KHR_materials_variants")) return;
+  for_each_in(primitive["extensions"]["KHR_materials_variants"], "mappings", [&](Json& mapping) {
+    if (mapping.contains("material")) f(mapping["material"]);
+  });
+}
+
+// Accessors a node reads through EXT_mesh_gpu_instancing (per-instance transforms).
+template <class F>
+void for_each_node_accessor(Json& node, F f) {
+  if (!node.contains("extensions") || !node["extensions"].contains("EXT_mesh_gpu_instancing")) return;
+  Json& instancing = node["extensions"]["EXT_mesh_gpu_instancing"];
+  if (!instancing.contains("attributes")) return;
+  for (auto& [name, a] : instancing["attributes"].items()) f(a);
+}
+
 // Every accessor that skins and animations read.
 template <class F>
 void for_each_other_accessor(Json& json, F f) {
@@ -157,8 +175,12 @@ std::vector<std::string> prune_unreachable(Document& doc) {
     if (!meshes.keep[m]) continue;
     for_each_in(json["meshes"][m], "primitives", [&](Json& p) {
       if (p.contains("material")) materials.mark(json, p["material"]);
+      for_each_variant_material(p, [&](Json& material) { materials.mark(json, material); });
       for_each_primitive_accessor(p, [&](Json& a) { accessors.mark(json, a); });
     });
+  }
+  for (std::size_t n = 0; n < in_scene.size(); ++n) {
+    if (in_scene[n]) for_each_node_accessor(json["nodes"][n], [&](Json& a) { accessors.mark(json, a); });
   }
   for_each_other_accessor(json, [&](Json& a) { accessors.mark(json, a); });
   Marks textures{"textures", std::vector<bool>(count_of(json, "textures"))};
@@ -192,9 +214,13 @@ std::vector<std::string> prune_unreachable(Document& doc) {
   const auto sampler_remap = keep_marked(json, samplers, "sampler", removed);
   const auto accessor_remap = keep_marked(json, accessors, "accessor", removed);
   const auto view_remap = keep_marked(json, views, "buffer view", removed);
-  for_each_in(json, "nodes", [&](Json& node) { remap_field(node, "mesh", mesh_remap); });
+  for_each_in(json, "nodes", [&](Json& node) {
+    remap_field(node, "mesh", mesh_remap);
+    for_each_node_accessor(node, [&](Json& a) { remap_value(a, accessor_remap); });
+  });
   for_each_primitive(json, [&](Json& p) {
     remap_field(p, "material", material_remap);
+    for_each_variant_material(p, [&](Json& material) { remap_value(material, material_remap); });
     for_each_primitive_accessor(p, [&](Json& a) { remap_value(a, accessor_remap); });
   });
   for_each_other_accessor(json, [&](Json& a) { remap_value(a, accessor_remap); });

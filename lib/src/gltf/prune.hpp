@@ -1,9 +1,9 @@
 #pragma once
 // Keeping only what a glTF's default scene reaches, as gltf-transform's prune does: meshes placed
 // by the scene's nodes, the materials their primitives use, the textures those materials name (in
-// the core and in any extension: every `...Texture` object with an index), their images and
-// samplers, and the accessors and buffer views all of these read. Skins and animations keep
-// what they reference. Nodes stay; one outside the scene loses its mesh when that is removed.
+// the core and in any extension: every `...Texture` object with an index) and KHR_materials_variants
+// names, their images and samplers, and the accessors and buffer views all of these read (with
+// EXT_mesh_gpu_instancing's). Skins and animations keep what they reference. Nodes stay; one outside the scene loses its mesh when that is removed.
 // The buffers are then compacted into one holding only the kept buffer views.
 #include <string>
 #include <vector>
