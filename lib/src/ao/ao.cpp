@@ -189,6 +189,8 @@ Result<Bake> bake(const scene::Scene& scene, const Options& options) {
 
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, first.back(), 64), [&](const tbb::blocked_range<std::size_t>& range) {
     RTCIntersectContext context;
+    // One vertex's rays as a stream: they share an origin, and Embree packs them itself.
+    std::vector<RTCRayHit> rays(std::size_t(options.samples));
     std::size_t k = std::size_t(std::upper_bound(first.begin(), first.end(), range.begin()) - first.begin()) - 1;
     for (std::size_t flat = range.begin(); flat != range.end(); ++flat) {
       while (flat >= first[k + 1]) ++k;
@@ -199,37 +201,28 @@ Result<Bake> bake(const scene::Scene& scene, const Options& options) {
       Vec3 t, b;
       basis(n, t, b);
       const std::uint64_t key = options.seed * 0x100000001b3ull ^ (std::uint64_t(k) << 40) ^ v;
+      for (int s = 0; s < options.samples; ++s) {
+        const Sample2 u = sample(options.sampler, std::uint32_t(s), key);
+        // Cosine-weighted: r = √u, φ = 2π v.
+        const float r = std::sqrt(u.u), phi = 2 * std::numbers::pi_v<float> * u.v;
+        const Vec3 d = t * (r * std::cos(phi)) + b * (r * std::sin(phi)) + n * std::sqrt(std::max(0.0f, 1 - u.u));
+        RTCRayHit& rh = rays[std::size_t(s)];
+        rh.ray.org_x = origin.x, rh.ray.org_y = origin.y, rh.ray.org_z = origin.z;
+        rh.ray.dir_x = d.x, rh.ray.dir_y = d.y, rh.ray.dir_z = d.z;
+        rh.ray.tnear = 0, rh.ray.tfar = far, rh.ray.time = 0;
+        rh.ray.mask = ~0u, rh.ray.id = unsigned(s), rh.ray.flags = 0;
+        rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+      }
+      rtcInitIntersectContext(&context);
       double sum = 0;
-      for (int s0 = 0; s0 < options.samples; s0 += 8) {
-        alignas(32) int valid[8];
-        RTCRayHit8 rh;
-        for (int j = 0; j < 8; ++j) {
-          const int s = s0 + j;
-          valid[j] = s < options.samples ? -1 : 0;
-          const Sample2 u = sample(options.sampler, std::uint32_t(s), key);
-          // Cosine-weighted: r = √u, φ = 2π v.
-          const float r = std::sqrt(u.u), phi = 2 * std::numbers::pi_v<float> * u.v;
-          const Vec3 d = t * (r * std::cos(phi)) + b * (r * std::sin(phi)) + n * std::sqrt(std::max(0.0f, 1 - u.u));
-          rh.ray.org_x[j] = origin.x, rh.ray.org_y[j] = origin.y, rh.ray.org_z[j] = origin.z;
-          rh.ray.dir_x[j] = d.x, rh.ray.dir_y[j] = d.y, rh.ray.dir_z[j] = d.z;
-          rh.ray.tnear[j] = 0, rh.ray.tfar[j] = far, rh.ray.time[j] = 0;
-          rh.ray.mask[j] = ~0u, rh.ray.id[j] = unsigned(j), rh.ray.flags[j] = 0;
-          rh.hit.geomID[j] = RTC_INVALID_GEOMETRY_ID;
-        }
-        rtcInitIntersectContext(&context);
-        if (binary) {
-          rtcOccluded8(valid, rtc.get(), &context, &rh.ray);
-          for (int j = 0; j < 8; ++j) {
-            if (valid[j]) sum += rh.ray.tfar[j] >= 0 ? 1.0 : 0.0;  // occluded rays come back with tfar = −inf
-          }
-        } else {
-          rtcIntersect8(valid, rtc.get(), &context, &rh);
-          for (int j = 0; j < 8; ++j) {
-            if (!valid[j]) continue;
-            sum += rh.hit.geomID[j] == RTC_INVALID_GEOMETRY_ID
-                       ? 1.0
-                       : std::min(1.0, (1.0 - std::exp(-tau * rh.ray.tfar[j])) * normalization);
-          }
+      if (binary) {
+        rtcOccluded1M(rtc.get(), &context, &rays[0].ray, unsigned(options.samples), sizeof(RTCRayHit));
+        for (const RTCRayHit& rh : rays) sum += rh.ray.tfar >= 0 ? 1.0 : 0.0;  // occluded rays come back with tfar = −inf
+      } else {
+        rtcIntersect1M(rtc.get(), &context, rays.data(), unsigned(options.samples), sizeof(RTCRayHit));
+        for (const RTCRayHit& rh : rays) {
+          sum += rh.hit.geomID == RTC_INVALID_GEOMETRY_ID ? 1.0
+                                                          : std::min(1.0, (1.0 - std::exp(-tau * rh.ray.tfar)) * normalization);
         }
       }
       result.values[k][v] = float(sum / options.samples);
