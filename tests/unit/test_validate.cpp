@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include <array>
 #include <cmath>
 #include <random>
 
@@ -165,6 +166,63 @@ TEST(Validate, HeatmapColoursFollowTheLegend) {
     for (std::size_t c = 0; c < 3; ++c) {
       EXPECT_EQ(color::quantize(color::Transfer::srgb, 8, map.pixels[i * 3 + c]), legend[expected[i]].srgb[c])
           << "texel " << i;
+    }
+  }
+}
+
+// The first pass runs 4 texels at a time: widths that are not a multiple of 4 (the padded tail),
+// masks, diffuse and a material, against the per-texel rule (classify_f0 of the mean, in float64)
+// and float64 statistics.
+TEST(Validate, VectorPassMatchesThePerTexelRule) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> u(0, 1);
+  for (const auto& [width, height] : {std::pair{37, 5}, std::pair{1, 3}, std::pair{6, 2}, std::pair{4, 4}}) {
+    const std::size_t n = std::size_t(width) * std::size_t(height);
+    std::vector<float> f0(n * 3), kd(n * 3), mask(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      const float base = std::pow(u(rng), 2.5f);  // most texels dielectric-ish, some metals
+      for (std::size_t c = 0; c < 3; ++c) f0[i * 3 + c] = base * (0.8f + 0.4f * u(rng));
+      for (std::size_t c = 0; c < 3; ++c) kd[i * 3 + c] = u(rng);
+      mask[i] = u(rng) < 0.2f ? 0.0f : 1.0f;
+    }
+    image::Image specular = rgb_image(width, height, f0), diffuse = rgb_image(width, height, kd);
+    image::Image m = rgb_image(width, height, mask);
+    m.channels = 1;
+    Options options;
+    options.class_map = true;
+    options.material = materials::find(materials::builtin_table(), "gold");
+    const Report r = check({&specular, &diffuse, &m}, options);
+    std::array<std::size_t, 5> classes{};
+    std::size_t masked = 0, flagged = 0;
+    std::array<double, 3> sum{}, lo{1e9, 1e9, 1e9}, hi{-1e9, -1e9, -1e9};
+    for (std::size_t i = 0; i < n; ++i) {
+      if (mask[i] <= 0) {
+        ++masked;
+        EXPECT_EQ(r.class_map[i], kMaskedTexel) << i;
+        continue;
+      }
+      const F0Class expected = materials::classify_f0((double(f0[i * 3]) + f0[i * 3 + 1] + f0[i * 3 + 2]) / 3);
+      ++classes[std::size_t(expected)];
+      EXPECT_EQ(r.class_map[i] & 0x7f, std::uint8_t(expected)) << width << "x" << height << " texel " << i;
+      const bool is_flagged = (r.class_map[i] & kFlaggedTexel) != 0;
+      flagged += is_flagged;
+      if (expected == F0Class::below || expected == F0Class::semiconductor) {
+        EXPECT_TRUE(is_flagged) << i;
+      }
+      for (std::size_t c = 0; c < 3; ++c) {
+        sum[c] += f0[i * 3 + c];
+        lo[c] = std::min(lo[c], double(f0[i * 3 + c]));
+        hi[c] = std::max(hi[c], double(f0[i * 3 + c]));
+      }
+    }
+    EXPECT_EQ(r.masked, masked);
+    EXPECT_EQ(r.checked, n - masked);
+    EXPECT_EQ(r.class_counts, classes);
+    EXPECT_EQ(r.violations, flagged);
+    for (std::size_t c = 0; c < 3 && r.checked; ++c) {
+      EXPECT_NEAR(r.f0_stats[c].mean, sum[c] / double(r.checked), 1e-6);
+      EXPECT_EQ(r.f0_stats[c].min, lo[c]);
+      EXPECT_EQ(r.f0_stats[c].max, hi[c]);
     }
   }
 }
