@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
-#include <set>
 
 #include "../ao/gltf_output.hpp"
 #include "../gltf/document.hpp"
