@@ -6,7 +6,7 @@
 #include "material_sources.hpp"
 #include "matbake/atomic_file.hpp"
 #include "matbake/export.hpp"
-#include "report_json.hpp"
+#include "matbake/report_json.hpp"
 #include "silenced_stderr.hpp"
 
 namespace matbake::cli {

@@ -5,6 +5,7 @@
 
 #include "commands.hpp"
 #include "matbake/materials.hpp"
+#include "matbake/report_json.hpp"
 #include "matbake/validate.hpp"
 #include "silenced_stderr.hpp"
 
@@ -31,20 +32,6 @@ std::string join(const std::vector<int>& v) {
   std::string s;
   for (int x : v) s += (s.empty() ? "" : ";") + std::to_string(x);
   return s;
-}
-
-std::string flag_list(std::uint8_t flags) {
-  std::string s;
-  for (int bit = 0; bit < validate::kFlagCount; ++bit) {
-    if (flags & (1 << bit)) s += (s.empty() ? "" : ",") + std::string(validate::flag_name(bit));
-  }
-  return s;
-}
-
-nlohmann::json stats_json(const std::array<validate::ChannelStats, 3>& s) {
-  nlohmann::json j = nlohmann::json::array();
-  for (const auto& c : s) j.push_back({{"min", c.min}, {"max", c.max}, {"mean", c.mean}});
-  return j;
 }
 
 }  // namespace
@@ -165,28 +152,10 @@ int run_validate(const ValidateSettings& s, const GlobalOptions& global) {
   const bool failed = report->violation_fraction() > s.max_violations;
   const int exit_code = failed ? kViolations : kOk;
 
-  nlohmann::json classes, flags, worst = nlohmann::json::array();
-  for (std::size_t c = 0; c < 5; ++c) classes[std::string(materials::f0_class_name(materials::F0Class(c)))] = report->class_counts[c];
-  for (int b = 0; b < validate::kFlagCount; ++b) flags[std::string(validate::flag_name(b))] = report->flag_counts[std::size_t(b)];
-  for (const validate::Texel& t : report->worst) {
-    worst.push_back({{"x", t.x}, {"y", t.y}, {"class", materials::f0_class_name(t.f0_class)},
-                     {"flags", flag_list(t.flags)}, {"severity", t.severity}, {"f0", rgb(t.f0)},
-                     {"diffuse", rgb(t.diffuse)}});
-  }
-  nlohmann::json doc = {{"command", "validate"},       {"width", report->width},
-                        {"height", report->height},    {"texels", report->texels},
-                        {"masked", report->masked},    {"checked", report->checked},
-                        {"classes", classes},          {"flags", flags},
-                        {"violations", report->violations}, {"violation_fraction", report->violation_fraction()},
-                        {"max_violations", s.max_violations}, {"passed", !failed},
-                        {"worst", worst},              {"f0_stats", stats_json(report->f0_stats)}};
-  if (inputs.diffuse) doc["diffuse_stats"] = stats_json(report->diffuse_stats);
-  if (options.material) {
-    doc["material"] = {{"name", options.material->name},
-                       {"tolerance", s.tolerance},
-                       {"within", report->material_within},
-                       {"share_within", report->checked ? double(report->material_within) / double(report->checked) : 0.0}};
-  }
+  nlohmann::json doc = {{"command", "validate"}};
+  doc.update(to_json(*report, options, inputs.diffuse != nullptr));
+  doc["max_violations"] = s.max_violations;
+  doc["passed"] = !failed;
   if (!s.heatmap.empty()) doc["heatmap"] = s.heatmap;
   if (global.json) {
     std::cout << doc.dump(2) << "\n";
@@ -211,7 +180,7 @@ int run_validate(const ValidateSettings& s, const GlobalOptions& global) {
     for (const validate::Texel& t : report->worst) {
       std::printf("    at (%d, %d): %s, F0 %.4f %.4f %.4f: %s\n", t.x, t.y,
                   std::string(materials::f0_class_name(t.f0_class)).c_str(), t.f0.r, t.f0.g, t.f0.b,
-                  flag_list(t.flags).c_str());
+                  validate::flag_names(t.flags).c_str());
     }
   }
   return exit_code;

@@ -5,7 +5,7 @@
 #include <fstream>
 
 #include "commands.hpp"
-#include "report_json.hpp"
+#include "matbake/report_json.hpp"
 #include "matbake/atomic_file.hpp"
 #include "matbake/workflow_maps.hpp"
 

@@ -32,4 +32,10 @@ class AtomicFile {
 // The whole of `bytes` as `target`, through a temporary file and a rename.
 Status write_file_atomically(const std::filesystem::path& target, std::string_view bytes);
 
+// Removes every temporary file an AtomicFile of this process holds now, and keeps new ones from
+// being made (create() fails from then on): for a SIGINT/SIGTERM handler that is about to _exit,
+// so that an interrupted run leaves its finished outputs and no temporary files. Call it from a
+// normal thread (one waiting in sigwait), not from an asynchronous signal handler: it takes a lock.
+void remove_temporary_files_for_exit();
+
 }  // namespace matbake

@@ -4,6 +4,7 @@
 #include <array>
 #include <cstdint>
 #include <span>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -27,6 +28,7 @@ enum Flag : std::uint8_t {
 };
 inline constexpr int kFlagCount = 7;
 std::string_view flag_name(int bit);  // "below_real", ...
+std::string flag_names(std::uint8_t flags);  // "below_real,metal_with_diffuse"
 
 // Bounds of a plausible diffuse albedo (luminance, linear): the darkest and brightest opaque
 // non-engineered materials of physicallybased.info, charcoal 0.02 and toothpaste 0.935

@@ -7,11 +7,42 @@
 #include <cerrno>
 #include <cstring>
 #include <fstream>
+#include <mutex>
+#include <set>
 #include <string>
 
 namespace fs = std::filesystem;
 
 namespace matbake {
+
+namespace {
+
+// The temporary files that exist now, for remove_temporary_files_for_exit(). A name is added before
+// the file is made and taken out after it is renamed or removed, under one lock.
+struct TemporaryFiles {
+  std::mutex mutex;
+  std::set<fs::path> paths;
+  bool closed = false;
+};
+TemporaryFiles& temporary_files() {
+  static TemporaryFiles files;
+  return files;
+}
+
+void forget_temporary(const fs::path& temp) {
+  TemporaryFiles& files = temporary_files();
+  std::lock_guard lock(files.mutex);
+  files.paths.erase(temp);
+}
+
+}  // namespace
+
+void remove_temporary_files_for_exit() {
+  TemporaryFiles& files = temporary_files();
+  files.mutex.lock();  // held until the process exits: no file is made or renamed after this
+  files.closed = true;
+  for (const fs::path& p : files.paths) ::unlink(p.c_str());
+}
 
 AtomicFile::AtomicFile(fs::path target, fs::path temp) : target_(std::move(target)), temp_(std::move(temp)) {}
 
@@ -24,6 +55,7 @@ AtomicFile::~AtomicFile() {
   if (!done_) {
     std::error_code ec;
     fs::remove(temp_, ec);
+    forget_temporary(temp_);
   }
 }
 
@@ -39,11 +71,18 @@ Result<AtomicFile> AtomicFile::create(const fs::path& target) {
     const fs::path temp = folder / ("." + target.stem().string() + ".matbake-" + std::to_string(getpid()) + "-" +
                                     std::to_string(counter++) + target.extension().string());
     // Creating it reserves the name and tells, with the real reason, whether the folder takes files.
+    TemporaryFiles& files = temporary_files();
+    std::unique_lock lock(files.mutex);
+    if (files.closed) return Error{target.string(), "interrupted"};
     const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+    const int open_errno = errno;
     if (fd >= 0) {
       ::close(fd);
+      files.paths.insert(temp);
       return AtomicFile(target, temp);
     }
+    lock.unlock();
+    errno = open_errno;
     if (errno != EEXIST) {
       return Error{target.string(), std::string("cannot write in the output folder: ") + std::strerror(errno)};
     }
@@ -53,7 +92,13 @@ Result<AtomicFile> AtomicFile::create(const fs::path& target) {
 
 Status AtomicFile::commit() {
   std::error_code ec;
-  fs::rename(temp_, target_, ec);
+  {
+    // Under the lock, so that an interrupt sees either the temporary file or the renamed output.
+    TemporaryFiles& files = temporary_files();
+    std::lock_guard lock(files.mutex);
+    fs::rename(temp_, target_, ec);
+    if (!ec) files.paths.erase(temp_);
+  }
   if (ec) return Error{target_.string(), "cannot replace the output: " + ec.message()};
   done_ = true;
   return success();

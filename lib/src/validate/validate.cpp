@@ -340,6 +340,14 @@ std::string_view flag_name(int bit) {
   return bit >= 0 && bit < kFlagCount ? kNames[bit] : "";
 }
 
+std::string flag_names(std::uint8_t flags) {
+  std::string s;
+  for (int bit = 0; bit < kFlagCount; ++bit) {
+    if (flags & (1 << bit)) s += (s.empty() ? "" : ",") + std::string(flag_name(bit));
+  }
+  return s;
+}
+
 Result<Report> validate(const Inputs& in, const Options& options) {
   if (!in.specular) return Error{"", "validation needs a specular map", true};
   if (Status s = check_size(in.specular, *in.specular, 3, "the specular map"); !s) return s.error();

@@ -1,0 +1,60 @@
+#include "matbake/report_json.hpp"
+
+namespace matbake {
+namespace {
+
+nlohmann::json rgb(const glm::dvec3& v) { return {v.r, v.g, v.b}; }
+
+nlohmann::json stats_json(const std::array<validate::ChannelStats, 3>& s) {
+  nlohmann::json j = nlohmann::json::array();
+  for (const auto& c : s) j.push_back({{"min", c.min}, {"max", c.max}, {"mean", c.mean}});
+  return j;
+}
+
+}  // namespace
+
+
+nlohmann::json to_json(const workflow::ErrorStats& s) {
+  return {{"mean", s.mean}, {"max", s.max}, {"max_at", {s.max_x, s.max_y}}, {"texels", s.count}};
+}
+
+nlohmann::json to_json(const workflow::ConversionErrors& e) {
+  return {{"diffuse_delta_e_ab", to_json(e.diffuse_delta_e)}, {"specular_f0_abs", to_json(e.specular)},
+          {"lobe_relative_rms", to_json(e.lobe)}};
+}
+
+nlohmann::json to_json(const workflow::DielectricF0& d) {
+  return {{"texels", d.texels},
+          {"mean_f0", d.mean_f0},
+          {"KHR_materials_ior", {{"ior", d.ior}}},
+          {"KHR_materials_specular", {{"specularColorFactor", d.specular_color_factor}}},
+          {"error_without_extensions", to_json(d.error_without_extensions)},
+          {"error_with_extensions", to_json(d.error_with_extensions)}};
+}
+
+nlohmann::json to_json(const validate::Report& r, const validate::Options& options, bool has_diffuse) {
+  nlohmann::json classes, flags, worst = nlohmann::json::array();
+  for (std::size_t c = 0; c < 5; ++c) classes[std::string(materials::f0_class_name(materials::F0Class(c)))] = r.class_counts[c];
+  for (int b = 0; b < validate::kFlagCount; ++b) flags[std::string(validate::flag_name(b))] = r.flag_counts[std::size_t(b)];
+  for (const validate::Texel& t : r.worst) {
+    worst.push_back({{"x", t.x}, {"y", t.y}, {"class", materials::f0_class_name(t.f0_class)},
+                     {"flags", validate::flag_names(t.flags)}, {"severity", t.severity}, {"f0", rgb(t.f0)},
+                     {"diffuse", rgb(t.diffuse)}});
+  }
+  nlohmann::json doc = {{"width", r.width},         {"height", r.height},
+                        {"texels", r.texels},       {"masked", r.masked},
+                        {"checked", r.checked},     {"classes", classes},
+                        {"flags", flags},           {"violations", r.violations},
+                        {"violation_fraction", r.violation_fraction()},
+                        {"worst", worst},           {"f0_stats", stats_json(r.f0_stats)}};
+  if (has_diffuse) doc["diffuse_stats"] = stats_json(r.diffuse_stats);
+  if (options.material) {
+    doc["material"] = {{"name", options.material->name},
+                       {"tolerance", options.tolerance},
+                       {"within", r.material_within},
+                       {"share_within", r.checked ? double(r.material_within) / double(r.checked) : 0.0}};
+  }
+  return doc;
+}
+
+}  // namespace matbake
