@@ -39,25 +39,6 @@ Result<exporter::MaterialMaps> parse_material(const std::string& text, color::Tr
   return m;
 }
 
-nlohmann::json report_to_json(const exporter::Report& r) {
-  nlohmann::json materials = nlohmann::json::array();
-  for (const exporter::MaterialReport& m : r.materials) {
-    nlohmann::json j = {{"index", m.index}, {"name", m.name}, {"action", m.action}, {"alphaMode", m.alpha_mode}};
-    if (m.conversion) {
-      j["texels"] = m.conversion->texels;
-      j["errors"] = to_json(m.conversion->errors);
-      j["khronos_converter_errors"] = to_json(m.conversion->khronos_errors);
-      j["dielectric_f0"] = to_json(m.conversion->dielectric);
-    }
-    if (m.specular_color_factor) j["KHR_materials_specular"] = {{"specularColorFactor", *m.specular_color_factor}};
-    if (m.ior) j["KHR_materials_ior"] = {{"ior", *m.ior}};
-    materials.push_back(std::move(j));
-  }
-  return {{"command", "export"},     {"materials", materials},           {"skipped", r.skipped},
-          {"written", r.written},    {"images_decoded", r.images_decoded}, {"textures_made", r.textures_made},
-          {"ao_rays", r.ao_rays}};
-}
-
 }  // namespace
 
 CLI::App* setup_export(CLI::App& app, ExportSettings& s) {
@@ -125,7 +106,8 @@ int run_export(const ExportSettings& s, const GlobalOptions& global) {
     report = exporter::export_scene(s.scene, s.output, options);
   }
   if (!report) return report_error(report.error());
-  const nlohmann::json doc = report_to_json(*report);
+  nlohmann::json doc = {{"command", "export"}};
+  doc.update(to_json(*report));
   if (!s.report.empty()) {
     if (Status st = write_file_atomically(s.report, doc.dump(2) + "\n"); !st) return report_error(st.error());
   }

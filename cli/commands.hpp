@@ -138,4 +138,23 @@ struct ExportSettings {
 CLI::App* setup_export(CLI::App& app, ExportSettings& settings);
 int run_export(const ExportSettings& settings, const GlobalOptions& global);
 
+struct BuildSettings {
+  std::string manifest;
+  bool force = false;
+  bool dry_run = false;
+  std::vector<std::string> only;
+  std::string depfile;
+  std::string stamp;
+};
+CLI::App* setup_build(CLI::App& app, BuildSettings& settings);
+int run_build(const BuildSettings& settings, const GlobalOptions& global);
+
+struct PlanSettings {
+  std::string manifest;
+  std::string output;
+  std::string matbake;
+};
+CLI::App* setup_plan(CLI::App& app, PlanSettings& settings);
+int run_plan(const PlanSettings& settings, const GlobalOptions& global);
+
 }  // namespace matbake::cli

@@ -3,6 +3,7 @@
 #include <memory>
 
 #include "commands.hpp"
+#include "interrupt.hpp"
 #include "matbake/image.hpp"
 #include "matbake/version.hpp"
 
@@ -37,6 +38,10 @@ int main(int argc, char** argv) {
   CLI::App* bake_ao_app = setup_bake_ao(app, bake_ao);
   ExportSettings export_settings;
   CLI::App* export_app = setup_export(app, export_settings);
+  BuildSettings build;
+  CLI::App* build_app = setup_build(app, build);
+  PlanSettings plan;
+  CLI::App* plan_app = setup_plan(app, plan);
 
   try {
     app.parse(argc, argv);
@@ -47,6 +52,7 @@ int main(int argc, char** argv) {
     return report_error(matbake::Error{"", message + " (see matbake --help)", true});
   }
 
+  remove_temporary_files_on_interrupt();  // before any thread starts, so that all inherit the mask
   std::unique_ptr<tbb::global_control> threads;
   if (global.jobs > 0) {
     threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, global.jobs);
@@ -62,5 +68,7 @@ int main(int argc, char** argv) {
   if (validate_app->parsed()) return run_validate(validate, global);
   if (bake_ao_app->parsed()) return run_bake_ao(bake_ao, global);
   if (export_app->parsed()) return run_export(export_settings, global);
+  if (build_app->parsed()) return run_build(build, global);
+  if (plan_app->parsed()) return run_plan(plan, global);
   return kUsage;
 }

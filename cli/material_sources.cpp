@@ -133,26 +133,8 @@ Result<pack::SourceMaps> read_packed(const std::string& layout_name, const std::
                                      std::optional<color::Transfer> input, color::Transfer authored) {
   auto layout = pack::find_layout(layout_name);
   if (!layout) return layout.error();
-  if (files.size() != layout->textures.size()) {
-    return Error{"", "layout " + layout_name + " takes " + std::to_string(layout->textures.size()) + " textures, got " +
-                         std::to_string(files.size()), true};
-  }
-  std::vector<image::Image> textures;
-  {
-    SilencedStderr quiet;
-    for (std::size_t t = 0; t < files.size(); ++t) {
-      color::Transfer decode = color::Transfer::linear;
-      if (layout->textures[t].color) {
-        auto d = input ? Result<color::Transfer>(*input) : pack::decode_transfer(files[t], authored);
-        if (!d) return d.error();
-        decode = *d;
-      }
-      auto image = image::read_image(files[t], decode);
-      if (!image) return image.error();
-      textures.push_back(std::move(image.value()));
-    }
-  }
-  return pack::unpack(*layout, textures, files);
+  SilencedStderr quiet;
+  return pack::read_packed(*layout, {files.begin(), files.end()}, input, authored);
 }
 
 void add_output_options(CLI::App& cmd, OutputSettings& o, const std::string& what) {

@@ -24,6 +24,8 @@ class SilencedStderr {
     if (null >= 0) ::close(null);
   }
   ~SilencedStderr() { restore(); }
+  // Where the CLI's own messages go meanwhile: the real stderr.
+  int original_fd() const { return saved_ >= 0 ? saved_ : 2; }
   SilencedStderr(const SilencedStderr&) = delete;
   SilencedStderr& operator=(const SilencedStderr&) = delete;
 

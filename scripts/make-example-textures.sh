@@ -18,12 +18,15 @@ oiiotool --pattern constant:color=1.0,0.78,0.34 $size 3 $(noise -0.04 0.0 2) --a
 oiiotool --pattern fill:left=0.45,0.27,0.13:right=0.62,0.40,0.22 $size 3 \
   --pattern checker:width=6:height=256:color1=0.92,0.9,0.9:color2=1,1,1 $size 3 --mul \
   $(noise -0.02 0.02 3) --add -d uint16 -o "$out/wood_albedo.png"
-# Rubber: dark grey, single channel.
-oiiotool --pattern constant:color=0.08 $size 1 \
+# Rubber: dark grey, single channel (sRGB 0.2: linear albedo 0.033, above charcoal's 0.02).
+oiiotool --pattern constant:color=0.2 $size 1 \
   --pattern noise:type=uniform:min=-0.02:max=0.02:mono=1:seed=4 $size 1 --add \
   -d uint8 -o "$out/rubber_albedo.png"
 # Glass: tinted colour with a mask in alpha (unassociated: colour is not multiplied by it).
 oiiotool --pattern fill:top=0.55,0.72,0.78:bottom=0.35,0.52,0.60 $size 3 \
   --pattern checker:width=32:height=32:color1=1:color2=0.25 $size 1 \
   --chappend --chnames R,G,B,A --attrib oiio:UnassociatedAlpha 1 -d uint8 -o "$out/glass_albedo_mask.png"
+# Glass's second texture of its Schüler pair: F0 0.04 (sRGB 0.2213) in RGB, gloss 0.95 in alpha.
+oiiotool --pattern constant:color=0.2213,0.2213,0.2213 $size 3 --pattern constant:color=0.95 $size 1 \
+  --chappend --chnames R,G,B,A --attrib oiio:UnassociatedAlpha 1 -d uint8 -o "$out/glass_specular_gloss.png"
 ls -l "$out"

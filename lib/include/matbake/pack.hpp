@@ -4,7 +4,9 @@
 // each output texture's channels, each taken from a source map's component, optionally as 1 − x.
 // docs/pack.md has the format and the presets.
 #include <filesystem>
+#include <functional>
 #include <map>
+#include <memory>
 #include <optional>
 #include <span>
 #include <string>
@@ -69,12 +71,16 @@ struct SourceInput {
   std::vector<double> constant; // linear values: 1 (scalar, or grey) or 3 (colour)
 };
 
+// Decodes a file (read_image, or a cache in front of it that decodes each file once).
+using ImageReader = std::function<Result<std::shared_ptr<const image::Image>>(const std::filesystem::path&, color::Transfer)>;
+
 struct LoadOptions {
   color::Transfer authored = color::Transfer::srgb;  // how 8-bit colour sources were encoded
   std::optional<color::Transfer> input;              // for every colour file, overriding the rule below
   bool resize = false;  // else sources of different sizes are an error
   int width = 0;        // size when every source is a constant (0: 1×1)
   int height = 0;
+  ImageReader read;  // empty: image::read_image
 };
 // Reads every file (colour files: 8-bit ones decoded with `authored`, 16-bit, half and float ones
 // as linear, which is how pack writes them, unless `input` says otherwise; a colour source from a grey
@@ -82,6 +88,12 @@ struct LoadOptions {
 // largest (by pixel count) when asked, in linear light with OIIO's default filter, and fills the
 // constants.
 Result<SourceMaps> load_sources(const std::vector<SourceInput>& inputs, const LoadOptions& options);
+
+// The source maps held by `files`, the textures of `layout` in order: colour textures decoded with
+// `input` when given, else as decode_transfer() says; the others linear.
+Result<SourceMaps> read_packed(const Layout& layout, const std::vector<std::filesystem::path>& files,
+                               std::optional<color::Transfer> input, color::Transfer authored,
+                               const ImageReader& read = {});
 
 // The sources a layout reads, and which of them it cannot do without (no fallback).
 std::vector<std::string> layout_sources(const Layout& layout);

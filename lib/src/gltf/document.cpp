@@ -91,6 +91,37 @@ Result<std::string> image_bytes(const Document& doc, std::size_t index) {
   return bytes;
 }
 
+Result<Json> read_json(const fs::path& path) {
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec)) return Error{path.string(), "cannot read the glTF (missing or not a file)"};
+  const std::string bytes = read_bytes(path);
+  std::string text = bytes;
+  if (path.extension() == ".glb") {
+    if (bytes.size() < 20) return Error{path.string(), "not a GLB: shorter than its header"};
+    const std::size_t json_length = u32_at(bytes, 12);
+    if (20 + json_length > bytes.size()) return Error{path.string(), "GLB JSON chunk is truncated"};
+    text = bytes.substr(20, json_length);
+  }
+  Json json = Json::parse(text, nullptr, false);
+  if (json.is_discarded() || !json.is_object()) return Error{path.string(), "not a valid glTF: the JSON is malformed"};
+  return json;
+}
+
+std::vector<fs::path> source_files(const fs::path& file, const Json& json, const std::map<std::string, std::string>& made) {
+  const fs::path absolute = fs::absolute(file).lexically_normal();
+  std::vector<fs::path> files = {absolute};
+  for (const char* array : {"buffers", "images"}) {
+    if (!json.contains(array) || !json[array].is_array()) continue;
+    for (const Json& item : json[array]) {
+      const std::string uri = item.is_object() ? item.value("uri", "") : "";
+      if (!uri.empty() && !is_data_uri(uri) && !made.contains(uri)) {
+        files.push_back((absolute.parent_path() / decode_uri(uri)).lexically_normal());
+      }
+    }
+  }
+  return files;
+}
+
 Result<Document> read_document(const fs::path& path) {
   tinygltf::Model model;  // tinygltf checks the container, the URIs and the buffer sizes
   if (Status loaded = load_model(path, model); !loaded) return loaded.error();
@@ -98,15 +129,9 @@ Result<Document> read_document(const fs::path& path) {
   Document doc;
   doc.file = path.string();
   doc.folder = fs::absolute(path).parent_path();
-  const std::string bytes = read_bytes(path);
-  std::string text = bytes;
-  if (path.extension() == ".glb") {
-    const std::size_t json_length = u32_at(bytes, 12);
-    if (bytes.size() < 20 || 20 + json_length > bytes.size()) return Error{doc.file, "GLB JSON chunk is truncated"};
-    text = bytes.substr(20, json_length);
-  }
-  doc.json = Json::parse(text, nullptr, false);
-  if (doc.json.is_discarded() || !doc.json.is_object()) return Error{doc.file, "not a valid glTF: the JSON is malformed"};
+  auto json = read_json(path);
+  if (!json) return json.error();
+  doc.json = std::move(*json);
   const std::size_t declared = doc.json.contains("buffers") ? doc.json["buffers"].size() : 0;
   if (declared != model.buffers.size()) return Error{doc.file, "not a valid glTF: buffers could not all be read"};
   for (std::size_t i = 0; i < model.buffers.size(); ++i) {
@@ -151,18 +176,7 @@ Result<std::vector<fs::path>> write_document(const Document& doc, const fs::path
   const fs::path bin_path = output.parent_path() / (output.stem().string() + ".bin");
 
   // Every file the document came from, none of which may be written.
-  std::vector<fs::path> inputs = {fs::absolute(doc.file).lexically_normal()};
-  const auto uri_files = [&](const char* array) {
-    if (!doc.json.contains(array)) return;
-    for (const Json& item : doc.json[array]) {
-      const std::string uri = item.value("uri", "");
-      if (!uri.empty() && !is_data_uri(uri) && !doc.new_files.contains(uri)) {
-        inputs.push_back((doc.folder / decode_uri(uri)).lexically_normal());
-      }
-    }
-  };
-  uri_files("buffers");
-  uri_files("images");
+  const std::vector<fs::path> inputs = source_files(doc.file, doc.json, doc.new_files);
   const auto is_input = [&](const fs::path& p) {
     const fs::path a = fs::absolute(p).lexically_normal();
     return std::find(inputs.begin(), inputs.end(), a) != inputs.end();

@@ -52,6 +52,14 @@ Result<std::vector<std::filesystem::path>> write_document(const Document& doc, c
 // one of new_files.
 Result<std::string> image_bytes(const Document& doc, std::size_t index);
 
+// The JSON of a .gltf or .glb alone (no buffers read, nothing checked but the container).
+Result<Json> read_json(const std::filesystem::path& path);
+
+// The files a document is read from: `file` itself, then its buffers' and images' URIs that are
+// neither data: URIs nor in `made` (absolute, normalized; whether they exist is not checked).
+std::vector<std::filesystem::path> source_files(const std::filesystem::path& file, const Json& json,
+                                                const std::map<std::string, std::string>& made = {});
+
 // Percent-decoding of a relative URI (RFC 3986), as glTF URIs are written.
 std::string decode_uri(const std::string& uri);
 

@@ -117,6 +117,12 @@ image::Image source_from_file(const image::Image& file, SourceKind kind) {
   return map;
 }
 
+Result<std::shared_ptr<const image::Image>> read_shared(const std::filesystem::path& path, color::Transfer decode) {
+  auto file = image::read_image(path, decode);
+  if (!file) return file.error();
+  return std::make_shared<const image::Image>(std::move(*file));
+}
+
 std::string option_name(std::string_view source) {
   std::string option = "--" + std::string(source);
   std::replace(option.begin(), option.end(), '_', '-');
@@ -206,9 +212,9 @@ Result<SourceMaps> load_sources(const std::vector<SourceInput>& inputs, const Lo
         decode = *t;
       }
     }
-    auto file = image::read_image(input.file, decode);
+    auto file = options.read ? options.read(input.file, decode) : read_shared(input.file, decode);
     if (!file) return file.error();
-    result.maps[input.name] = source_from_file(*file, source->kind);
+    result.maps[input.name] = source_from_file(**file, source->kind);
     origin[input.name] = input.file.string();
   }
   // One size for all: the largest by pixel count, the others resized to it or refused.
@@ -251,6 +257,29 @@ Result<SourceMaps> load_sources(const std::vector<SourceInput>& inputs, const Lo
     result.maps[input.name] = std::move(map);
   }
   return result;
+}
+
+Result<SourceMaps> read_packed(const Layout& layout, const std::vector<std::filesystem::path>& files,
+                               std::optional<color::Transfer> input, color::Transfer authored, const ImageReader& read) {
+  if (files.size() != layout.textures.size()) {
+    return Error{"", "layout " + layout.name + " takes " + std::to_string(layout.textures.size()) + " textures, got " +
+                         std::to_string(files.size()), true};
+  }
+  std::vector<image::Image> textures;
+  std::vector<std::string> paths;
+  for (std::size_t t = 0; t < files.size(); ++t) {
+    color::Transfer decode = color::Transfer::linear;
+    if (layout.textures[t].color) {
+      auto d = input ? Result<color::Transfer>(*input) : decode_transfer(files[t], authored);
+      if (!d) return d.error();
+      decode = *d;
+    }
+    auto image = read ? read(files[t], decode) : read_shared(files[t], decode);
+    if (!image) return image.error();
+    textures.push_back(**image);
+    paths.push_back(files[t].string());
+  }
+  return unpack(layout, textures, paths);
 }
 
 std::vector<std::string> layout_sources(const Layout& layout) {

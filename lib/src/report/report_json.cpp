@@ -57,4 +57,23 @@ nlohmann::json to_json(const validate::Report& r, const validate::Options& optio
   return doc;
 }
 
+nlohmann::json to_json(const exporter::Report& r) {
+  nlohmann::json materials = nlohmann::json::array();
+  for (const exporter::MaterialReport& m : r.materials) {
+    nlohmann::json j = {{"index", m.index}, {"name", m.name}, {"action", m.action}, {"alphaMode", m.alpha_mode}};
+    if (m.conversion) {
+      j["texels"] = m.conversion->texels;
+      j["errors"] = to_json(m.conversion->errors);
+      j["khronos_converter_errors"] = to_json(m.conversion->khronos_errors);
+      j["dielectric_f0"] = to_json(m.conversion->dielectric);
+    }
+    if (m.specular_color_factor) j["KHR_materials_specular"] = {{"specularColorFactor", *m.specular_color_factor}};
+    if (m.ior) j["KHR_materials_ior"] = {{"ior", *m.ior}};
+    materials.push_back(std::move(j));
+  }
+  return {{"materials", materials},           {"skipped", r.skipped},
+          {"written", r.written},    {"images_decoded", r.images_decoded}, {"textures_made", r.textures_made},
+          {"ao_rays", r.ao_rays}};
+}
+
 }  // namespace matbake

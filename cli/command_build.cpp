@@ -1,0 +1,192 @@
+#include <unistd.h>
+
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+#include <cstdio>
+#include <iostream>
+#include <optional>
+
+#include "commands.hpp"
+#include "matbake/atomic_file.hpp"
+#include "matbake/build.hpp"
+#include "progress_bar.hpp"
+#include "silenced_stderr.hpp"
+
+namespace matbake::cli {
+namespace fs = std::filesystem;
+namespace {
+
+std::string_view outcome_name(build::Outcome o) {
+  switch (o) {
+    case build::Outcome::built: return "built";
+    case build::Outcome::up_to_date: return "up_to_date";
+    case build::Outcome::failed: return "failed";
+    case build::Outcome::out_of_date: return "out_of_date";
+  }
+  return "";
+}
+
+nlohmann::json job_json(const build::JobReport& r) {
+  std::vector<std::string> inputs, outputs;
+  for (const fs::path& p : r.job->inputs) inputs.push_back(p.string());
+  for (const fs::path& p : r.job->outputs) outputs.push_back(p.string());
+  nlohmann::json j = {{"name", r.job->name}, {"outcome", outcome_name(r.outcome)}, {"inputs", inputs},
+                      {"outputs", outputs},  {"seconds", r.seconds},              {"warnings", r.warnings}};
+  if (!r.reason.empty()) j["reason"] = r.reason;
+  if (r.error) j["error"] = r.error->to_string();
+  if (!r.details.is_null()) j["details"] = r.details;
+  return j;
+}
+
+std::string job_error(const build::JobReport& r) { return r.error->to_string() + " (" + r.job->name + ")"; }
+
+Result<build::Plan> load(const std::string& manifest_file, build::Manifest& manifest) {
+  auto m = build::read_manifest(manifest_file);
+  if (!m) return m.error();
+  manifest = std::move(*m);
+  return build::make_plan(manifest);
+}
+
+}  // namespace
+
+CLI::App* setup_build(CLI::App& app, BuildSettings& s) {
+  CLI::App* cmd = app.add_subcommand(
+      "build",
+      "Build a manifest's materials and scenes (docs/build.md): sources are decoded, converted to the layout's\n"
+      "workflow, packed, validated; scenes are exported with them and AO. Only out-of-date outputs are built.");
+  cmd->add_option("manifest", s.manifest, "The manifest (TOML)")->required();
+  cmd->add_flag("--force", s.force, "Build every job, up to date or not");
+  cmd->add_flag("-n,--dry-run", s.dry_run, "List what would be built, and why, without building it");
+  cmd->add_option("--only", s.only, "Build only this job (material:NAME or scene:NAME); repeatable");
+  cmd->add_option("--depfile", s.depfile,
+                  "Write a Make depfile of every input read, for CMake add_custom_command(DEPFILE) and Ninja");
+  cmd->add_option("--stamp", s.stamp,
+                  "Write this file after a successful run; the depfile's target is then this file rather than the outputs");
+  return cmd;
+}
+
+CLI::App* setup_plan(CLI::App& app, PlanSettings& s) {
+  CLI::App* cmd = app.add_subcommand(
+      "plan", "Write a Ninja file with one edge per job of a manifest: Ninja schedules them and re-runs what changed");
+  cmd->add_option("manifest", s.manifest, "The manifest (TOML)")->required();
+  cmd->add_option("-o,--output", s.output, "The Ninja file to write (e.g. build.ninja)")->required();
+  cmd->add_option("--matbake", s.matbake, "The matbake the edges run (default: this one)");
+  return cmd;
+}
+
+int run_plan(const PlanSettings& s, const GlobalOptions& global) {
+  build::Manifest manifest;
+  auto plan = load(s.manifest, manifest);
+  if (!plan) return report_error(plan.error());
+  std::error_code ec;
+  const fs::path self = s.matbake.empty() ? fs::read_symlink("/proc/self/exe", ec) : fs::absolute(s.matbake);
+  if (Status st = write_file_atomically(s.output, build::ninja_text(manifest, *plan, self)); !st) {
+    return report_error(st.error());
+  }
+  if (global.json) {
+    nlohmann::json jobs = nlohmann::json::array();
+    for (const build::Job& j : plan->jobs) jobs.push_back(j.name);
+    std::cout << nlohmann::json{{"command", "plan"}, {"ninja_file", s.output}, {"jobs", jobs}}.dump(2) << "\n";
+  } else if (!global.quiet) {
+    std::printf("%s: %zu edges\n", s.output.c_str(), plan->jobs.size());
+  }
+  for (const std::string& w : plan->warnings) std::cerr << "matbake: warning: " << w << "\n";
+  return kOk;
+}
+
+int run_build(const BuildSettings& s, const GlobalOptions& global) {
+  const auto start = std::chrono::steady_clock::now();
+  build::Manifest manifest;
+  auto plan = load(s.manifest, manifest);
+  if (!plan) return report_error(plan.error());
+  if (!global.quiet) {
+    for (const std::string& w : plan->warnings) std::cerr << "matbake: warning: " << w << "\n";
+  }
+
+  // Progress: a bar on a terminal; elsewhere (build logs) one line per finished job.
+  const bool terminal = isatty(STDERR_FILENO) != 0;
+  std::optional<SilencedStderr> quiet(std::in_place);  // libpng's own messages: each job's error line says it
+  ProgressBar bar(terminal && !global.quiet, quiet->original_fd());
+  build::RunOptions options;
+  options.force = s.force;
+  options.dry_run = s.dry_run;
+  options.only = s.only;
+  options.progress = [&](const build::JobReport& r, std::size_t done, std::size_t total) {
+    if (r.outcome == build::Outcome::failed) {
+      bar.print_above("matbake: error: " + job_error(r));
+    } else if (!global.quiet && !terminal) {
+      char line[64];
+      std::snprintf(line, sizeof line, "[%zu/%zu] ", done, total);
+      bar.print_above(line + r.job->name + " built (" + std::to_string(int(r.seconds * 1000)) + " ms)");
+    }
+    bar.update(done, total);
+  };
+  auto report = build::run(manifest, *plan, options);
+  bar.finish();
+  quiet.reset();
+  if (!report) return report_error(report.error());
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const std::size_t failed = report->count(build::Outcome::failed);
+
+  if (!s.depfile.empty() && !s.dry_run) {
+    std::vector<fs::path> targets, inputs = {manifest.file};
+    for (const build::JobReport& r : report->jobs) {
+      targets.insert(targets.end(), r.job->outputs.begin(), r.job->outputs.end());
+      for (const fs::path& p : r.job->inputs) {
+        if (std::find(inputs.begin(), inputs.end(), p) == inputs.end()) inputs.push_back(p);
+      }
+    }
+    if (!s.stamp.empty()) targets = {fs::absolute(s.stamp).lexically_normal()};
+    if (Status st = write_file_atomically(s.depfile, build::depfile_text(targets, inputs)); !st) return report_error(st.error());
+  }
+  if (!s.stamp.empty() && !s.dry_run && failed == 0) {
+    const std::string text = "matbake build " + manifest.file.string() + ": " + std::to_string(report->jobs.size()) + " jobs\n";
+    if (Status st = write_file_atomically(s.stamp, text); !st) return report_error(st.error());
+  }
+
+  if (global.json) {
+    nlohmann::json jobs = nlohmann::json::array();
+    for (const build::JobReport& r : report->jobs) jobs.push_back(job_json(r));
+    std::cout << nlohmann::json{{"command", "build"},
+                                {"manifest", manifest.file.string()},
+                                {"output", manifest.output.string()},
+                                {"dry_run", s.dry_run},
+                                {"jobs", jobs},
+                                {"built", report->count(build::Outcome::built)},
+                                {"up_to_date", report->count(build::Outcome::up_to_date)},
+                                {"out_of_date", report->count(build::Outcome::out_of_date)},
+                                {"failed", failed},
+                                {"images_decoded", report->images_decoded},
+                                {"seconds", seconds},
+                                {"warnings", plan->warnings}}
+                     .dump(2)
+              << "\n";
+  } else if (!global.quiet) {
+    if (s.dry_run) {
+      for (const build::JobReport& r : report->jobs) {
+        if (r.outcome == build::Outcome::out_of_date) std::printf("would build %s: %s\n", r.job->name.c_str(), r.reason.c_str());
+      }
+    }
+    for (const build::JobReport& r : report->jobs) {
+      for (const std::string& w : r.warnings) std::cerr << "matbake: warning: " << r.job->name << ": " << w << "\n";
+    }
+    const std::size_t built = report->count(build::Outcome::built), current = report->count(build::Outcome::up_to_date),
+                      pending = report->count(build::Outcome::out_of_date);
+    if (built + failed + pending == 0) {
+      std::printf("nothing to do: %zu jobs up to date\n", current);
+    } else if (s.dry_run) {
+      std::printf("%zu of %zu jobs would be built\n", pending, report->jobs.size());
+    } else {
+      std::printf("built %zu, up to date %zu, failed %zu; %zu images decoded; %.2f s\n", built, current, failed,
+                  report->images_decoded, seconds);
+    }
+  }
+  if (failed) {
+    std::cerr << "matbake: error: " << s.manifest << ": " << failed << " of " << report->jobs.size() << " jobs failed\n";
+    return kFailed;
+  }
+  return kOk;
+}
+
+}  // namespace matbake::cli

@@ -1,0 +1,141 @@
+#pragma once
+// `matbake build`: a TOML manifest of materials and scenes, built the way a build tool builds.
+// - A material's sources are decoded (convert), converted to the workflow its layout needs
+//   (workflow), packed into the layout's textures (pack) and checked (validate); a scene is written
+//   again as glTF 2.0 with those materials and per-vertex AO (bake-ao, export).
+// - Each output job runs only when it is out of date: a stamp beside the outputs records its
+//   inputs (size, time, content hash), its options and matbake's version.
+// - Jobs run in parallel (TBB), each source file is decoded once however many jobs read it, and a
+//   failing job does not stop the others.
+// docs/build.md has the manifest's schema.
+#include <nlohmann/json.hpp>
+
+#include <cstddef>
+#include <filesystem>
+#include <functional>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "matbake/ao.hpp"
+#include "matbake/export.hpp"
+#include "matbake/image.hpp"
+#include "matbake/pack.hpp"
+#include "matbake/result.hpp"
+#include "matbake/workflow.hpp"
+
+namespace matbake::build {
+
+struct ValidationRules {
+  bool enabled = true;
+  double tolerance = 0.1;     // relative, against the material table entry (`reference`)
+  double max_violations = 0;  // share of checked texels that may be flagged before the job fails
+  bool heatmap = false;       // also write <name>_validation.png
+};
+
+struct MaterialSpec {
+  std::string name;  // [A-Za-z0-9_.-], names its output files
+  // Either separate source maps (files or constants) ...
+  std::vector<pack::SourceInput> sources;
+  // ... or the packed textures of a layout (e.g. a Schüler pair).
+  std::string packed_layout;
+  std::vector<std::filesystem::path> packed_files;
+  color::Transfer transfer = color::Transfer::srgb;  // how 8-bit colour sources were authored
+  std::optional<color::Transfer> decode;  // how every colour file is decoded, whatever its depth
+  bool resize = false;                               // sources of different sizes: resample to the largest
+  std::string layout;          // textures to write (a preset or layout file); empty: none
+  std::string format = "png";  // png, exr, tif
+  image::SampleType bits = image::SampleType::u8;
+  workflow::RoughnessMapping mapping = workflow::RoughnessMapping::fitted;
+  std::string reference;  // a material table entry to validate against
+  ValidationRules validation;
+};
+
+struct SceneSpec {
+  std::string name;
+  std::filesystem::path input;   // .gltf or .glb
+  std::filesystem::path output;  // inside the output folder
+  std::map<std::string, std::string> materials;  // glTF material name → manifest material
+  bool match_names = true;  // also: glTF materials named like a manifest material get it
+  std::optional<ao::Options> ao;
+  ao::Into ao_into = ao::Into::color_multiply;
+  exporter::DielectricF0 dielectric_f0 = exporter::DielectricF0::specular;
+  bool orm = true;
+};
+
+struct Manifest {
+  std::filesystem::path file;    // absolute
+  std::filesystem::path folder;  // relative paths in the manifest resolve here
+  std::filesystem::path output;  // absolute; everything is written inside it
+  std::filesystem::path table;   // material table (empty: the built-in one)
+  std::vector<MaterialSpec> materials;
+  std::vector<SceneSpec> scenes;
+};
+
+// Errors name the manifest with line and column, and the key.
+Result<Manifest> parse_manifest(std::string_view toml_text, const std::filesystem::path& file);
+Result<Manifest> read_manifest(const std::filesystem::path& file);
+
+enum class JobKind { material, scene };
+
+struct Job {
+  JobKind kind = JobKind::material;
+  std::size_t spec = 0;  // index into the manifest's materials or scenes
+  std::string name;      // "material:wood", "scene:showroom"
+  std::vector<std::filesystem::path> outputs;  // every file it writes, as known before it runs
+  std::vector<std::filesystem::path> inputs;   // every file it reads
+  std::map<std::string, std::size_t> materials;  // a scene: glTF material name → manifest material
+  std::string options;   // what besides the inputs decides the outputs (canonical JSON)
+  std::string problem;   // found while planning: the job fails with it when run
+};
+
+struct Plan {
+  std::vector<Job> jobs;
+  std::vector<std::string> warnings;  // e.g. a material nothing uses
+  std::filesystem::path state_folder;  // the stamps: <output>/.matbake
+};
+
+// Which jobs the manifest makes and what each reads and writes (a scene's buffers and images are
+// read from its JSON). Fails only for problems of the manifest as a whole (an output that is an
+// input, two jobs writing one file).
+Result<Plan> make_plan(const Manifest& manifest);
+
+enum class Outcome { built, up_to_date, failed, out_of_date /* --dry-run */ };
+
+struct JobReport {
+  const Job* job = nullptr;
+  Outcome outcome = Outcome::up_to_date;
+  std::string reason;  // why it ran: "no earlier build", "input changed: ...", "forced", ...
+  double seconds = 0;
+  std::vector<std::string> warnings;
+  std::optional<Error> error;
+  nlohmann::json details;  // validation, conversion errors, the export report
+};
+
+struct RunOptions {
+  bool force = false;
+  bool dry_run = false;
+  std::vector<std::string> only;  // job names; empty: all
+  // Called as each job finishes (from worker threads, one call at a time).
+  std::function<void(const JobReport&, std::size_t done, std::size_t total)> progress;
+};
+
+struct Report {
+  std::vector<JobReport> jobs;  // in plan order
+  std::size_t images_decoded = 0;
+  std::size_t count(Outcome o) const;
+};
+
+// Runs the out-of-date jobs of the plan (all jobs with force). Errors are per job, in the report.
+Result<Report> run(const Manifest& manifest, const Plan& plan, const RunOptions& options);
+
+// Make syntax: `targets: inputs`, spaces escaped, one prerequisite per line.
+std::string depfile_text(const std::vector<std::filesystem::path>& targets,
+                         const std::vector<std::filesystem::path>& inputs);
+
+// A Ninja file with one edge per job, each running `matbake build MANIFEST --only JOB`, with the
+// job's depfile so Ninja also learns what it read.
+std::string ninja_text(const Manifest& manifest, const Plan& plan, const std::filesystem::path& matbake);
+
+}  // namespace matbake::build

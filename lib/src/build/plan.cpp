@@ -1,0 +1,251 @@
+// The jobs of a manifest, what each reads and writes, and the files build systems read: Make
+// depfiles and a Ninja file.
+#include <algorithm>
+#include <set>
+
+#include "../gltf/document.hpp"
+#include "state.hpp"
+#include "matbake/build.hpp"
+#include "matbake/version.hpp"
+
+namespace matbake::build {
+namespace fs = std::filesystem;
+namespace {
+
+fs::path normalized(const fs::path& p) {
+  std::error_code ec;
+  return fs::absolute(p, ec).lexically_normal();
+}
+
+// Everything in a material's spec that decides its outputs, for the stamp.
+nlohmann::json material_options(const MaterialSpec& m, const Manifest& manifest) {
+  nlohmann::json sources = nlohmann::json::object();
+  for (const pack::SourceInput& s : m.sources) {
+    sources[s.name] = s.file.empty() ? nlohmann::json(s.constant) : nlohmann::json(normalized(s.file).string());
+  }
+  std::vector<std::string> packed;
+  for (const fs::path& f : m.packed_files) packed.push_back(normalized(f).string());
+  return {{"sources", sources},
+          {"packed", {{"layout", m.packed_layout}, {"files", packed}}},
+          {"transfer", color::transfer_name(m.transfer)},
+          {"decode", m.decode ? color::transfer_name(*m.decode) : ""},
+          {"resize", m.resize},
+          {"layout", m.layout},
+          {"format", m.format},
+          {"bits", image::sample_type_name(m.bits)},
+          {"mapping", workflow::roughness_mapping_name(m.mapping)},
+          {"reference", m.reference},
+          {"table", manifest.table.string()},
+          {"validate",
+           {{"enabled", m.validation.enabled},
+            {"tolerance", m.validation.tolerance},
+            {"max_violations", m.validation.max_violations},
+            {"heatmap", m.validation.heatmap}}}};
+}
+
+std::vector<fs::path> material_inputs(const MaterialSpec& m, const Manifest& manifest) {
+  std::vector<fs::path> inputs;
+  for (const pack::SourceInput& s : m.sources) {
+    if (!s.file.empty()) inputs.push_back(normalized(s.file));
+  }
+  for (const fs::path& f : m.packed_files) inputs.push_back(normalized(f));
+  // A layout file (not a preset) and the material table are read too.
+  if (!m.layout.empty() && fs::path(m.layout).has_extension()) inputs.push_back(normalized(manifest.folder / m.layout));
+  if (!m.packed_layout.empty() && fs::path(m.packed_layout).has_extension()) {
+    inputs.push_back(normalized(manifest.folder / m.packed_layout));
+  }
+  if (!manifest.table.empty() && m.validation.enabled) inputs.push_back(normalized(manifest.table));
+  return inputs;
+}
+
+void add_unique(std::vector<fs::path>& to, const std::vector<fs::path>& from) {
+  for (const fs::path& p : from) {
+    if (std::find(to.begin(), to.end(), p) == to.end()) to.push_back(p);
+  }
+}
+
+std::string ninja_escape(const std::string& path) {
+  std::string out;
+  for (char c : path) {
+    if (c == '$' || c == ' ' || c == ':' || c == '\n') out += '$';
+    out += c;
+  }
+  return out;
+}
+
+std::string make_escape(const std::string& path) {
+  std::string out;
+  for (char c : path) {
+    if (c == ' ' || c == '#' || c == '\\') out += '\\';
+    if (c == '$') out += '$';
+    out += c;
+  }
+  return out;
+}
+
+}  // namespace
+
+std::size_t Report::count(Outcome o) const {
+  return std::size_t(std::count_if(jobs.begin(), jobs.end(), [&](const JobReport& j) { return j.outcome == o; }));
+}
+
+Result<Plan> make_plan(const Manifest& manifest) {
+  Plan plan;
+  plan.state_folder = manifest.output / ".matbake";
+  const fs::path materials_folder = manifest.output / "materials";
+  std::vector<bool> used(manifest.materials.size(), false);
+  const auto material_index = [&](const std::string& name) -> std::optional<std::size_t> {
+    for (std::size_t i = 0; i < manifest.materials.size(); ++i) {
+      if (manifest.materials[i].name == name) return i;
+    }
+    return std::nullopt;
+  };
+
+  std::vector<Job> scenes;
+  for (std::size_t i = 0; i < manifest.scenes.size(); ++i) {
+    const SceneSpec& s = manifest.scenes[i];
+    Job job;
+    job.kind = JobKind::scene;
+    job.spec = i;
+    job.name = "scene:" + s.name;
+    const fs::path out = manifest.output / s.output;
+    job.outputs.push_back(out);
+    if (out.extension() == ".gltf") job.outputs.push_back(out.parent_path() / (out.stem().string() + ".bin"));
+    // Which manifest materials the scene gets: named in the spec, or by the glTF material's name.
+    std::map<std::string, std::string> assigned = s.materials;
+    auto json = gltf::read_json(s.input);
+    if (!json) {
+      job.problem = json.error().to_string();
+      job.inputs.push_back(normalized(s.input));
+    } else {
+      job.inputs = gltf::source_files(s.input, *json);
+      std::set<std::string> names;
+      if (json->contains("materials") && (*json)["materials"].is_array()) {
+        for (const auto& m : (*json)["materials"]) {
+          if (m.is_object() && m.contains("name") && m["name"].is_string()) names.insert(m["name"].get<std::string>());
+        }
+      }
+      for (const auto& [gltf_name, material] : s.materials) {
+        if (!names.count(gltf_name)) {
+          job.problem = s.input.string() + ": scenes." + s.name + ".materials names '" + gltf_name +
+                        "', but the glTF has no material of that name";
+        }
+      }
+      if (s.match_names) {
+        for (const std::string& n : names) {
+          if (!assigned.count(n) && material_index(n)) assigned[n] = n;
+        }
+      }
+    }
+    nlohmann::json materials = nlohmann::json::object();
+    for (const auto& [gltf_name, material] : assigned) {
+      const std::size_t m = *material_index(material);
+      used[m] = true;
+      job.materials[gltf_name] = m;
+      add_unique(job.inputs, material_inputs(manifest.materials[m], manifest));
+      materials[gltf_name] = material_options(manifest.materials[m], manifest);
+    }
+    nlohmann::json ao = nullptr;
+    if (s.ao) {
+      ao = {{"samples", s.ao->samples},     {"distance", s.ao->max_distance},
+            {"relative", s.ao->relative_distance}, {"tau", s.ao->tau},
+            {"falloff", int(s.ao->falloff)}, {"bias", s.ao->bias},
+            {"two_sided", s.ao->two_sided}, {"seed", s.ao->seed},
+            {"sampler", int(s.ao->sampler)}, {"watertight", s.ao->watertight},
+            {"into", int(s.ao_into)}};
+    }
+    job.options = nlohmann::json{{"input", normalized(s.input).string()},
+                                 {"output", s.output.string()},
+                                 {"materials", materials},
+                                 {"ao", ao},
+                                 {"dielectric_f0", int(s.dielectric_f0)},
+                                 {"orm", s.orm}}
+                      .dump();
+    scenes.push_back(std::move(job));
+  }
+
+  for (std::size_t i = 0; i < manifest.materials.size(); ++i) {
+    const MaterialSpec& m = manifest.materials[i];
+    Job job;
+    job.kind = JobKind::material;
+    job.spec = i;
+    job.name = "material:" + m.name;
+    job.inputs = material_inputs(m, manifest);
+    job.options = material_options(m, manifest).dump();
+    if (!m.layout.empty()) {
+      auto layout = pack::find_layout(m.layout.find('/') != std::string::npos || fs::path(m.layout).has_extension()
+                                          ? (manifest.folder / m.layout).string()
+                                          : m.layout);
+      if (!layout) {
+        job.problem = "materials." + m.name + ".layout: " + layout.error().to_string();
+      } else {
+        for (const pack::Texture& t : layout->textures) {
+          job.outputs.push_back(materials_folder / (m.name + "_" + t.name + "." + m.format));
+        }
+      }
+    }
+    if (m.validation.enabled) {
+      job.outputs.push_back(materials_folder / (m.name + ".validation.json"));
+      if (m.validation.heatmap) job.outputs.push_back(materials_folder / (m.name + "_validation.png"));
+    }
+    if (m.layout.empty() && !used[i]) {
+      plan.warnings.push_back("materials." + m.name + ": no layout and no scene uses it, so nothing is built from it");
+      continue;
+    }
+    if (job.outputs.empty()) continue;  // used by scenes only, nothing of its own to write
+    plan.jobs.push_back(std::move(job));
+  }
+  for (Job& s : scenes) plan.jobs.push_back(std::move(s));
+
+  // No file written twice, and no input written at all.
+  std::map<fs::path, std::string> writers;
+  std::set<fs::path> inputs;
+  for (const Job& job : plan.jobs) inputs.insert(job.inputs.begin(), job.inputs.end());
+  inputs.insert(manifest.file);
+  for (const Job& job : plan.jobs) {
+    for (const fs::path& out : job.outputs) {
+      if (inputs.count(out)) return Error{out.string(), job.name + " would overwrite an input; matbake never does"};
+      if (const auto [it, added] = writers.emplace(out, job.name); !added) {
+        return Error{out.string(), "written by both " + it->second + " and " + job.name};
+      }
+    }
+  }
+  return plan;
+}
+
+std::string depfile_text(const std::vector<fs::path>& targets, const std::vector<fs::path>& inputs) {
+  std::string text;
+  for (const fs::path& t : targets) text += (text.empty() ? "" : " ") + make_escape(t.string());
+  text += ":";
+  for (const fs::path& in : inputs) text += " \\\n  " + make_escape(in.string());
+  return text + "\n";
+}
+
+std::string ninja_text(const Manifest& manifest, const Plan& plan, const fs::path& matbake) {
+  std::string text = "# Written by `matbake plan` (matbake " + std::string(version) + ") from " + manifest.file.string() +
+                     ".\n# One edge per job; each edge's depfile adds what the job read. Written again by\n"
+                     "# `matbake plan` when the manifest changes (the regenerate edge).\n"
+                     "ninja_required_version = 1.10\n\n";
+  text += "matbake = " + ninja_escape(matbake.string()) + "\n";
+  text += "manifest = " + ninja_escape(manifest.file.string()) + "\n\n";
+  text += "rule matbake\n"
+          "  command = $matbake build $manifest --only $job --quiet --depfile $depfile_path\n"
+          "  description = matbake $job\n"
+          "  depfile = $depfile_path\n"
+          "  deps = gcc\n"
+          "  restat = 1\n\n";
+  for (const Job& job : plan.jobs) {
+    text += "build";
+    for (const fs::path& out : job.outputs) text += " " + ninja_escape(out.string());
+    text += ": matbake $manifest";
+    if (!job.inputs.empty()) {
+      text += " |";
+      for (const fs::path& in : job.inputs) text += " " + ninja_escape(in.string());
+    }
+    text += "\n  job = " + job.name + "\n";
+    text += "  depfile_path = " + ninja_escape((plan.state_folder / (job_file_stem(job) + ".d")).string()) + "\n\n";
+  }
+  return text;
+}
+
+}  // namespace matbake::build

@@ -1,0 +1,339 @@
+// Running a plan: the out-of-date jobs in parallel, each source file decoded once and freed when
+// the last job that reads it is done.
+#include <tbb/parallel_for_each.h>
+#include <tbb/task_arena.h>
+
+#include <atomic>
+#include <chrono>
+#include <memory>
+#include <mutex>
+#include <set>
+
+#include "matbake/atomic_file.hpp"
+#include "matbake/build.hpp"
+#include "matbake/materials.hpp"
+#include "matbake/report_json.hpp"
+#include "matbake/validate.hpp"
+#include "matbake/workflow_maps.hpp"
+#include "state.hpp"
+
+namespace matbake::build {
+namespace fs = std::filesystem;
+namespace {
+
+// Decoded source files shared by the jobs of one run. Each file is decoded once per transfer; it is
+// freed when every job that declared it has released it, so memory follows the jobs in flight, not
+// the size of the manifest.
+class DecodeCache {
+ public:
+  explicit DecodeCache(const std::map<fs::path, std::size_t>& uses) {
+    for (const auto& [path, n] : uses) entries_[path] = std::make_unique<Entry>(n);
+  }
+
+  Result<std::shared_ptr<const image::Image>> read(const fs::path& file, color::Transfer transfer) {
+    const fs::path key = fs::absolute(file).lexically_normal();
+    Entry* entry = nullptr;
+    {
+      std::lock_guard lock(mutex_);
+      auto& e = entries_[key];
+      if (!e) e = std::make_unique<Entry>(0);  // not declared: decoded, kept until the run ends
+      entry = e.get();
+    }
+    std::lock_guard lock(entry->mutex);  // a second reader of the same file waits for the first decode
+    if (const auto found = entry->images.find(transfer); found != entry->images.end()) return found->second;
+    auto decoded = image::read_image(file, transfer);
+    if (!decoded) return decoded.error();
+    ++decoded_;
+    auto shared = std::make_shared<const image::Image>(std::move(*decoded));
+    entry->images[transfer] = shared;
+    return shared;
+  }
+
+  void release(const fs::path& file) {
+    std::lock_guard lock(mutex_);
+    const auto found = entries_.find(file);
+    if (found == entries_.end() || found->second->uses == 0) return;
+    if (--found->second->uses == 0) {
+      std::lock_guard entry_lock(found->second->mutex);
+      found->second->images.clear();
+    }
+  }
+
+  std::size_t decoded() const { return decoded_; }
+
+ private:
+  struct Entry {
+    explicit Entry(std::size_t n) : uses(n) {}
+    std::mutex mutex;
+    std::map<color::Transfer, std::shared_ptr<const image::Image>> images;
+    std::size_t uses;
+  };
+  std::mutex mutex_;
+  std::map<fs::path, std::unique_ptr<Entry>> entries_;
+  std::atomic<std::size_t> decoded_{0};
+};
+
+// The image files a material decodes.
+std::vector<fs::path> decoded_files(const MaterialSpec& m) {
+  std::vector<fs::path> files;
+  for (const pack::SourceInput& s : m.sources) {
+    if (!s.file.empty()) files.push_back(fs::absolute(s.file).lexically_normal());
+  }
+  for (const fs::path& f : m.packed_files) files.push_back(fs::absolute(f).lexically_normal());
+  std::sort(files.begin(), files.end());
+  files.erase(std::unique(files.begin(), files.end()), files.end());
+  return files;
+}
+
+std::vector<fs::path> decoded_files(const Job& job, const Manifest& manifest) {
+  if (job.kind == JobKind::material) return decoded_files(manifest.materials[job.spec]);
+  std::set<fs::path> files;
+  for (const auto& [gltf_name, m] : job.materials) {
+    for (const fs::path& f : decoded_files(manifest.materials[m])) files.insert(f);
+  }
+  return {files.begin(), files.end()};
+}
+
+std::string layout_reference(const std::string& layout, const Manifest& manifest) {
+  return fs::path(layout).has_extension() ? (manifest.folder / layout).string() : layout;
+}
+
+Result<pack::SourceMaps> load_material(const MaterialSpec& m, const Manifest& manifest, DecodeCache& cache) {
+  const pack::ImageReader read = [&cache](const fs::path& f, color::Transfer t) { return cache.read(f, t); };
+  if (!m.packed_layout.empty()) {
+    auto layout = pack::find_layout(layout_reference(m.packed_layout, manifest));
+    if (!layout) return layout.error();
+    return pack::read_packed(*layout, m.packed_files, m.decode, m.transfer, read);
+  }
+  pack::LoadOptions options;
+  options.authored = m.transfer;
+  options.input = m.decode;
+  options.resize = m.resize;
+  options.read = read;
+  return pack::load_sources(m.sources, options);
+}
+
+bool has_any(const pack::SourceMaps& maps, std::initializer_list<const char*> names) {
+  for (const char* n : names) {
+    if (maps.find(n)) return true;
+  }
+  return false;
+}
+
+// The maps in the workflow the layout reads, converted when the sources are in the other one.
+Result<pack::SourceMaps> in_layout_workflow(pack::SourceMaps maps, const pack::Layout& layout, const MaterialSpec& m,
+                                            nlohmann::json& details) {
+  const std::vector<std::string> wanted = layout_sources(layout);
+  const auto wants = [&](std::initializer_list<const char*> names) {
+    for (const char* n : names) {
+      if (std::find(wanted.begin(), wanted.end(), n) != wanted.end()) return true;
+    }
+    return false;
+  };
+  workflow::ConversionReport report;
+  Result<pack::SourceMaps> converted = Error{};
+  if (wants({"base_color", "metallic", "roughness"}) && !has_any(maps, {"base_color", "metallic", "roughness"}) &&
+      has_any(maps, {"kd", "ks", "gloss"})) {
+    converted = workflow::metal_rough_from_spec_gloss(maps, m.mapping, report);
+    details["conversion"] = {{"from", "spec-gloss"}, {"to", "metal-rough"}};
+  } else if (wants({"kd", "ks", "gloss"}) && !has_any(maps, {"kd", "ks", "gloss"}) &&
+             has_any(maps, {"base_color", "metallic", "roughness"})) {
+    converted = workflow::spec_gloss_from_metal_rough(maps, m.mapping, report);
+    details["conversion"] = {{"from", "metal-rough"}, {"to", "spec-gloss"}};
+  } else {
+    return maps;
+  }
+  if (!converted) return converted.error();
+  details["conversion"]["mapping"] = workflow::roughness_mapping_name(m.mapping);
+  details["conversion"]["texels"] = report.texels;
+  details["conversion"]["errors"] = to_json(report.errors);
+  return converted;
+}
+
+struct JobContext {
+  const Manifest& manifest;
+  DecodeCache& cache;
+  const std::vector<materials::Material>* table;  // null when it could not be read
+  const Error* table_error;
+};
+
+Status ensure_folder(const fs::path& folder) {
+  std::error_code ec;
+  fs::create_directories(folder, ec);
+  if (ec) return Error{folder.string(), "cannot make the output folder: " + ec.message()};
+  return success();
+}
+
+// Validation of the material as authored; a job error when more texels are flagged than allowed.
+Status validate_material(const MaterialSpec& m, const pack::SourceMaps& maps, const JobContext& ctx,
+                         const std::vector<fs::path>& outputs, JobReport& report) {
+  validate::Options options;
+  options.tolerance = m.validation.tolerance;
+  options.class_map = m.validation.heatmap;
+  if (!m.reference.empty()) {
+    if (!ctx.table) return *ctx.table_error;
+    options.material = materials::find(*ctx.table, m.reference);
+    if (!options.material) {
+      return Error{ctx.manifest.file.string(), "materials." + m.name + ".reference: unknown material '" + m.reference +
+                                                   "' (`matbake materials` lists them)"};
+    }
+  }
+  validate::Inputs inputs;
+  inputs.mask = maps.find("mask");
+  validate::SpecularDiffuse from_metal_rough;
+  if (maps.find("ks")) {
+    inputs.specular = maps.find("ks");
+    inputs.diffuse = maps.find("kd");
+  } else if (maps.find("base_color") && maps.find("metallic")) {
+    auto sd = validate::from_metal_rough(*maps.find("base_color"), *maps.find("metallic"));
+    if (!sd) return sd.error();
+    from_metal_rough = std::move(*sd);
+    inputs.specular = &from_metal_rough.specular;
+    inputs.diffuse = &from_metal_rough.diffuse;
+  } else {
+    return Error{ctx.manifest.file.string(), "materials." + m.name +
+                                                 ": validation needs ks (spec-gloss) or base_color and metallic "
+                                                 "(metal-rough); set validate = { enabled = false } to skip it"};
+  }
+  auto result = validate::validate(inputs, options);
+  if (!result) return result.error();
+  const bool passed = result->violation_fraction() <= m.validation.max_violations;
+  nlohmann::json v = to_json(*result, options, inputs.diffuse != nullptr);
+  v["max_violations"] = m.validation.max_violations;
+  v["passed"] = passed;
+  report.details["validation"] = {{"checked", result->checked},
+                                  {"violations", result->violations},
+                                  {"violation_fraction", result->violation_fraction()},
+                                  {"passed", passed}};
+  const fs::path& json_file = *std::find_if(outputs.begin(), outputs.end(), [](const fs::path& p) {
+    return p.string().ends_with(".validation.json");
+  });
+  report.details["validation"]["report"] = json_file.string();
+  if (Status s = write_file_atomically(json_file, v.dump(2) + "\n"); !s) return s;
+  if (m.validation.heatmap) {
+    const image::WriteOptions png{color::Transfer::srgb, image::SampleType::u8, "", "sRGB"};
+    if (Status s = image::write_image(validate::heatmap(*result), outputs.back(), png); !s) return s;
+  }
+  char line[160];
+  std::snprintf(line, sizeof line, "validation: %zu of %zu texels flagged (%.3g%%; max_violations %.3g%%)",
+                result->violations, result->checked, 100 * result->violation_fraction(),
+                100 * m.validation.max_violations);
+  if (!passed) return Error{json_file.string(), line};
+  if (result->violations) report.warnings.push_back(line);
+  return success();
+}
+
+Status run_material(const Job& job, const JobContext& ctx, JobReport& report) {
+  const MaterialSpec& m = ctx.manifest.materials[job.spec];
+  auto maps = load_material(m, ctx.manifest, ctx.cache);
+  if (!maps) return maps.error();
+  report.details["size"] = {maps->width, maps->height};
+  if (Status s = ensure_folder(ctx.manifest.output / "materials"); !s) return s;
+  if (!m.layout.empty()) {
+    auto layout = pack::find_layout(layout_reference(m.layout, ctx.manifest));
+    if (!layout) return layout.error();
+    auto in_workflow = in_layout_workflow(*maps, *layout, m, report.details);
+    if (!in_workflow) return in_workflow.error();
+    auto textures = pack::pack(*layout, *in_workflow);
+    if (!textures) return textures.error();
+    for (std::size_t t = 0; t < textures->size(); ++t) {
+      const image::WriteOptions w = pack::write_options(layout->textures[t].color, {m.bits, m.transfer});
+      if (Status s = image::write_image((*textures)[t], job.outputs[t], w); !s) return s;
+    }
+  }
+  if (m.validation.enabled) return validate_material(m, *maps, ctx, job.outputs, report);
+  return success();
+}
+
+Result<std::vector<fs::path>> run_scene(const Job& job, const JobContext& ctx, JobReport& report) {
+  const SceneSpec& s = ctx.manifest.scenes[job.spec];
+  exporter::Options options;
+  options.dielectric_f0 = s.dielectric_f0;
+  options.pack_orm = s.orm;
+  options.ao = s.ao;
+  options.ao_into = s.ao_into;
+  for (const auto& [gltf_name, m] : job.materials) {
+    auto maps = load_material(ctx.manifest.materials[m], ctx.manifest, ctx.cache);
+    if (!maps) return maps.error();
+    options.materials.push_back({gltf_name, std::move(*maps)});
+  }
+  const fs::path output = job.outputs.front();
+  if (Status st = ensure_folder(output.parent_path()); !st) return st.error();
+  auto exported = exporter::export_scene(s.input, output, options);
+  if (!exported) return exported.error();
+  report.details = to_json(*exported);
+  return std::vector<fs::path>(exported->written.begin(), exported->written.end());
+}
+
+void run_job(const Job& job, const JobContext& ctx, const fs::path& state_folder, JobReport& report) {
+  const auto start = std::chrono::steady_clock::now();
+  remove_stamp(job, state_folder);  // from here until it succeeds, the job is not up to date
+  std::vector<fs::path> written = job.outputs;
+  Status status = success();
+  if (!job.problem.empty()) {
+    status = Error{"", job.problem};
+  } else if (job.kind == JobKind::material) {
+    status = run_material(job, ctx, report);
+  } else if (auto files = run_scene(job, ctx, report); files) {
+    written = *files;
+  } else {
+    status = files.error();
+  }
+  if (status) status = write_stamp(job, job.inputs, written, state_folder);
+  report.outcome = status ? Outcome::built : Outcome::failed;
+  if (!status) report.error = status.error();
+  report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace
+
+Result<Report> run(const Manifest& manifest, const Plan& plan, const RunOptions& options) {
+  for (const std::string& name : options.only) {
+    if (std::none_of(plan.jobs.begin(), plan.jobs.end(), [&](const Job& j) { return j.name == name; })) {
+      std::string names;
+      for (const Job& j : plan.jobs) names += (names.empty() ? "" : ", ") + j.name;
+      return Error{manifest.file.string(), "no job '" + name + "' (jobs: " + names + ")", true};
+    }
+  }
+  Report report;
+  std::vector<std::size_t> to_run;
+  for (const Job& job : plan.jobs) {
+    if (!options.only.empty() && std::find(options.only.begin(), options.only.end(), job.name) == options.only.end()) continue;
+    JobReport r;
+    r.job = &job;
+    r.reason = options.force ? "forced" : out_of_date_reason(job, plan.state_folder);
+    if (!r.reason.empty()) {
+      r.outcome = Outcome::out_of_date;
+      to_run.push_back(report.jobs.size());
+    }
+    report.jobs.push_back(std::move(r));
+  }
+  if (options.dry_run) return report;
+  if (Status s = ensure_folder(plan.state_folder); !s) return s.error();
+
+  std::map<fs::path, std::size_t> uses;
+  for (std::size_t i : to_run) {
+    for (const fs::path& f : decoded_files(*report.jobs[i].job, manifest)) ++uses[f];
+  }
+  DecodeCache cache(uses);
+  auto table = manifest.table.empty() ? Result<std::vector<materials::Material>>(materials::builtin_table())
+                                      : materials::load_table(manifest.table);
+  const JobContext ctx{manifest, cache, table ? &*table : nullptr, table ? nullptr : &table.error()};
+
+  std::mutex progress_mutex;
+  std::size_t done = 0;
+  tbb::parallel_for_each(to_run.begin(), to_run.end(), [&](std::size_t i) {
+    JobReport& r = report.jobs[i];
+    // Isolated: a worker waiting inside this job's own parallel loops does not start another job,
+    // which would hold a second job's images at once.
+    tbb::this_task_arena::isolate([&] { run_job(*r.job, ctx, plan.state_folder, r); });
+    for (const fs::path& f : decoded_files(*r.job, manifest)) cache.release(f);
+    std::lock_guard lock(progress_mutex);
+    ++done;
+    if (options.progress) options.progress(r, done, to_run.size());
+  });
+  report.images_decoded = cache.decoded();
+  return report;
+}
+
+}  // namespace matbake::build
