@@ -81,7 +81,7 @@ int run_plan(const PlanSettings& s, const GlobalOptions& global) {
   if (!plan) return report_error(plan.error());
   std::error_code ec;
   const fs::path self = s.matbake.empty() ? fs::read_symlink("/proc/self/exe", ec) : fs::absolute(s.matbake);
-  if (Status st = write_file_atomically(s.output, build::ninja_text(manifest, *plan, self)); !st) {
+  if (Status st = write_file_atomically(s.output, build::ninja_text(manifest, *plan, self, s.output)); !st) {
     return report_error(st.error());
   }
   if (global.json) {

@@ -11,8 +11,9 @@ noise() { echo "--pattern noise:type=uniform:min=$1:max=$2:mono=1:seed=$3 $size 
 # Painted metal: blue-grey paint with fine speckle.
 oiiotool --pattern constant:color=0.20,0.32,0.45 $size 3 $(noise -0.03 0.03 1) --add \
   -d uint8 -o "$out/painted_metal_albedo.png"
-# Gold trim: the specular colour of gold, slightly brushed.
-oiiotool --pattern constant:color=1.0,0.78,0.34 $size 3 $(noise -0.04 0.0 2) --add \
+# Gold trim: the specular colour of gold (the material table's F0 0.966, 0.820, 0.389 is sRGB
+# 251, 234, 167), slightly brushed: within the table's 10% so that `reference = "gold"` passes.
+oiiotool --pattern constant:color=0.990,0.922,0.660 $size 3 $(noise -0.012 0.0 2) --add \
   -d uint8 -o "$out/gold_trim_specular.png"
 # Wood: vertical grain bands, 16-bit to exercise the 16-bit path.
 oiiotool --pattern fill:left=0.45,0.27,0.13:right=0.62,0.40,0.22 $size 3 \

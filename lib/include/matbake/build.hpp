@@ -135,7 +135,9 @@ std::string depfile_text(const std::vector<std::filesystem::path>& targets,
                          const std::vector<std::filesystem::path>& inputs);
 
 // A Ninja file with one edge per job, each running `matbake build MANIFEST --only JOB`, with the
-// job's depfile so Ninja also learns what it read.
-std::string ninja_text(const Manifest& manifest, const Plan& plan, const std::filesystem::path& matbake);
+// job's depfile so Ninja also learns what it read, and an edge that writes `ninja_file` again
+// (named as Ninja will be given it) when the manifest changes.
+std::string ninja_text(const Manifest& manifest, const Plan& plan, const std::filesystem::path& matbake,
+                       const std::filesystem::path& ninja_file);
 
 }  // namespace matbake::build

@@ -221,10 +221,10 @@ std::string depfile_text(const std::vector<fs::path>& targets, const std::vector
   return text + "\n";
 }
 
-std::string ninja_text(const Manifest& manifest, const Plan& plan, const fs::path& matbake) {
+std::string ninja_text(const Manifest& manifest, const Plan& plan, const fs::path& matbake, const fs::path& ninja_file) {
   std::string text = "# Written by `matbake plan` (matbake " + std::string(version) + ") from " + manifest.file.string() +
                      ".\n# One edge per job; each edge's depfile adds what the job read. Written again by\n"
-                     "# `matbake plan` when the manifest changes (the regenerate edge).\n"
+                     "# `matbake plan` when the manifest changes (the last edge).\n"
                      "ninja_required_version = 1.10\n\n";
   text += "matbake = " + ninja_escape(matbake.string()) + "\n";
   text += "manifest = " + ninja_escape(manifest.file.string()) + "\n\n";
@@ -245,6 +245,11 @@ std::string ninja_text(const Manifest& manifest, const Plan& plan, const fs::pat
     text += "\n  job = " + job.name + "\n";
     text += "  depfile_path = " + ninja_escape((plan.state_folder / (job_file_stem(job) + ".d")).string()) + "\n\n";
   }
+  text += "rule matbake_plan\n"
+          "  command = $matbake plan $manifest -o $out --quiet\n"
+          "  description = matbake plan $manifest\n"
+          "  generator = 1\n\n"
+          "build " + ninja_escape(ninja_file.string()) + ": matbake_plan $manifest\n";
   return text;
 }
 
