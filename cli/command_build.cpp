@@ -41,11 +41,17 @@ nlohmann::json job_json(const build::JobReport& r) {
 
 std::string job_error(const build::JobReport& r) { return r.error->to_string() + " (" + r.job->name + ")"; }
 
-Result<build::Plan> load(const std::string& manifest_file, build::Manifest& manifest) {
+Result<build::Plan> load(const std::string& manifest_file, const std::string& output_dir, build::Manifest& manifest) {
   auto m = build::read_manifest(manifest_file);
   if (!m) return m.error();
   manifest = std::move(*m);
+  if (!output_dir.empty()) manifest.output = fs::absolute(output_dir).lexically_normal();
   return build::make_plan(manifest);
+}
+
+void add_output_dir_option(CLI::App& cmd, std::string& output_dir) {
+  cmd.add_option("--output-dir", output_dir,
+                 "Write the outputs here instead of the manifest's `output` (e.g. inside a build tree)");
 }
 
 }  // namespace
@@ -56,6 +62,7 @@ CLI::App* setup_build(CLI::App& app, BuildSettings& s) {
       "Build a manifest's materials and scenes (docs/build.md): sources are decoded, converted to the layout's\n"
       "workflow, packed, validated; scenes are exported with them and AO. Only out-of-date outputs are built.");
   cmd->add_option("manifest", s.manifest, "The manifest (TOML)")->required();
+  add_output_dir_option(*cmd, s.output_dir);
   cmd->add_flag("--force", s.force, "Build every job, up to date or not");
   cmd->add_flag("-n,--dry-run", s.dry_run, "List what would be built, and why, without building it");
   cmd->add_option("--only", s.only, "Build only this job (material:NAME or scene:NAME); repeatable");
@@ -72,12 +79,13 @@ CLI::App* setup_plan(CLI::App& app, PlanSettings& s) {
   cmd->add_option("manifest", s.manifest, "The manifest (TOML)")->required();
   cmd->add_option("-o,--output", s.output, "The Ninja file to write (e.g. build.ninja)")->required();
   cmd->add_option("--matbake", s.matbake, "The matbake the edges run (default: this one)");
+  add_output_dir_option(*cmd, s.output_dir);
   return cmd;
 }
 
 int run_plan(const PlanSettings& s, const GlobalOptions& global) {
   build::Manifest manifest;
-  auto plan = load(s.manifest, manifest);
+  auto plan = load(s.manifest, s.output_dir, manifest);
   if (!plan) return report_error(plan.error());
   std::error_code ec;
   const fs::path self = s.matbake.empty() ? fs::read_symlink("/proc/self/exe", ec) : fs::absolute(s.matbake);
@@ -98,7 +106,7 @@ int run_plan(const PlanSettings& s, const GlobalOptions& global) {
 int run_build(const BuildSettings& s, const GlobalOptions& global) {
   const auto start = std::chrono::steady_clock::now();
   build::Manifest manifest;
-  auto plan = load(s.manifest, manifest);
+  auto plan = load(s.manifest, s.output_dir, manifest);
   if (!plan) return report_error(plan.error());
   if (!global.quiet) {
     for (const std::string& w : plan->warnings) std::cerr << "matbake: warning: " << w << "\n";

@@ -140,6 +140,7 @@ int run_export(const ExportSettings& settings, const GlobalOptions& global);
 
 struct BuildSettings {
   std::string manifest;
+  std::string output_dir;
   bool force = false;
   bool dry_run = false;
   std::vector<std::string> only;
@@ -153,6 +154,7 @@ struct PlanSettings {
   std::string manifest;
   std::string output;
   std::string matbake;
+  std::string output_dir;
 };
 CLI::App* setup_plan(CLI::App& app, PlanSettings& settings);
 int run_plan(const PlanSettings& settings, const GlobalOptions& global);

@@ -227,9 +227,10 @@ std::string ninja_text(const Manifest& manifest, const Plan& plan, const fs::pat
                      "# `matbake plan` when the manifest changes (the last edge).\n"
                      "ninja_required_version = 1.10\n\n";
   text += "matbake = " + ninja_escape(matbake.string()) + "\n";
-  text += "manifest = " + ninja_escape(manifest.file.string()) + "\n\n";
+  text += "manifest = " + ninja_escape(manifest.file.string()) + "\n";
+  text += "output = " + ninja_escape(manifest.output.string()) + "\n\n";
   text += "rule matbake\n"
-          "  command = $matbake build $manifest --only $job --quiet --depfile $depfile_path\n"
+          "  command = \"$matbake\" build \"$manifest\" --output-dir \"$output\" --only $job --quiet --depfile \"$depfile_path\"\n"
           "  description = matbake $job\n"
           "  depfile = $depfile_path\n"
           "  deps = gcc\n"
@@ -246,7 +247,7 @@ std::string ninja_text(const Manifest& manifest, const Plan& plan, const fs::pat
     text += "  depfile_path = " + ninja_escape((plan.state_folder / (job_file_stem(job) + ".d")).string()) + "\n\n";
   }
   text += "rule matbake_plan\n"
-          "  command = $matbake plan $manifest -o $out --quiet\n"
+          "  command = \"$matbake\" plan \"$manifest\" --output-dir \"$output\" -o \"$out\" --quiet\n"
           "  description = matbake plan $manifest\n"
           "  generator = 1\n\n"
           "build " + ninja_escape(ninja_file.string()) + ": matbake_plan $manifest\n";
