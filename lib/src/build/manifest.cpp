@@ -17,10 +17,10 @@ namespace {
 struct Reader {
   std::string file;
 
-  Error at(const toml::node& node, const std::string& message) const {
-    const toml::source_region& where = node.source();
+  Error at(const toml::source_region& where, const std::string& message) const {
     return Error{file + ":" + std::to_string(where.begin.line) + ":" + std::to_string(where.begin.column), message};
   }
+  Error at(const toml::node& node, const std::string& message) const { return at(node.source(), message); }
 
   Status known_keys(const toml::table& table, const std::string& where, std::initializer_list<std::string_view> keys) const {
     for (const auto& [key, value] : table) {
@@ -29,7 +29,7 @@ struct Reader {
       if (!known) {
         std::string list;
         for (std::string_view k : keys) list += (list.empty() ? "" : ", ") + std::string(k);
-        return at(value, "unknown key '" + std::string(key.str()) + "' in " + where + " (known: " + list + ")");
+        return at(key.source(), "unknown key '" + std::string(key.str()) + "' in " + where + " (known: " + list + ")");
       }
     }
     return success();
@@ -142,7 +142,7 @@ Result<MaterialSpec> read_material(const Reader& r, const std::string& name, con
       if (!pack::find_source(source)) {
         std::string known;
         for (const pack::Source& s : pack::sources()) known += (known.empty() ? "" : ", ") + std::string(s.name);
-        return r.at(value, where + ".sources: unknown source '" + source + "' (known: " + known + ")");
+        return r.at(key.source(), where + ".sources: unknown source '" + source + "' (known: " + known + ")");
       }
       pack::SourceInput in{source, {}, {}};
       if (auto file = value.value<std::string>()) {

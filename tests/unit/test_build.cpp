@@ -1,0 +1,241 @@
+// The build module's pure parts: manifest parsing (every key reaches its field; errors carry the
+// manifest's line and column), plans (inputs, outputs, refusals), depfile escaping, Ninja text,
+// and the progress bar's drawing.
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <chrono>
+#include <thread>
+
+#include "cli/progress_bar.hpp"
+#include "matbake/build.hpp"
+#include "support/files.hpp"
+#include "support/gltf_files.hpp"
+#include "support/temp_dir.hpp"
+
+namespace matbake::test {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr const char* kFull = R"(output = "built"
+transfer = "gamma2.2"
+[validate]
+tolerance = 0.2
+max_violations = 0.01
+[materials.brick]
+sources = { kd = "t/brick.png", ks = 0.04, gloss = [0.5] }
+layout = "schuler"
+format = "tif"
+bits = "16"
+mapping = "fitted"
+[materials.gold]
+packed = { layout = "gltf-orm", files = ["a.png", "b.png"] }
+transfer = "srgb"
+decode = "linear"
+reference = "gold"
+validate = { max_violations = 0.5, heatmap = true }
+[scenes.room]
+input = "room.gltf"
+output = "sub/room.gltf"
+materials = { "Bricks" = "brick" }
+match_names = false
+dielectric_f0 = "ior"
+orm = false
+ao = { samples = 32, absolute_distance = 2.5, falloff = "none", into = "_AO", seed = 7, two_sided = false }
+)";
+
+TEST(BuildManifest, EveryKeyReachesItsField) {
+  auto m = build::parse_manifest(kFull, "/project/assets.toml");
+  ASSERT_TRUE(m) << m.error().to_string();
+  EXPECT_EQ(m->folder, fs::path("/project"));
+  EXPECT_EQ(m->output, fs::path("/project/built"));
+  ASSERT_EQ(m->materials.size(), 2u);
+  const build::MaterialSpec& brick = m->materials[0];  // tables are sorted by name
+  EXPECT_EQ(brick.name, "brick");
+  ASSERT_EQ(brick.sources.size(), 3u);
+  EXPECT_EQ(brick.sources[0].name, "gloss");
+  EXPECT_EQ(brick.sources[0].constant, std::vector<double>{0.5});
+  EXPECT_EQ(brick.sources[1].name, "kd");
+  EXPECT_EQ(brick.sources[1].file, fs::path("/project/t/brick.png"));
+  EXPECT_EQ(brick.sources[2].constant, std::vector<double>{0.04});
+  EXPECT_EQ(brick.transfer, color::Transfer::gamma22);  // the manifest's default
+  EXPECT_EQ(brick.layout, "schuler");
+  EXPECT_EQ(brick.format, "tif");
+  EXPECT_EQ(brick.bits, image::SampleType::u16);
+  EXPECT_DOUBLE_EQ(brick.validation.tolerance, 0.2);
+  EXPECT_DOUBLE_EQ(brick.validation.max_violations, 0.01);
+  const build::MaterialSpec& gold = m->materials[1];
+  EXPECT_EQ(gold.packed_layout, "gltf-orm");
+  EXPECT_EQ(gold.packed_files, (std::vector<fs::path>{"/project/a.png", "/project/b.png"}));
+  EXPECT_EQ(gold.transfer, color::Transfer::srgb);
+  EXPECT_EQ(gold.decode, color::Transfer::linear);
+  EXPECT_EQ(gold.reference, "gold");
+  EXPECT_DOUBLE_EQ(gold.validation.tolerance, 0.2);  // inherited, then overridden key by key
+  EXPECT_DOUBLE_EQ(gold.validation.max_violations, 0.5);
+  EXPECT_TRUE(gold.validation.heatmap);
+  ASSERT_EQ(m->scenes.size(), 1u);
+  const build::SceneSpec& room = m->scenes[0];
+  EXPECT_EQ(room.input, fs::path("/project/room.gltf"));
+  EXPECT_EQ(room.output, fs::path("sub/room.gltf"));
+  EXPECT_EQ(room.materials.at("Bricks"), "brick");
+  EXPECT_FALSE(room.match_names);
+  EXPECT_EQ(room.dielectric_f0, exporter::DielectricF0::ior);
+  EXPECT_FALSE(room.orm);
+  ASSERT_TRUE(room.ao);
+  EXPECT_EQ(room.ao->samples, 32);
+  EXPECT_DOUBLE_EQ(room.ao->max_distance, 2.5);
+  EXPECT_FALSE(room.ao->relative_distance);
+  EXPECT_EQ(room.ao->falloff, ao::Falloff::none);
+  EXPECT_EQ(room.ao->seed, 7u);
+  EXPECT_FALSE(room.ao->two_sided);
+  EXPECT_EQ(room.ao_into, ao::Into::attribute);
+}
+
+// Each bad manifest: the error names the file with line and column and says what is wrong.
+TEST(BuildManifest, ErrorsSayWhereAndWhat) {
+  struct Case {
+    const char* text;
+    const char* where;
+    const char* says;
+  };
+  const Case cases[] = {
+      {"output = \"o\"\n[materials.a]\nsources = { kd = 0.5 }\nlayot = \"x\"\n", "m.toml:4:1", "unknown key 'layot' in materials.a"},
+      {"[materials.a\n", "m.toml:1:", "not valid TOML"},
+      {"[materials.a]\nsources = { kd = 0.5 }\nbits = \"12\"\n", "m.toml:3:", "materials.a.bits '12'"},
+      {"[materials.a]\nsources = { albedo = \"x.png\" }\n", "m.toml:2:", "unknown source 'albedo'"},
+      {"[materials.a]\nlayout = \"schuler\"\n", "m.toml:1:", "give either sources = {...} or packed = {...}"},
+      {"[materials.\"../up\"]\nsources = { kd = 0.5 }\n", "m.toml:", "letters, digits"},
+      {"[scenes.s]\ninput = \"a.gltf\"\noutput = \"../a.glb\"\n", "m.toml:3:", "inside the output folder"},
+      {"[scenes.s]\ninput = \"a.gltf\"\noutput = \"/tmp/a.glb\"\n", "m.toml:3:", "inside the output folder"},
+      {"[scenes.s]\ninput = \"a.gltf\"\nao = { samples = 0 }\n", "m.toml:3:", "samples: 1 to"},
+      {"[scenes.s]\ninput = \"a.gltf\"\nmaterials = { \"X\" = \"nope\" }\n", "m.toml", "no [materials.nope]"},
+      {"[validate]\nmax_violations = 2.0\n[materials.a]\nsources = { kd = 0.5 }\n", "m.toml:1:", "max_violations in [0, 1]"},
+      {"output = 3\n", "m.toml:1:", "output: a string expected"},
+      {"", "m.toml", "nothing to build"},
+  };
+  for (const Case& c : cases) {
+    auto m = build::parse_manifest(c.text, "m.toml");
+    ASSERT_FALSE(m) << c.text;
+    EXPECT_EQ(m.error().path.rfind(c.where, 0), 0u) << c.text << "\n→ " << m.error().to_string();
+    EXPECT_NE(m.error().message.find(c.says), std::string::npos) << c.text << "\n→ " << m.error().to_string();
+    EXPECT_EQ(m.error().to_string().find('\n'), std::string::npos);
+  }
+  auto missing = build::read_manifest("/nonexistent/m.toml");
+  ASSERT_FALSE(missing);
+  EXPECT_EQ(missing.error().path, "/nonexistent/m.toml");
+}
+
+TEST(BuildPlan, JobsWithTheirInputsAndOutputs) {
+  TempDir dir;
+  GltfBuilder scene;
+  const int positions = scene.add_vec3({0, 0, 0, 1, 0, 0, 0, 1, 0});
+  scene.add_node({{"mesh", scene.add_mesh(positions)}});
+  scene.doc["materials"] = {{{"name", "paint"}}, {{"name", "other"}}};
+  scene.doc["images"] = {{{"uri", "tex%20a.png"}}};
+  scene.write(dir / "room.gltf", {0});
+  write_bytes(dir / "build.toml", R"(
+[materials.paint]
+sources = { kd = "paint.png", ks = 0.04, gloss = 0.5 }
+layout = "gltf-orm"
+[materials.unused]
+sources = { kd = 0.5 }
+[materials.scene_only]
+sources = { kd = "s.png" }
+validate = { enabled = false }
+[scenes.room]
+input = "room.gltf"
+materials = { "other" = "scene_only" }
+)");
+  auto m = build::read_manifest(dir / "build.toml");
+  ASSERT_TRUE(m) << m.error().to_string();
+  auto plan = build::make_plan(*m);
+  ASSERT_TRUE(plan) << plan.error().to_string();
+  // paint: textures + report; unused: no layout, no scene (a warning); scene_only: nothing of its own.
+  ASSERT_EQ(plan->jobs.size(), 2u);
+  const build::Job& paint = plan->jobs[0];
+  EXPECT_EQ(paint.name, "material:paint");
+  const fs::path out = dir.path() / "out";
+  EXPECT_EQ(paint.outputs, (std::vector<fs::path>{out / "materials/paint_base_color.png", out / "materials/paint_orm.png",
+                                                 out / "materials/paint.validation.json"}));
+  EXPECT_EQ(paint.inputs, std::vector<fs::path>{dir.path() / "paint.png"});
+  const build::Job& room = plan->jobs[1];
+  EXPECT_EQ(room.name, "scene:room");
+  EXPECT_EQ(room.outputs, std::vector<fs::path>{out / "room.glb"});
+  // The scene, its image (URI decoded), and the sources of both materials it gets (by name and by the map).
+  EXPECT_EQ(room.inputs, (std::vector<fs::path>{dir.path() / "room.gltf", dir.path() / "tex a.png", dir.path() / "s.png",
+                                               dir.path() / "paint.png"}));
+  EXPECT_EQ(room.materials.size(), 2u);
+  EXPECT_EQ(room.materials.at("paint"), 0u);
+  ASSERT_EQ(plan->warnings.size(), 1u);
+  EXPECT_NE(plan->warnings[0].find("materials.unused"), std::string::npos);
+  EXPECT_EQ(plan->state_folder, out / ".matbake");
+
+  // Ninja: one edge per job with its outputs, inputs and depfile, and the regenerate edge.
+  const std::string ninja = build::ninja_text(*m, *plan, "/usr/bin/matbake", "build.ninja");
+  EXPECT_NE(ninja.find("build " + (out / "room.glb").string() + ": matbake $manifest | " + (dir.path() / "room.gltf").string() +
+                       " " + (dir.path() / "tex$ a.png").string()),
+            std::string::npos)
+      << ninja;
+  EXPECT_NE(ninja.find("  job = scene:room\n  depfile_path = " + (out / ".matbake/scene-room.d").string()), std::string::npos);
+  EXPECT_NE(ninja.find("build build.ninja: matbake_plan $manifest\n"), std::string::npos);
+}
+
+TEST(BuildPlan, RefusesToWriteAnInputOrOneFileTwice) {
+  TempDir dir;
+  write_bytes(dir / "a.toml", "output = \".\"\n[materials.x]\nsources = { kd = \"x.png\" }\nlayout = \"schuler\"\n"
+                              "[materials.y]\nsources = { kd = \"materials/x.validation.json\" }\nlayout = \"schuler\"\n");
+  auto m = build::read_manifest(dir / "a.toml");
+  ASSERT_TRUE(m) << m.error().to_string();
+  auto plan = build::make_plan(*m);
+  ASSERT_FALSE(plan);
+  EXPECT_EQ(plan.error().path, (dir.path() / "materials/x.validation.json").string());
+  EXPECT_NE(plan.error().message.find("would overwrite an input"), std::string::npos);
+
+  GltfBuilder scene;
+  scene.add_node({{"mesh", scene.add_mesh(scene.add_vec3({0, 0, 0, 1, 0, 0, 0, 1, 0}))}});
+  scene.write(dir / "s.gltf", {0});
+  write_bytes(dir / "b.toml", "[scenes.one]\ninput = \"s.gltf\"\noutput = \"s.glb\"\n"
+                              "[scenes.two]\ninput = \"s.gltf\"\noutput = \"s.glb\"\n");
+  m = build::read_manifest(dir / "b.toml");
+  ASSERT_TRUE(m) << m.error().to_string();
+  plan = build::make_plan(*m);
+  ASSERT_FALSE(plan);
+  EXPECT_NE(plan.error().message.find("written by both scene:one and scene:two"), std::string::npos);
+}
+
+TEST(BuildDepfile, MakeSyntaxWithEscapes) {
+  EXPECT_EQ(build::depfile_text({"/o/a b.png", "/o/c.json"}, {"/in/x#1.png", "/in/$y.png", "/in/z.png"}),
+            "/o/a\\ b.png /o/c.json: \\\n  /in/x\\#1.png \\\n  /in/$$y.png \\\n  /in/z.png\n");
+}
+
+// The bar is drawn only after half a second, with done/total and an ETA, and cleared at the end.
+TEST(ProgressBar, DrawsAfterAMomentAndClears) {
+  int fds[2];
+  ASSERT_EQ(pipe(fds), 0);
+  {
+    cli::ProgressBar bar(true, fds[1]);
+    bar.update(1, 4);  // quick: nothing yet
+    std::this_thread::sleep_for(std::chrono::milliseconds(600));
+    bar.update(2, 4);
+    bar.print_above("a message");
+    bar.finish();
+    cli::ProgressBar off(false, fds[1]);
+    std::this_thread::sleep_for(std::chrono::milliseconds(600));
+    off.update(3, 4);  // disabled (not a terminal, or --quiet): no bar ...
+    off.print_above("still printed");  // ... but messages
+  }
+  close(fds[1]);
+  std::string text(4096, '\0');
+  text.resize(std::size_t(read(fds[0], text.data(), text.size())));
+  close(fds[0]);
+  EXPECT_EQ(text.find("1/4"), std::string::npos);
+  EXPECT_NE(text.find("[###############...............] 2/4  ETA 0:0"), std::string::npos) << text;
+  EXPECT_NE(text.find("\r\033[Ka message\n"), std::string::npos);
+  EXPECT_EQ(text.find("3/4"), std::string::npos);
+  EXPECT_EQ(text.substr(text.size() - 14), "still printed\n");
+}
+
+}  // namespace
+}  // namespace matbake::test
