@@ -1,0 +1,400 @@
+// `matbake build` and `matbake plan` end to end: the bundled example (validator-clean, each source
+// decoded once, a second run does nothing), texel values of packed outputs, byte-identical outputs
+// across job counts, what makes a job out of date, failing jobs beside finished ones, validation
+// rules, depfiles, JSON, dry runs, Ninja, and interrupts that leave no temporary file.
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <map>
+#include <thread>
+
+#include "support/files.hpp"
+#include "support/gltf_validator.hpp"
+#include "support/run.hpp"
+#include "support/temp_dir.hpp"
+
+extern char** environ;
+
+namespace matbake::test {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+const fs::path kExamples = fs::path(MATBAKE_SOURCE_DIR) / "examples";
+
+// The bundled example copied into `dir` (the manifest's output then goes to dir/out), optionally
+// with its AO samples lowered to keep the test quick.
+void copy_example(const fs::path& dir, bool few_samples = false) {
+  for (const char* f : {"showroom.toml", "showroom.gltf", "showroom.bin"}) fs::copy_file(kExamples / f, dir / f);
+  fs::copy(kExamples / "textures", dir / "textures", fs::copy_options::recursive);
+  if (few_samples) {
+    std::string text = read_bytes(dir / "showroom.toml");
+    const std::size_t at = text.find("samples = 128");
+    ASSERT_NE(at, std::string::npos);
+    text.replace(at, 13, "samples = 16");
+    write_bytes(dir / "showroom.toml", text);
+  }
+}
+
+json run_json(const std::vector<std::string>& args, int expected_exit = 0) {
+  std::vector<std::string> all = {"--json"};
+  all.insert(all.end(), args.begin(), args.end());
+  const RunResult r = matbake(all);
+  EXPECT_EQ(r.exit_code, expected_exit) << r.err;
+  return json::parse(r.out, nullptr, false);
+}
+
+// Every file under `folder` but the stamps, by relative path, with its bytes.
+std::map<std::string, std::string> outputs_under(const fs::path& folder) {
+  std::map<std::string, std::string> files;
+  for (const auto& e : fs::recursive_directory_iterator(folder)) {
+    const std::string rel = fs::relative(e.path(), folder).string();
+    if (e.is_regular_file() && rel.rfind(".matbake", 0) != 0) files[rel] = read_bytes(e.path());
+  }
+  return files;
+}
+
+std::vector<std::string> temporary_files_under(const fs::path& folder) {
+  std::vector<std::string> found;
+  for (const auto& e : fs::recursive_directory_iterator(folder)) {
+    if (e.path().filename().string().find(".matbake-") != std::string::npos) found.push_back(e.path().string());
+  }
+  return found;
+}
+
+std::string outcome_of(const json& report, const std::string& job) {
+  for (const json& j : report["jobs"]) {
+    if (j["name"] == job) return j["outcome"].get<std::string>() + (j.contains("reason") ? ": " + j["reason"].get<std::string>() : "");
+  }
+  return "absent";
+}
+
+TEST(CliBuild, ExampleBuildsOnceAndPassesTheValidator) {
+  TempDir dir;
+  copy_example(dir.path());
+  const json first = run_json({"build", (dir / "showroom.toml").string()});
+  ASSERT_TRUE(first.is_object());
+  EXPECT_EQ(first["built"], 6);
+  EXPECT_EQ(first["failed"], 0);
+  // Six source files, read by five material jobs and the scene job: each decoded once.
+  EXPECT_EQ(first["images_decoded"], 6);
+  // The scene job reads the scene, its buffer, and every material's sources.
+  for (const json& j : first["jobs"]) {
+    if (j["name"] != "scene:showroom") continue;
+    EXPECT_EQ(j["inputs"].size(), 8u) << j["inputs"].dump();
+    EXPECT_EQ(j["details"]["materials"].size(), 5u);
+    EXPECT_GT(j["details"]["ao_rays"].get<double>(), 0);
+  }
+
+  // Rubber is metal-rough with an sRGB base colour: the packed base colour keeps its codes, alpha
+  // 255 (no mask); ORM = (1, 0.85, 0) → (255, 217, 0).
+  const RawImage source = read_raw(dir / "textures/rubber_albedo.png");
+  const RawImage base = read_raw(dir / "out/materials/rubber_base_color.png");
+  ASSERT_EQ(base.channels, 4);
+  ASSERT_EQ(base.width, source.width);
+  for (std::size_t i = 0; i < std::size_t(source.width * source.height); i += 997) {
+    ASSERT_EQ(base.samples[4 * i], source.samples[i]);
+    ASSERT_EQ(base.samples[4 * i + 1], source.samples[i]);
+    ASSERT_EQ(base.samples[4 * i + 3], 255);
+  }
+  const RawImage orm = read_raw(dir / "out/materials/rubber_orm.png");
+  EXPECT_EQ(orm.samples[0], 255);
+  EXPECT_EQ(orm.samples[1], 217);
+  EXPECT_EQ(orm.samples[2], 0);
+  // Gold is checked against the table's gold and passes.
+  const json gold = json::parse(read_bytes(dir / "out/materials/gold_trim.validation.json"));
+  EXPECT_EQ(gold["material"]["name"], "gold");
+  EXPECT_EQ(gold["passed"], true);
+  EXPECT_EQ(gold["classes"]["metal"], 256 * 256);
+
+  MATBAKE_VALIDATE_OR_SKIP(report, dir / "out/showroom.glb");
+  EXPECT_EQ(report->errors, 0) << report->summary;
+  EXPECT_EQ(report->warnings, 0) << report->summary;
+
+  const RunResult second = matbake({"build", (dir / "showroom.toml").string()});
+  EXPECT_EQ(second.exit_code, 0) << second.err;
+  EXPECT_EQ(second.out, "nothing to do: 6 jobs up to date\n");
+  EXPECT_EQ(second.err, "");
+}
+
+TEST(CliBuild, SameBytesWhateverTheJobCount) {
+  TempDir dir;
+  copy_example(dir.path(), true);
+  ASSERT_EQ(matbake({"build", (dir / "showroom.toml").string(), "--jobs", "1"}).exit_code, 0);
+  const auto one = outputs_under(dir / "out");
+  EXPECT_EQ(one.size(), 16u);  // 5 × (2 textures + report) + the .glb
+  const RunResult again = matbake({"build", (dir / "showroom.toml").string(), "--jobs", "2", "--force"});
+  ASSERT_EQ(again.exit_code, 0) << again.err;
+  EXPECT_EQ(outputs_under(dir / "out"), one);
+}
+
+TEST(CliBuild, RebuildsWhatChangedAndOnlyThat) {
+  TempDir dir;
+  copy_example(dir.path(), true);
+  const std::string manifest = (dir / "showroom.toml").string();
+  ASSERT_EQ(matbake({"build", manifest}).exit_code, 0);
+
+  // A touched file whose bytes are the same is not a change.
+  const fs::path wood = dir / "textures/wood_albedo.png";
+  fs::last_write_time(wood, fs::last_write_time(wood) + std::chrono::seconds(5));
+  json dry = run_json({"build", manifest, "--dry-run"});
+  EXPECT_EQ(dry["out_of_date"], 0) << dry.dump();
+
+  // New bytes in the rubber texture: rubber and the scene (which uses it), nothing else.
+  write_raw(dir / "textures/rubber_albedo.png", 2, 2, 1, "uint8", {50, 51, 52, 53});
+  dry = run_json({"build", manifest, "--dry-run"});
+  EXPECT_EQ(dry["out_of_date"], 2);
+  EXPECT_EQ(outcome_of(dry, "material:rubber"), "out_of_date: input changed: " + (dir / "textures/rubber_albedo.png").string());
+  EXPECT_EQ(outcome_of(dry, "scene:showroom").rfind("out_of_date: input changed", 0), 0u);
+  EXPECT_EQ(outcome_of(dry, "material:wood"), "up_to_date");
+  const RunResult dry_text = matbake({"build", manifest, "-n"});
+  EXPECT_NE(dry_text.out.find("would build material:rubber: input changed"), std::string::npos) << dry_text.out;
+  EXPECT_NE(dry_text.out.find("2 of 6 jobs would be built"), std::string::npos);
+  json built = run_json({"build", manifest});
+  EXPECT_EQ(built["built"], 2);
+  EXPECT_EQ(read_raw(dir / "out/materials/rubber_base_color.png").width, 2);
+
+  // An option: only the material it belongs to, and the scene that uses it.
+  std::string text = read_bytes(dir / "showroom.toml");
+  text.replace(text.find("gloss = 0.45"), 12, "gloss = 0.50");
+  write_bytes(dir / "showroom.toml", text);
+  dry = run_json({"build", manifest, "--dry-run"});
+  EXPECT_EQ(outcome_of(dry, "material:wood"), "out_of_date: its options changed");
+  EXPECT_EQ(outcome_of(dry, "scene:showroom"), "out_of_date: its options changed");
+  EXPECT_EQ(dry["out_of_date"], 2);
+  ASSERT_EQ(matbake({"build", manifest}).exit_code, 0);
+
+  // A deleted or edited output is built again.
+  fs::remove(dir / "out/materials/glass_orm.png");
+  write_bytes(dir / "out/materials/painted_metal.validation.json", "{}");
+  dry = run_json({"build", manifest, "--dry-run"});
+  EXPECT_EQ(outcome_of(dry, "material:glass"), "out_of_date: output missing: " + (dir / "out/materials/glass_orm.png").string());
+  EXPECT_EQ(outcome_of(dry, "material:painted_metal").rfind("out_of_date: output changed since it was built", 0), 0u);
+  built = run_json({"build", manifest, "--only", "material:glass"});
+  EXPECT_EQ(built["jobs"].size(), 1u);
+  EXPECT_TRUE(fs::exists(dir / "out/materials/glass_orm.png"));
+
+  // --force builds all; an unknown --only is a usage error.
+  EXPECT_EQ(run_json({"build", manifest, "--force"})["built"], 6);
+  const RunResult unknown = matbake({"build", manifest, "--only", "material:nope"});
+  EXPECT_EQ(unknown.exit_code, 2);
+  EXPECT_NE(unknown.err.find("no job 'material:nope' (jobs: material:glass, "), std::string::npos) << unknown.err;
+}
+
+TEST(CliBuild, FailingJobsAreReportedAndTheOthersFinish) {
+  TempDir dir;
+  write_bytes(dir / "corrupt.png", "\x89PNG\r\n\x1a\nnot really");
+  write_bytes(dir / "m.toml", R"(
+[materials.good]
+sources = { kd = [0.5, 0.4, 0.3], ks = 0.04, gloss = 0.7 }
+layout = "gltf-orm"
+[materials.missing]
+sources = { kd = "missing.png", ks = 0.04, gloss = 0.5 }
+layout = "gltf-orm"
+[materials.corrupt]
+sources = { kd = "corrupt.png", ks = 0.04, gloss = 0.5 }
+layout = "gltf-orm"
+[materials.below_real]
+sources = { kd = 0.5, ks = 0.01, gloss = 0.5 }
+layout = "gltf-orm"
+)");
+  const RunResult r = matbake({"build", (dir / "m.toml").string()});
+  EXPECT_EQ(r.exit_code, 1);
+  // One line per failed job naming the file and the job, then the summary; the finished job's
+  // progress line (stderr is not a terminal); no library noise.
+  std::vector<std::string> lines;
+  for (std::size_t at = 0; at < r.err.size();) {
+    const std::size_t end = r.err.find('\n', at);
+    const std::string line = r.err.substr(at, end - at);
+    if (line.rfind("[", 0) == 0) {
+      EXPECT_NE(line.find("/4] material:good built ("), std::string::npos) << line;
+    } else {
+      lines.push_back(line);
+    }
+    at = end + 1;
+  }
+  ASSERT_EQ(lines.size(), 4u) << r.err;
+  std::sort(lines.begin(), lines.begin() + 3);
+  EXPECT_EQ(lines[0].rfind("matbake: error: " + (dir / "corrupt.png").string() + ": ", 0), 0u) << lines[0];
+  EXPECT_NE(lines[0].find("(material:corrupt)"), std::string::npos);
+  EXPECT_EQ(lines[1].rfind("matbake: error: " + (dir / "missing.png").string() + ": ", 0), 0u) << lines[1];
+  EXPECT_EQ(lines[2].rfind("matbake: error: " + (dir / "out/materials/below_real.validation.json").string() +
+                               ": validation: 1 of 1 texels flagged (100%; max_violations 0%) (material:below_real)",
+                           0),
+            0u)
+      << lines[2];
+  EXPECT_EQ(lines[3], "matbake: error: " + (dir / "m.toml").string() + ": 3 of 4 jobs failed");
+  // The good material is complete (a 1×1 texture of constants); the failed ones left no partial file.
+  const RawImage good = read_raw(dir / "out/materials/good_base_color.png");
+  EXPECT_EQ(good.width, 1);
+  EXPECT_EQ(list_folder(dir / "out/materials"),
+            (std::vector<std::string>{"below_real.validation.json", "below_real_base_color.png", "below_real_orm.png",
+                                      "good.validation.json", "good_base_color.png", "good_orm.png"}));
+  // Failed jobs run again next time; the finished one does not.
+  const json dry = run_json({"build", (dir / "m.toml").string(), "-n"});
+  EXPECT_EQ(outcome_of(dry, "material:good"), "up_to_date");
+  EXPECT_EQ(outcome_of(dry, "material:missing"), "out_of_date: no earlier build");
+  EXPECT_EQ(outcome_of(dry, "material:below_real"), "out_of_date: no earlier build");
+
+  // A rule that allows the flagged texels turns the failure into a warning.
+  std::string text = read_bytes(dir / "m.toml");
+  text += "validate = { max_violations = 1.0 }\n";
+  write_bytes(dir / "m.toml", text);
+  const RunResult allowed = matbake({"build", (dir / "m.toml").string(), "--only", "material:below_real"});
+  EXPECT_EQ(allowed.exit_code, 0) << allowed.err;
+  EXPECT_NE(allowed.err.find("matbake: warning: material:below_real: validation: 1 of 1 texels flagged"), std::string::npos)
+      << allowed.err;
+}
+
+TEST(CliBuild, BadManifestsAreOneLineAndWriteNothing) {
+  TempDir dir;
+  write_bytes(dir / "typo.toml", "[materials.a]\nsources = { kd = 0.5 }\nlayuot = \"gltf-orm\"\n");
+  write_bytes(dir / "escape.toml", "[scenes.s]\ninput = \"s.gltf\"\noutput = \"../../s.glb\"\n");
+  write_bytes(dir / "overwrite.toml", "output = \".\"\n[materials.a]\nsources = { kd = \"materials/a_a.png\" }\nlayout = \"schuler\"\n");
+  const std::pair<const char*, std::string> cases[] = {
+      {"typo.toml", (dir / "typo.toml").string() + ":3:1: unknown key 'layuot' in materials.a"},
+      {"escape.toml", (dir / "escape.toml").string() + ":3:10: scenes.s.output '../../s.glb': a .gltf or .glb path inside"},
+      {"missing.toml", (dir / "missing.toml").string() + ": cannot read the manifest"},
+      {"overwrite.toml", (dir / "materials/a_a.png").string() + ": material:a would overwrite an input"},
+  };
+  for (const auto& [file, says] : cases) {
+    const RunResult r = matbake({"build", (dir / file).string()});
+    EXPECT_EQ(r.exit_code, 1) << file;
+    EXPECT_EQ(r.err.rfind("matbake: error: " + says, 0), 0u) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  }
+  EXPECT_EQ(list_folder(dir.path()), (std::vector<std::string>{"escape.toml", "overwrite.toml", "typo.toml"}));
+}
+
+TEST(CliBuild, DepfileStampAndJson) {
+  TempDir dir;
+  fs::create_directories(dir / "my assets");
+  const fs::path folder = dir / "my assets";
+  write_raw(folder / "k d.png", 2, 2, 3, "uint8", {100, 110, 120, 130, 140, 150, 160, 170, 180, 190, 200, 210});
+  write_bytes(folder / "m.toml", "[materials.brick]\nsources = { kd = \"k d.png\", ks = 0.04, gloss = 0.5 }\nlayout = \"schuler\"\n");
+  const fs::path depfile = dir / "deps.d", stamp = dir / "all.stamp";
+  const json report = run_json({"build", (folder / "m.toml").string(), "--depfile", depfile.string(), "--stamp", stamp.string()});
+  EXPECT_EQ(read_bytes(depfile), dir.path().string() + "/all.stamp: \\\n  " + dir.path().string() + "/my\\ assets/m.toml \\\n  " +
+                                     dir.path().string() + "/my\\ assets/k\\ d.png\n");
+  EXPECT_TRUE(fs::exists(stamp));
+  ASSERT_EQ(report["jobs"].size(), 1u);
+  const json& job = report["jobs"][0];
+  EXPECT_EQ(job["name"], "material:brick");
+  EXPECT_EQ(job["outcome"], "built");
+  EXPECT_EQ(job["reason"], "no earlier build");
+  EXPECT_EQ(job["inputs"], json::array({(folder / "k d.png").string()}));
+  EXPECT_EQ(job["outputs"], json::array({(folder / "out/materials/brick_a.png").string(), (folder / "out/materials/brick_b.png").string(),
+                                         (folder / "out/materials/brick.validation.json").string()}));
+  EXPECT_GE(job["seconds"].get<double>(), 0);
+  EXPECT_EQ(job["details"]["size"], json::array({2, 2}));
+  EXPECT_EQ(job["details"]["validation"]["checked"], 4);
+  EXPECT_EQ(job["details"]["validation"]["passed"], true);
+  EXPECT_FALSE(job["details"].contains("conversion"));  // the schuler layout takes spec-gloss as given
+
+  // Without --stamp the targets are the outputs; --quiet prints nothing; not on a terminal, each
+  // finished job is one line.
+  const RunResult quiet = matbake({"build", (folder / "m.toml").string(), "--force", "--quiet", "--depfile", depfile.string()});
+  EXPECT_EQ(quiet.out + quiet.err, "");
+  std::string first_output = (folder / "out/materials/brick_a.png").string();
+  first_output.replace(first_output.find(' '), 1, "\\ ");
+  EXPECT_EQ(read_bytes(depfile).rfind(first_output + " ", 0), 0u) << read_bytes(depfile);
+  const RunResult plain = matbake({"build", (folder / "m.toml").string(), "--force"});
+  EXPECT_EQ(plain.err.rfind("[1/1] material:brick built (", 0), 0u) << plain.err;
+}
+
+// Ninja runs the plan's edges; a changed source re-runs its material and nothing else.
+TEST(CliPlan, NinjaBuildsTheEdges) {
+  const RunResult which = run("/bin/sh", {"-c", "command -v ninja"});
+  if (which.exit_code != 0) GTEST_SKIP() << "ninja is not installed";
+  const std::string ninja_exe = which.out.substr(0, which.out.find('\n'));
+  TempDir dir;
+  copy_example(dir.path(), true);
+  const RunResult plan = matbake({"plan", (dir / "showroom.toml").string(), "-o", (dir / "build.ninja").string()});
+  ASSERT_EQ(plan.exit_code, 0) << plan.err;
+  EXPECT_EQ(plan.out, (dir / "build.ninja").string() + ": 6 edges\n");
+  RunResult ninja = run(ninja_exe, {"-C", dir.path().string()});
+  ASSERT_EQ(ninja.exit_code, 0) << ninja.out << ninja.err;
+  EXPECT_NE(ninja.out.find("[6/6]"), std::string::npos) << ninja.out;
+  EXPECT_TRUE(fs::exists(dir / "out/showroom.glb"));
+  ninja = run(ninja_exe, {"-C", dir.path().string()});
+  EXPECT_NE(ninja.out.find("no work to do"), std::string::npos) << ninja.out;
+  write_raw(dir / "textures/rubber_albedo.png", 2, 2, 1, "uint8", {50, 51, 52, 53});
+  ninja = run(ninja_exe, {"-C", dir.path().string()});
+  EXPECT_NE(ninja.out.find("[1/2] matbake material:rubber"), std::string::npos) << ninja.out;
+  EXPECT_NE(ninja.out.find("[2/2] matbake scene:showroom"), std::string::npos) << ninja.out;
+}
+
+// A build of many large materials killed mid-way by SIGINT, then by SIGTERM: exit 128 + signal,
+// no temporary file anywhere, every finished output complete; the next run builds only the rest.
+TEST(CliBuild, InterruptKeepsFinishedOutputsAndNoTemporaryFiles) {
+  TempDir dir;
+  constexpr int kSize = 1024, kMaterials = 24;
+  std::vector<double> noise(std::size_t(kSize) * kSize * 3);
+  std::uint32_t state = 12345;
+  for (double& v : noise) {
+    state = state * 1664525u + 1013904223u;
+    v = double(state >> 24);
+  }
+  write_raw(dir / "noise.png", kSize, kSize, 3, "uint8", noise);
+  std::string manifest;
+  for (int m = 0; m < kMaterials; ++m) {
+    manifest += "[materials.m" + std::to_string(100 + m) + "]\nsources = { base_color = \"noise.png\", metallic = 0.0, roughness = " +
+                std::to_string(0.3 + 0.01 * m) + " }\nlayout = \"gltf-orm\"\nformat = \"tif\"\nbits = \"16\"\n"
+                "validate = { enabled = false }\n";
+  }
+  write_bytes(dir / "m.toml", manifest);
+  for (int signal : {SIGINT, SIGTERM}) {
+    const fs::path state_folder = dir / "out/.matbake";
+    fs::remove_all(dir / "out");
+    const std::string exe = MATBAKE_EXE, manifest_path = (dir / "m.toml").string();
+    std::vector<char*> argv = {const_cast<char*>(exe.c_str()), const_cast<char*>("build"), const_cast<char*>(manifest_path.c_str()),
+                               const_cast<char*>("--quiet"), nullptr};
+    pid_t pid = 0;
+    ASSERT_EQ(posix_spawn(&pid, exe.c_str(), nullptr, nullptr, argv.data(), environ), 0);
+    // Wait for the first finished job, then interrupt.
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(300);
+    while (std::chrono::steady_clock::now() < deadline &&
+           (!fs::exists(state_folder) || fs::is_empty(state_folder))) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    kill(pid, signal);
+    int status = 0;
+    ASSERT_EQ(waitpid(pid, &status, 0), pid);
+    ASSERT_TRUE(WIFEXITED(status));
+    ASSERT_EQ(WEXITSTATUS(status), 128 + signal) << "the build ended before the signal: make it larger";
+    EXPECT_EQ(temporary_files_under(dir.path()), std::vector<std::string>{});
+    std::size_t finished = 0;
+    for (const auto& e : fs::directory_iterator(state_folder)) {
+      if (e.path().extension() != ".json") continue;
+      ++finished;
+      for (const json& out : json::parse(read_bytes(e.path()))["outputs"]) {
+        const RawImage image = read_raw(out["path"].get<std::string>());
+        EXPECT_EQ(image.width, kSize);
+      }
+    }
+    EXPECT_GE(finished, 1u);
+    EXPECT_LT(finished, std::size_t(kMaterials));
+    const json rest = run_json({"build", manifest_path});
+    EXPECT_EQ(rest["up_to_date"], finished);
+    EXPECT_EQ(rest["built"], kMaterials - finished);
+  }
+}
+
+// examples/showroom.gltf and .bin are what examples/scene/make_example_scene writes.
+TEST(ExampleScene, GeneratorWritesTheCommittedFiles) {
+  TempDir dir;
+  const RunResult r = run(MATBAKE_EXAMPLE_SCENE_EXE, {dir.path().string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(read_bytes(dir / "showroom.gltf"), read_bytes(kExamples / "showroom.gltf"));
+  EXPECT_EQ(read_bytes(dir / "showroom.bin"), read_bytes(kExamples / "showroom.bin"));
+}
+
+}  // namespace
+}  // namespace matbake::test
