@@ -358,10 +358,15 @@ TEST(CliBuild, InterruptKeepsFinishedOutputsAndNoTemporaryFiles) {
                                const_cast<char*>("--quiet"), nullptr};
     pid_t pid = 0;
     ASSERT_EQ(posix_spawn(&pid, exe.c_str(), nullptr, nullptr, argv.data(), environ), 0);
-    // Wait for the first finished job, then interrupt.
+    // Wait for the first finished job's stamp (not the temporary file it is written through), then interrupt.
+    const auto stamps = [&] {
+      std::size_t n = 0;
+      std::error_code ec;
+      for (const auto& e : fs::directory_iterator(state_folder, ec)) n += e.path().filename().string()[0] != '.';
+      return n;
+    };
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(300);
-    while (std::chrono::steady_clock::now() < deadline &&
-           (!fs::exists(state_folder) || fs::is_empty(state_folder))) {
+    while (std::chrono::steady_clock::now() < deadline && stamps() == 0) {
       std::this_thread::sleep_for(std::chrono::milliseconds(5));
     }
     kill(pid, signal);
@@ -372,7 +377,7 @@ TEST(CliBuild, InterruptKeepsFinishedOutputsAndNoTemporaryFiles) {
     EXPECT_EQ(temporary_files_under(dir.path()), std::vector<std::string>{});
     std::size_t finished = 0;
     for (const auto& e : fs::directory_iterator(state_folder)) {
-      if (e.path().extension() != ".json") continue;
+      ASSERT_NE(e.path().filename().string()[0], '.') << e.path();
       ++finished;
       for (const json& out : json::parse(read_bytes(e.path()))["outputs"]) {
         const RawImage image = read_raw(out["path"].get<std::string>());
