@@ -1,0 +1,51 @@
+#!/usr/bin/env bash
+# Benchmark of `matbake build` at scale (not part of the test run): N generated materials of
+# SIZE² (default 200 of 2048²), each a metal-rough base colour and roughness PNG packed into
+# glTF ORM textures and validated, built with --jobs 1 and then --jobs 2 (each from scratch).
+# Prints wall time, speed-up and peak RSS. The sources are generated once into WORK (default
+# /tmp/matbake-bench-build, about 3 GB for 200 × 2048²) and kept for later runs.
+#   scripts/bench-build.sh [N [SIZE [WORK]]]
+set -euo pipefail
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+n=${1:-200}
+size=${2:-2048}
+work=${3:-/tmp/matbake-bench-build}
+bash "$root/scripts/build.sh" "$root/build" >/dev/null
+matbake=$root/build/cli/matbake
+
+mkdir -p "$work/src"
+if [ "$(cat "$work/made" 2>/dev/null)" != "$n $size" ]; then
+  echo "generating $n materials of ${size}x${size} in $work/src ..." >&2
+  # Each material its own colour and grain: gradients with low noise, as painted textures are
+  # (they compress like real ones, unlike pure noise).
+  seq 0 $((n - 1)) | xargs -P "$(nproc)" -I{} bash -c '
+    i=$1; size=$2; out=$3
+    # Every fourth one a metal (bright, F0 above 0.45), the others painted dielectrics.
+    if [ $((i % 4)) -eq 0 ]; then top=0.97,0.92,0.85; bottom=0.93,0.88,0.80
+    else top=$(awk -v i="$i" "BEGIN { printf \"%.2f,%.2f,0.3\", 0.25 + (i % 7) / 10, 0.2 + (i % 5) / 10 }"); bottom=0.5,0.4,0.3; fi
+    oiiotool --pattern fill:top=$top:bottom=$bottom ${size}x${size} 3 \
+      --pattern noise:type=uniform:min=-0.03:max=0.03:mono=1:seed=$i ${size}x${size} 3 --add \
+      -d uint8 -o "$out/m$i-base.png"
+    oiiotool --pattern checker:width=64:height=64:color1=0.35:color2=0.6 ${size}x${size} 1 \
+      --pattern noise:type=uniform:min=-0.05:max=0.05:mono=1:seed=$((i + 1000)) ${size}x${size} 1 --add \
+      -d uint8 -o "$out/m$i-rough.png"' _ {} "$size" "$work/src"
+  {
+    for ((i = 0; i < n; i++)); do
+      printf '[materials.m%03d]\nsources = { base_color = "src/m%d-base.png", roughness = "src/m%d-rough.png", metallic = %s }\nlayout = "gltf-orm"\n' \
+        "$i" "$i" "$i" "$([ $((i % 4)) -eq 0 ] && echo 1.0 || echo 0.0)"
+    done
+  } >"$work/materials.toml"
+  echo "$n $size" >"$work/made"
+fi
+
+declare -A seconds rss
+for jobs in 1 2; do
+  rm -rf "$work/out"
+  sync
+  /usr/bin/time -f "%e %M" -o "$work/time.txt" "$matbake" build "$work/materials.toml" --jobs "$jobs" --quiet
+  read -r seconds[$jobs] rss[$jobs] <"$work/time.txt"
+  awk -v j="$jobs" -v s="${seconds[$jobs]}" -v n="$n" -v kb="${rss[$jobs]}" \
+    'BEGIN { printf "jobs %d: %6.1f s  %.2f materials/s  peak RSS %d MB\n", j, s, n / s, kb / 1024 }'
+done
+awk -v a="${seconds[1]}" -v b="${seconds[2]}" 'BEGIN { printf "speed-up with 2 jobs: %.2fx\n", a / b }'
+"$matbake" build "$work/materials.toml" --jobs 2 --json | grep -E '"(built|up_to_date|images_decoded)"'
