@@ -17,18 +17,22 @@ mkdir -p "$work/src"
 if [ "$(cat "$work/made" 2>/dev/null)" != "$n $size" ]; then
   echo "generating $n materials of ${size}x${size} in $work/src ..." >&2
   # Each material its own colour and grain: gradients with low noise, as painted textures are
-  # (they compress like real ones, unlike pure noise).
+  # (they compress like real ones, unlike pure noise). The noise comes from 8 files made first
+  # (oiiotool's noise pattern is the slow part).
+  for ((k = 0; k < 8; k++)); do
+    oiiotool --pattern noise:type=uniform:min=-0.03:max=0.03:mono=1:seed=$k ${size}x${size} 3 \
+      -d half -o "$work/src/noise$k.exr" &
+    [ $((k % $(nproc))) -eq $(($(nproc) - 1)) ] && wait
+  done
+  wait
   seq 0 $((n - 1)) | xargs -P "$(nproc)" -I{} bash -c '
-    i=$1; size=$2; out=$3
+    i=$1; size=$2; out=$3; noise=$out/noise$(($1 % 8)).exr
     # Every fourth one a metal (bright, F0 above 0.45), the others painted dielectrics.
     if [ $((i % 4)) -eq 0 ]; then top=0.97,0.92,0.85; bottom=0.93,0.88,0.80
     else top=$(awk -v i="$i" "BEGIN { printf \"%.2f,%.2f,0.3\", 0.25 + (i % 7) / 10, 0.2 + (i % 5) / 10 }"); bottom=0.5,0.4,0.3; fi
-    oiiotool --pattern fill:top=$top:bottom=$bottom ${size}x${size} 3 \
-      --pattern noise:type=uniform:min=-0.03:max=0.03:mono=1:seed=$i ${size}x${size} 3 --add \
-      -d uint8 -o "$out/m$i-base.png"
+    oiiotool --pattern fill:top=$top:bottom=$bottom ${size}x${size} 3 "$noise" --add -d uint8 -o "$out/m$i-base.png"
     oiiotool --pattern checker:width=64:height=64:color1=0.35:color2=0.6 ${size}x${size} 1 \
-      --pattern noise:type=uniform:min=-0.05:max=0.05:mono=1:seed=$((i + 1000)) ${size}x${size} 1 --add \
-      -d uint8 -o "$out/m$i-rough.png"' _ {} "$size" "$work/src"
+      "$noise" --ch R --mulc 1.5 --add -d uint8 -o "$out/m$i-rough.png"' _ {} "$size" "$work/src"
   {
     for ((i = 0; i < n; i++)); do
       printf '[materials.m%03d]\nsources = { base_color = "src/m%d-base.png", roughness = "src/m%d-rough.png", metallic = %s }\nlayout = "gltf-orm"\n' \
