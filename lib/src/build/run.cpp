@@ -301,7 +301,7 @@ Result<Report> run(const Manifest& manifest, const Plan& plan, const RunOptions&
     if (!options.only.empty() && std::find(options.only.begin(), options.only.end(), job.name) == options.only.end()) continue;
     JobReport r;
     r.job = &job;
-    r.reason = options.force ? "forced" : out_of_date_reason(job, plan.state_folder);
+    r.reason = options.force ? "forced" : out_of_date_reason(job, plan.state_folder, !options.dry_run);
     if (!r.reason.empty()) {
       r.outcome = Outcome::out_of_date;
       to_run.push_back(report.jobs.size());

@@ -53,10 +53,10 @@ std::string job_file_stem(const Job& job) {
   return stem;
 }
 
-std::string out_of_date_reason(const Job& job, const fs::path& state_folder) {
+std::string out_of_date_reason(const Job& job, const fs::path& state_folder, bool refresh) {
   std::ifstream in(stamp_path(job, state_folder));
   if (!in) return "no earlier build";
-  const nlohmann::json stamp = nlohmann::json::parse(in, nullptr, false);
+  nlohmann::json stamp = nlohmann::json::parse(in, nullptr, false);
   if (stamp.is_discarded() || !stamp.is_object()) return "its stamp is unreadable";
   if (stamp.value("matbake", "") != version) return "matbake's version changed";
   if (stamp.value("options", "") != job.options) return "its options changed";
@@ -66,12 +66,15 @@ std::string out_of_date_reason(const Job& job, const fs::path& state_folder) {
   for (const fs::path& p : job.inputs) {
     if (std::find(recorded.begin(), recorded.end(), p) == recorded.end()) return "new input: " + p.string();
   }
-  for (const nlohmann::json& f : inputs) {
+  bool touched = false;
+  for (nlohmann::json& f : stamp["inputs"]) {
     const fs::path p = f.value("path", "");
     const FileState now = state_of(p);
     if (!now.exists) return "input missing: " + p.string();
     if (now.size == f.value("size", std::uintmax_t(0)) && now.mtime == f.value("mtime", std::int64_t(0))) continue;
     if (content_hash(p) != f.value("hash", "")) return "input changed: " + p.string();
+    f["mtime"] = now.mtime;
+    touched = true;
   }
   for (const nlohmann::json& f : stamp.value("outputs", nlohmann::json::array())) {
     const fs::path p = f.value("path", "");
@@ -81,6 +84,8 @@ std::string out_of_date_reason(const Job& job, const fs::path& state_folder) {
       return "output changed since it was built: " + p.string();
     }
   }
+  // Best effort: a stamp that cannot be written again only costs the next run some hashing.
+  if (touched && refresh) (void)write_file_atomically(stamp_path(job, state_folder), stamp.dump(1) + "\n");
   return {};
 }
 
