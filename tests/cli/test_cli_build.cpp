@@ -146,6 +146,12 @@ TEST(CliBuild, RebuildsWhatChangedAndOnlyThat) {
   fs::last_write_time(wood, fs::last_write_time(wood) + std::chrono::seconds(5));
   json dry = run_json({"build", manifest, "--dry-run"});
   EXPECT_EQ(dry["out_of_date"], 0) << dry.dump();
+  // A real run then records the new time, so the next one need not hash the file again.
+  EXPECT_EQ(run_json({"build", manifest})["up_to_date"], 6);
+  const json stamp = json::parse(read_bytes(dir / "out/.matbake/material-wood.json"));
+  EXPECT_EQ(stamp["inputs"][0]["path"], wood.string());
+  EXPECT_EQ(stamp["inputs"][0]["mtime"].get<std::int64_t>(),
+            std::chrono::duration_cast<std::chrono::nanoseconds>(fs::last_write_time(wood).time_since_epoch()).count());
 
   // New bytes in the rubber texture: rubber and the scene (which uses it), nothing else.
   write_raw(dir / "textures/rubber_albedo.png", 2, 2, 1, "uint8", {50, 51, 52, 53});
@@ -307,6 +313,27 @@ TEST(CliBuild, DepfileStampAndJson) {
   EXPECT_EQ(read_bytes(depfile).rfind(first_output + " ", 0), 0u) << read_bytes(depfile);
   const RunResult plain = matbake({"build", (folder / "m.toml").string(), "--force"});
   EXPECT_EQ(plain.err.rfind("[1/1] material:brick built (", 0), 0u) << plain.err;
+}
+
+// On a terminal (script(1) gives the build one), stderr shows the bar with done/total and ETA.
+TEST(CliBuild, ProgressBarOnATerminal) {
+  const RunResult which = run("/bin/sh", {"-c", "command -v script"});
+  if (which.exit_code != 0) GTEST_SKIP() << "script(1) is not installed";
+  TempDir dir;
+  write_raw(dir / "grey.png", 512, 512, 1, "uint8", std::vector<double>(512 * 512, 120));
+  std::string manifest;
+  for (int m = 0; m < 40; ++m) {
+    manifest += "[materials.m" + std::to_string(m) + "]\nsources = { base_color = \"grey.png\", metallic = 0.0, roughness = 0." +
+                std::to_string(10 + m) + " }\nlayout = \"gltf-orm\"\n";
+  }
+  write_bytes(dir / "m.toml", manifest);
+  const std::string command = std::string(MATBAKE_EXE) + " build '" + (dir / "m.toml").string() + "' --jobs 1";
+  const RunResult r = run(which.out.substr(0, which.out.find('\n')), {"-qec", command, "/dev/null"});
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  EXPECT_NE(r.out.find("/40  ETA "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("] 40/40"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("material:m1 built"), std::string::npos);  // no per-job lines on a terminal
+  EXPECT_NE(r.out.find("built 40, up to date 0, failed 0"), std::string::npos) << r.out;
 }
 
 // Ninja runs the plan's edges; a changed source re-runs its material and nothing else.
