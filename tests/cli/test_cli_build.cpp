@@ -406,7 +406,8 @@ TEST(CliBuild, InterruptKeepsFinishedOutputsAndNoTemporaryFiles) {
     for (const auto& e : fs::directory_iterator(state_folder)) {
       ASSERT_NE(e.path().filename().string()[0], '.') << e.path();
       ++finished;
-      for (const json& out : json::parse(read_bytes(e.path()))["outputs"]) {
+      const json stamp = json::parse(read_bytes(e.path()));
+      for (const json& out : stamp["outputs"]) {
         const RawImage image = read_raw(out["path"].get<std::string>());
         EXPECT_EQ(image.width, kSize);
       }
