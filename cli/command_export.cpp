@@ -3,6 +3,7 @@
 #include <cstdio>
 
 #include "commands.hpp"
+#include "option_names.hpp"
 #include "material_sources.hpp"
 #include "matbake/atomic_file.hpp"
 #include "matbake/export.hpp"
@@ -54,49 +55,27 @@ CLI::App* setup_export(CLI::App& app, ExportSettings& s) {
   cmd->add_option("--material", s.materials,
                   "NAME=A.png,B.png: material NAME (or its index) from a Schüler pair; NAME=LAYOUT:FILE,... from\n"
                   "any pack layout's textures (e.g. gltf-metal-rough:base.png,mr.png). Repeatable");
-  cmd->add_option("--transfer", s.transfer, "How 8-bit colour in --material files was authored: srgb or gamma2.2")
-      ->capture_default_str();
-  cmd->add_option("--mapping", s.mapping, "Gloss -> roughness: fitted or walter")->capture_default_str();
-  cmd->add_option("--dielectric-f0", s.dielectric_f0,
-                  "A converted dielectric whose F0 is not 0.04: specular (KHR_materials_specular), ior\n"
-                  "(KHR_materials_ior), or none (core glTF's 0.04)")
-      ->capture_default_str();
-  cmd->add_flag("--no-orm", s.no_orm, "Keep occlusion and metallic-roughness textures apart");
-  cmd->add_option("--ao-samples", s.ao_samples, "Bake per-vertex AO with this many rays per vertex (0: none)")
-      ->capture_default_str();
-  cmd->add_option("--ao-into", s.ao_into, "COLOR_0 (times the file's own colours) or _AO")->capture_default_str();
+  add_name_option(*cmd, "--transfer", s.transfer, color::kTransferNames, "How 8-bit colour in --material files was authored");
+  add_name_option(*cmd, "--mapping", s.options.mapping, workflow::kRoughnessMappingNames, "Gloss -> roughness");
+  add_name_option(*cmd, "--dielectric-f0", s.options.dielectric_f0, exporter::kDielectricF0Names,
+                  "A converted dielectric whose F0 is not 0.04: KHR_materials_specular, KHR_materials_ior, or\n"
+                  "none (core glTF's 0.04)");
+  cmd->add_flag_callback("--no-orm", [&s] { s.options.pack_orm = false; },
+                         "Keep occlusion and metallic-roughness textures apart");
+  add_ao_options(*cmd, s.ao, "ao-");
+  // AO is baked when --ao-samples is given (0 keeps it off, as before).
+  cmd->get_option("--ao-samples")->each([&s](const std::string& v) { s.bake_ao = v != "0"; });
   cmd->add_option("--report", s.report, "Also write the report as JSON to this file");
   return cmd;
 }
 
 int run_export(const ExportSettings& s, const GlobalOptions& global) {
-  exporter::Options options;
-  if (!workflow::roughness_mapping_from_name(s.mapping, options.mapping)) {
-    return report_error(Error{"", "--mapping '" + s.mapping + "': use fitted or walter", true});
-  }
-  auto transfer = parse_transfer(s.transfer, "--transfer");
-  if (!transfer) return report_error(transfer.error());
-  options.pack_orm = !s.no_orm;
-  if (s.dielectric_f0 == "specular") {
-    options.dielectric_f0 = exporter::DielectricF0::specular;
-  } else if (s.dielectric_f0 == "ior") {
-    options.dielectric_f0 = exporter::DielectricF0::ior;
-  } else if (s.dielectric_f0 == "none") {
-    options.dielectric_f0 = exporter::DielectricF0::none;
-  } else {
-    return report_error(Error{"", "--dielectric-f0 '" + s.dielectric_f0 + "': use specular, ior or none", true});
-  }
-  if (s.ao_into != "COLOR_0" && s.ao_into != "_AO") {
-    return report_error(Error{"", "--ao-into '" + s.ao_into + "': use COLOR_0 or _AO", true});
-  }
-  options.ao_into = s.ao_into == "_AO" ? ao::Into::attribute : ao::Into::color_multiply;
-  if (s.ao_samples < 0) return report_error(Error{"", "--ao-samples must not be negative", true});
-  if (s.ao_samples > 0) {
-    options.ao = ao::Options{};
-    options.ao->samples = s.ao_samples;
-  }
+  exporter::Options options = s.options;
+  auto request = ao_request(s.ao, "ao-");
+  if (!request) return report_error(request.error());
+  if (s.bake_ao) options.ao = *request;
   for (const std::string& text : s.materials) {
-    auto m = parse_material(text, *transfer);
+    auto m = parse_material(text, s.transfer);
     if (!m) return report_error(m.error());
     options.materials.push_back(std::move(*m));
   }

@@ -14,11 +14,6 @@ namespace fs = std::filesystem;
 namespace matbake::cli {
 namespace {
 
-Result<std::vector<materials::Material>> table_from(const std::string& path) {
-  if (path.empty()) return materials::builtin_table();
-  return materials::load_table(path);
-}
-
 nlohmann::json rgb(const glm::dvec3& v) { return {v.r, v.g, v.b}; }
 
 std::vector<int> codes(const glm::dvec3& f0, color::Transfer transfer) {
@@ -46,7 +41,7 @@ CLI::App* setup_materials(CLI::App& app, MaterialsSettings& s) {
 }
 
 int run_materials(const MaterialsSettings& s, const GlobalOptions& global) {
-  auto table = table_from(s.table);
+  auto table = materials::table_or_builtin(s.table);
   if (!table) return report_error(table.error());
   nlohmann::json list = nlohmann::json::array();
   for (const materials::Material& m : *table) {
@@ -96,65 +91,44 @@ CLI::App* setup_validate(CLI::App& app, ValidateSettings& s) {
   add_source_options(*cmd, s.sources);
   cmd->add_option("--material", s.material, "Also compare with a table entry (see `matbake materials`)");
   cmd->add_option("--materials-table", s.table, "Another table file in the TOML format of presets/materials.toml");
-  cmd->add_option("--tolerance", s.tolerance, "With --material: relative tolerance per channel")->capture_default_str();
-  cmd->add_option("--max-violations", s.max_violations, "Flagged share of unmasked texels allowed before exit 3")
+  cmd->add_option("--tolerance", s.options.tolerance, "With --material: relative tolerance per channel")
+      ->capture_default_str();
+  cmd->add_option("--max-violations", s.options.max_violations, "Flagged share of unmasked texels allowed before exit 3")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1.0));
   cmd->add_option("--heatmap", s.heatmap, "Write a false-colour class map (.png; legend in the README)");
-  cmd->add_option("--worst", s.worst, "How many of the worst texels to list")->capture_default_str();
+  cmd->add_option("--report", s.report, "Also write the report as JSON to this file (as `matbake build` writes it)");
+  cmd->add_option("--worst", s.options.worst_count, "How many of the worst texels to list")->capture_default_str();
   return cmd;
 }
 
 int run_validate(const ValidateSettings& s, const GlobalOptions& global) {
-  auto table = table_from(s.table);
+  auto table = materials::table_or_builtin(s.table);
   if (!table) return report_error(table.error());
-  validate::Options options;
-  options.tolerance = s.tolerance;
-  options.worst_count = std::size_t(std::max(s.worst, 0));
+  validate::Options options = s.options;
   options.class_map = !s.heatmap.empty();
   if (!s.material.empty()) {
-    options.material = materials::find(*table, s.material);
-    if (!options.material) {
-      std::string near;
-      for (const std::string& n : materials::near_names(*table, s.material)) near += (near.empty() ? "" : ", ") + n;
-      return report_error(Error{"", "unknown material '" + s.material + "'" +
-                                        (near.empty() ? " (`matbake materials` lists them)" : "; near: " + near),
-                                true});
-    }
+    auto material = materials::lookup(*table, s.material);
+    if (!material) return report_error(material.error());
+    options.material = *material;
   }
   auto sources = gather_sources(s.sources);
   if (!sources) return report_error(sources.error());
-  validate::Inputs inputs;
-  inputs.mask = sources->find("mask");
-  validate::SpecularDiffuse from_metal_rough;
-  if (sources->find("ks")) {
-    inputs.specular = sources->find("ks");
-    inputs.diffuse = sources->find("kd");
-  } else if (sources->find("base_color") && sources->find("metallic")) {
-    auto sd = validate::from_metal_rough(*sources->find("base_color"), *sources->find("metallic"));
-    if (!sd) return report_error(sd.error());
-    from_metal_rough = std::move(sd.value());
-    inputs.specular = &from_metal_rough.specular;
-    inputs.diffuse = &from_metal_rough.diffuse;
-  } else {
-    return report_error(Error{"", "validate needs a specular map (--ks, or --from schuler A.png B.png) or metal-rough "
-                                  "maps (--base-color and --metallic)",
-                              true});
-  }
-  auto report = validate::validate(inputs, options);
+  auto report = validate::validate_maps(*sources, options);
   if (!report) return report_error(report.error());
   if (!s.heatmap.empty()) {
-    if (fs::path(s.heatmap).extension() != ".png") return report_error(Error{s.heatmap, "the heatmap is a .png", true});
     SilencedStderr quiet;
-    const image::WriteOptions png{color::Transfer::srgb, image::SampleType::u8, "", "sRGB"};
-    if (Status st = image::write_image(validate::heatmap(*report), s.heatmap, png); !st) return report_error(st.error());
+    if (Status st = validate::write_heatmap(*report, s.heatmap); !st) return report_error(st.error());
   }
-  const bool failed = report->violation_fraction() > s.max_violations;
+  if (!s.report.empty()) {
+    if (Status st = write_validation_report(*report, options, s.report); !st) return report_error(st.error());
+  }
+  const bool failed = !validate::passed(*report, options);
   const int exit_code = failed ? kViolations : kOk;
 
   nlohmann::json doc = {{"command", "validate"}};
-  doc.update(to_json(*report, options, inputs.diffuse != nullptr));
-  doc["max_violations"] = s.max_violations;
+  doc.update(to_json(*report, options));
+  doc["max_violations"] = options.max_violations;
   doc["passed"] = !failed;
   if (!s.heatmap.empty()) doc["heatmap"] = s.heatmap;
   if (global.json) {
@@ -166,12 +140,12 @@ int run_validate(const ValidateSettings& s, const GlobalOptions& global) {
                 report->class_counts[0], report->class_counts[1], report->class_counts[2], report->class_counts[3],
                 report->class_counts[4]);
     if (options.material) {
-      std::printf("  %s within %.0f%%: %zu texels (%.2f%%)\n", options.material->name.c_str(), 100 * s.tolerance,
+      std::printf("  %s within %.0f%%: %zu texels (%.2f%%)\n", options.material->name.c_str(), 100 * options.tolerance,
                   report->material_within,
                   report->checked ? 100.0 * double(report->material_within) / double(report->checked) : 0.0);
     }
     std::printf("  flagged: %zu texels (%.4f%%, allowed %.4f%%)%s\n", report->violations,
-                100 * report->violation_fraction(), 100 * s.max_violations, failed ? ": FAILED" : "");
+                100 * report->violation_fraction(), 100 * options.max_violations, failed ? ": FAILED" : "");
     for (int b = 0; b < validate::kFlagCount; ++b) {
       if (report->flag_counts[std::size_t(b)]) {
         std::printf("    %-22s %zu\n", std::string(validate::flag_name(b)).c_str(), report->flag_counts[std::size_t(b)]);

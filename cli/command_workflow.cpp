@@ -5,6 +5,7 @@
 #include <fstream>
 
 #include "commands.hpp"
+#include "option_names.hpp"
 #include "matbake/report_json.hpp"
 #include "matbake/atomic_file.hpp"
 #include "matbake/workflow_maps.hpp"
@@ -13,12 +14,6 @@ namespace matbake::cli {
 namespace {
 
 using workflow::ErrorStats;
-
-bool uses_any(const pack::Layout& layout, std::initializer_list<std::string_view> names) {
-  const auto used = pack::layout_sources(layout);
-  return std::any_of(names.begin(), names.end(),
-                     [&](std::string_view n) { return std::find(used.begin(), used.end(), n) != used.end(); });
-}
 
 std::string line(const char* label, const ErrorStats& s, double scale, const char* unit) {
   char buffer[160];
@@ -53,8 +48,8 @@ CLI::App* setup_workflow(CLI::App& app, WorkflowSettings& s) {
       "(and, to metal-rough, of the Khronos spec-gloss converter on the same texels).\n"
       "Example: matbake workflow --from schuler A.png B.png --to gltf-orm -o out/brick_{texture}.png");
   cmd->add_option("--to", s.to, "Target layout: a preset or a layout JSON file")->required();
-  cmd->add_option("--mapping", s.mapping, "Gloss <-> roughness: fitted (least squares over the lobe) or walter")
-      ->capture_default_str();
+  add_name_option(*cmd, "--mapping", s.mapping, workflow::kRoughnessMappingNames,
+                  "Gloss <-> roughness (fitted: least squares over the lobe)");
   cmd->add_option("--report", s.report, "Also write the error report as JSON to this file");
   add_source_options(*cmd, s.sources);
   add_output_options(*cmd, s.output, "textures");
@@ -62,42 +57,29 @@ CLI::App* setup_workflow(CLI::App& app, WorkflowSettings& s) {
 }
 
 int run_workflow(const WorkflowSettings& s, const GlobalOptions& global) {
-  workflow::RoughnessMapping mapping;
-  if (!workflow::roughness_mapping_from_name(s.mapping, mapping)) {
-    return report_error(Error{"", "--mapping '" + s.mapping + "': use fitted or walter", true});
-  }
   auto layout = pack::find_layout(s.to);
   if (!layout) return report_error(layout.error());
   auto sources = gather_sources(s.sources);
   if (!sources) return report_error(sources.error());
 
-  const bool has_spec_gloss = sources->find("kd") || sources->find("ks") || sources->find("gloss");
-  const bool has_metal_rough = sources->find("base_color") || sources->find("metallic") || sources->find("roughness");
-  const bool to_metal_rough = uses_any(*layout, {"base_color", "metallic", "roughness"});
-  const bool to_spec_gloss = uses_any(*layout, {"kd", "ks", "gloss"});
-  workflow::ConversionReport report;
-  Result<pack::SourceMaps> converted = Error{"", "", true};
-  std::string direction;
-  if (to_metal_rough && has_spec_gloss && !has_metal_rough) {
-    direction = "spec-gloss to metal-rough";
-    converted = workflow::metal_rough_from_spec_gloss(*sources, mapping, report);
-  } else if (to_spec_gloss && has_metal_rough && !has_spec_gloss) {
-    direction = "metal-rough to spec-gloss";
-    converted = workflow::spec_gloss_from_metal_rough(*sources, mapping, report);
-  } else {
+  auto converted = workflow::in_layout_workflow(std::move(*sources), *layout, s.mapping);
+  if (!converted) return report_error(converted.error());
+  if (!converted->direction) {
     return report_error(Error{"", "nothing to convert: give Schüler sources (--kd, --ks, --gloss) for a metal-rough "
                                   "layout or metal-rough ones (--base-color, --metallic, --roughness) for schuler; "
                                   "`matbake pack` packs without converting",
                               true});
   }
-  if (!converted) return report_error(converted.error());
-  auto written = write_textures(*layout, *converted, s.output, s.sources);
+  auto written = write_textures(*layout, converted->maps, s.output, s.sources);
   if (!written) return report_error(written.error());
 
+  const workflow::ConversionReport& report = converted->report;
+  const std::string direction(workflow::direction_name(*converted->direction));
+  const std::string mapping(workflow::roughness_mapping_name(s.mapping));
   nlohmann::json doc = {{"command", "workflow"}, {"direction", direction}, {"layout", layout->name},
-                        {"mapping", s.mapping}, {"outputs", *written}, {"texels", report.texels},
+                        {"mapping", mapping}, {"outputs", *written}, {"texels", report.texels},
                         {"errors", to_json(report.errors)}};
-  const bool spec_gloss_source = direction.starts_with("spec-gloss");
+  const bool spec_gloss_source = *converted->direction == workflow::Direction::metal_rough_from_spec_gloss;
   if (spec_gloss_source) {
     doc["khronos_converter_errors"] = to_json(report.khronos_errors);
     doc["dielectric_f0"] = to_json(report.dielectric);
@@ -109,8 +91,8 @@ int run_workflow(const WorkflowSettings& s, const GlobalOptions& global) {
     std::cout << doc.dump(2) << "\n";
   } else if (!global.quiet) {
     for (const std::string& p : *written) std::cout << p << "\n";
-    std::cout << direction << ", " << converted->width << "x" << converted->height << ", roughness mapping "
-              << s.mapping << "; errors of what the result renders against the source:\n"
+    std::cout << direction << ", " << converted->maps.width << "x" << converted->maps.height << ", roughness mapping "
+              << mapping << "; errors of what the result renders against the source:\n"
               << describe(report.errors);
     if (spec_gloss_source) {
       std::cout << "Khronos spec-gloss converter (roughness = 1 - gloss) on the same texels:\n"

@@ -7,11 +7,15 @@
 #include <string>
 #include <vector>
 
+#include "ao_options.hpp"
 #include "material_sources.hpp"
 #include "matbake/ao.hpp"
 #include "matbake/convert.hpp"
+#include "matbake/export.hpp"
 #include "matbake/preview.hpp"
 #include "matbake/result.hpp"
+#include "matbake/validate.hpp"
+#include "matbake/workflow.hpp"
 
 namespace matbake::cli {
 
@@ -79,7 +83,7 @@ int run_unpack(const UnpackSettings& settings, const GlobalOptions& global);
 
 struct WorkflowSettings {
   std::string to;  // target layout
-  std::string mapping = "fitted";
+  workflow::RoughnessMapping mapping = workflow::kDefaultRoughnessMapping;
   std::string report;  // JSON file
   SourceSettings sources;
   OutputSettings output;
@@ -97,10 +101,9 @@ struct ValidateSettings {
   SourceSettings sources;
   std::string material;
   std::string table;
-  double tolerance = 0.1;
-  double max_violations = 0;
+  validate::Options options;
   std::string heatmap;
-  int worst = 10;
+  std::string report;
 };
 CLI::App* setup_validate(CLI::App& app, ValidateSettings& settings);
 int run_validate(const ValidateSettings& settings, const GlobalOptions& global);
@@ -108,17 +111,8 @@ int run_validate(const ValidateSettings& settings, const GlobalOptions& global);
 struct BakeAoSettings {
   std::string scene;
   std::string output;
-  std::string into = "COLOR_0";
-  std::string existing_colors = "multiply";
   std::string dump;
-  ao::Options options;
-  double relative_distance = 0.25;
-  double absolute_distance = 0;
-  std::string falloff = "exponential";
-  std::string sampler = "sobol";
-  bool two_sided = false;
-  bool fast_traversal = false;
-  std::string recompute_normals;
+  AoSettings ao;
 };
 CLI::App* setup_bake_ao(CLI::App& app, BakeAoSettings& settings);
 int run_bake_ao(const BakeAoSettings& settings, const GlobalOptions& global);
@@ -127,12 +121,10 @@ struct ExportSettings {
   std::string scene;
   std::string output;
   std::vector<std::string> materials;  // NAME=[LAYOUT:]FILE,FILE...
-  std::string transfer = "srgb";       // of 8-bit colour in those files
-  std::string mapping = "fitted";
-  std::string dielectric_f0 = "specular";
-  bool no_orm = false;
-  int ao_samples = 0;                  // 0: no AO
-  std::string ao_into = "COLOR_0";
+  color::Transfer transfer = pack::LoadOptions{}.authored;  // of 8-bit colour in those files
+  exporter::Options options;
+  bool bake_ao = false;                // --ao-samples given (and not 0)
+  AoSettings ao;
   std::string report;
 };
 CLI::App* setup_export(CLI::App& app, ExportSettings& settings);

@@ -17,14 +17,6 @@ std::string option_of(std::string_view source) {
   return "--" + name;
 }
 
-// The output type: --bits, else half for EXR and 8-bit for the rest.
-Result<image::SampleType> output_type(const std::string& bits, const fs::path& path) {
-  if (bits.empty()) return path.extension() == ".exr" ? image::SampleType::half : image::SampleType::u8;
-  auto type = image::sample_type_from_name(bits);
-  if (!type) return Error{"", "--bits '" + bits + "': use 8, 16, half or float", true};
-  return *type;
-}
-
 }  // namespace
 
 std::optional<std::vector<double>> parse_numbers(const std::string& text) {
@@ -150,43 +142,18 @@ Result<std::vector<std::string>> write_textures(const pack::Layout& layout, cons
                                                 const OutputSettings& o, const SourceSettings& inputs) {
   auto transfer = parse_transfer(inputs.transfer, "--transfer");
   if (!transfer) return transfer.error();
-  std::vector<std::string> paths;
-  if (o.outputs.size() == 1 && o.outputs[0].find("{texture}") != std::string::npos) {
-    for (const pack::Texture& t : layout.textures) {
-      std::string p = o.outputs[0];
-      p.replace(p.find("{texture}"), 9, t.name);
-      paths.push_back(p);
-    }
-  } else if (o.outputs.size() == layout.textures.size()) {
-    paths = o.outputs;
-  } else {
-    std::string names;
-    for (const pack::Texture& t : layout.textures) names += (names.empty() ? "" : ", ") + t.name;
-    return Error{"", "layout " + layout.name + " writes " + std::to_string(layout.textures.size()) + " textures (" +
-                         names + "): give as many -o, or one with {texture}", true};
+  pack::WriteRequest request{o.outputs, std::nullopt, *transfer, {inputs.inputs.begin(), inputs.inputs.end()}};
+  if (!o.bits.empty()) {
+    request.type = image::sample_type_from_name(o.bits);
+    if (!request.type) return Error{"", "--bits '" + o.bits + "': use 8, 16, half or float", true};
   }
-  std::vector<std::string> input_files = inputs.inputs;
   for (const std::string& v : inputs.values) {
-    if (!v.empty() && !parse_numbers(v)) input_files.push_back(v);
+    if (!v.empty() && !parse_numbers(v)) request.inputs.emplace_back(v);
   }
-  for (const std::string& out : paths) {
-    for (const std::string& in : input_files) {
-      std::error_code ec;
-      if (fs::equivalent(out, in, ec)) return Error{out, "is an input; matbake never overwrites its inputs", true};
-    }
-  }
-  auto images = pack::pack(layout, sources);
-  if (!images) return images.error();
-  for (std::size_t t = 0; t < paths.size(); ++t) {
-    auto type = output_type(o.bits, paths[t]);
-    if (!type) return type.error();
-    SilencedStderr quiet;
-    if (Status st = image::write_image((*images)[t], paths[t], pack::write_options(layout.textures[t].color, {*type, *transfer}));
-        !st) {
-      return st.error();
-    }
-  }
-  return paths;
+  SilencedStderr quiet;
+  auto written = pack::write_textures(layout, sources, request);
+  if (!written) return written.error();
+  return std::vector<std::string>(written->begin(), written->end());
 }
 
 }  // namespace matbake::cli

@@ -98,10 +98,10 @@ TEST(CliBakeAo, BadScenesAndUsage) {
   const std::string before = read_bytes(dir / "good.gltf");
   using Case = std::pair<std::vector<std::string>, std::string>;
   for (const auto& [args, problem] :
-       {Case{{"bake-ao", good}, "bake-ao writes -o FILE, --dump FILE or both"},
+       {Case{{"bake-ao", good}, "bake-ao writes a glTF, a dump or both"},
         Case{{"bake-ao", good, "-o", good}, good + ": would overwrite an input"},
         Case{{"bake-ao", good, "-o", (dir / "out.obj").string()}, (dir / "out.obj").string() + ": the output is .gltf or .glb"},
-        Case{{"bake-ao", good, "-o", (dir / "x.glb").string(), "--into", "COLOR_1"}, "--into 'COLOR_1': use COLOR_0 or _AO"}}) {
+        Case{{"bake-ao", good, "-o", (dir / "x.glb").string(), "--into", "COLOR_1"}, "--into 'COLOR_1' --existing-colors 'multiply': use COLOR_0 (with multiply or replace) or _AO"}}) {
     const auto r = matbake(args);
     EXPECT_EQ(r.exit_code, 2) << problem;
     expect_one_error_line(r, "", problem);

@@ -137,7 +137,7 @@ TEST(CliPack, BadInputsAndUsage) {
   // Two outputs wanted, one given; an output that is an input.
   const auto count = matbake({"pack", "--kd", "0.5", "--ks", "0.04", "--gloss", "0.5", "-o", (dir / "x.png").string()});
   EXPECT_EQ(count.exit_code, 2);
-  expect_one_error_line(count, "", "layout schuler writes 2 textures (a, b): give as many -o, or one with {texture}");
+  expect_one_error_line(count, "", "layout schuler writes 2 textures (a, b): give as many outputs, or one path with {texture}");
   const std::string bytes = read_bytes(dir / "big.png");
   const auto clobber = matbake({"pack", "--kd", "0.5", "--ks", "0.04", "--gloss", big, "-o", big, "-o",
                                 (dir / "b.png").string()});

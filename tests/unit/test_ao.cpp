@@ -49,8 +49,7 @@ Options binary(int samples) {
   Options o;
   o.samples = samples;
   o.falloff = Falloff::none;
-  o.relative_distance = false;
-  o.max_distance = 1e5;
+  o.absolute_distance = 1e5;
   return o;
 }
 
@@ -91,9 +90,8 @@ TEST(AmbientOcclusion, PlaneUnderAParallelPlaneIsOneMinusTwoE3) {
   const double expected = 1 - 2 * e3;  // 0.7806
   Options o;
   o.samples = 4096;
-  o.relative_distance = false;
-  o.max_distance = 1e4;  // effectively unbounded: μ(x) = 1 − e^(−τx)
-  o.tau = tau * o.max_distance;
+  o.absolute_distance = 1e4;  // effectively unbounded: μ(x) = 1 − e^(−τx)
+  o.tau = tau * o.absolute_distance;
   const auto s = scene_of({square({0, 0, 0}, kX, kY, kHalf), square({0, 0, float(h)}, kY, kX, kHalf)});
   // μ is continuous: σ ≤ 0.5/√N; the large quads lose at most e^(−τ·1000)-ish of the integral.
   EXPECT_NEAR(centre_value(s, o), expected, 3 * 0.5 / std::sqrt(4096.0));
@@ -137,7 +135,7 @@ TEST(AmbientOcclusion, InsideAClosedSphereIsDark) {
     }
   }
   Options o = binary(256);
-  o.max_distance = 10;
+  o.absolute_distance = 10;
   auto r = bake(scene_of({sphere}), o);
   ASSERT_TRUE(r);
   for (std::size_t v = kSegments; v < sphere.positions.size() - kSegments; ++v) EXPECT_EQ(r->values[0][v], 0.0f) << v;
@@ -149,7 +147,7 @@ TEST(AmbientOcclusion, ScaleInvariantWithARelativeRange) {
   };
   Options o;
   o.samples = 256;
-  o.max_distance = 0.3;  // relative to the scene radius
+  o.relative_distance = 0.3;
   const auto reference = bake(make(1), o);
   ASSERT_TRUE(reference);
   for (float scale : {1e-3f, 1e3f}) {
@@ -170,6 +168,7 @@ TEST(AmbientOcclusion, SameValuesWhateverTheThreadCount) {
   Options o;
   o.samples = 64;
   o.seed = 7;
+  o.two_sided = true;  // the squares above show their backs
   Bake one;
   {
     tbb::global_control c(tbb::global_control::max_allowed_parallelism, 1);
@@ -225,7 +224,7 @@ Instance flat_box(const Vec3& center, float half, bool inward) {
 // coordinates, not the scene's size.
 TEST(AmbientOcclusion, SharedCornersDegenerateFacesAndMixedScales) {
   Options o = binary(256);
-  o.max_distance = 1e3;  // the boxes, 2.5e4 apart, do not see each other
+  o.absolute_distance = 1e3;  // the boxes, 2.5e4 apart, do not see each other
   const auto outside = scene_of({flat_box({0, 0, 0}, 5e-5f, false), flat_box({3e4f, 0, 0}, 5e3f, false)});
   auto open = bake(outside, o);
   ASSERT_TRUE(open);
@@ -233,7 +232,7 @@ TEST(AmbientOcclusion, SharedCornersDegenerateFacesAndMixedScales) {
     for (std::size_t v = 0; v < 25; ++v) EXPECT_EQ(open->values[k][v], 1.0f) << "box " << k << " vertex " << v;
   }
   // Inside a closed box nothing is open: no ray may leak out through an edge or a corner.
-  o.max_distance = 1e6;
+  o.absolute_distance = 1e6;
   const auto inside = scene_of({flat_box({0, 0, 0}, 5e-5f, true), flat_box({3e4f, 0, 0}, 5e3f, true)});
   auto closed = bake(inside, o);
   ASSERT_TRUE(closed);
@@ -276,7 +275,13 @@ TEST(AmbientOcclusion, BadOptions) {
   o.samples = 0;
   EXPECT_FALSE(bake(s, o));
   o = Options{};
-  o.max_distance = -1;
+  o.absolute_distance = -1;
+  EXPECT_FALSE(bake(s, o));
+  o = Options{};
+  o.relative_distance = std::nan("");
+  EXPECT_FALSE(bake(s, o));
+  o = Options{};
+  o.samples = kMaxSamples + 1;
   EXPECT_FALSE(bake(s, o));
 }
 

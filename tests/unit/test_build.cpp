@@ -43,7 +43,8 @@ materials = { "Bricks" = "brick" }
 match_names = false
 dielectric_f0 = "ior"
 orm = false
-ao = { samples = 32, absolute_distance = 2.5, falloff = "none", into = "_AO", seed = 7, two_sided = false }
+mapping = "walter"
+ao = { samples = 32, absolute_distance = 2.5, falloff = "none", into = "_AO", seed = 7, two_sided = true, tau = 2, bias = 1e-4, sampler = "random", recompute_normals = "angle", fast_traversal = true }
 )";
 
 TEST(BuildManifest, EveryKeyReachesItsField) {
@@ -64,16 +65,16 @@ TEST(BuildManifest, EveryKeyReachesItsField) {
   EXPECT_EQ(brick.layout, "schuler");
   EXPECT_EQ(brick.format, "tif");
   EXPECT_EQ(brick.bits, image::SampleType::u16);
-  EXPECT_DOUBLE_EQ(brick.validation.tolerance, 0.2);
-  EXPECT_DOUBLE_EQ(brick.validation.max_violations, 0.01);
+  EXPECT_DOUBLE_EQ(brick.validation.options.tolerance, 0.2);
+  EXPECT_DOUBLE_EQ(brick.validation.options.max_violations, 0.01);
   const build::MaterialSpec& gold = m->materials[1];
   EXPECT_EQ(gold.packed_layout, "gltf-orm");
   EXPECT_EQ(gold.packed_files, (std::vector<fs::path>{"/project/a.png", "/project/b.png"}));
   EXPECT_EQ(gold.transfer, color::Transfer::srgb);
   EXPECT_EQ(gold.decode, color::Transfer::linear);
   EXPECT_EQ(gold.reference, "gold");
-  EXPECT_DOUBLE_EQ(gold.validation.tolerance, 0.2);  // inherited, then overridden key by key
-  EXPECT_DOUBLE_EQ(gold.validation.max_violations, 0.5);
+  EXPECT_DOUBLE_EQ(gold.validation.options.tolerance, 0.2);  // inherited, then overridden key by key
+  EXPECT_DOUBLE_EQ(gold.validation.options.max_violations, 0.5);
   EXPECT_TRUE(gold.validation.heatmap);
   ASSERT_EQ(m->scenes.size(), 1u);
   const build::SceneSpec& room = m->scenes[0];
@@ -81,16 +82,22 @@ TEST(BuildManifest, EveryKeyReachesItsField) {
   EXPECT_EQ(room.output, fs::path("sub/room.gltf"));
   EXPECT_EQ(room.materials.at("Bricks"), "brick");
   EXPECT_FALSE(room.match_names);
-  EXPECT_EQ(room.dielectric_f0, exporter::DielectricF0::ior);
-  EXPECT_FALSE(room.orm);
-  ASSERT_TRUE(room.ao);
-  EXPECT_EQ(room.ao->samples, 32);
-  EXPECT_DOUBLE_EQ(room.ao->max_distance, 2.5);
-  EXPECT_FALSE(room.ao->relative_distance);
-  EXPECT_EQ(room.ao->falloff, ao::Falloff::none);
-  EXPECT_EQ(room.ao->seed, 7u);
-  EXPECT_FALSE(room.ao->two_sided);
-  EXPECT_EQ(room.ao_into, ao::Into::attribute);
+  EXPECT_EQ(room.options.dielectric_f0, exporter::DielectricF0::ior);
+  EXPECT_FALSE(room.options.pack_orm);
+  EXPECT_EQ(room.options.mapping, workflow::RoughnessMapping::walter);
+  ASSERT_TRUE(room.options.ao);
+  const ao::Options& o = room.options.ao->options;
+  EXPECT_EQ(o.samples, 32);
+  EXPECT_DOUBLE_EQ(o.absolute_distance, 2.5);
+  EXPECT_EQ(o.falloff, ao::Falloff::none);
+  EXPECT_EQ(o.seed, 7u);
+  EXPECT_TRUE(o.two_sided);  // the default is one-sided
+  EXPECT_DOUBLE_EQ(o.tau, 2);
+  EXPECT_DOUBLE_EQ(o.bias, 1e-4);
+  EXPECT_EQ(o.sampler, ao::Sampler::random);
+  EXPECT_EQ(o.recompute_normals, scene::NormalWeighting::angle);
+  EXPECT_FALSE(o.watertight);
+  EXPECT_EQ(room.options.ao->into, ao::Into::attribute);
 }
 
 // Each bad manifest: the error names the file with line and column and says what is wrong.

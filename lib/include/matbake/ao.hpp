@@ -8,35 +8,54 @@
 // With cosine-weighted directions (pdf cos θ / π) the estimator is the mean of μ over the rays.
 #include <cstdint>
 #include <filesystem>
+#include <optional>
+#include <string_view>
 #include <vector>
 
+#include "matbake/enum_names.hpp"
 #include "matbake/result.hpp"
 #include "matbake/scene.hpp"
 
 namespace matbake::ao {
 
 enum class Falloff { exponential, none };
+inline constexpr NameTable<Falloff, 2> kFalloffNames{{{Falloff::exponential, "exponential"}, {Falloff::none, "none"}}};
+inline std::string_view falloff_name(Falloff f) { return name_in(kFalloffNames, f); }
+inline std::optional<Falloff> falloff_from_name(std::string_view name) { return value_in(kFalloffNames, name); }
+
 enum class Sampler {
   sobol,   // (0, 2)-sequence in base 2, XOR-scrambled per vertex: low discrepancy
   random,  // independent uniform pairs per vertex: for comparison
 };
+inline constexpr NameTable<Sampler, 2> kSamplerNames{{{Sampler::sobol, "sobol"}, {Sampler::random, "random"}}};
+inline std::string_view sampler_name(Sampler s) { return name_in(kSamplerNames, s); }
+inline std::optional<Sampler> sampler_from_name(std::string_view name) { return value_in(kSamplerNames, name); }
 
+// Every option of the estimator, with its default: `bake-ao`, `export --ao-*` and a manifest's
+// `ao = { ... }` fill this struct and nothing else decides a default.
 struct Options {
-  int samples = 64;                // rays per vertex
-  double max_distance = 0.25;      // d_max: absolute, or × the scene radius when relative_distance
-  bool relative_distance = true;
-  double tau = 4.0;                // τ in units of 1/d_max (so e^(−τ d_max) = e^(−4) by default)
+  int samples = 64;                 // rays per vertex, 1 to kMaxSamples
+  double relative_distance = 0.25;  // d_max as a fraction of the scene radius ...
+  double absolute_distance = 0;     // ... or, when > 0, in scene units
+  double tau = 4.0;                 // τ in units of 1/d_max (so e^(−τ d_max) = e^(−4) by default)
   Falloff falloff = Falloff::exponential;
   double bias = 1e-5;  // origin offset along the normal, × the vertex's mean edge length, capped at
                        // 1e-4 × the scene radius, at least 1e-6 × the vertex's coordinates' magnitude
-  bool two_sided = true;           // false: surfaces seen from behind do not occlude
+  bool two_sided = false;           // false: surfaces seen from behind (by their winding) do not occlude
   std::uint64_t seed = 0;
   Sampler sampler = Sampler::sobol;
+  // Normals the rays start around: the file's (area-weighted from the faces where it has none), or
+  // recomputed from the faces with this weighting.
+  std::optional<scene::NormalWeighting> recompute_normals;
   std::vector<bool> targets;  // per instance: bake it (all occlude either way); empty: all
   // Embree's robust traversal: no ray slips between two triangles sharing an edge (without it, 1
   // ray in 256 leaked out of a closed box from its corners). Costs about a third of the speed.
   bool watertight = true;
 };
+constexpr int kMaxSamples = 1 << 20;
+
+// The options' ranges (samples, distances, τ, bias); errors name the option as the Options field.
+Status check(const Options& options);
 
 struct Bake {
   std::vector<std::vector<float>> values;  // per scene instance, per vertex: w in [0, 1] (empty: not a target)
@@ -58,13 +77,17 @@ enum class Into {
   color_multiply,  // COLOR_0 = the file's COLOR_0 × w (alpha kept); (w, w, w) where there is none
   attribute,       // `_AO`, one float per vertex (an application-specific attribute)
 };
+// As both front ends name it: an attribute ("COLOR_0" or "_AO") and, for COLOR_0, what happens to
+// the file's own colours ("multiply" or "replace").
+std::string_view into_attribute_name(Into into);
+std::string_view into_existing_colors_name(Into into);  // "multiply" for Into::attribute too
+std::optional<Into> into_from_names(std::string_view attribute, std::string_view existing_colors);
 
-// Writes the scene file `input` again as `output` (.gltf with a .bin beside it, or .glb; either
-// from either) with each baked primitive's values in it; everything else is kept as written. A
-// mesh placed by several nodes gets a copy per further node (sharing every accessor but the new
-// one), because each placement has its own occlusion. `scene` must be load_scene(input).
-Status write_gltf(const std::filesystem::path& input, const scene::Scene& scene, const Bake& bake, Into into,
-                  const std::filesystem::path& output);
+// A bake for a written glTF: the estimator's options and where the values go.
+struct Request {
+  Options options;
+  Into into = Into::color_multiply;
+};
 
 // Sample i of the per-vertex sequence, in [0, 1)².
 struct Sample2 {

@@ -23,14 +23,14 @@
 #include "matbake/image.hpp"
 #include "matbake/pack.hpp"
 #include "matbake/result.hpp"
+#include "matbake/validate.hpp"
 #include "matbake/workflow.hpp"
 
 namespace matbake::build {
 
 struct ValidationRules {
   bool enabled = true;
-  double tolerance = 0.1;     // relative, against the material table entry (`reference`)
-  double max_violations = 0;  // share of checked texels that may be flagged before the job fails
+  validate::Options options;  // tolerance (against `reference`), max_violations (else the job fails), worst_count
   bool heatmap = false;       // also write <name>_validation.png
 };
 
@@ -46,8 +46,8 @@ struct MaterialSpec {
   bool resize = false;                               // sources of different sizes: resample to the largest
   std::string layout;          // textures to write (a preset or layout file); empty: none
   std::string format = "png";  // png, exr, tif
-  image::SampleType bits = image::SampleType::u8;
-  workflow::RoughnessMapping mapping = workflow::RoughnessMapping::fitted;
+  std::optional<image::SampleType> bits;  // unset: pack::default_sample_type (half for exr, else 8)
+  workflow::RoughnessMapping mapping = workflow::kDefaultRoughnessMapping;
   std::string reference;  // a material table entry to validate against
   ValidationRules validation;
 };
@@ -58,10 +58,7 @@ struct SceneSpec {
   std::filesystem::path output;  // inside the output folder
   std::map<std::string, std::string> materials;  // glTF material name → manifest material
   bool match_names = true;  // also: glTF materials named like a manifest material get it
-  std::optional<ao::Options> ao;
-  ao::Into ao_into = ao::Into::color_multiply;
-  exporter::DielectricF0 dielectric_f0 = exporter::DielectricF0::specular;
-  bool orm = true;
+  exporter::Options options;  // as `matbake export` fills it; its materials are added when the job runs
 };
 
 struct Manifest {

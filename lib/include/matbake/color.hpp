@@ -11,6 +11,8 @@
 #include <span>
 #include <string_view>
 
+#include "matbake/enum_names.hpp"
+
 namespace matbake::color {
 
 enum class Transfer {
@@ -19,8 +21,10 @@ enum class Transfer {
   gamma22,  // pure power 2.2, the display gamma of Schüler's article
 };
 
-std::optional<Transfer> transfer_from_name(std::string_view name);  // "linear", "srgb", "gamma2.2"
-std::string_view transfer_name(Transfer transfer);
+inline constexpr NameTable<Transfer, 3> kTransferNames{
+    {{Transfer::srgb, "srgb"}, {Transfer::gamma22, "gamma2.2"}, {Transfer::linear, "linear"}}};
+inline std::optional<Transfer> transfer_from_name(std::string_view name) { return value_in(kTransferNames, name); }
+inline std::string_view transfer_name(Transfer transfer) { return name_in(kTransferNames, transfer); }
 
 // float64 reference formulas. Odd-symmetric: a negative value is decoded (encoded) as the negative
 // of its magnitude's value, so the curves stay monotone and invertible on the whole real line. HDR

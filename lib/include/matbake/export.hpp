@@ -21,24 +21,31 @@
 
 namespace matbake::exporter {
 
-// A material's maps from outside the glTF, replacing what it had.
+// A material's maps from outside the glTF, replacing what it had (its spec-gloss, specular and IOR
+// extensions included: the maps say what F0 is).
 struct MaterialMaps {
   std::string material;  // the glTF material's name (or its index, as a number)
   pack::SourceMaps maps;  // kd, ks, gloss (Schüler) or base_color, metallic, roughness; mask, occlusion optional
+  std::optional<workflow::RoughnessMapping> mapping;  // for Schüler maps; unset: Options::mapping
 };
 
 // How a converted dielectric whose F0 is not 0.04 says so: KHR_materials_specular's
 // specularColorFactor = F0 / 0.04 (the IOR stays 1.5), or KHR_materials_ior's IOR from F0 =
 // ((n − 1)/(n + 1))² (which also bends refraction, for transmissive materials), or neither.
 enum class DielectricF0 { specular, ior, none };
+inline constexpr NameTable<DielectricF0, 3> kDielectricF0Names{
+    {{DielectricF0::specular, "specular"}, {DielectricF0::ior, "ior"}, {DielectricF0::none, "none"}}};
+inline std::string_view dielectric_f0_name(DielectricF0 d) { return name_in(kDielectricF0Names, d); }
+inline std::optional<DielectricF0> dielectric_f0_from_name(std::string_view name) {
+  return value_in(kDielectricF0Names, name);
+}
 
 struct Options {
   std::vector<MaterialMaps> materials;
   DielectricF0 dielectric_f0 = DielectricF0::specular;
-  workflow::RoughnessMapping mapping = workflow::RoughnessMapping::fitted;
+  workflow::RoughnessMapping mapping = workflow::kDefaultRoughnessMapping;
   bool pack_orm = true;           // occlusion + metallic-roughness into one texture
-  std::optional<ao::Options> ao;  // bake per-vertex AO when set
-  ao::Into ao_into = ao::Into::color_multiply;
+  std::optional<ao::Request> ao;  // bake per-vertex AO when set
 };
 
 struct MaterialReport {
@@ -62,5 +69,25 @@ struct Report {
 
 Result<Report> export_scene(const std::filesystem::path& input, const std::filesystem::path& output,
                             const Options& options);
+
+// `matbake bake-ao`: a scene's per-vertex AO written into the scene again (everything else kept as
+// written: nothing pruned or converted) and/or dumped as raw values (ao::write_dump). Neither output
+// may be a file the scene is read from.
+struct BakeAoOptions {
+  ao::Request ao;
+  std::filesystem::path output;  // .gltf or .glb; empty: none
+  std::filesystem::path dump;    // .csv or .bin; empty: none
+};
+struct BakeAoReport {
+  std::size_t instances = 0;
+  std::size_t vertices = 0;  // baked
+  std::uint64_t rays = 0;
+  double seconds = 0;        // of ray casting
+  double max_distance = 0;   // d_max as used
+  double mean = 0;           // over baked vertices
+  std::vector<std::string> notes;    // the scene's (what was skipped)
+  std::vector<std::string> written;  // files
+};
+Result<BakeAoReport> bake_ao_file(const std::filesystem::path& input, const BakeAoOptions& options);
 
 }  // namespace matbake::exporter

@@ -38,6 +38,10 @@ Result<std::vector<Material>> parse_table(std::string_view toml_text, const std:
 const Material* find(const std::vector<Material>& table, std::string_view name);
 // Names within a small edit distance of `name` (for "unknown material" errors), nearest first.
 std::vector<std::string> near_names(const std::vector<Material>& table, std::string_view name);
+// The entry named `name`, or an error listing near names.
+Result<const Material*> lookup(const std::vector<Material>& table, std::string_view name);
+// The table in `path`, or the built-in one when `path` is empty.
+Result<std::vector<Material>> table_or_builtin(const std::filesystem::path& path);
 
 // --- F0 classes (Schüler's table; validation) ---------------------------------------------------
 // F0 < 0.02: below any real material; [0.02, 0.08): dielectric; [0.08, 0.2): gem;

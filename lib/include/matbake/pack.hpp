@@ -107,6 +107,23 @@ struct OutputOptions {
   color::Transfer transfer = color::Transfer::srgb;  // for colour channels of 8-bit output; else linear
 };
 image::WriteOptions write_options(bool color, const OutputOptions& options);
+// Where a layout's textures go: one path per texture, in order, or one path holding "{texture}"
+// (replaced by each texture's name).
+Result<std::vector<std::filesystem::path>> output_paths(const Layout& layout, const std::vector<std::string>& outputs);
+// The sample type when none is asked: half for .exr, 8-bit for the rest.
+image::SampleType default_sample_type(const std::filesystem::path& path);
+
+struct WriteRequest {
+  std::vector<std::string> outputs;        // as output_paths takes them
+  std::optional<image::SampleType> type;   // unset: default_sample_type of each path
+  color::Transfer transfer = color::Transfer::srgb;  // colour channels of 8-bit outputs
+  std::vector<std::filesystem::path> inputs;         // files the maps were read from: never written over
+};
+// Packs `sources` into the layout's textures and writes them (each atomically). An output that is
+// an input, or two outputs that are one file, are refused before anything is written.
+Result<std::vector<std::filesystem::path>> write_textures(const Layout& layout, const SourceMaps& sources,
+                                                          const WriteRequest& request);
+
 // How to decode a file holding colour: `authored` for 8-bit files, linear for 16-bit and float
 // ones (the rule write_options follows).
 Result<color::Transfer> decode_transfer(const std::filesystem::path& path, color::Transfer authored);

@@ -14,9 +14,16 @@ nlohmann::json to_json(const workflow::ConversionErrors& e);
 nlohmann::json to_json(const workflow::DielectricF0& d);
 // Counts by class and flag, the worst texels, F0 (and diffuse) statistics, and the material
 // comparison when options.material is set.
-nlohmann::json to_json(const validate::Report& r, const validate::Options& options, bool has_diffuse);
+nlohmann::json to_json(const validate::Report& r, const validate::Options& options);
+// The validation report file (`validate --report`, a build's NAME.validation.json): to_json plus
+// max_violations and passed.
+Status write_validation_report(const validate::Report& r, const validate::Options& options,
+                               const std::filesystem::path& json);
 // Materials written (with their conversion errors), what was left out, files written: as
 // `export --json` prints it (without its "command" key).
 nlohmann::json to_json(const exporter::Report& r);
+// Options by the names the manifest uses (a build's stamp records them; material maps not included).
+nlohmann::json to_json(const ao::Request& r);
+nlohmann::json to_json(const exporter::Options& o);
 
 }  // namespace matbake

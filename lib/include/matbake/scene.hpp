@@ -9,9 +9,12 @@
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
+#include "matbake/enum_names.hpp"
 #include "matbake/result.hpp"
 
 namespace matbake::scene {
@@ -48,6 +51,12 @@ Result<Scene> load_scene(const std::filesystem::path& path);
 // file when there is one, else takes the area-weighted normal of the whole primitive, else +z;
 // fallbacks are counted.
 enum class NormalWeighting { equal, area, angle };
+inline constexpr NameTable<NormalWeighting, 3> kNormalWeightingNames{
+    {{NormalWeighting::equal, "equal"}, {NormalWeighting::area, "area"}, {NormalWeighting::angle, "angle"}}};
+inline std::string_view normal_weighting_name(NormalWeighting w) { return name_in(kNormalWeightingNames, w); }
+inline std::optional<NormalWeighting> normal_weighting_from_name(std::string_view name) {
+  return value_in(kNormalWeightingNames, name);
+}
 struct NormalResult {
   std::vector<Vec3> normals;
   std::size_t fallbacks = 0;

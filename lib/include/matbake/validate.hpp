@@ -3,6 +3,7 @@
 // mask: the F0 class of every texel (materials::classify_f0) and what is wrong with it.
 #include <array>
 #include <cstdint>
+#include <filesystem>
 #include <span>
 #include <string>
 #include <string_view>
@@ -10,6 +11,7 @@
 
 #include "matbake/image.hpp"
 #include "matbake/materials.hpp"
+#include "matbake/pack.hpp"
 #include "matbake/result.hpp"
 
 namespace matbake::validate {
@@ -49,6 +51,7 @@ struct Options {
   double tolerance = 0.1;                          // relative, per channel: |F0 − ref| ≤ tol · ref
   std::size_t worst_count = 10;
   bool class_map = false;  // keep the per-texel class map (for heatmap())
+  double max_violations = 0;  // share of checked texels that may be flagged and still pass
 };
 
 struct Texel {
@@ -76,6 +79,7 @@ struct Report {
   std::array<ChannelStats, 3> f0_stats{}, diffuse_stats{};
   std::vector<Texel> worst;          // the most severe, most severe first
   std::vector<std::uint8_t> class_map;
+  bool has_diffuse = false;          // a diffuse map was checked too
   double violation_fraction() const { return checked ? double(violations) / double(checked) : 0.0; }
 };
 
@@ -85,11 +89,19 @@ Result<Report> validate(const Inputs& inputs, const Options& options);
 // The class map as an RGB image (linear), one colour per class, flagged texels red; see
 // heatmap_legend().
 image::Image heatmap(const Report& report);
+// heatmap() as an 8-bit sRGB PNG, written atomically.
+Status write_heatmap(const Report& report, const std::filesystem::path& png);
+// Whether the flagged share is within options.max_violations.
+bool passed(const Report& report, const Options& options);
 struct LegendEntry {
   std::string_view label;
   std::array<std::uint8_t, 3> srgb;  // 8-bit sRGB as written in the PNG
 };
 std::span<const LegendEntry> heatmap_legend();
+
+// A material's maps validated: ks (with kd when given) as they are, or F0 and diffuse from base_color
+// and metallic (from_metal_rough); the mask when given. Errors say which maps are missing.
+Result<Report> validate_maps(const pack::SourceMaps& maps, const Options& options);
 
 // F0 and diffuse of metal-rough maps (glTF): F0 = lerp(0.04, base, m), diffuse = base (1 − m).
 struct SpecularDiffuse {

@@ -4,9 +4,12 @@
 // shading module. docs/workflow.md has the derivations and the measured tables.
 #include <glm/vec3.hpp>
 
+#include <optional>
 #include <span>
 #include <string_view>
 #include <vector>
+
+#include "matbake/enum_names.hpp"
 
 namespace matbake::workflow {
 
@@ -43,8 +46,14 @@ enum class RoughnessMapping {
   fitted,
 };
 inline constexpr double kFittedF0[] = {0.02, 0.04, 0.2, 0.5, 0.8, 1.0};
-std::string_view roughness_mapping_name(RoughnessMapping mapping);
-bool roughness_mapping_from_name(std::string_view name, RoughnessMapping& mapping);
+// The mapping every front end uses unless told otherwise.
+inline constexpr RoughnessMapping kDefaultRoughnessMapping = RoughnessMapping::fitted;
+inline constexpr NameTable<RoughnessMapping, 2> kRoughnessMappingNames{
+    {{RoughnessMapping::fitted, "fitted"}, {RoughnessMapping::walter, "walter"}}};
+inline std::string_view roughness_mapping_name(RoughnessMapping m) { return name_in(kRoughnessMappingNames, m); }
+inline std::optional<RoughnessMapping> roughness_mapping_from_name(std::string_view name) {
+  return value_in(kRoughnessMappingNames, name);
+}
 // g in [0, 1] (clamped); both mappings are strictly decreasing in g, so each has an inverse for a
 // given F0 (the mean of the specular colour's channels; walter ignores it).
 double roughness_from_gloss(double gloss, RoughnessMapping mapping, double f0 = kDielectricF0);

@@ -54,4 +54,15 @@ Result<pack::SourceMaps> metal_rough_from_spec_gloss(const pack::SourceMaps& in,
 Result<pack::SourceMaps> spec_gloss_from_metal_rough(const pack::SourceMaps& in, RoughnessMapping mapping,
                                                      ConversionReport& report);
 
+// The maps in the workflow a layout reads: converted when they are all of the other workflow
+// (Schüler maps for a metal-rough layout, or the reverse), else as they are (direction unset).
+enum class Direction { metal_rough_from_spec_gloss, spec_gloss_from_metal_rough };
+std::string_view direction_name(Direction d);  // "spec-gloss to metal-rough", "metal-rough to spec-gloss"
+struct LayoutMaps {
+  pack::SourceMaps maps;
+  std::optional<Direction> direction;
+  ConversionReport report;  // when converted
+};
+Result<LayoutMaps> in_layout_workflow(pack::SourceMaps maps, const pack::Layout& layout, RoughnessMapping mapping);
+
 }  // namespace matbake::workflow

@@ -60,14 +60,24 @@ struct Mesh {
   std::vector<Vec3> face_normals;  // for one-sided occlusion
 };
 
-Mesh prepare(const scene::Instance& inst) {
-  Mesh m;
-  m.normals = scene::vertex_normals(inst.positions, inst.triangles, scene::NormalWeighting::area, inst.normals).normals;
-  if (!inst.normals.empty()) {
-    for (std::size_t v = 0; v < m.normals.size(); ++v) {
-      if (glm::length(inst.normals[v]) > 0) m.normals[v] = inst.normals[v];
+// The file's unit normals where it has them; else (or when asked) from the faces.
+std::vector<Vec3> ray_normals(const scene::Instance& inst, std::optional<scene::NormalWeighting> recompute) {
+  const bool usable = !recompute && !inst.normals.empty() &&
+                      std::all_of(inst.normals.begin(), inst.normals.end(), [](const Vec3& n) { return glm::length(n) > 0; });
+  if (usable) return inst.normals;  // the common case: no face pass at all
+  const scene::NormalWeighting weighting = recompute.value_or(scene::NormalWeighting::area);
+  std::vector<Vec3> normals = scene::vertex_normals(inst.positions, inst.triangles, weighting, inst.normals).normals;
+  if (!recompute && !inst.normals.empty()) {
+    for (std::size_t v = 0; v < normals.size(); ++v) {
+      if (glm::length(inst.normals[v]) > 0) normals[v] = inst.normals[v];
     }
   }
+  return normals;
+}
+
+Mesh prepare(const scene::Instance& inst, std::optional<scene::NormalWeighting> recompute) {
+  Mesh m;
+  m.normals = ray_normals(inst, recompute);
   std::vector<double> sum(inst.positions.size(), 0.0);
   std::vector<int> count(inst.positions.size(), 0);
   for (const auto& t : inst.triangles) {
@@ -127,11 +137,30 @@ Sample2 sample(Sampler sampler, std::uint32_t i, std::uint64_t key) {
   return {unit(std::uint32_t(bits)), unit(std::uint32_t(bits >> 32))};
 }
 
-Result<Bake> bake(const scene::Scene& scene, const Options& options) {
-  if (options.samples < 1) return Error{"", "--samples must be at least 1", true};
-  if (!(options.max_distance > 0) || !(options.tau > 0) || !(options.bias >= 0)) {
-    return Error{"", "--max-distance and --tau must be positive, --bias not negative", true};
+Status check(const Options& options) {
+  if (options.samples < 1 || options.samples > kMaxSamples) {
+    return Error{"", "AO samples must be 1 to " + std::to_string(kMaxSamples), true};
   }
+  if (!(options.relative_distance > 0) || !std::isfinite(options.relative_distance) ||
+      !(options.absolute_distance >= 0) || !std::isfinite(options.absolute_distance)) {
+    return Error{"", "AO distances must be finite and positive", true};
+  }
+  if (!(options.tau > 0) || !std::isfinite(options.tau)) return Error{"", "AO tau must be finite and positive", true};
+  if (!(options.bias >= 0) || !std::isfinite(options.bias)) return Error{"", "AO bias must be finite and not negative", true};
+  return success();
+}
+
+std::string_view into_attribute_name(Into into) { return into == Into::attribute ? "_AO" : "COLOR_0"; }
+std::string_view into_existing_colors_name(Into into) { return into == Into::color ? "replace" : "multiply"; }
+std::optional<Into> into_from_names(std::string_view attribute, std::string_view existing_colors) {
+  if (existing_colors != "multiply" && existing_colors != "replace") return std::nullopt;
+  if (attribute == "_AO") return Into::attribute;
+  if (attribute == "COLOR_0") return existing_colors == "multiply" ? Into::color_multiply : Into::color;
+  return std::nullopt;
+}
+
+Result<Bake> bake(const scene::Scene& scene, const Options& options) {
+  if (Status s = check(options); !s) return s.error();
   Device device(rtcNewDevice(nullptr));
   if (!device) return Error{"", "Embree could not start (rtcNewDevice failed)"};
   RtcScene rtc(rtcNewScene(device.get()));
@@ -140,7 +169,7 @@ Result<Bake> bake(const scene::Scene& scene, const Options& options) {
   std::vector<Mesh> meshes;
   meshes.reserve(scene.instances.size());
   for (const scene::Instance& inst : scene.instances) {
-    meshes.push_back(prepare(inst));
+    meshes.push_back(prepare(inst, options.recompute_normals));
     RTCGeometry g = rtcNewGeometry(device.get(), RTC_GEOMETRY_TYPE_TRIANGLE);
     // Embree reads vertex buffers in 16-byte loads: rtcSetNewGeometryBuffer pads for us.
     auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
@@ -166,7 +195,8 @@ Result<Bake> bake(const scene::Scene& scene, const Options& options) {
   if (rtcGetDeviceError(device.get()) != RTC_ERROR_NONE) return Error{"", "Embree could not build the scene"};
 
   Bake result;
-  const double d_max = options.relative_distance ? options.max_distance * scene.radius() : options.max_distance;
+  const double d_max = options.absolute_distance > 0 ? options.absolute_distance
+                                                     : options.relative_distance * scene.radius();
   result.max_distance = d_max;
   const float far = float(d_max);
   const double tau = options.tau / d_max;

@@ -35,6 +35,19 @@ struct Reader {
     return success();
   }
 
+  // A key whose value is one of an option enum's names.
+  // `out` is the enum, or an optional one.
+  template <class E, std::size_t N, class Out>
+  Status get_name(const toml::table& table, std::string_view key, const std::string& where,
+                  const NameTable<E, N>& names, Out& out) const {
+    std::string name;
+    if (Status s = get(table, key, where, name); !s || !table.get(key)) return s;
+    const auto value = value_in(names, name);
+    if (!value) return at(*table.get(key), where + "." + std::string(key) + " '" + name + "': use " + names_in(names));
+    out = *value;
+    return success();
+  }
+
   template <class T>
   Status get(const toml::table& table, std::string_view key, const std::string& where, T& out) const {
     const toml::node* node = table.get(key);
@@ -66,28 +79,58 @@ bool is_file_name_safe(const std::string& name) {
 }
 
 Status read_validation(const Reader& r, const toml::table& t, const std::string& where, ValidationRules& rules) {
-  if (Status s = r.known_keys(t, where, {"enabled", "tolerance", "max_violations", "heatmap"}); !s) return s;
-  for (Status s : {r.get(t, "enabled", where, rules.enabled), r.get(t, "tolerance", where, rules.tolerance),
-                   r.get(t, "max_violations", where, rules.max_violations), r.get(t, "heatmap", where, rules.heatmap)}) {
+  if (Status s = r.known_keys(t, where, {"enabled", "tolerance", "max_violations", "heatmap", "worst"}); !s) return s;
+  validate::Options& o = rules.options;
+  std::int64_t worst = std::int64_t(o.worst_count);
+  for (Status s : {r.get(t, "enabled", where, rules.enabled), r.get(t, "tolerance", where, o.tolerance),
+                   r.get(t, "max_violations", where, o.max_violations), r.get(t, "heatmap", where, rules.heatmap),
+                   r.get(t, "worst", where, worst)}) {
     if (!s) return s;
   }
-  if (!(rules.tolerance > 0) || !(rules.max_violations >= 0 && rules.max_violations <= 1)) {
-    return r.at(t, where + ": tolerance must be > 0 and max_violations in [0, 1]");
+  if (!(o.tolerance > 0) || !(o.max_violations >= 0 && o.max_violations <= 1) || worst < 0) {
+    return r.at(t, where + ": tolerance must be > 0, max_violations in [0, 1] and worst not negative");
   }
+  o.worst_count = std::size_t(worst);
   return success();
 }
 
-template <class T>
-Status read_transfer(const Reader& r, const toml::table& t, const std::string& where, T& transfer,
-                     std::string_view key = "transfer") {
-  std::string name;
-  if (Status s = r.get(t, key, where, name); !s || name.empty()) return s;
-  auto parsed = color::transfer_from_name(name);
-  if (!parsed) {
-    return r.at(*t.get(key), where + "." + std::string(key) + " '" + name + "': use srgb, gamma2.2 or linear");
+// `ao = { ... }` of a scene: every field of ao::Request, by the names the command line uses.
+Result<ao::Request> read_ao(const Reader& r, const toml::node& node, const std::string& where) {
+  const toml::table* t = node.as_table();
+  if (!t) return r.at(node, where + " must be a table");
+  if (Status s = r.known_keys(*t, where, {"samples", "distance", "absolute_distance", "tau", "falloff", "bias",
+                                          "two_sided", "seed", "sampler", "recompute_normals", "into",
+                                          "existing_colors", "fast_traversal"});
+      !s) {
+    return s.error();
   }
-  transfer = *parsed;
-  return success();
+  ao::Request request;
+  ao::Options& o = request.options;
+  std::int64_t samples = o.samples, seed = std::int64_t(o.seed);
+  bool fast = !o.watertight;
+  std::string into{ao::into_attribute_name(request.into)}, existing{ao::into_existing_colors_name(request.into)};
+  scene::NormalWeighting weighting = scene::NormalWeighting::area;
+  for (Status s : {r.get(*t, "samples", where, samples), r.get(*t, "distance", where, o.relative_distance),
+                   r.get(*t, "absolute_distance", where, o.absolute_distance), r.get(*t, "tau", where, o.tau),
+                   r.get_name(*t, "falloff", where, ao::kFalloffNames, o.falloff), r.get(*t, "bias", where, o.bias),
+                   r.get(*t, "two_sided", where, o.two_sided), r.get(*t, "seed", where, seed),
+                   r.get_name(*t, "sampler", where, ao::kSamplerNames, o.sampler),
+                   r.get_name(*t, "recompute_normals", where, scene::kNormalWeightingNames, weighting),
+                   r.get(*t, "into", where, into), r.get(*t, "existing_colors", where, existing),
+                   r.get(*t, "fast_traversal", where, fast)}) {
+    if (!s) return s.error();
+  }
+  if (samples < 1 || samples > ao::kMaxSamples) return r.at(node, where + ".samples: 1 to " + std::to_string(ao::kMaxSamples));
+  if (seed < 0) return r.at(node, where + ".seed: not negative");
+  o.samples = int(samples);
+  o.seed = std::uint64_t(seed);
+  o.watertight = !fast;
+  if (t->get("recompute_normals")) o.recompute_normals = weighting;
+  const auto target = ao::into_from_names(into, existing);
+  if (!target) return r.at(node, where + ": into = \"COLOR_0\" (existing_colors = \"multiply\" or \"replace\") or \"_AO\"");
+  request.into = *target;
+  if (Status s = ao::check(o); !s) return r.at(node, where + ": " + s.error().message);
+  return request;
 }
 
 Result<MaterialSpec> read_material(const Reader& r, const std::string& name, const toml::node& node,
@@ -107,25 +150,22 @@ Result<MaterialSpec> read_material(const Reader& r, const std::string& name, con
   spec.name = name;
   spec.transfer = transfer;
   spec.validation = rules;
-  if (Status s = read_transfer(r, *t, where, spec.transfer); !s) return s.error();
-  if (Status s = read_transfer(r, *t, where, spec.decode, "decode"); !s) return s.error();
-  std::string bits, mapping;
-  for (Status s : {r.get(*t, "resize", where, spec.resize), r.get(*t, "layout", where, spec.layout),
+  std::string bits;
+  for (Status s : {r.get_name(*t, "transfer", where, color::kTransferNames, spec.transfer),
+                   r.get_name(*t, "decode", where, color::kTransferNames, spec.decode),
+                   r.get(*t, "resize", where, spec.resize), r.get(*t, "layout", where, spec.layout),
                    r.get(*t, "format", where, spec.format), r.get(*t, "bits", where, bits),
-                   r.get(*t, "mapping", where, mapping), r.get(*t, "reference", where, spec.reference)}) {
+                   r.get_name(*t, "mapping", where, workflow::kRoughnessMappingNames, spec.mapping),
+                   r.get(*t, "reference", where, spec.reference)}) {
     if (!s) return s.error();
   }
   if (spec.format != "png" && spec.format != "exr" && spec.format != "tif") {
     return r.at(*t->get("format"), where + ".format '" + spec.format + "': use png, exr or tif");
   }
-  if (spec.format == "exr") spec.bits = image::SampleType::half;
   if (!bits.empty()) {
     auto type = image::sample_type_from_name(bits);
     if (!type) return r.at(*t->get("bits"), where + ".bits '" + bits + "': use 8, 16, half or float");
     spec.bits = *type;
-  }
-  if (!mapping.empty() && !workflow::roughness_mapping_from_name(mapping, spec.mapping)) {
-    return r.at(*t->get("mapping"), where + ".mapping '" + mapping + "': unknown");
   }
   if (const toml::node* v = t->get("validate")) {
     if (!v->is_table()) return r.at(*v, where + ".validate must be a table");
@@ -184,16 +224,19 @@ Result<SceneSpec> read_scene(const Reader& r, const std::string& name, const tom
   const toml::table* t = node.as_table();
   if (!t) return r.at(node, where + " must be a table");
   if (!is_file_name_safe(name)) return r.at(node, "scene name '" + name + "': letters, digits, '_', '-' and '.' only");
-  if (Status s = r.known_keys(*t, where, {"input", "output", "materials", "match_names", "ao", "dielectric_f0", "orm"});
+  if (Status s = r.known_keys(*t, where, {"input", "output", "materials", "match_names", "ao", "dielectric_f0", "orm",
+                                          "mapping"});
       !s) {
     return s.error();
   }
   SceneSpec spec;
   spec.name = name;
-  std::string input, output = name + ".glb", dielectric = "specular";
+  std::string input, output = name + ".glb";
   for (Status s : {r.get(*t, "input", where, input), r.get(*t, "output", where, output),
-                   r.get(*t, "match_names", where, spec.match_names), r.get(*t, "dielectric_f0", where, dielectric),
-                   r.get(*t, "orm", where, spec.orm)}) {
+                   r.get(*t, "match_names", where, spec.match_names),
+                   r.get_name(*t, "dielectric_f0", where, exporter::kDielectricF0Names, spec.options.dielectric_f0),
+                   r.get(*t, "orm", where, spec.options.pack_orm),
+                   r.get_name(*t, "mapping", where, workflow::kRoughnessMappingNames, spec.options.mapping)}) {
     if (!s) return s.error();
   }
   if (input.empty()) return r.at(node, where + ": input = \"scene.gltf\" is required");
@@ -205,15 +248,6 @@ Result<SceneSpec> read_scene(const Reader& r, const std::string& name, const tom
                 where + ".output '" + output + "': a .gltf or .glb path inside the output folder");
   }
   spec.output = out.lexically_normal();
-  if (dielectric == "specular") {
-    spec.dielectric_f0 = exporter::DielectricF0::specular;
-  } else if (dielectric == "ior") {
-    spec.dielectric_f0 = exporter::DielectricF0::ior;
-  } else if (dielectric == "none") {
-    spec.dielectric_f0 = exporter::DielectricF0::none;
-  } else {
-    return r.at(*t->get("dielectric_f0"), where + ".dielectric_f0 '" + dielectric + "': use specular, ior or none");
-  }
   if (const toml::node* mats = t->get("materials")) {
     if (!mats->is_table()) return r.at(*mats, where + ".materials must be a table: { \"glTF name\" = \"material\" }");
     for (const auto& [key, value] : *mats->as_table()) {
@@ -223,47 +257,9 @@ Result<SceneSpec> read_scene(const Reader& r, const std::string& name, const tom
     }
   }
   if (const toml::node* a = t->get("ao")) {
-    const toml::table* at = a->as_table();
-    const std::string w = where + ".ao";
-    if (!at) return r.at(*a, w + " must be a table");
-    if (Status s = r.known_keys(*at, w, {"samples", "distance", "absolute_distance", "falloff", "two_sided", "seed",
-                                         "sampler", "into", "existing_colors", "fast_traversal"});
-        !s) {
-      return s.error();
-    }
-    ao::Options o;
-    std::int64_t samples = o.samples, seed = 0;
-    double absolute = 0;
-    bool fast = false;
-    std::string falloff = "exponential", sampler = "sobol", into = "COLOR_0", existing = "multiply";
-    for (Status s : {r.get(*at, "samples", w, samples), r.get(*at, "distance", w, o.max_distance),
-                     r.get(*at, "absolute_distance", w, absolute), r.get(*at, "falloff", w, falloff),
-                     r.get(*at, "two_sided", w, o.two_sided), r.get(*at, "seed", w, seed),
-                     r.get(*at, "sampler", w, sampler), r.get(*at, "into", w, into),
-                     r.get(*at, "existing_colors", w, existing), r.get(*at, "fast_traversal", w, fast)}) {
-      if (!s) return s.error();
-    }
-    if (samples < 1 || samples > (1 << 20)) return r.at(*a, w + ".samples: 1 to 1048576");
-    o.samples = int(samples);
-    o.seed = std::uint64_t(seed);
-    o.watertight = !fast;
-    if (absolute > 0) {
-      o.max_distance = absolute;
-      o.relative_distance = false;
-    }
-    if (!(o.max_distance > 0)) return r.at(*a, w + ": distances must be > 0");
-    if (falloff != "exponential" && falloff != "none") return r.at(*a, w + ".falloff '" + falloff + "': exponential or none");
-    o.falloff = falloff == "none" ? ao::Falloff::none : ao::Falloff::exponential;
-    if (sampler != "sobol" && sampler != "random") return r.at(*a, w + ".sampler '" + sampler + "': sobol or random");
-    o.sampler = sampler == "random" ? ao::Sampler::random : ao::Sampler::sobol;
-    if (into == "_AO") {
-      spec.ao_into = ao::Into::attribute;
-    } else if (into == "COLOR_0" && (existing == "multiply" || existing == "replace")) {
-      spec.ao_into = existing == "multiply" ? ao::Into::color_multiply : ao::Into::color;
-    } else {
-      return r.at(*a, w + ": into = \"COLOR_0\" (existing_colors = \"multiply\" or \"replace\") or \"_AO\"");
-    }
-    spec.ao = o;
+    auto request = read_ao(r, *a, where + ".ao");
+    if (!request) return request.error();
+    spec.options.ao = *request;
   }
   return spec;
 }
@@ -292,8 +288,8 @@ Result<Manifest> parse_manifest(std::string_view toml_text, const fs::path& file
   if (Status s = r.get(doc, "table", "manifest", table); !s) return s.error();
   m.output = (m.folder / output).lexically_normal();
   if (!table.empty()) m.table = m.folder / table;
-  color::Transfer transfer = color::Transfer::srgb;
-  if (Status s = read_transfer(r, doc, "manifest", transfer); !s) return s.error();
+  color::Transfer transfer = MaterialSpec{}.transfer;
+  if (Status s = r.get_name(doc, "transfer", "manifest", color::kTransferNames, transfer); !s) return s.error();
   ValidationRules rules;
   if (const toml::node* v = doc.get("validate")) {
     if (!v->is_table()) return r.at(*v, "validate must be a table");

@@ -6,6 +6,7 @@
 #include "../gltf/document.hpp"
 #include "state.hpp"
 #include "matbake/build.hpp"
+#include "matbake/report_json.hpp"
 #include "matbake/version.hpp"
 
 namespace matbake::build {
@@ -32,14 +33,15 @@ nlohmann::json material_options(const MaterialSpec& m, const Manifest& manifest)
           {"resize", m.resize},
           {"layout", m.layout},
           {"format", m.format},
-          {"bits", image::sample_type_name(m.bits)},
+          {"bits", m.bits ? image::sample_type_name(*m.bits) : "default"},
           {"mapping", workflow::roughness_mapping_name(m.mapping)},
           {"reference", m.reference},
           {"table", manifest.table.string()},
           {"validate",
            {{"enabled", m.validation.enabled},
-            {"tolerance", m.validation.tolerance},
-            {"max_violations", m.validation.max_violations},
+            {"tolerance", m.validation.options.tolerance},
+            {"max_violations", m.validation.options.max_violations},
+            {"worst", m.validation.options.worst_count},
             {"heatmap", m.validation.heatmap}}}};
 }
 
@@ -145,21 +147,10 @@ Result<Plan> make_plan(const Manifest& manifest) {
       add_unique(job.inputs, material_inputs(manifest.materials[m], manifest));
       materials[gltf_name] = material_options(manifest.materials[m], manifest);
     }
-    nlohmann::json ao = nullptr;
-    if (s.ao) {
-      ao = {{"samples", s.ao->samples},     {"distance", s.ao->max_distance},
-            {"relative", s.ao->relative_distance}, {"tau", s.ao->tau},
-            {"falloff", int(s.ao->falloff)}, {"bias", s.ao->bias},
-            {"two_sided", s.ao->two_sided}, {"seed", s.ao->seed},
-            {"sampler", int(s.ao->sampler)}, {"watertight", s.ao->watertight},
-            {"into", int(s.ao_into)}};
-    }
     job.options = nlohmann::json{{"input", normalized(s.input).string()},
                                  {"output", s.output.string()},
                                  {"materials", materials},
-                                 {"ao", ao},
-                                 {"dielectric_f0", int(s.dielectric_f0)},
-                                 {"orm", s.orm}}
+                                 {"export", to_json(s.options)}}
                       .dump();
     scenes.push_back(std::move(job));
   }
@@ -179,9 +170,8 @@ Result<Plan> make_plan(const Manifest& manifest) {
       if (!layout) {
         job.problem = "materials." + m.name + ".layout: " + layout.error().to_string();
       } else {
-        for (const pack::Texture& t : layout->textures) {
-          job.outputs.push_back(materials_folder / (m.name + "_" + t.name + "." + m.format));
-        }
+        auto paths = pack::output_paths(*layout, {(materials_folder / (m.name + "_{texture}." + m.format)).string()});
+        if (paths) job.outputs = *paths;
       }
     }
     if (m.validation.enabled) {

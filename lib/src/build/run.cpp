@@ -113,43 +113,6 @@ Result<pack::SourceMaps> load_material(const MaterialSpec& m, const Manifest& ma
   return pack::load_sources(m.sources, options);
 }
 
-bool has_any(const pack::SourceMaps& maps, std::initializer_list<const char*> names) {
-  for (const char* n : names) {
-    if (maps.find(n)) return true;
-  }
-  return false;
-}
-
-// The maps in the workflow the layout reads, converted when the sources are in the other one.
-Result<pack::SourceMaps> in_layout_workflow(pack::SourceMaps maps, const pack::Layout& layout, const MaterialSpec& m,
-                                            nlohmann::json& details) {
-  const std::vector<std::string> wanted = layout_sources(layout);
-  const auto wants = [&](std::initializer_list<const char*> names) {
-    for (const char* n : names) {
-      if (std::find(wanted.begin(), wanted.end(), n) != wanted.end()) return true;
-    }
-    return false;
-  };
-  workflow::ConversionReport report;
-  Result<pack::SourceMaps> converted = Error{};
-  if (wants({"base_color", "metallic", "roughness"}) && !has_any(maps, {"base_color", "metallic", "roughness"}) &&
-      has_any(maps, {"kd", "ks", "gloss"})) {
-    converted = workflow::metal_rough_from_spec_gloss(maps, m.mapping, report);
-    details["conversion"] = {{"from", "spec-gloss"}, {"to", "metal-rough"}};
-  } else if (wants({"kd", "ks", "gloss"}) && !has_any(maps, {"kd", "ks", "gloss"}) &&
-             has_any(maps, {"base_color", "metallic", "roughness"})) {
-    converted = workflow::spec_gloss_from_metal_rough(maps, m.mapping, report);
-    details["conversion"] = {{"from", "metal-rough"}, {"to", "spec-gloss"}};
-  } else {
-    return maps;
-  }
-  if (!converted) return converted.error();
-  details["conversion"]["mapping"] = workflow::roughness_mapping_name(m.mapping);
-  details["conversion"]["texels"] = report.texels;
-  details["conversion"]["errors"] = to_json(report.errors);
-  return converted;
-}
-
 struct JobContext {
   const Manifest& manifest;
   DecodeCache& cache;
@@ -167,40 +130,20 @@ Status ensure_folder(const fs::path& folder) {
 // Validation of the material as authored; a job error when more texels are flagged than allowed.
 Status validate_material(const MaterialSpec& m, const pack::SourceMaps& maps, const JobContext& ctx,
                          const std::vector<fs::path>& outputs, JobReport& report) {
-  validate::Options options;
-  options.tolerance = m.validation.tolerance;
+  validate::Options options = m.validation.options;
   options.class_map = m.validation.heatmap;
   if (!m.reference.empty()) {
     if (!ctx.table) return *ctx.table_error;
-    options.material = materials::find(*ctx.table, m.reference);
-    if (!options.material) {
-      return Error{ctx.manifest.file.string(), "materials." + m.name + ".reference: unknown material '" + m.reference +
-                                                   "' (`matbake materials` lists them)"};
-    }
+    auto material = materials::lookup(*ctx.table, m.reference);
+    if (!material) return Error{ctx.manifest.file.string(), "materials." + m.name + ".reference: " + material.error().message};
+    options.material = *material;
   }
-  validate::Inputs inputs;
-  inputs.mask = maps.find("mask");
-  validate::SpecularDiffuse from_metal_rough;
-  if (maps.find("ks")) {
-    inputs.specular = maps.find("ks");
-    inputs.diffuse = maps.find("kd");
-  } else if (maps.find("base_color") && maps.find("metallic")) {
-    auto sd = validate::from_metal_rough(*maps.find("base_color"), *maps.find("metallic"));
-    if (!sd) return sd.error();
-    from_metal_rough = std::move(*sd);
-    inputs.specular = &from_metal_rough.specular;
-    inputs.diffuse = &from_metal_rough.diffuse;
-  } else {
-    return Error{ctx.manifest.file.string(), "materials." + m.name +
-                                                 ": validation needs ks (spec-gloss) or base_color and metallic "
-                                                 "(metal-rough); set validate = { enabled = false } to skip it"};
+  auto result = validate::validate_maps(maps, options);
+  if (!result) {
+    return Error{ctx.manifest.file.string(), "materials." + m.name + ": " + result.error().message +
+                                                 "; set validate = { enabled = false } to skip it"};
   }
-  auto result = validate::validate(inputs, options);
-  if (!result) return result.error();
-  const bool passed = result->violation_fraction() <= m.validation.max_violations;
-  nlohmann::json v = to_json(*result, options, inputs.diffuse != nullptr);
-  v["max_violations"] = m.validation.max_violations;
-  v["passed"] = passed;
+  const bool passed = validate::passed(*result, options);
   report.details["validation"] = {{"checked", result->checked},
                                   {"violations", result->violations},
                                   {"violation_fraction", result->violation_fraction()},
@@ -209,15 +152,13 @@ Status validate_material(const MaterialSpec& m, const pack::SourceMaps& maps, co
     return p.string().ends_with(".validation.json");
   });
   report.details["validation"]["report"] = json_file.string();
-  if (Status s = write_file_atomically(json_file, v.dump(2) + "\n"); !s) return s;
+  if (Status s = write_validation_report(*result, options, json_file); !s) return s;
   if (m.validation.heatmap) {
-    const image::WriteOptions png{color::Transfer::srgb, image::SampleType::u8, "", "sRGB"};
-    if (Status s = image::write_image(validate::heatmap(*result), outputs.back(), png); !s) return s;
+    if (Status s = validate::write_heatmap(*result, outputs.back()); !s) return s;
   }
   char line[160];
   std::snprintf(line, sizeof line, "validation: %zu of %zu texels flagged (%.3g%%; max_violations %.3g%%)",
-                result->violations, result->checked, 100 * result->violation_fraction(),
-                100 * m.validation.max_violations);
+                result->violations, result->checked, 100 * result->violation_fraction(), 100 * options.max_violations);
   if (!passed) return Error{json_file.string(), line};
   if (result->violations) report.warnings.push_back(line);
   return success();
@@ -232,14 +173,17 @@ Status run_material(const Job& job, const JobContext& ctx, JobReport& report) {
   if (!m.layout.empty()) {
     auto layout = pack::find_layout(layout_reference(m.layout, ctx.manifest));
     if (!layout) return layout.error();
-    auto in_workflow = in_layout_workflow(*maps, *layout, m, report.details);
+    auto in_workflow = workflow::in_layout_workflow(*maps, *layout, m.mapping);
     if (!in_workflow) return in_workflow.error();
-    auto textures = pack::pack(*layout, *in_workflow);
-    if (!textures) return textures.error();
-    for (std::size_t t = 0; t < textures->size(); ++t) {
-      const image::WriteOptions w = pack::write_options(layout->textures[t].color, {m.bits, m.transfer});
-      if (Status s = image::write_image((*textures)[t], job.outputs[t], w); !s) return s;
+    if (const auto& d = in_workflow->direction) {
+      report.details["conversion"] = {{"direction", workflow::direction_name(*d)},
+                                      {"mapping", workflow::roughness_mapping_name(m.mapping)},
+                                      {"texels", in_workflow->report.texels},
+                                      {"errors", to_json(in_workflow->report.errors)}};
     }
+    const std::vector<std::string> outputs(job.outputs.begin(), job.outputs.begin() + std::ptrdiff_t(layout->textures.size()));
+    auto written = pack::write_textures(*layout, in_workflow->maps, {outputs, m.bits, m.transfer, decoded_files(m)});
+    if (!written) return written.error();
   }
   if (m.validation.enabled) return validate_material(m, *maps, ctx, job.outputs, report);
   return success();
@@ -247,15 +191,12 @@ Status run_material(const Job& job, const JobContext& ctx, JobReport& report) {
 
 Result<std::vector<fs::path>> run_scene(const Job& job, const JobContext& ctx, JobReport& report) {
   const SceneSpec& s = ctx.manifest.scenes[job.spec];
-  exporter::Options options;
-  options.dielectric_f0 = s.dielectric_f0;
-  options.pack_orm = s.orm;
-  options.ao = s.ao;
-  options.ao_into = s.ao_into;
+  exporter::Options options = s.options;
   for (const auto& [gltf_name, m] : job.materials) {
-    auto maps = load_material(ctx.manifest.materials[m], ctx.manifest, ctx.cache);
+    const MaterialSpec& spec = ctx.manifest.materials[m];
+    auto maps = load_material(spec, ctx.manifest, ctx.cache);
     if (!maps) return maps.error();
-    options.materials.push_back({gltf_name, std::move(*maps)});
+    options.materials.push_back({gltf_name, std::move(*maps), spec.mapping});
   }
   const fs::path output = job.outputs.front();
   if (Status st = ensure_folder(output.parent_path()); !st) return st.error();

@@ -57,22 +57,6 @@ double decode_exponent(Transfer transfer) { return transfer == Transfer::srgb ? 
 
 }  // namespace
 
-std::optional<Transfer> transfer_from_name(std::string_view name) {
-  if (name == "linear") return Transfer::linear;
-  if (name == "srgb") return Transfer::srgb;
-  if (name == "gamma2.2") return Transfer::gamma22;
-  return std::nullopt;
-}
-
-std::string_view transfer_name(Transfer transfer) {
-  switch (transfer) {
-    case Transfer::linear: return "linear";
-    case Transfer::srgb: return "srgb";
-    case Transfer::gamma22: return "gamma2.2";
-  }
-  return "?";
-}
-
 double linear_from_encoded(Transfer transfer, double encoded) {
   const StdPow power{decode_exponent(transfer)};
   return std::copysign(decode_magnitude(transfer, std::fabs(encoded), power), encoded);

@@ -4,10 +4,10 @@
 #include <cmath>
 #include <map>
 
-#include "../ao/gltf_output.hpp"
 #include "../gltf/document.hpp"
 #include "../gltf/prune.hpp"
 #include "matbake/scene.hpp"
+#include "occlusion.hpp"
 #include "texture_files.hpp"
 
 namespace matbake::exporter {
@@ -222,7 +222,14 @@ struct Exporter {
     return success();
   }
 
-  Status from_maps(int index, Json& material, const pack::SourceMaps& given, MaterialReport& out) {
+  Status from_maps(int index, Json& material, const MaterialMaps& replacement, MaterialReport& out) {
+    const pack::SourceMaps& given = replacement.maps;
+    // The new maps say what the surface is: what described it before goes (spec-gloss and its
+    // textures, a specular or IOR extension that would change the new F0).
+    if (material.contains("extensions")) {
+      for (const char* name : {kSpecGloss, kSpecular, kIor}) material["extensions"].erase(name);
+      if (material["extensions"].empty()) material.erase("extensions");
+    }
     Json info = Json::object();
     int sampler_of = -1;
     if (material.contains("pbrMetallicRoughness") && material["pbrMetallicRoughness"].contains("baseColorTexture")) {
@@ -233,7 +240,7 @@ struct Exporter {
     const std::string name = "material" + std::to_string(index);
     if (given.find("kd")) {
       workflow::ConversionReport conversion;
-      auto maps = workflow::metal_rough_from_spec_gloss(given, options.mapping, conversion);
+      auto maps = workflow::metal_rough_from_spec_gloss(given, replacement.mapping.value_or(options.mapping), conversion);
       if (!maps) return Error{doc.file, "material " + std::to_string(index) + ": " + maps.error().message};
       if (Status s = write_metal_rough(material, *maps, name, info, sampler_of); !s) return s;
       add_dielectric_f0(material, conversion, out);
@@ -344,11 +351,11 @@ Result<Report> export_scene(const fs::path& input, const fs::path& output, const
   report.skipped = gltf::prune_unreachable(*doc);  // from here on, everything in doc is reachable
   for (std::string& s : report.skipped) s += ": not reachable from the default scene";
 
-  std::map<int, const pack::SourceMaps*> given;
+  std::map<int, const MaterialMaps*> given;
   for (const MaterialMaps& m : options.materials) {
     auto index = material_index(*doc, m.material);
     if (!index) return index.error();
-    given[*index] = &m.maps;
+    given[*index] = &m;
   }
 
   ImageCache cache(*doc);
@@ -374,19 +381,25 @@ Result<Report> export_scene(const fs::path& input, const fs::path& output, const
     out.alpha_mode = material.value("alphaMode", "OPAQUE");
     report.materials.push_back(std::move(out));
   }
-  // The spec-gloss extension is gone from every material that had it.
-  for (const char* list : {"extensionsUsed", "extensionsRequired"}) {
-    if (!doc->json.contains(list)) continue;
-    Json& names = doc->json[list];
-    names.erase(std::remove(names.begin(), names.end(), kSpecGloss), names.end());
-    if (names.empty()) doc->json.erase(list);
+  // The spec-gloss extension is gone from every material that had it; a replaced material may also
+  // have dropped the last use of the specular or IOR extension.
+  for (const char* extension : {kSpecGloss, kSpecular, kIor}) {
+    const auto uses = [&](const Json& m) { return m.contains("extensions") && m["extensions"].contains(extension); };
+    if (doc->json.contains("materials") && std::any_of(doc->json["materials"].begin(), doc->json["materials"].end(), uses)) {
+      continue;
+    }
+    for (const char* list : {"extensionsUsed", "extensionsRequired"}) {
+      if (!doc->json.contains(list)) continue;
+      Json& names = doc->json[list];
+      names.erase(std::remove(names.begin(), names.end(), extension), names.end());
+      if (names.empty()) doc->json.erase(list);
+    }
   }
   if (Status s = check_texture_coordinates(*doc); !s) return s.error();
 
   if (options.ao) {
-    auto baked = ao::bake(*scene, *options.ao);
+    auto baked = bake_into(*doc, *scene, *options.ao);
     if (!baked) return baked.error();
-    ao::add_to_document(*doc, *scene, *baked, options.ao_into);
     report.ao_rays = baked->rays;
   }
   // What the conversions replaced (spec-gloss textures, separate occlusion maps, old colours).

@@ -164,4 +164,17 @@ std::vector<std::string> near_names(const std::vector<Material>& table, std::str
   return names;
 }
 
+Result<const Material*> lookup(const std::vector<Material>& table, std::string_view name) {
+  if (const Material* m = find(table, name)) return m;
+  std::string near;
+  for (const std::string& n : near_names(table, name)) near += (near.empty() ? "" : ", ") + n;
+  return Error{"", "unknown material '" + std::string(name) + "'" +
+                       (near.empty() ? " (`matbake materials` lists them)" : "; near: " + near), true};
+}
+
+Result<std::vector<Material>> table_or_builtin(const std::filesystem::path& path) {
+  if (path.empty()) return builtin_table();
+  return load_table(path);
+}
+
 }  // namespace matbake::materials

@@ -360,4 +360,51 @@ image::WriteOptions write_options(bool color, const OutputOptions& options) {
   return w;
 }
 
+Result<std::vector<fs::path>> output_paths(const Layout& layout, const std::vector<std::string>& outputs) {
+  std::vector<fs::path> paths;
+  if (outputs.size() == 1 && outputs[0].find("{texture}") != std::string::npos) {
+    for (const Texture& t : layout.textures) {
+      std::string p = outputs[0];
+      p.replace(p.find("{texture}"), 9, t.name);
+      paths.emplace_back(p);
+    }
+    return paths;
+  }
+  if (outputs.size() == layout.textures.size()) return std::vector<fs::path>(outputs.begin(), outputs.end());
+  std::string names;
+  for (const Texture& t : layout.textures) names += (names.empty() ? "" : ", ") + t.name;
+  return Error{"", "layout " + layout.name + " writes " + std::to_string(layout.textures.size()) + " textures (" + names +
+                       "): give as many outputs, or one path with {texture}", true};
+}
+
+image::SampleType default_sample_type(const fs::path& path) {
+  return path.extension() == ".exr" ? image::SampleType::half : image::SampleType::u8;
+}
+
+Result<std::vector<fs::path>> write_textures(const Layout& layout, const SourceMaps& sources, const WriteRequest& request) {
+  auto paths = output_paths(layout, request.outputs);
+  if (!paths) return paths.error();
+  for (std::size_t i = 0; i < paths->size(); ++i) {
+    const fs::path& out = (*paths)[i];
+    std::error_code ec;
+    for (const fs::path& in : request.inputs) {
+      if (fs::equivalent(out, in, ec)) return Error{out.string(), "is an input; matbake never overwrites its inputs", true};
+    }
+    for (std::size_t j = 0; j < i; ++j) {
+      if (out.lexically_normal() == (*paths)[j].lexically_normal() || fs::equivalent(out, (*paths)[j], ec)) {
+        return Error{out.string(), "is written twice (textures " + layout.textures[j].name + " and " +
+                                       layout.textures[i].name + ")", true};
+      }
+    }
+  }
+  auto images = pack(layout, sources);
+  if (!images) return images.error();
+  for (std::size_t t = 0; t < paths->size(); ++t) {
+    const image::SampleType type = request.type.value_or(default_sample_type((*paths)[t]));
+    const image::WriteOptions options = write_options(layout.textures[t].color, {type, request.transfer});
+    if (Status s = image::write_image((*images)[t], (*paths)[t], options); !s) return s.error();
+  }
+  return paths;
+}
+
 }  // namespace matbake::pack

@@ -1,5 +1,7 @@
 #include "matbake/report_json.hpp"
 
+#include "matbake/atomic_file.hpp"
+
 namespace matbake {
 namespace {
 
@@ -32,7 +34,8 @@ nlohmann::json to_json(const workflow::DielectricF0& d) {
           {"error_with_extensions", to_json(d.error_with_extensions)}};
 }
 
-nlohmann::json to_json(const validate::Report& r, const validate::Options& options, bool has_diffuse) {
+nlohmann::json to_json(const validate::Report& r, const validate::Options& options) {
+  const bool has_diffuse = r.has_diffuse;
   nlohmann::json classes, flags, worst = nlohmann::json::array();
   for (std::size_t c = 0; c < 5; ++c) classes[std::string(materials::f0_class_name(materials::F0Class(c)))] = r.class_counts[c];
   for (int b = 0; b < validate::kFlagCount; ++b) flags[std::string(validate::flag_name(b))] = r.flag_counts[std::size_t(b)];
@@ -74,6 +77,39 @@ nlohmann::json to_json(const exporter::Report& r) {
   return {{"materials", materials},           {"skipped", r.skipped},
           {"written", r.written},    {"images_decoded", r.images_decoded}, {"textures_made", r.textures_made},
           {"ao_rays", r.ao_rays}};
+}
+
+Status write_validation_report(const validate::Report& r, const validate::Options& options,
+                               const std::filesystem::path& json) {
+  nlohmann::json v = to_json(r, options);
+  v["max_violations"] = options.max_violations;
+  v["passed"] = validate::passed(r, options);
+  return write_file_atomically(json, v.dump(2) + "\n");
+}
+
+nlohmann::json to_json(const ao::Request& r) {
+  const ao::Options& o = r.options;
+  return {{"samples", o.samples},
+          {"distance", o.relative_distance},
+          {"absolute_distance", o.absolute_distance},
+          {"tau", o.tau},
+          {"falloff", ao::falloff_name(o.falloff)},
+          {"bias", o.bias},
+          {"two_sided", o.two_sided},
+          {"seed", o.seed},
+          {"sampler", ao::sampler_name(o.sampler)},
+          {"recompute_normals", o.recompute_normals ? nlohmann::json(scene::normal_weighting_name(*o.recompute_normals))
+                                                    : nlohmann::json(nullptr)},
+          {"fast_traversal", !o.watertight},
+          {"into", ao::into_attribute_name(r.into)},
+          {"existing_colors", ao::into_existing_colors_name(r.into)}};
+}
+
+nlohmann::json to_json(const exporter::Options& o) {
+  return {{"dielectric_f0", exporter::dielectric_f0_name(o.dielectric_f0)},
+          {"mapping", workflow::roughness_mapping_name(o.mapping)},
+          {"orm", o.pack_orm},
+          {"ao", o.ao ? to_json(*o.ao) : nlohmann::json(nullptr)}};
 }
 
 }  // namespace matbake

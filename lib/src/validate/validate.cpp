@@ -354,6 +354,7 @@ Result<Report> validate(const Inputs& in, const Options& options) {
   if (Status s = check_size(in.diffuse, *in.specular, 3, "the diffuse map"); !s) return s.error();
   if (Status s = check_size(in.mask, *in.specular, 1, "the mask"); !s) return s.error();
   Report report;
+  report.has_diffuse = in.diffuse != nullptr;
   report.width = in.specular->width;
   report.height = in.specular->height;
   report.texels = std::size_t(report.width) * std::size_t(report.height);
@@ -450,6 +451,36 @@ Result<SpecularDiffuse> from_metal_rough(const image::Image& base, const image::
     }
   }
   return out;
+}
+
+Result<Report> validate_maps(const pack::SourceMaps& maps, const Options& options) {
+  Inputs inputs;
+  inputs.mask = maps.find("mask");
+  SpecularDiffuse converted;
+  if (maps.find("ks")) {
+    inputs.specular = maps.find("ks");
+    inputs.diffuse = maps.find("kd");
+  } else if (maps.find("base_color") && maps.find("metallic")) {
+    auto sd = from_metal_rough(*maps.find("base_color"), *maps.find("metallic"));
+    if (!sd) return sd.error();
+    converted = std::move(*sd);
+    inputs.specular = &converted.specular;
+    inputs.diffuse = &converted.diffuse;
+  } else {
+    return Error{"", "validation needs a specular map (ks, e.g. a Schüler pair) or metal-rough maps (base_color and "
+                     "metallic)", true};
+  }
+  return validate(inputs, options);
+}
+
+Status write_heatmap(const Report& report, const std::filesystem::path& png) {
+  if (png.extension() != ".png") return Error{png.string(), "the heatmap is a .png", true};
+  const image::WriteOptions options{color::Transfer::srgb, image::SampleType::u8, "", "sRGB"};
+  return image::write_image(heatmap(report), png, options);
+}
+
+bool passed(const Report& report, const Options& options) {
+  return report.violation_fraction() <= options.max_violations;
 }
 
 }  // namespace matbake::validate

@@ -89,21 +89,6 @@ Vec3 specular_from_metal_rough(const Vec3& base, double metallic) {
   return Vec3(kDielectricF0) + (base - Vec3(kDielectricF0)) * metallic;
 }
 
-std::string_view roughness_mapping_name(RoughnessMapping mapping) {
-  return mapping == RoughnessMapping::walter ? "walter" : "fitted";
-}
-
-bool roughness_mapping_from_name(std::string_view name, RoughnessMapping& mapping) {
-  if (name == "walter") {
-    mapping = RoughnessMapping::walter;
-  } else if (name == "fitted") {
-    mapping = RoughnessMapping::fitted;
-  } else {
-    return false;
-  }
-  return true;
-}
-
 std::span<const double> fitted_roughness_table(std::size_t row) { return kFittedRoughness.at(row); }
 
 double roughness_from_gloss(double gloss, RoughnessMapping mapping, double f0) {

@@ -199,4 +199,35 @@ Result<pack::SourceMaps> spec_gloss_from_metal_rough(const pack::SourceMaps& in,
   return out;
 }
 
+std::string_view direction_name(Direction d) {
+  return d == Direction::metal_rough_from_spec_gloss ? "spec-gloss to metal-rough" : "metal-rough to spec-gloss";
+}
+
+Result<LayoutMaps> in_layout_workflow(pack::SourceMaps maps, const pack::Layout& layout, RoughnessMapping mapping) {
+  const std::vector<std::string> read = pack::layout_sources(layout);
+  const auto reads = [&](std::initializer_list<std::string_view> names) {
+    return std::any_of(names.begin(), names.end(),
+                       [&](std::string_view n) { return std::find(read.begin(), read.end(), n) != read.end(); });
+  };
+  const auto has = [&](std::initializer_list<std::string_view> names) {
+    return std::any_of(names.begin(), names.end(), [&](std::string_view n) { return maps.find(n) != nullptr; });
+  };
+  const bool spec_gloss = has({"kd", "ks", "gloss"}), metal_rough = has({"base_color", "metallic", "roughness"});
+  LayoutMaps out;
+  Result<pack::SourceMaps> converted = Error{};
+  if (reads({"base_color", "metallic", "roughness"}) && spec_gloss && !metal_rough) {
+    out.direction = Direction::metal_rough_from_spec_gloss;
+    converted = metal_rough_from_spec_gloss(maps, mapping, out.report);
+  } else if (reads({"kd", "ks", "gloss"}) && metal_rough && !spec_gloss) {
+    out.direction = Direction::spec_gloss_from_metal_rough;
+    converted = spec_gloss_from_metal_rough(maps, mapping, out.report);
+  } else {
+    out.maps = std::move(maps);
+    return out;
+  }
+  if (!converted) return converted.error();
+  out.maps = std::move(*converted);
+  return out;
+}
+
 }  // namespace matbake::workflow

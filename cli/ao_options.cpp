@@ -1,0 +1,59 @@
+#include "ao_options.hpp"
+
+#include "option_names.hpp"
+
+namespace matbake::cli {
+
+void add_ao_options(CLI::App& cmd, AoSettings& s, const std::string& prefix) {
+  ao::Options& o = s.request.options;
+  const std::string p = "--" + prefix;
+  const std::string group = prefix.empty() ? "Options" : "Ambient occlusion";
+  cmd.add_option(p + "samples", o.samples, "Rays per vertex")->capture_default_str()->group(group);
+  cmd.add_option(p + "relative-distance", o.relative_distance, "d_max as a fraction of the scene radius")
+      ->capture_default_str()->group(group);
+  cmd.add_option(p + "max-distance", o.absolute_distance, "d_max in scene units (instead of the relative distance)")
+      ->group(group);
+  cmd.add_option(p + "tau", o.tau, "Falloff rate τ in units of 1/d_max")->capture_default_str()->group(group);
+  add_name_option(cmd, p + "falloff", o.falloff, ao::kFalloffNames,
+                  "exponential (1 − e^(−τx), normalized to 1 at d_max) or none (binary AO)")
+      ->group(group);
+  cmd.add_option(p + "bias", o.bias, "Ray-origin offset along the normal × the vertex's mean edge length")
+      ->capture_default_str()->group(group);
+  cmd.add_flag(p + "two-sided", o.two_sided, "Surfaces seen from behind occlude too (default: only their fronts)")
+      ->group(group);
+  cmd.add_flag_callback(p + "fast-traversal", [&o] { o.watertight = false; },
+                        "Embree's non-robust traversal: faster, but a ray may slip between triangles sharing an edge")
+      ->group(group);
+  cmd.add_option(p + "seed", o.seed, "Sample scrambling seed (same seed, same values, any --jobs)")
+      ->capture_default_str()->group(group);
+  add_name_option(cmd, p + "sampler", o.sampler, ao::kSamplerNames, "Directions")->group(group);
+  cmd.add_option_function<std::string>(
+         p + "recompute-normals",
+         [&o, p](const std::string& text) {
+           o.recompute_normals = scene::normal_weighting_from_name(text);
+           if (!o.recompute_normals) {
+             throw CLI::ValidationError(p + "recompute-normals", "'" + text + "': use " + names_in(scene::kNormalWeightingNames));
+           }
+         },
+         "Replace the file's normals, weighting faces by: " + names_in(scene::kNormalWeightingNames))
+      ->group(group);
+  cmd.add_option(p + "into", s.into, "COLOR_0 (multiplies the base colour in any viewer) or _AO (a float attribute)")
+      ->capture_default_str()->group(group);
+  cmd.add_option(p + "existing-colors", s.existing_colors,
+                 "With COLOR_0, a primitive's own COLOR_0: multiply (kept, times AO; alpha kept) or replace")
+      ->capture_default_str()->group(group);
+}
+
+Result<ao::Request> ao_request(const AoSettings& s, const std::string& prefix) {
+  ao::Request r = s.request;
+  const auto into = ao::into_from_names(s.into, s.existing_colors);
+  if (!into) {
+    return Error{"", "--" + prefix + "into '" + s.into + "' --" + prefix + "existing-colors '" + s.existing_colors +
+                         "': use COLOR_0 (with multiply or replace) or _AO", true};
+  }
+  r.into = *into;
+  if (Status st = ao::check(r.options); !st) return st.error();
+  return r;
+}
+
+}  // namespace matbake::cli

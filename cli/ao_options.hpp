@@ -1,0 +1,22 @@
+#pragma once
+// The AO options of `bake-ao` and `export --ao-*`: every field of ao::Request, its defaults the
+// library's.
+#include <CLI/CLI.hpp>
+
+#include <string>
+
+#include "matbake/ao.hpp"
+
+namespace matbake::cli {
+
+struct AoSettings {
+  ao::Request request;
+  std::string into{ao::into_attribute_name(request.into)};
+  std::string existing_colors{ao::into_existing_colors_name(request.into)};
+};
+// `prefix` goes before every option name ("" for bake-ao, "ao-" for export).
+void add_ao_options(CLI::App& cmd, AoSettings& s, const std::string& prefix);
+// The request, checked; errors name the option as given on the command line.
+Result<ao::Request> ao_request(const AoSettings& s, const std::string& prefix);
+
+}  // namespace matbake::cli
