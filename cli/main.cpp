@@ -59,16 +59,25 @@ int main(int argc, char** argv) {
   }
   matbake::image::set_thread_count(global.jobs);
 
-  if (convert_app->parsed()) return run_convert(convert, global);
-  if (preview_app->parsed()) return run_preview(preview, global);
-  if (pack_app->parsed()) return run_pack(pack, global);
-  if (unpack_app->parsed()) return run_unpack(unpack, global);
-  if (workflow_app->parsed()) return run_workflow(workflow, global);
-  if (materials_app->parsed()) return run_materials(materials, global);
-  if (validate_app->parsed()) return run_validate(validate, global);
-  if (bake_ao_app->parsed()) return run_bake_ao(bake_ao, global);
-  if (export_app->parsed()) return run_export(export_settings, global);
-  if (build_app->parsed()) return run_build(build, global);
-  if (plan_app->parsed()) return run_plan(plan, global);
+  // The library turns its dependencies' exceptions into errors at its edges; this is the last net,
+  // so that nothing ends in abort (exit 134) without a line saying why.
+  try {
+    if (convert_app->parsed()) return run_convert(convert, global);
+    if (preview_app->parsed()) return run_preview(preview, global);
+    if (pack_app->parsed()) return run_pack(pack, global);
+    if (unpack_app->parsed()) return run_unpack(unpack, global);
+    if (workflow_app->parsed()) return run_workflow(workflow, global);
+    if (materials_app->parsed()) return run_materials(materials, global);
+    if (validate_app->parsed()) return run_validate(validate, global);
+    if (bake_ao_app->parsed()) return run_bake_ao(bake_ao, global);
+    if (export_app->parsed()) return run_export(export_settings, global);
+    if (build_app->parsed()) return run_build(build, global);
+    if (plan_app->parsed()) return run_plan(plan, global);
+  } catch (const std::bad_alloc&) {
+    return report_error(matbake::Error{"", "out of memory"});
+  } catch (const std::exception& e) {
+    std::string what = e.what();
+    return report_error(matbake::Error{"", "internal error: " + what.substr(0, what.find('\n'))});
+  }
   return kUsage;
 }

@@ -52,6 +52,11 @@ struct ReadInfo {
 Result<Image> read_image(const std::filesystem::path& path, color::Transfer colour,
                          ReadInfo* info = nullptr);
 
+// An image held in memory (a glTF's embedded PNG, say): `name`'s extension picks the reader, and
+// names the image in errors. Same checks as read_image.
+Result<Image> decode_image(std::span<const unsigned char> bytes, const std::filesystem::path& name,
+                           color::Transfer colour, ReadInfo* info = nullptr);
+
 // Opens the file's header only: what it stores, without reading pixels.
 Result<ReadInfo> probe_image(const std::filesystem::path& path);
 
@@ -66,6 +71,9 @@ struct WriteOptions {
 // The format follows the extension. Output bytes depend only on the inputs (no timestamps).
 // Errors: unwritable folder, unknown extension, half output beyond the half range (±65504).
 Status write_image(const Image& image, const std::filesystem::path& path, const WriteOptions& options);
+
+// The bytes of `image` in the format of `name`'s extension (as write_image would write the file).
+Result<std::string> encode_image(const Image& image, const std::filesystem::path& name, const WriteOptions& options);
 
 // Reads `input` and writes `output` band by band (rows), `transform` applied to each decoded band
 // in between: reading, transforming and writing overlap on the cores, and memory stays a few bands

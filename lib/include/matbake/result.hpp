@@ -1,6 +1,8 @@
 #pragma once
 // Errors that user input can cause are values, not exceptions or prints: the library returns them
 // and only the CLI prints `matbake: error: <path>: <problem>` and picks the exit code.
+#include <exception>
+#include <new>
 #include <string>
 #include <utility>
 #include <variant>
@@ -38,5 +40,21 @@ class [[nodiscard]] Result {
 // For operations that produce nothing but can fail.
 using Status = Result<std::monostate>;
 inline Status success() { return std::monostate{}; }
+
+// A module's edge: `body` (returning a Result or Status) run so that an exception from a dependency
+// (nlohmann, tinygltf, toml++, OIIO, std::bad_alloc, std::length_error, filesystem, ...) comes back
+// as one Error about `path` rather than ending the process.
+template <class Body>
+auto guarded(const std::string& path, Body&& body) -> decltype(body()) {
+  try {
+    return body();
+  } catch (const std::bad_alloc&) {
+    return Error{path, "out of memory"};
+  } catch (const std::exception& e) {
+    std::string what = e.what();
+    what = what.substr(0, what.find('\n'));
+    return Error{path, what.empty() ? "failed (an exception without a message)" : what};
+  }
+}
 
 }  // namespace matbake

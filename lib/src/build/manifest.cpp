@@ -267,62 +267,64 @@ Result<SceneSpec> read_scene(const Reader& r, const std::string& name, const tom
 }  // namespace
 
 Result<Manifest> parse_manifest(std::string_view toml_text, const fs::path& file) {
-  Manifest m;
-  std::error_code ec;
-  m.file = fs::absolute(file, ec).lexically_normal();
-  m.folder = m.file.parent_path();
-  const Reader r{file.string()};
-  toml::table doc;
-  try {
-    doc = toml::parse(toml_text, file.string());
-  } catch (const toml::parse_error& e) {
-    return Error{file.string() + ":" + std::to_string(e.source().begin.line) + ":" +
-                     std::to_string(e.source().begin.column),
-                 "not valid TOML: " + std::string(e.description())};
-  }
-  if (Status s = r.known_keys(doc, "the manifest", {"output", "table", "transfer", "validate", "materials", "scenes"}); !s) {
-    return s.error();
-  }
-  std::string output = "out", table;
-  if (Status s = r.get(doc, "output", "manifest", output); !s) return s.error();
-  if (Status s = r.get(doc, "table", "manifest", table); !s) return s.error();
-  m.output = (m.folder / output).lexically_normal();
-  if (!table.empty()) m.table = m.folder / table;
-  color::Transfer transfer = MaterialSpec{}.transfer;
-  if (Status s = r.get_name(doc, "transfer", "manifest", color::kTransferNames, transfer); !s) return s.error();
-  ValidationRules rules;
-  if (const toml::node* v = doc.get("validate")) {
-    if (!v->is_table()) return r.at(*v, "validate must be a table");
-    if (Status s = read_validation(r, *v->as_table(), "validate", rules); !s) return s.error();
-  }
-  if (const toml::node* mats = doc.get("materials")) {
-    if (!mats->is_table()) return r.at(*mats, "materials must be a table of tables: [materials.NAME]");
-    for (const auto& [key, value] : *mats->as_table()) {
-      auto spec = read_material(r, std::string(key.str()), value, m, transfer, rules);
-      if (!spec) return spec.error();
-      m.materials.push_back(std::move(*spec));
+  return guarded(file.string(), [&]() -> Result<Manifest> {
+    Manifest m;
+    std::error_code ec;
+    m.file = fs::absolute(file, ec).lexically_normal();
+    m.folder = m.file.parent_path();
+    const Reader r{file.string()};
+    toml::table doc;
+    try {
+      doc = toml::parse(toml_text, file.string());
+    } catch (const toml::parse_error& e) {
+      return Error{file.string() + ":" + std::to_string(e.source().begin.line) + ":" +
+                       std::to_string(e.source().begin.column),
+                   "not valid TOML: " + std::string(e.description())};
     }
-  }
-  if (const toml::node* scenes = doc.get("scenes")) {
-    if (!scenes->is_table()) return r.at(*scenes, "scenes must be a table of tables: [scenes.NAME]");
-    for (const auto& [key, value] : *scenes->as_table()) {
-      auto spec = read_scene(r, std::string(key.str()), value, m);
-      if (!spec) return spec.error();
-      m.scenes.push_back(std::move(*spec));
+    if (Status s = r.known_keys(doc, "the manifest", {"output", "table", "transfer", "validate", "materials", "scenes"}); !s) {
+      return s.error();
     }
-  }
-  if (m.materials.empty() && m.scenes.empty()) return Error{file.string(), "no [materials.NAME] or [scenes.NAME]: nothing to build"};
-  std::set<std::string> names;
-  for (const MaterialSpec& s : m.materials) names.insert(s.name);
-  for (const SceneSpec& s : m.scenes) {
-    for (const auto& [gltf_name, material] : s.materials) {
-      if (!names.count(material)) {
-        return Error{file.string(), "scenes." + s.name + ".materials: '" + gltf_name + "' = '" + material +
-                                        "', but there is no [materials." + material + "]"};
+    std::string output = "out", table;
+    if (Status s = r.get(doc, "output", "manifest", output); !s) return s.error();
+    if (Status s = r.get(doc, "table", "manifest", table); !s) return s.error();
+    m.output = (m.folder / output).lexically_normal();
+    if (!table.empty()) m.table = m.folder / table;
+    color::Transfer transfer = MaterialSpec{}.transfer;
+    if (Status s = r.get_name(doc, "transfer", "manifest", color::kTransferNames, transfer); !s) return s.error();
+    ValidationRules rules;
+    if (const toml::node* v = doc.get("validate")) {
+      if (!v->is_table()) return r.at(*v, "validate must be a table");
+      if (Status s = read_validation(r, *v->as_table(), "validate", rules); !s) return s.error();
+    }
+    if (const toml::node* mats = doc.get("materials")) {
+      if (!mats->is_table()) return r.at(*mats, "materials must be a table of tables: [materials.NAME]");
+      for (const auto& [key, value] : *mats->as_table()) {
+        auto spec = read_material(r, std::string(key.str()), value, m, transfer, rules);
+        if (!spec) return spec.error();
+        m.materials.push_back(std::move(*spec));
       }
     }
-  }
-  return m;
+    if (const toml::node* scenes = doc.get("scenes")) {
+      if (!scenes->is_table()) return r.at(*scenes, "scenes must be a table of tables: [scenes.NAME]");
+      for (const auto& [key, value] : *scenes->as_table()) {
+        auto spec = read_scene(r, std::string(key.str()), value, m);
+        if (!spec) return spec.error();
+        m.scenes.push_back(std::move(*spec));
+      }
+    }
+    if (m.materials.empty() && m.scenes.empty()) return Error{file.string(), "no [materials.NAME] or [scenes.NAME]: nothing to build"};
+    std::set<std::string> names;
+    for (const MaterialSpec& s : m.materials) names.insert(s.name);
+    for (const SceneSpec& s : m.scenes) {
+      for (const auto& [gltf_name, material] : s.materials) {
+        if (!names.count(material)) {
+          return Error{file.string(), "scenes." + s.name + ".materials: '" + gltf_name + "' = '" + material +
+                                          "', but there is no [materials." + material + "]"};
+        }
+      }
+    }
+    return m;
+  });
 }
 
 Result<Manifest> read_manifest(const fs::path& file) {

@@ -92,115 +92,117 @@ std::size_t Report::count(Outcome o) const {
 }
 
 Result<Plan> make_plan(const Manifest& manifest) {
-  Plan plan;
-  plan.state_folder = manifest.output / ".matbake";
-  const fs::path materials_folder = manifest.output / "materials";
-  std::vector<bool> used(manifest.materials.size(), false);
-  const auto material_index = [&](const std::string& name) -> std::optional<std::size_t> {
-    for (std::size_t i = 0; i < manifest.materials.size(); ++i) {
-      if (manifest.materials[i].name == name) return i;
-    }
-    return std::nullopt;
-  };
+  return guarded(manifest.file.string(), [&]() -> Result<Plan> {
+    Plan plan;
+    plan.state_folder = manifest.output / ".matbake";
+    const fs::path materials_folder = manifest.output / "materials";
+    std::vector<bool> used(manifest.materials.size(), false);
+    const auto material_index = [&](const std::string& name) -> std::optional<std::size_t> {
+      for (std::size_t i = 0; i < manifest.materials.size(); ++i) {
+        if (manifest.materials[i].name == name) return i;
+      }
+      return std::nullopt;
+    };
 
-  std::vector<Job> scenes;
-  for (std::size_t i = 0; i < manifest.scenes.size(); ++i) {
-    const SceneSpec& s = manifest.scenes[i];
-    Job job;
-    job.kind = JobKind::scene;
-    job.spec = i;
-    job.name = "scene:" + s.name;
-    const fs::path out = manifest.output / s.output;
-    job.outputs.push_back(out);
-    if (out.extension() == ".gltf") job.outputs.push_back(out.parent_path() / (out.stem().string() + ".bin"));
-    // Which manifest materials the scene gets: named in the spec, or by the glTF material's name.
-    std::map<std::string, std::string> assigned = s.materials;
-    auto json = gltf::read_json(s.input);
-    if (!json) {
-      job.problem = json.error().to_string();
-      job.inputs.push_back(normalized(s.input));
-    } else {
-      job.inputs = gltf::source_files(s.input, *json);
-      std::set<std::string> names;
-      if (json->contains("materials") && (*json)["materials"].is_array()) {
-        for (const auto& m : (*json)["materials"]) {
-          if (m.is_object() && m.contains("name") && m["name"].is_string()) names.insert(m["name"].get<std::string>());
-        }
-      }
-      for (const auto& [gltf_name, material] : s.materials) {
-        if (!names.count(gltf_name)) {
-          job.problem = s.input.string() + ": scenes." + s.name + ".materials names '" + gltf_name +
-                        "', but the glTF has no material of that name";
-        }
-      }
-      if (s.match_names) {
-        for (const std::string& n : names) {
-          if (!assigned.count(n) && material_index(n)) assigned[n] = n;
-        }
-      }
-    }
-    nlohmann::json materials = nlohmann::json::object();
-    for (const auto& [gltf_name, material] : assigned) {
-      const std::size_t m = *material_index(material);
-      used[m] = true;
-      job.materials[gltf_name] = m;
-      add_unique(job.inputs, material_inputs(manifest.materials[m], manifest));
-      materials[gltf_name] = material_options(manifest.materials[m], manifest);
-    }
-    job.options = nlohmann::json{{"input", normalized(s.input).string()},
-                                 {"output", s.output.string()},
-                                 {"materials", materials},
-                                 {"export", to_json(s.options)}}
-                      .dump();
-    scenes.push_back(std::move(job));
-  }
-
-  for (std::size_t i = 0; i < manifest.materials.size(); ++i) {
-    const MaterialSpec& m = manifest.materials[i];
-    Job job;
-    job.kind = JobKind::material;
-    job.spec = i;
-    job.name = "material:" + m.name;
-    job.inputs = material_inputs(m, manifest);
-    job.options = material_options(m, manifest).dump();
-    if (!m.layout.empty()) {
-      auto layout = pack::find_layout(m.layout.find('/') != std::string::npos || fs::path(m.layout).has_extension()
-                                          ? (manifest.folder / m.layout).string()
-                                          : m.layout);
-      if (!layout) {
-        job.problem = "materials." + m.name + ".layout: " + layout.error().to_string();
+    std::vector<Job> scenes;
+    for (std::size_t i = 0; i < manifest.scenes.size(); ++i) {
+      const SceneSpec& s = manifest.scenes[i];
+      Job job;
+      job.kind = JobKind::scene;
+      job.spec = i;
+      job.name = "scene:" + s.name;
+      const fs::path out = manifest.output / s.output;
+      job.outputs.push_back(out);
+      if (out.extension() == ".gltf") job.outputs.push_back(out.parent_path() / (out.stem().string() + ".bin"));
+      // Which manifest materials the scene gets: named in the spec, or by the glTF material's name.
+      std::map<std::string, std::string> assigned = s.materials;
+      auto json = gltf::read_json(s.input);
+      if (!json) {
+        job.problem = json.error().to_string();
+        job.inputs.push_back(normalized(s.input));
       } else {
-        auto paths = pack::output_paths(*layout, {(materials_folder / (m.name + "_{texture}." + m.format)).string()});
-        if (paths) job.outputs = *paths;
+        job.inputs = gltf::source_files(s.input, *json);
+        std::set<std::string> names;
+        if (json->contains("materials") && (*json)["materials"].is_array()) {
+          for (const auto& m : (*json)["materials"]) {
+            if (m.is_object() && m.contains("name") && m["name"].is_string()) names.insert(m["name"].get<std::string>());
+          }
+        }
+        for (const auto& [gltf_name, material] : s.materials) {
+          if (!names.count(gltf_name)) {
+            job.problem = s.input.string() + ": scenes." + s.name + ".materials names '" + gltf_name +
+                          "', but the glTF has no material of that name";
+          }
+        }
+        if (s.match_names) {
+          for (const std::string& n : names) {
+            if (!assigned.count(n) && material_index(n)) assigned[n] = n;
+          }
+        }
       }
+      nlohmann::json materials = nlohmann::json::object();
+      for (const auto& [gltf_name, material] : assigned) {
+        const std::size_t m = *material_index(material);
+        used[m] = true;
+        job.materials[gltf_name] = m;
+        add_unique(job.inputs, material_inputs(manifest.materials[m], manifest));
+        materials[gltf_name] = material_options(manifest.materials[m], manifest);
+      }
+      job.options = nlohmann::json{{"input", normalized(s.input).string()},
+                                   {"output", s.output.string()},
+                                   {"materials", materials},
+                                   {"export", to_json(s.options)}}
+                        .dump();
+      scenes.push_back(std::move(job));
     }
-    if (m.validation.enabled) {
-      job.outputs.push_back(materials_folder / (m.name + ".validation.json"));
-      if (m.validation.heatmap) job.outputs.push_back(materials_folder / (m.name + "_validation.png"));
-    }
-    if (m.layout.empty() && !used[i]) {
-      plan.warnings.push_back("materials." + m.name + ": no layout and no scene uses it, so nothing is built from it");
-      continue;
-    }
-    if (job.outputs.empty()) continue;  // used by scenes only, nothing of its own to write
-    plan.jobs.push_back(std::move(job));
-  }
-  for (Job& s : scenes) plan.jobs.push_back(std::move(s));
 
-  // No file written twice, and no input written at all.
-  std::map<fs::path, std::string> writers;
-  std::set<fs::path> inputs;
-  for (const Job& job : plan.jobs) inputs.insert(job.inputs.begin(), job.inputs.end());
-  inputs.insert(manifest.file);
-  for (const Job& job : plan.jobs) {
-    for (const fs::path& out : job.outputs) {
-      if (inputs.count(out)) return Error{out.string(), job.name + " would overwrite an input; matbake never does"};
-      if (const auto [it, added] = writers.emplace(out, job.name); !added) {
-        return Error{out.string(), "written by both " + it->second + " and " + job.name};
+    for (std::size_t i = 0; i < manifest.materials.size(); ++i) {
+      const MaterialSpec& m = manifest.materials[i];
+      Job job;
+      job.kind = JobKind::material;
+      job.spec = i;
+      job.name = "material:" + m.name;
+      job.inputs = material_inputs(m, manifest);
+      job.options = material_options(m, manifest).dump();
+      if (!m.layout.empty()) {
+        auto layout = pack::find_layout(m.layout.find('/') != std::string::npos || fs::path(m.layout).has_extension()
+                                            ? (manifest.folder / m.layout).string()
+                                            : m.layout);
+        if (!layout) {
+          job.problem = "materials." + m.name + ".layout: " + layout.error().to_string();
+        } else {
+          auto paths = pack::output_paths(*layout, {(materials_folder / (m.name + "_{texture}." + m.format)).string()});
+          if (paths) job.outputs = *paths;
+        }
+      }
+      if (m.validation.enabled) {
+        job.outputs.push_back(materials_folder / (m.name + ".validation.json"));
+        if (m.validation.heatmap) job.outputs.push_back(materials_folder / (m.name + "_validation.png"));
+      }
+      if (m.layout.empty() && !used[i]) {
+        plan.warnings.push_back("materials." + m.name + ": no layout and no scene uses it, so nothing is built from it");
+        continue;
+      }
+      if (job.outputs.empty()) continue;  // used by scenes only, nothing of its own to write
+      plan.jobs.push_back(std::move(job));
+    }
+    for (Job& s : scenes) plan.jobs.push_back(std::move(s));
+
+    // No file written twice, and no input written at all.
+    std::map<fs::path, std::string> writers;
+    std::set<fs::path> inputs;
+    for (const Job& job : plan.jobs) inputs.insert(job.inputs.begin(), job.inputs.end());
+    inputs.insert(manifest.file);
+    for (const Job& job : plan.jobs) {
+      for (const fs::path& out : job.outputs) {
+        if (inputs.count(out)) return Error{out.string(), job.name + " would overwrite an input; matbake never does"};
+        if (const auto [it, added] = writers.emplace(out, job.name); !added) {
+          return Error{out.string(), "written by both " + it->second + " and " + job.name};
+        }
       }
     }
-  }
-  return plan;
+    return plan;
+  });
 }
 
 std::string depfile_text(const std::vector<fs::path>& targets, const std::vector<fs::path>& inputs) {

@@ -165,45 +165,49 @@ Status validate_material(const MaterialSpec& m, const pack::SourceMaps& maps, co
 }
 
 Status run_material(const Job& job, const JobContext& ctx, JobReport& report) {
-  const MaterialSpec& m = ctx.manifest.materials[job.spec];
-  auto maps = load_material(m, ctx.manifest, ctx.cache);
-  if (!maps) return maps.error();
-  report.details["size"] = {maps->width, maps->height};
-  if (Status s = ensure_folder(ctx.manifest.output / "materials"); !s) return s;
-  if (!m.layout.empty()) {
-    auto layout = pack::find_layout(layout_reference(m.layout, ctx.manifest));
-    if (!layout) return layout.error();
-    auto in_workflow = workflow::in_layout_workflow(*maps, *layout, m.mapping);
-    if (!in_workflow) return in_workflow.error();
-    if (const auto& d = in_workflow->direction) {
-      report.details["conversion"] = {{"direction", workflow::direction_name(*d)},
-                                      {"mapping", workflow::roughness_mapping_name(m.mapping)},
-                                      {"texels", in_workflow->report.texels},
-                                      {"errors", to_json(in_workflow->report.errors)}};
+  return guarded(ctx.manifest.materials[job.spec].name, [&]() -> Status {
+    const MaterialSpec& m = ctx.manifest.materials[job.spec];
+    auto maps = load_material(m, ctx.manifest, ctx.cache);
+    if (!maps) return maps.error();
+    report.details["size"] = {maps->width, maps->height};
+    if (Status s = ensure_folder(ctx.manifest.output / "materials"); !s) return s;
+    if (!m.layout.empty()) {
+      auto layout = pack::find_layout(layout_reference(m.layout, ctx.manifest));
+      if (!layout) return layout.error();
+      auto in_workflow = workflow::in_layout_workflow(*maps, *layout, m.mapping);
+      if (!in_workflow) return in_workflow.error();
+      if (const auto& d = in_workflow->direction) {
+        report.details["conversion"] = {{"direction", workflow::direction_name(*d)},
+                                        {"mapping", workflow::roughness_mapping_name(m.mapping)},
+                                        {"texels", in_workflow->report.texels},
+                                        {"errors", to_json(in_workflow->report.errors)}};
+      }
+      const std::vector<std::string> outputs(job.outputs.begin(), job.outputs.begin() + std::ptrdiff_t(layout->textures.size()));
+      auto written = pack::write_textures(*layout, in_workflow->maps, {outputs, m.bits, m.transfer, decoded_files(m)});
+      if (!written) return written.error();
     }
-    const std::vector<std::string> outputs(job.outputs.begin(), job.outputs.begin() + std::ptrdiff_t(layout->textures.size()));
-    auto written = pack::write_textures(*layout, in_workflow->maps, {outputs, m.bits, m.transfer, decoded_files(m)});
-    if (!written) return written.error();
-  }
-  if (m.validation.enabled) return validate_material(m, *maps, ctx, job.outputs, report);
-  return success();
+    if (m.validation.enabled) return validate_material(m, *maps, ctx, job.outputs, report);
+    return success();
+  });
 }
 
 Result<std::vector<fs::path>> run_scene(const Job& job, const JobContext& ctx, JobReport& report) {
-  const SceneSpec& s = ctx.manifest.scenes[job.spec];
-  exporter::Options options = s.options;
-  for (const auto& [gltf_name, m] : job.materials) {
-    const MaterialSpec& spec = ctx.manifest.materials[m];
-    auto maps = load_material(spec, ctx.manifest, ctx.cache);
-    if (!maps) return maps.error();
-    options.materials.push_back({gltf_name, std::move(*maps), spec.mapping});
-  }
-  const fs::path output = job.outputs.front();
-  if (Status st = ensure_folder(output.parent_path()); !st) return st.error();
-  auto exported = exporter::export_scene(s.input, output, options);
-  if (!exported) return exported.error();
-  report.details = to_json(*exported);
-  return std::vector<fs::path>(exported->written.begin(), exported->written.end());
+  return guarded(ctx.manifest.scenes[job.spec].input.string(), [&]() -> Result<std::vector<fs::path>> {
+    const SceneSpec& s = ctx.manifest.scenes[job.spec];
+    exporter::Options options = s.options;
+    for (const auto& [gltf_name, m] : job.materials) {
+      const MaterialSpec& spec = ctx.manifest.materials[m];
+      auto maps = load_material(spec, ctx.manifest, ctx.cache);
+      if (!maps) return maps.error();
+      options.materials.push_back({gltf_name, std::move(*maps), spec.mapping});
+    }
+    const fs::path output = job.outputs.front();
+    if (Status st = ensure_folder(output.parent_path()); !st) return st.error();
+    auto exported = exporter::export_scene(s.input, output, options);
+    if (!exported) return exported.error();
+    report.details = to_json(*exported);
+    return std::vector<fs::path>(exported->written.begin(), exported->written.end());
+  });
 }
 
 void run_job(const Job& job, const JobContext& ctx, const fs::path& state_folder, JobReport& report) {

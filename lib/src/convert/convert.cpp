@@ -83,46 +83,48 @@ fs::path output_path_in_folder(const fs::path& input, const fs::path& folder, co
 
 Result<ConvertReport> convert_file(const ConversionPlan& plan, const fs::path& input, const fs::path& output,
                                    const ConvertOptions& options) {
-  if (!is_supported_output_extension(output)) {
-    return Error{output.string(), "unsupported output format (matbake writes .exr, .png, .tif)", true};
-  }
-  if (options.type && !format_stores(output, *options.type)) {
-    return Error{output.string(),
-                 "this format cannot store " + std::string(image::sample_type_name(*options.type)) +
-                     " samples (EXR: half or float; PNG: 8 or 16)",
-                 true};
-  }
-  std::error_code ec;
-  if (fs::exists(output, ec) && fs::equivalent(input, output, ec)) {
-    return Error{output.string(), "output is the input file; matbake never overwrites an input"};
-  }
-
-  // Without --bits the output type depends on the input's, known only once the input is open.
-  image::ReadInfo info;
-  image::ImageLayout layout;
-  image::WriteOptions write{plan.encode, options.type.value_or(image::SampleType::half), options.compression,
-                            colorspace_tag(plan, options)};
-  image::BandTransform transform;
-  transform.accept = [&](const image::ImageLayout& l) -> Status {
-    if (plan.ocio && l.channels < 3) {
-      return Error{input.string(), "OCIO colour spaces need RGB or RGBA; this image has " +
-                                       std::to_string(l.channels) + " channel(s)"};
+  return guarded(input.string(), [&]() -> Result<ConvertReport> {
+    if (!is_supported_output_extension(output)) {
+      return Error{output.string(), "unsupported output format (matbake writes .exr, .png, .tif)", true};
     }
-    return success();
-  };
-  if (plan.ocio) {
-    transform.apply = [&](std::span<float> band, const image::ImageLayout& l) { plan.ocio->apply(band, l.channels); };
-  }
-  if (!options.type) {
-    // Peek at the stored type first (opening is cheap: the header only).
-    auto probe = image::probe_image(input);
-    if (!probe) return probe.error();
-    write.type = default_sample_type(output, plan.target_is_linear, probe->stored_type);
-  }
-  if (Status s = image::stream_image(input, plan.decode, output, write, transform, &info, &layout); !s) {
-    return s.error();
-  }
-  return ConvertReport{input, output, layout.width, layout.height, layout.channels, info.stored_type, write.type};
+    if (options.type && !format_stores(output, *options.type)) {
+      return Error{output.string(),
+                   "this format cannot store " + std::string(image::sample_type_name(*options.type)) +
+                       " samples (EXR: half or float; PNG: 8 or 16)",
+                   true};
+    }
+    std::error_code ec;
+    if (fs::exists(output, ec) && fs::equivalent(input, output, ec)) {
+      return Error{output.string(), "output is the input file; matbake never overwrites an input"};
+    }
+
+    // Without --bits the output type depends on the input's, known only once the input is open.
+    image::ReadInfo info;
+    image::ImageLayout layout;
+    image::WriteOptions write{plan.encode, options.type.value_or(image::SampleType::half), options.compression,
+                              colorspace_tag(plan, options)};
+    image::BandTransform transform;
+    transform.accept = [&](const image::ImageLayout& l) -> Status {
+      if (plan.ocio && l.channels < 3) {
+        return Error{input.string(), "OCIO colour spaces need RGB or RGBA; this image has " +
+                                         std::to_string(l.channels) + " channel(s)"};
+      }
+      return success();
+    };
+    if (plan.ocio) {
+      transform.apply = [&](std::span<float> band, const image::ImageLayout& l) { plan.ocio->apply(band, l.channels); };
+    }
+    if (!options.type) {
+      // Peek at the stored type first (opening is cheap: the header only).
+      auto probe = image::probe_image(input);
+      if (!probe) return probe.error();
+      write.type = default_sample_type(output, plan.target_is_linear, probe->stored_type);
+    }
+    if (Status s = image::stream_image(input, plan.decode, output, write, transform, &info, &layout); !s) {
+      return s.error();
+    }
+    return ConvertReport{input, output, layout.width, layout.height, layout.channels, info.stored_type, write.type};
+  });
 }
 
 }  // namespace matbake

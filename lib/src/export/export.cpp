@@ -39,11 +39,20 @@ image::Image at_size(const image::Image& im, int width, int height) {
   return im.width == width && im.height == height ? im : image::resize_image(im, width, height);
 }
 
-std::vector<double> numbers(const Json& object, const char* key, std::vector<double> fallback) {
-  if (!object.contains(key) || !object[key].is_array()) return fallback;
+// A factor of `object` (as many numbers as `fallback` has; `fallback` when absent).
+Result<std::vector<double>> numbers(const Json& object, const char* key, std::vector<double> fallback,
+                                    const std::string& file, const std::string& where) {
+  if (!object.contains(key)) return fallback;
+  const Json& value = object[key];
+  const bool scalar = fallback.size() == 1;
+  if (scalar ? !value.is_number() : !value.is_array() || value.size() != fallback.size() ||
+                                        !std::all_of(value.begin(), value.end(), [](const Json& v) { return v.is_number(); })) {
+    return Error{file, where + "." + key + " must be " + (scalar ? "a number" : std::to_string(fallback.size()) + " numbers")};
+  }
+  if (scalar) return std::vector<double>{value.get<double>()};
   std::vector<double> out;
-  for (const Json& v : object[key]) out.push_back(v.get<double>());
-  return out.size() == fallback.size() ? out : fallback;
+  for (const Json& v : value) out.push_back(v.get<double>());
+  return out;
 }
 
 void add_extension_used(Json& json, const char* name) {
@@ -147,10 +156,17 @@ struct Exporter {
 
   // KHR_materials_pbrSpecularGlossiness's factors and textures as Schüler sources (kd, ks, gloss,
   // and the diffuse alpha as mask), at the size of the larger texture.
-  Result<pack::SourceMaps> spec_gloss_sources(const Json& ext) {
-    const std::vector<double> diffuse = numbers(ext, "diffuseFactor", {1, 1, 1, 1});
-    const std::vector<double> specular = numbers(ext, "specularFactor", {1, 1, 1});
-    const double gloss = ext.value("glossinessFactor", 1.0);
+  Result<pack::SourceMaps> spec_gloss_sources(int index, const Json& ext) {
+    const std::string where = "material " + std::to_string(index) + " " + kSpecGloss;
+    auto diffuse_factor = numbers(ext, "diffuseFactor", {1, 1, 1, 1}, doc.file, where);
+    auto specular_factor = numbers(ext, "specularFactor", {1, 1, 1}, doc.file, where);
+    auto gloss_factor = numbers(ext, "glossinessFactor", {1}, doc.file, where);
+    for (const auto* r : {&diffuse_factor, &specular_factor, &gloss_factor}) {
+      if (!*r) return r->error();
+    }
+    const std::vector<double>& diffuse = *diffuse_factor;
+    const std::vector<double>& specular = *specular_factor;
+    const double gloss = (*gloss_factor)[0];
     const image::Image* textures[2] = {nullptr, nullptr};
     const char* keys[2] = {"diffuseTexture", "specularGlossinessTexture"};
     int width = 1, height = 1;
@@ -200,7 +216,7 @@ struct Exporter {
       out.action += " (same as an earlier material: its textures reused)";
       return success();
     }
-    auto sources = spec_gloss_sources(ext);
+    auto sources = spec_gloss_sources(index, ext);
     if (!sources) return sources.error();
     workflow::ConversionReport conversion;
     auto maps = workflow::metal_rough_from_spec_gloss(*sources, options.mapping, conversion);
@@ -340,76 +356,78 @@ Status check_texture_coordinates(const gltf::Document& doc) {
 }  // namespace
 
 Result<Report> export_scene(const fs::path& input, const fs::path& output, const Options& options) {
-  const std::string ext = output.extension().string();
-  if (ext != ".gltf" && ext != ".glb") return Error{output.string(), "the output is .gltf or .glb", true};
-  auto scene = scene::load_scene(input);
-  if (!scene) return scene.error();
-  auto doc = gltf::read_document(input);
-  if (!doc) return doc.error();
+  return guarded(input.string(), [&]() -> Result<Report> {
+    const std::string ext = output.extension().string();
+    if (ext != ".gltf" && ext != ".glb") return Error{output.string(), "the output is .gltf or .glb", true};
+    auto scene = scene::load_scene(input);
+    if (!scene) return scene.error();
+    auto doc = gltf::read_document(input);
+    if (!doc) return doc.error();
 
-  Report report;
-  report.skipped = gltf::prune_unreachable(*doc);  // from here on, everything in doc is reachable
-  for (std::string& s : report.skipped) s += ": not reachable from the default scene";
+    Report report;
+    report.skipped = gltf::prune_unreachable(*doc);  // from here on, everything in doc is reachable
+    for (std::string& s : report.skipped) s += ": not reachable from the default scene";
 
-  std::map<int, const MaterialMaps*> given;
-  for (const MaterialMaps& m : options.materials) {
-    auto index = material_index(*doc, m.material);
-    if (!index) return index.error();
-    given[*index] = &m;
-  }
-
-  ImageCache cache(*doc);
-  for (std::size_t i = 0; doc->json.contains("images") && i < doc->json["images"].size(); ++i) {
-    if (Status s = cache.check(i); !s) return s.error();
-  }
-  Exporter exporter{*doc, cache, options, output.stem().string(), report, {}, {}};
-  const std::size_t materials = doc->json.contains("materials") ? doc->json["materials"].size() : 0;
-  for (std::size_t i = 0; i < materials; ++i) {
-    Json& material = doc->json["materials"][i];
-    MaterialReport out;
-    out.index = int(i);
-    out.name = material.value("name", "");
-    out.action = "kept";
-    Status done = success();
-    if (const auto maps = given.find(int(i)); maps != given.end()) {
-      done = exporter.from_maps(int(i), material, *maps->second, out);
-    } else if (material.contains("extensions") && material["extensions"].contains(kSpecGloss)) {
-      done = exporter.from_spec_gloss(int(i), material, out);
+    std::map<int, const MaterialMaps*> given;
+    for (const MaterialMaps& m : options.materials) {
+      auto index = material_index(*doc, m.material);
+      if (!index) return index.error();
+      given[*index] = &m;
     }
-    if (done && options.pack_orm) done = exporter.pack_orm(material, out);
-    if (!done) return done.error();
-    out.alpha_mode = material.value("alphaMode", "OPAQUE");
-    report.materials.push_back(std::move(out));
-  }
-  // The spec-gloss extension is gone from every material that had it; a replaced material may also
-  // have dropped the last use of the specular or IOR extension.
-  for (const char* extension : {kSpecGloss, kSpecular, kIor}) {
-    const auto uses = [&](const Json& m) { return m.contains("extensions") && m["extensions"].contains(extension); };
-    if (doc->json.contains("materials") && std::any_of(doc->json["materials"].begin(), doc->json["materials"].end(), uses)) {
-      continue;
-    }
-    for (const char* list : {"extensionsUsed", "extensionsRequired"}) {
-      if (!doc->json.contains(list)) continue;
-      Json& names = doc->json[list];
-      names.erase(std::remove(names.begin(), names.end(), extension), names.end());
-      if (names.empty()) doc->json.erase(list);
-    }
-  }
-  if (Status s = check_texture_coordinates(*doc); !s) return s.error();
 
-  if (options.ao) {
-    auto baked = bake_into(*doc, *scene, *options.ao);
-    if (!baked) return baked.error();
-    report.ao_rays = baked->rays;
-  }
-  // What the conversions replaced (spec-gloss textures, separate occlusion maps, old colours).
-  for (std::string& s : gltf::prune_unreachable(*doc)) report.skipped.push_back(s + ": replaced");
-  report.images_decoded = cache.decoded();
+    ImageCache cache(*doc);
+    for (std::size_t i = 0; doc->json.contains("images") && i < doc->json["images"].size(); ++i) {
+      if (Status s = cache.check(i); !s) return s.error();
+    }
+    Exporter exporter{*doc, cache, options, output.stem().string(), report, {}, {}};
+    const std::size_t materials = doc->json.contains("materials") ? doc->json["materials"].size() : 0;
+    for (std::size_t i = 0; i < materials; ++i) {
+      Json& material = doc->json["materials"][i];
+      MaterialReport out;
+      out.index = int(i);
+      out.name = material.value("name", "");
+      out.action = "kept";
+      Status done = success();
+      if (const auto maps = given.find(int(i)); maps != given.end()) {
+        done = exporter.from_maps(int(i), material, *maps->second, out);
+      } else if (material.contains("extensions") && material["extensions"].contains(kSpecGloss)) {
+        done = exporter.from_spec_gloss(int(i), material, out);
+      }
+      if (done && options.pack_orm) done = exporter.pack_orm(material, out);
+      if (!done) return done.error();
+      out.alpha_mode = material.value("alphaMode", "OPAQUE");
+      report.materials.push_back(std::move(out));
+    }
+    // The spec-gloss extension is gone from every material that had it; a replaced material may also
+    // have dropped the last use of the specular or IOR extension.
+    for (const char* extension : {kSpecGloss, kSpecular, kIor}) {
+      const auto uses = [&](const Json& m) { return m.contains("extensions") && m["extensions"].contains(extension); };
+      if (doc->json.contains("materials") && std::any_of(doc->json["materials"].begin(), doc->json["materials"].end(), uses)) {
+        continue;
+      }
+      for (const char* list : {"extensionsUsed", "extensionsRequired"}) {
+        if (!doc->json.contains(list)) continue;
+        Json& names = doc->json[list];
+        names.erase(std::remove(names.begin(), names.end(), extension), names.end());
+        if (names.empty()) doc->json.erase(list);
+      }
+    }
+    if (Status s = check_texture_coordinates(*doc); !s) return s.error();
 
-  auto written = gltf::write_document(*doc, output);
-  if (!written) return written.error();
-  for (const fs::path& p : *written) report.written.push_back(p.string());
-  return report;
+    if (options.ao) {
+      auto baked = bake_into(*doc, *scene, *options.ao);
+      if (!baked) return baked.error();
+      report.ao_rays = baked->rays;
+    }
+    // What the conversions replaced (spec-gloss textures, separate occlusion maps, old colours).
+    for (std::string& s : gltf::prune_unreachable(*doc)) report.skipped.push_back(s + ": replaced");
+    report.images_decoded = cache.decoded();
+
+    auto written = gltf::write_document(*doc, output);
+    if (!written) return written.error();
+    for (const fs::path& p : *written) report.written.push_back(p.string());
+    return report;
+  });
 }
 
 }  // namespace matbake::exporter

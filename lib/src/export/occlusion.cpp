@@ -52,47 +52,49 @@ Result<ao::Bake> bake_into(gltf::Document& doc, const scene::Scene& scene, const
 }
 
 Result<BakeAoReport> bake_ao_file(const fs::path& input, const BakeAoOptions& options) {
-  if (options.output.empty() && options.dump.empty()) return Error{"", "bake-ao writes a glTF, a dump or both", true};
-  if (const fs::path ext = options.output.extension(); !options.output.empty() && ext != ".gltf" && ext != ".glb") {
-    return Error{options.output.string(), "the output is .gltf or .glb", true};
-  }
-  if (const fs::path ext = options.dump.extension(); !options.dump.empty() && ext != ".csv" && ext != ".bin") {
-    return Error{options.dump.string(), "the dump is .csv or .bin", true};
-  }
-  if (Status s = ao::check(options.ao.options); !s) return s.error();
-  auto scene = scene::load_scene(input);
-  if (!scene) return scene.error();
-  if (Status s = check_outputs(input, options); !s) return s.error();
+  return guarded(input.string(), [&]() -> Result<BakeAoReport> {
+    if (options.output.empty() && options.dump.empty()) return Error{"", "bake-ao writes a glTF, a dump or both", true};
+    if (const fs::path ext = options.output.extension(); !options.output.empty() && ext != ".gltf" && ext != ".glb") {
+      return Error{options.output.string(), "the output is .gltf or .glb", true};
+    }
+    if (const fs::path ext = options.dump.extension(); !options.dump.empty() && ext != ".csv" && ext != ".bin") {
+      return Error{options.dump.string(), "the dump is .csv or .bin", true};
+    }
+    if (Status s = ao::check(options.ao.options); !s) return s.error();
+    auto scene = scene::load_scene(input);
+    if (!scene) return scene.error();
+    if (Status s = check_outputs(input, options); !s) return s.error();
 
-  const auto start = std::chrono::steady_clock::now();
-  auto baked = ao::bake(*scene, options.ao.options);
-  if (!baked) return baked.error();
-  BakeAoReport report;
-  report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (!options.dump.empty()) {
-    if (Status s = ao::write_dump(options.dump, *scene, *baked); !s) return s.error();
-    report.written.push_back(options.dump.string());
-  }
-  if (!options.output.empty()) {
-    auto doc = gltf::read_document(input);
-    if (!doc) return doc.error();
-    const std::vector<gltf::PlacedValues> placed = placed_values(*scene, *baked);
-    gltf::add_vertex_occlusion(*doc, placed, options.ao.into);
-    auto written = gltf::write_document(*doc, options.output);
-    if (!written) return written.error();
-    for (const fs::path& p : *written) report.written.push_back(p.string());
-  }
-  double sum = 0;
-  for (const auto& values : baked->values) {
-    report.vertices += values.size();
-    for (float w : values) sum += w;
-  }
-  report.instances = scene->instances.size();
-  report.rays = baked->rays;
-  report.max_distance = baked->max_distance;
-  report.mean = report.vertices ? sum / double(report.vertices) : 0.0;
-  report.notes = scene->notes;
-  return report;
+    const auto start = std::chrono::steady_clock::now();
+    auto baked = ao::bake(*scene, options.ao.options);
+    if (!baked) return baked.error();
+    BakeAoReport report;
+    report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (!options.dump.empty()) {
+      if (Status s = ao::write_dump(options.dump, *scene, *baked); !s) return s.error();
+      report.written.push_back(options.dump.string());
+    }
+    if (!options.output.empty()) {
+      auto doc = gltf::read_document(input);
+      if (!doc) return doc.error();
+      const std::vector<gltf::PlacedValues> placed = placed_values(*scene, *baked);
+      gltf::add_vertex_occlusion(*doc, placed, options.ao.into);
+      auto written = gltf::write_document(*doc, options.output);
+      if (!written) return written.error();
+      for (const fs::path& p : *written) report.written.push_back(p.string());
+    }
+    double sum = 0;
+    for (const auto& values : baked->values) {
+      report.vertices += values.size();
+      for (float w : values) sum += w;
+    }
+    report.instances = scene->instances.size();
+    report.rays = baked->rays;
+    report.max_distance = baked->max_distance;
+    report.mean = report.vertices ? sum / double(report.vertices) : 0.0;
+    report.notes = scene->notes;
+    return report;
+  });
 }
 
 }  // namespace matbake::exporter

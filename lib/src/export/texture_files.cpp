@@ -1,15 +1,6 @@
 #include "texture_files.hpp"
 
-#include <unistd.h>
-
-#include <atomic>
-#include <fstream>
-#include <iterator>
-
-#include "matbake/atomic_file.hpp"
-
 namespace matbake::exporter {
-namespace fs = std::filesystem;
 namespace {
 
 // The extension OIIO picks its reader by, from the bytes' signature.
@@ -20,17 +11,11 @@ const char* extension_of(const std::string& bytes) {
   return "";
 }
 
+std::span<const unsigned char> as_bytes(const std::string& s) {
+  return {reinterpret_cast<const unsigned char*>(s.data()), s.size()};
+}
+
 }  // namespace
-
-ImageCache::ImageCache(const gltf::Document& doc) : doc_(doc) {
-  static std::atomic<unsigned> counter{0};
-  folder_ = fs::temp_directory_path() / ("matbake-export-" + std::to_string(getpid()) + "-" + std::to_string(counter++));
-}
-
-ImageCache::~ImageCache() {
-  std::error_code ec;
-  fs::remove_all(folder_, ec);
-}
 
 Result<const image::Image*> ImageCache::texture(int texture, color::Transfer colour) {
   const gltf::Json& json = doc_.json;
@@ -38,21 +23,16 @@ Result<const image::Image*> ImageCache::texture(int texture, color::Transfer col
     return Error{doc_.file, "texture " + std::to_string(texture) + " does not exist"};
   }
   const gltf::Json& t = json["textures"][std::size_t(texture)];
-  if (!t.contains("source")) {
+  if (!t.contains("source") || !t["source"].is_number_integer()) {
     return Error{doc_.file, "texture " + std::to_string(texture) + " has no PNG or JPEG source matbake could read"};
   }
   const int source = t["source"].get<int>();
   if (const auto found = images_.find({source, colour}); found != images_.end()) return &found->second;
   auto bytes = gltf::image_bytes(doc_, std::size_t(source));
   if (!bytes) return bytes.error();
-  std::error_code ec;
-  fs::create_directories(folder_, ec);
   const char* extension = extension_of(*bytes);
   if (!*extension) return Error{doc_.file, "image " + std::to_string(source) + " is not PNG, JPEG or WebP"};
-  const fs::path file = folder_ / ("image" + std::to_string(files_++) + extension);
-  if (Status s = write_file_atomically(file, *bytes); !s) return s.error();
-  auto decoded = image::read_image(file, colour);
-  fs::remove(file, ec);
+  auto decoded = image::decode_image(as_bytes(*bytes), std::string("image") + extension, colour);
   if (!decoded) return Error{doc_.file, "image " + std::to_string(source) + ": " + decoded.error().message};
   return &(images_[{source, colour}] = std::move(*decoded));
 }
@@ -64,28 +44,17 @@ Status ImageCache::check(std::size_t index) {
   if (bytes->rfind("\xabKTX 20\xbb", 0) == 0) return success();
   const char* extension = extension_of(*bytes);
   if (!*extension) return Error{doc_.file, what + " is not PNG, JPEG, WebP or KTX2"};
-  std::error_code ec;
-  fs::create_directories(folder_, ec);
-  const fs::path file = folder_ / ("check" + std::to_string(files_++) + extension);
-  if (Status s = write_file_atomically(file, *bytes); !s) return s.error();
-  auto probed = image::probe_image(file);
-  fs::remove(file, ec);
-  if (!probed) return Error{doc_.file, what + ": " + probed.error().message};
+  // Decoded in full: a header that reads over truncated or corrupt pixels must not pass.
+  auto decoded = image::decode_image(as_bytes(*bytes), std::string("image") + extension, color::Transfer::linear);
+  if (!decoded) return Error{doc_.file, what + ": " + decoded.error().message};
   return success();
 }
 
 Result<std::string> ImageCache::encode_png(const image::Image& img, color::Transfer colour) {
-  std::error_code ec;
-  fs::create_directories(folder_, ec);
-  const fs::path file = folder_ / ("made" + std::to_string(files_++) + ".png");
   image::WriteOptions options;
   options.colour = colour;
   options.type = image::SampleType::u8;
-  if (Status s = image::write_image(img, file, options); !s) return s.error();
-  std::ifstream in(file, std::ios::binary);
-  std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-  fs::remove(file, ec);
-  return bytes;
+  return image::encode_image(img, "made.png", options);
 }
 
 }  // namespace matbake::exporter

@@ -1,10 +1,7 @@
 #pragma once
-// A glTF document's images decoded through OIIO (each once per transfer), and images encoded as
-// PNG bytes for the document's new files. OIIO reads and writes files, so both go through a
-// private temporary folder, removed with the cache.
-#include <filesystem>
+// A glTF document's images decoded in memory through OIIO (each once per transfer), and images
+// encoded as PNG bytes for the document's new files. No file is written outside the output.
 #include <map>
-#include <memory>
 #include <string>
 #include <utility>
 
@@ -15,8 +12,7 @@ namespace matbake::exporter {
 
 class ImageCache {
  public:
-  explicit ImageCache(const gltf::Document& doc);
-  ~ImageCache();
+  explicit ImageCache(const gltf::Document& doc) : doc_(doc) {}
   ImageCache(const ImageCache&) = delete;
   ImageCache& operator=(const ImageCache&) = delete;
 
@@ -32,8 +28,6 @@ class ImageCache {
 
  private:
   const gltf::Document& doc_;
-  std::filesystem::path folder_;  // private temporary folder
-  int files_ = 0;
   std::map<std::pair<int, color::Transfer>, image::Image> images_;  // by (image index, transfer)
 };
 

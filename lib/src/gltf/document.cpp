@@ -61,50 +61,54 @@ std::string decode_uri(const std::string& uri) {
 }
 
 Result<std::string> image_bytes(const Document& doc, std::size_t index) {
-  const std::string what = "image " + std::to_string(index);
-  if (!doc.json.contains("images") || index >= doc.json["images"].size()) return Error{doc.file, what + " does not exist"};
-  const Json& image = doc.json["images"][index];
-  if (image.contains("bufferView")) {
-    const std::size_t v = image["bufferView"].get<std::size_t>();
-    if (!doc.json.contains("bufferViews") || v >= doc.json["bufferViews"].size()) return Error{doc.file, what + ": no such buffer view"};
-    const Json& view = doc.json["bufferViews"][v];
-    const std::size_t buffer = view.value("buffer", std::size_t{0}), offset = view.value("byteOffset", std::size_t{0}),
-                      length = view.value("byteLength", std::size_t{0});
-    if (buffer >= doc.buffers.size() || offset + length > doc.buffers[buffer].size()) {
-      return Error{doc.file, what + ": its buffer view reaches beyond its buffer"};
+  return guarded(doc.file, [&]() -> Result<std::string> {
+    const std::string what = "image " + std::to_string(index);
+    if (!doc.json.contains("images") || index >= doc.json["images"].size()) return Error{doc.file, what + " does not exist"};
+    const Json& image = doc.json["images"][index];
+    if (image.contains("bufferView")) {
+      const std::size_t v = image["bufferView"].get<std::size_t>();
+      if (!doc.json.contains("bufferViews") || v >= doc.json["bufferViews"].size()) return Error{doc.file, what + ": no such buffer view"};
+      const Json& view = doc.json["bufferViews"][v];
+      const std::size_t buffer = view.value("buffer", std::size_t{0}), offset = view.value("byteOffset", std::size_t{0}),
+                        length = view.value("byteLength", std::size_t{0});
+      if (buffer >= doc.buffers.size() || offset + length > doc.buffers[buffer].size()) {
+        return Error{doc.file, what + ": its buffer view reaches beyond its buffer"};
+      }
+      return std::string(reinterpret_cast<const char*>(doc.buffers[buffer].data()) + offset, length);
     }
-    return std::string(reinterpret_cast<const char*>(doc.buffers[buffer].data()) + offset, length);
-  }
-  const std::string uri = image.value("uri", "");
-  if (uri.empty()) return Error{doc.file, what + " has neither a URI nor a buffer view"};
-  if (const auto made = doc.new_files.find(uri); made != doc.new_files.end()) return made->second;
-  if (is_data_uri(uri)) {
-    std::vector<unsigned char> decoded;
-    std::string uri_copy = uri, mime;
-    if (!tinygltf::DecodeDataURI(&decoded, mime, uri_copy, 0, false)) return Error{doc.file, what + ": its data: URI cannot be decoded"};
-    return std::string(decoded.begin(), decoded.end());
-  }
-  const fs::path path = doc.folder / decode_uri(uri);
-  if (!is_inside(doc.folder, path)) return Error{doc.file, what + ": URI '" + uri + "' is outside the glTF's folder"};
-  std::string bytes = read_bytes(path);
-  if (bytes.empty()) return Error{doc.file, what + ": '" + uri + "' cannot be read"};
-  return bytes;
+    const std::string uri = image.value("uri", "");
+    if (uri.empty()) return Error{doc.file, what + " has neither a URI nor a buffer view"};
+    if (const auto made = doc.new_files.find(uri); made != doc.new_files.end()) return made->second;
+    if (is_data_uri(uri)) {
+      std::vector<unsigned char> decoded;
+      std::string uri_copy = uri, mime;
+      if (!tinygltf::DecodeDataURI(&decoded, mime, uri_copy, 0, false)) return Error{doc.file, what + ": its data: URI cannot be decoded"};
+      return std::string(decoded.begin(), decoded.end());
+    }
+    const fs::path path = doc.folder / decode_uri(uri);
+    if (!is_inside(doc.folder, path)) return Error{doc.file, what + ": URI '" + uri + "' is outside the glTF's folder"};
+    std::string bytes = read_bytes(path);
+    if (bytes.empty()) return Error{doc.file, what + ": '" + uri + "' cannot be read"};
+    return bytes;
+  });
 }
 
 Result<Json> read_json(const fs::path& path) {
-  std::error_code ec;
-  if (!fs::is_regular_file(path, ec)) return Error{path.string(), "cannot read the glTF (missing or not a file)"};
-  const std::string bytes = read_bytes(path);
-  std::string text = bytes;
-  if (path.extension() == ".glb") {
-    if (bytes.size() < 20) return Error{path.string(), "not a GLB: shorter than its header"};
-    const std::size_t json_length = u32_at(bytes, 12);
-    if (20 + json_length > bytes.size()) return Error{path.string(), "GLB JSON chunk is truncated"};
-    text = bytes.substr(20, json_length);
-  }
-  Json json = Json::parse(text, nullptr, false);
-  if (json.is_discarded() || !json.is_object()) return Error{path.string(), "not a valid glTF: the JSON is malformed"};
-  return json;
+  return guarded(path.string(), [&]() -> Result<Json> {
+    std::error_code ec;
+    if (!fs::is_regular_file(path, ec)) return Error{path.string(), "cannot read the glTF (missing or not a file)"};
+    const std::string bytes = read_bytes(path);
+    std::string text = bytes;
+    if (path.extension() == ".glb") {
+      if (bytes.size() < 20) return Error{path.string(), "not a GLB: shorter than its header"};
+      const std::size_t json_length = u32_at(bytes, 12);
+      if (20 + json_length > bytes.size()) return Error{path.string(), "GLB JSON chunk is truncated"};
+      text = bytes.substr(20, json_length);
+    }
+    Json json = Json::parse(text, nullptr, false);
+    if (json.is_discarded() || !json.is_object()) return Error{path.string(), "not a valid glTF: the JSON is malformed"};
+    return json;
+  });
 }
 
 std::vector<fs::path> source_files(const fs::path& file, const Json& json, const std::map<std::string, std::string>& made) {
@@ -123,24 +127,26 @@ std::vector<fs::path> source_files(const fs::path& file, const Json& json, const
 }
 
 Result<Document> read_document(const fs::path& path) {
-  tinygltf::Model model;  // tinygltf checks the container, the URIs and the buffer sizes
-  if (Status loaded = load_model(path, model); !loaded) return loaded.error();
+  return guarded(path.string(), [&]() -> Result<Document> {
+    tinygltf::Model model;  // tinygltf checks the container, the URIs and the buffer sizes
+    if (Status loaded = load_model(path, model); !loaded) return loaded.error();
 
-  Document doc;
-  doc.file = path.string();
-  doc.folder = fs::absolute(path).parent_path();
-  auto json = read_json(path);
-  if (!json) return json.error();
-  doc.json = std::move(*json);
-  const std::size_t declared = doc.json.contains("buffers") ? doc.json["buffers"].size() : 0;
-  if (declared != model.buffers.size()) return Error{doc.file, "not a valid glTF: buffers could not all be read"};
-  for (std::size_t i = 0; i < model.buffers.size(); ++i) {
-    std::vector<unsigned char> data = std::move(model.buffers[i].data);
-    // A GLB's BIN chunk may carry up to 3 bytes of padding beyond the buffer's byteLength.
-    data.resize(std::min(data.size(), std::size_t(doc.json["buffers"][i].value("byteLength", std::size_t{0}))));
-    doc.buffers.push_back(std::move(data));
-  }
-  return doc;
+    Document doc;
+    doc.file = path.string();
+    doc.folder = fs::absolute(path).parent_path();
+    auto json = read_json(path);
+    if (!json) return json.error();
+    doc.json = std::move(*json);
+    const std::size_t declared = doc.json.contains("buffers") ? doc.json["buffers"].size() : 0;
+    if (declared != model.buffers.size()) return Error{doc.file, "not a valid glTF: buffers could not all be read"};
+    for (std::size_t i = 0; i < model.buffers.size(); ++i) {
+      std::vector<unsigned char> data = std::move(model.buffers[i].data);
+      // A GLB's BIN chunk may carry up to 3 bytes of padding beyond the buffer's byteLength.
+      data.resize(std::min(data.size(), std::size_t(doc.json["buffers"][i].value("byteLength", std::size_t{0}))));
+      doc.buffers.push_back(std::move(data));
+    }
+    return doc;
+  });
 }
 
 int add_view(Document& doc, std::span<const unsigned char> bytes, int target) {
@@ -168,114 +174,116 @@ int add_float_accessor(Document& doc, const std::vector<float>& values, std::siz
 }
 
 Result<std::vector<fs::path>> write_document(const Document& doc, const fs::path& output) {
-  const std::string out_name = output.string();
-  const std::string ext = output.extension().string();
-  if (ext != ".gltf" && ext != ".glb") return Error{out_name, "the output is .gltf or .glb", true};
-  const bool glb = ext == ".glb";
-  const fs::path out_folder = fs::absolute(output).parent_path().lexically_normal();
-  const fs::path bin_path = output.parent_path() / (output.stem().string() + ".bin");
+  return guarded(output.string(), [&]() -> Result<std::vector<fs::path>> {
+    const std::string out_name = output.string();
+    const std::string ext = output.extension().string();
+    if (ext != ".gltf" && ext != ".glb") return Error{out_name, "the output is .gltf or .glb", true};
+    const bool glb = ext == ".glb";
+    const fs::path out_folder = fs::absolute(output).parent_path().lexically_normal();
+    const fs::path bin_path = output.parent_path() / (output.stem().string() + ".bin");
 
-  // Every file the document came from, none of which may be written.
-  const std::vector<fs::path> inputs = source_files(doc.file, doc.json, doc.new_files);
-  const auto is_input = [&](const fs::path& p) {
-    const fs::path a = fs::absolute(p).lexically_normal();
-    return std::find(inputs.begin(), inputs.end(), a) != inputs.end();
-  };
-  if (is_input(output)) return Error{out_name, "would overwrite an input; write somewhere else", true};
-  if (!glb && is_input(bin_path)) {
-    return Error{out_name, "its buffer " + bin_path.filename().string() + " would overwrite an input; name the output differently", true};
-  }
-
-  // All buffers become one: each starts 4-byte aligned, the views move with it.
-  Json json = doc.json;
-  std::string bin;
-  std::vector<std::size_t> base(doc.buffers.size());
-  for (std::size_t i = 0; i < doc.buffers.size(); ++i) {
-    pad(bin, 4, '\0');
-    base[i] = bin.size();
-    bin.append(reinterpret_cast<const char*>(doc.buffers[i].data()), doc.buffers[i].size());
-  }
-  if (json.contains("bufferViews")) {
-    for (Json& view : json["bufferViews"]) {
-      const std::size_t buffer = view.value("buffer", std::size_t{0});
-      if (buffer >= base.size()) return Error{doc.file, "a buffer view names a buffer that does not exist"};
-      view["buffer"] = 0;
-      view["byteOffset"] = base[buffer] + view.value("byteOffset", std::size_t{0});
+    // Every file the document came from, none of which may be written.
+    const std::vector<fs::path> inputs = source_files(doc.file, doc.json, doc.new_files);
+    const auto is_input = [&](const fs::path& p) {
+      const fs::path a = fs::absolute(p).lexically_normal();
+      return std::find(inputs.begin(), inputs.end(), a) != inputs.end();
+    };
+    if (is_input(output)) return Error{out_name, "would overwrite an input; write somewhere else", true};
+    if (!glb && is_input(bin_path)) {
+      return Error{out_name, "its buffer " + bin_path.filename().string() + " would overwrite an input; name the output differently", true};
     }
-  }
 
-  // Images by URI: embedded in a .glb (a GLB holds no URIs, data: ones included); written beside a
-  // .gltf when made here, copied beside it when the folder differs.
-  std::vector<std::pair<fs::path, std::string>> files;  // written beside the output: target, bytes
-  if (json.contains("images")) {
-    for (std::size_t i = 0; i < json["images"].size(); ++i) {
-      Json& image = json["images"][i];
-      const std::string uri = image.value("uri", "");
-      if (uri.empty() || (!glb && is_data_uri(uri))) continue;
-      const bool made = doc.new_files.contains(uri);
-      if (!glb && !made && out_folder == doc.folder.lexically_normal()) continue;
-      auto bytes = image_bytes(doc, i);
-      if (!bytes) return bytes.error();
-      if (!glb) {
-        const fs::path target = output.parent_path() / decode_uri(uri);
-        if (is_input(target)) return Error{out_name, "writing image '" + uri + "' would overwrite an input", true};
-        files.emplace_back(target, std::move(*bytes));
-        continue;
-      }
-      std::string mime = image.value("mimeType", "");
-      if (mime.empty() && is_data_uri(uri)) mime = uri.substr(5, uri.find(';') - 5);
-      if (mime.empty()) mime = mime_type_of(decode_uri(uri));
-      if (mime.empty()) return Error{doc.file, "image " + std::to_string(i) + ": unknown type, cannot embed it in a GLB"};
+    // All buffers become one: each starts 4-byte aligned, the views move with it.
+    Json json = doc.json;
+    std::string bin;
+    std::vector<std::size_t> base(doc.buffers.size());
+    for (std::size_t i = 0; i < doc.buffers.size(); ++i) {
       pad(bin, 4, '\0');
-      json["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", bin.size()}, {"byteLength", bytes->size()}});
-      bin += *bytes;
-      image.erase("uri");
-      image["bufferView"] = json["bufferViews"].size() - 1;
-      image["mimeType"] = mime;
+      base[i] = bin.size();
+      bin.append(reinterpret_cast<const char*>(doc.buffers[i].data()), doc.buffers[i].size());
     }
-  }
-  if (bin.empty()) {
-    json.erase("buffers");
-  } else {
-    json["buffers"] = Json::array({{{"byteLength", bin.size()}}});
-    if (!glb) json["buffers"][0]["uri"] = bin_path.filename().string();
-  }
+    if (json.contains("bufferViews")) {
+      for (Json& view : json["bufferViews"]) {
+        const std::size_t buffer = view.value("buffer", std::size_t{0});
+        if (buffer >= base.size()) return Error{doc.file, "a buffer view names a buffer that does not exist"};
+        view["buffer"] = 0;
+        view["byteOffset"] = base[buffer] + view.value("byteOffset", std::size_t{0});
+      }
+    }
 
-  std::vector<fs::path> written;
-  if (!glb && !bin.empty()) {
-    if (Status s = write_file_atomically(bin_path, bin); !s) return s.error();
-    written.push_back(bin_path);
-  }
-  for (const auto& [target, bytes] : files) {
-    std::error_code ec;
-    fs::create_directories(target.parent_path().empty() ? fs::path(".") : target.parent_path(), ec);
-    if (Status s = write_file_atomically(target, bytes); !s) return s.error();
-    written.push_back(target);
-  }
-  if (!glb) {
-    if (Status s = write_file_atomically(output, json.dump(2) + "\n"); !s) return s.error();
+    // Images by URI: embedded in a .glb (a GLB holds no URIs, data: ones included); written beside a
+    // .gltf when made here, copied beside it when the folder differs.
+    std::vector<std::pair<fs::path, std::string>> files;  // written beside the output: target, bytes
+    if (json.contains("images")) {
+      for (std::size_t i = 0; i < json["images"].size(); ++i) {
+        Json& image = json["images"][i];
+        const std::string uri = image.value("uri", "");
+        if (uri.empty() || (!glb && is_data_uri(uri))) continue;
+        const bool made = doc.new_files.contains(uri);
+        if (!glb && !made && out_folder == doc.folder.lexically_normal()) continue;
+        auto bytes = image_bytes(doc, i);
+        if (!bytes) return bytes.error();
+        if (!glb) {
+          const fs::path target = output.parent_path() / decode_uri(uri);
+          if (is_input(target)) return Error{out_name, "writing image '" + uri + "' would overwrite an input", true};
+          files.emplace_back(target, std::move(*bytes));
+          continue;
+        }
+        std::string mime = image.value("mimeType", "");
+        if (mime.empty() && is_data_uri(uri)) mime = uri.substr(5, uri.find(';') - 5);
+        if (mime.empty()) mime = mime_type_of(decode_uri(uri));
+        if (mime.empty()) return Error{doc.file, "image " + std::to_string(i) + ": unknown type, cannot embed it in a GLB"};
+        pad(bin, 4, '\0');
+        json["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", bin.size()}, {"byteLength", bytes->size()}});
+        bin += *bytes;
+        image.erase("uri");
+        image["bufferView"] = json["bufferViews"].size() - 1;
+        image["mimeType"] = mime;
+      }
+    }
+    if (bin.empty()) {
+      json.erase("buffers");
+    } else {
+      json["buffers"] = Json::array({{{"byteLength", bin.size()}}});
+      if (!glb) json["buffers"][0]["uri"] = bin_path.filename().string();
+    }
+
+    std::vector<fs::path> written;
+    if (!glb && !bin.empty()) {
+      if (Status s = write_file_atomically(bin_path, bin); !s) return s.error();
+      written.push_back(bin_path);
+    }
+    for (const auto& [target, bytes] : files) {
+      std::error_code ec;
+      fs::create_directories(target.parent_path().empty() ? fs::path(".") : target.parent_path(), ec);
+      if (Status s = write_file_atomically(target, bytes); !s) return s.error();
+      written.push_back(target);
+    }
+    if (!glb) {
+      if (Status s = write_file_atomically(output, json.dump(2) + "\n"); !s) return s.error();
+      written.push_back(output);
+      return written;
+    }
+
+    std::string text = json.dump();
+    pad(text, 4, ' ');
+    pad(bin, 4, '\0');
+    std::string file;
+    file += "glTF";
+    append_u32(file, 2);
+    append_u32(file, std::uint32_t(12 + 8 + text.size() + (bin.empty() ? 0 : 8 + bin.size())));
+    append_u32(file, std::uint32_t(text.size()));
+    file += "JSON";
+    file += text;
+    if (!bin.empty()) {
+      append_u32(file, std::uint32_t(bin.size()));
+      file += std::string("BIN\0", 4);
+      file += bin;
+    }
+    if (Status s = write_file_atomically(output, file); !s) return s.error();
     written.push_back(output);
     return written;
-  }
-
-  std::string text = json.dump();
-  pad(text, 4, ' ');
-  pad(bin, 4, '\0');
-  std::string file;
-  file += "glTF";
-  append_u32(file, 2);
-  append_u32(file, std::uint32_t(12 + 8 + text.size() + (bin.empty() ? 0 : 8 + bin.size())));
-  append_u32(file, std::uint32_t(text.size()));
-  file += "JSON";
-  file += text;
-  if (!bin.empty()) {
-    append_u32(file, std::uint32_t(bin.size()));
-    file += std::string("BIN\0", 4);
-    file += bin;
-  }
-  if (Status s = write_file_atomically(output, file); !s) return s.error();
-  written.push_back(output);
-  return written;
+  });
 }
 
 }  // namespace matbake::gltf

@@ -1,5 +1,6 @@
 // All image file I/O goes through OpenImageIO here, and only here. Reading and writing work in
 // bands of rows (RowReader, RowWriter); whole-image reads and writes are one band.
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 #include <tbb/parallel_pipeline.h>
 
@@ -7,6 +8,7 @@
 #include <atomic>
 #include <cmath>
 #include <memory>
+#include <optional>
 #include <string>
 #include <thread>
 
@@ -79,9 +81,24 @@ class RowReader {
     std::error_code ec;
     if (!fs::exists(path, ec)) return Error{path.string(), "no such file"};
     if (fs::is_directory(path, ec)) return Error{path.string(), "is a folder, not an image"};
+    return open(path, colour, nullptr);
+  }
+
+  // An image in memory: `name`'s extension picks the reader; `bytes` must outlive the reader.
+  static Result<RowReader> open_memory(std::span<const unsigned char> bytes, const fs::path& name, color::Transfer colour) {
+    auto proxy = std::make_unique<OIIO::Filesystem::IOMemReader>(bytes.data(), bytes.size());
+    auto reader = open(name, colour, proxy.get());
+    if (reader) reader->proxy_ = std::move(proxy);
+    return reader;
+  }
+
+ private:
+  static Result<RowReader> open(const fs::path& path, color::Transfer colour, OIIO::Filesystem::IOProxy* proxy) {
     ImageSpec config;
     config.attribute("oiio:UnassociatedAlpha", 1);
-    auto in = OIIO::ImageInput::open(path.string(), &config);
+    // The readers of OIIO 2.4 look for the proxy in the configuration hint.
+    if (proxy) config.attribute("oiio:ioproxy", TypeDesc::PTR, &proxy);
+    auto in = OIIO::ImageInput::open(path.string(), &config, proxy);
     if (!in) return Error{path.string(), "not a readable image: " + first_line(OIIO::geterror())};
     const ImageSpec& spec = in->spec();
     if (spec.nchannels < 1 || spec.nchannels > 4) {
@@ -92,6 +109,7 @@ class RowReader {
     return RowReader(path, std::move(in), colour);
   }
 
+ public:
   const ImageLayout& layout() const { return layout_; }
   ReadInfo info() const { return {stored_, in_->format_name()}; }
 
@@ -167,6 +185,7 @@ class RowReader {
   }
 
   fs::path path_;
+  std::unique_ptr<OIIO::Filesystem::IOProxy> proxy_;  // the bytes of an image in memory (declared first: outlives in_)
   std::unique_ptr<OIIO::ImageInput> in_;
   color::Transfer colour_;
   ImageLayout layout_;
@@ -185,8 +204,25 @@ class RowWriter {
   static Result<RowWriter> open(const fs::path& path, const ImageLayout& layout, const WriteOptions& options) {
     auto file = AtomicFile::create(path);
     if (!file) return file.error();
-    auto out = OIIO::ImageOutput::create(file->temp_path().string());
+    const fs::path temp = file->temp_path();  // copied: the file is moved in the same call
+    return open(path, temp, std::move(*file), nullptr, layout, options);
+  }
+
+  // Into `bytes`: `name`'s extension picks the writer.
+  static Result<RowWriter> open_memory(std::vector<unsigned char>& bytes, const fs::path& name, const ImageLayout& layout,
+                                       const WriteOptions& options) {
+    auto proxy = std::make_unique<OIIO::Filesystem::IOVecOutput>(bytes);
+    auto writer = open(name, name, std::nullopt, proxy.get(), layout, options);
+    if (writer) writer->proxy_ = std::move(proxy);
+    return writer;
+  }
+
+ private:
+  static Result<RowWriter> open(const fs::path& path, const fs::path& written, std::optional<AtomicFile> file,
+                                OIIO::Filesystem::IOProxy* proxy, const ImageLayout& layout, const WriteOptions& options) {
+    auto out = OIIO::ImageOutput::create(written.string());
     if (!out) return Error{path.string(), "no image writer for this extension: " + first_line(OIIO::geterror())};
+    if (proxy && !out->set_ioproxy(proxy)) return Error{path.string(), "this format cannot be written to memory"};
 
     ImageSpec spec(layout.width, layout.height, layout.channels, type_desc(options.type));
     if (layout.channel_names.size() == std::size_t(layout.channels)) spec.channelnames = layout.channel_names;
@@ -199,12 +235,11 @@ class RowWriter {
     std::string compression = options.compression;
     if (compression.empty() && std::string_view(out->format_name()) == "openexr") compression = "zip";
     if (!compression.empty()) spec.attribute("compression", compression);
-    if (!out->open(file->temp_path().string(), spec)) {
-      return Error{path.string(), "cannot write: " + first_line(out->geterror())};
-    }
-    return RowWriter(path, std::move(file.value()), std::move(out), layout, options);
+    if (!out->open(written.string(), spec)) return Error{path.string(), "cannot write: " + first_line(out->geterror())};
+    return RowWriter(path, std::move(file), std::move(out), layout, options);
   }
 
+ public:
   Status write_rows(int y, int rows, std::span<const float> pixels) {
     switch (options_.type) {
       case SampleType::u8: return encode_and_write<uint8_t>(y, rows, pixels);
@@ -221,11 +256,11 @@ class RowWriter {
                    std::to_string(beyond_half_) + " samples exceed the half-float range (65504); use float samples"};
     }
     if (!out_->close()) return Error{path_.string(), "cannot write: " + first_line(out_->geterror())};
-    return file_.commit();
+    return file_ ? file_->commit() : success();
   }
 
  private:
-  RowWriter(fs::path path, AtomicFile file, std::unique_ptr<OIIO::ImageOutput> out, const ImageLayout& layout,
+  RowWriter(fs::path path, std::optional<AtomicFile> file, std::unique_ptr<OIIO::ImageOutput> out, const ImageLayout& layout,
             const WriteOptions& options)
       : path_(std::move(path)), file_(std::move(file)), out_(std::move(out)), options_(options),
         transfers_(channel_transfers(layout, options.colour)) {}
@@ -257,7 +292,8 @@ class RowWriter {
   }
 
   fs::path path_;
-  AtomicFile file_;
+  std::optional<AtomicFile> file_;  // none when writing to memory
+  std::unique_ptr<OIIO::Filesystem::IOProxy> proxy_;  // declared before out_: outlives it
   std::unique_ptr<OIIO::ImageOutput> out_;
   WriteOptions options_;
   std::vector<color::Transfer> transfers_;
@@ -269,6 +305,24 @@ class RowWriter {
 // compresses in parallel while the next band is read. Measured on a 2048x2048 RGBA PNG -> half
 // zip EXR, 2 cores: 16 rows 1.28 s, 32 rows 0.81 s, 64 rows 0.90 s, 256 rows 0.95 s.
 constexpr int kBandRows = 32;
+
+Result<Image> read_whole(RowReader& reader, ReadInfo* info) {
+  if (info != nullptr) *info = reader.info();
+  Image image;
+  static_cast<ImageLayout&>(image) = reader.layout();
+  image.pixels.resize(image.sample_count());
+  if (Status s = reader.read_rows(0, image.height, image.pixels); !s) return s.error();
+  if (Status s = reader.finish(); !s) return s.error();
+  return image;
+}
+
+Status write_whole(RowWriter& writer, const Image& image) {
+  if (image.channels < 1 || image.channels > 4 || image.pixels.size() != image.sample_count()) {
+    return Error{"", "internal: inconsistent image"};
+  }
+  if (Status s = writer.write_rows(0, image.height, image.pixels); !s) return s;
+  return writer.commit();
+}
 
 }  // namespace
 
@@ -303,96 +357,118 @@ std::vector<color::Transfer> channel_transfers(const ImageLayout& layout, color:
 void set_thread_count(int threads) { OIIO::attribute("threads", threads); }
 
 Result<ReadInfo> probe_image(const fs::path& path) {
-  auto reader = RowReader::open(path, color::Transfer::linear);
-  if (!reader) return reader.error();
-  return reader->info();
+  return guarded(path.string(), [&]() -> Result<ReadInfo> {
+    auto reader = RowReader::open(path, color::Transfer::linear);
+    if (!reader) return reader.error();
+    return reader->info();
+  });
 }
 
 Result<Image> read_image(const fs::path& path, color::Transfer colour, ReadInfo* info) {
-  auto reader = RowReader::open(path, colour);
-  if (!reader) return reader.error();
-  if (info != nullptr) *info = reader->info();
-  Image image;
-  static_cast<ImageLayout&>(image) = reader->layout();
-  image.pixels.resize(image.sample_count());
-  if (Status s = reader->read_rows(0, image.height, image.pixels); !s) return s.error();
-  if (Status s = reader->finish(); !s) return s.error();
-  return image;
+  return guarded(path.string(), [&]() -> Result<Image> {
+    auto reader = RowReader::open(path, colour);
+    if (!reader) return reader.error();
+    return read_whole(*reader, info);
+  });
+}
+
+Result<Image> decode_image(std::span<const unsigned char> bytes, const fs::path& name, color::Transfer colour,
+                           ReadInfo* info) {
+  return guarded(name.string(), [&]() -> Result<Image> {
+    auto reader = RowReader::open_memory(bytes, name, colour);
+    if (!reader) return reader.error();
+    return read_whole(*reader, info);
+  });
+}
+
+Result<std::string> encode_image(const Image& image, const fs::path& name, const WriteOptions& options) {
+  return guarded(name.string(), [&]() -> Result<std::string> {
+    std::vector<unsigned char> bytes;
+    {
+      auto writer = RowWriter::open_memory(bytes, name, image, options);
+      if (!writer) return writer.error();
+      if (Status s = write_whole(*writer, image); !s) return s.error();
+    }
+    return std::string(bytes.begin(), bytes.end());
+  });
 }
 
 Status write_image(const Image& image, const fs::path& path, const WriteOptions& options) {
-  if (image.channels < 1 || image.channels > 4 || image.pixels.size() != image.sample_count()) {
-    return Error{path.string(), "internal: inconsistent image"};
-  }
-  auto writer = RowWriter::open(path, image, options);
-  if (!writer) return writer.error();
-  if (Status s = writer->write_rows(0, image.height, image.pixels); !s) return s;
-  return writer->commit();
+  return guarded(path.string(), [&]() -> Status {
+    if (image.channels < 1 || image.channels > 4 || image.pixels.size() != image.sample_count()) {
+      return Error{path.string(), "internal: inconsistent image"};
+    }
+    auto writer = RowWriter::open(path, image, options);
+    if (!writer) return writer.error();
+    return write_whole(*writer, image);
+  });
 }
 
 Status stream_image(const fs::path& input, color::Transfer decode, const fs::path& output, const WriteOptions& options,
                     const BandTransform& transform, ReadInfo* info, ImageLayout* layout_out) {
-  auto reader = RowReader::open(input, decode);
-  if (!reader) return reader.error();
-  const ImageLayout& layout = reader->layout();
-  if (info != nullptr) *info = reader->info();
-  if (layout_out != nullptr) *layout_out = layout;
-  if (transform.accept) {
-    if (Status s = transform.accept(layout); !s) return s;
-  }
-  auto writer = RowWriter::open(output, layout, options);
-  if (!writer) return writer.error();
+  return guarded(input.string(), [&]() -> Status {
+    auto reader = RowReader::open(input, decode);
+    if (!reader) return reader.error();
+    const ImageLayout& layout = reader->layout();
+    if (info != nullptr) *info = reader->info();
+    if (layout_out != nullptr) *layout_out = layout;
+    if (transform.accept) {
+      if (Status s = transform.accept(layout); !s) return s;
+    }
+    auto writer = RowWriter::open(output, layout, options);
+    if (!writer) return writer.error();
 
-  struct Band {
-    int y = 0;
-    int rows = 0;
-    std::vector<float> pixels;
-  };
-  // Stage 1 alone touches the reader and read_error, stage 3 alone the writer and write_error; the
-  // atomic flag is all they share. After bad input the rest is still read (so the error counts it
-  // all) but nothing more is transformed or written.
-  std::optional<Error> read_error, write_error;
-  std::atomic<bool> stop{false};
-  int next_row = 0;
-  const std::size_t row_samples = std::size_t(layout.width) * layout.channels;
-  // Read in order, transform in parallel, write in order: decoding, OCIO and compression overlap.
-  const std::size_t tokens = 2 * std::max(1u, std::thread::hardware_concurrency());
-  tbb::parallel_pipeline(
-      tokens,
-      tbb::make_filter<void, std::shared_ptr<Band>>(
-          tbb::filter_mode::serial_in_order,
-          [&](tbb::flow_control& fc) -> std::shared_ptr<Band> {
-            if (read_error || next_row >= layout.height) {
-              fc.stop();
-              return nullptr;
-            }
-            auto band = std::make_shared<Band>();
-            band->y = next_row;
-            band->rows = std::min(kBandRows, layout.height - next_row);
-            band->pixels.resize(row_samples * band->rows);
-            next_row += band->rows;
-            if (Status s = reader->read_rows(band->y, band->rows, band->pixels); !s) read_error = s.error();
-            if (read_error || reader->failed()) stop = true;
-            return band;
-          }) &
-          tbb::make_filter<std::shared_ptr<Band>, std::shared_ptr<Band>>(
-              tbb::filter_mode::parallel,
-              [&](std::shared_ptr<Band> band) {
-                if (transform.apply && !stop) transform.apply(band->pixels, layout);
-                return band;
-              }) &
-          tbb::make_filter<std::shared_ptr<Band>, void>(
-              tbb::filter_mode::serial_in_order, [&](std::shared_ptr<Band> band) {
-                if (stop) return;
-                if (Status s = writer->write_rows(band->y, band->rows, band->pixels); !s) {
-                  write_error = s.error();
-                  stop = true;
-                }
-              }));
-  if (read_error) return *read_error;
-  if (write_error) return *write_error;
-  if (Status s = reader->finish(); !s) return s;
-  return writer->commit();
+    struct Band {
+      int y = 0;
+      int rows = 0;
+      std::vector<float> pixels;
+    };
+    // Stage 1 alone touches the reader and read_error, stage 3 alone the writer and write_error; the
+    // atomic flag is all they share. After bad input the rest is still read (so the error counts it
+    // all) but nothing more is transformed or written.
+    std::optional<Error> read_error, write_error;
+    std::atomic<bool> stop{false};
+    int next_row = 0;
+    const std::size_t row_samples = std::size_t(layout.width) * layout.channels;
+    // Read in order, transform in parallel, write in order: decoding, OCIO and compression overlap.
+    const std::size_t tokens = 2 * std::max(1u, std::thread::hardware_concurrency());
+    tbb::parallel_pipeline(
+        tokens,
+        tbb::make_filter<void, std::shared_ptr<Band>>(
+            tbb::filter_mode::serial_in_order,
+            [&](tbb::flow_control& fc) -> std::shared_ptr<Band> {
+              if (read_error || next_row >= layout.height) {
+                fc.stop();
+                return nullptr;
+              }
+              auto band = std::make_shared<Band>();
+              band->y = next_row;
+              band->rows = std::min(kBandRows, layout.height - next_row);
+              band->pixels.resize(row_samples * band->rows);
+              next_row += band->rows;
+              if (Status s = reader->read_rows(band->y, band->rows, band->pixels); !s) read_error = s.error();
+              if (read_error || reader->failed()) stop = true;
+              return band;
+            }) &
+            tbb::make_filter<std::shared_ptr<Band>, std::shared_ptr<Band>>(
+                tbb::filter_mode::parallel,
+                [&](std::shared_ptr<Band> band) {
+                  if (transform.apply && !stop) transform.apply(band->pixels, layout);
+                  return band;
+                }) &
+            tbb::make_filter<std::shared_ptr<Band>, void>(
+                tbb::filter_mode::serial_in_order, [&](std::shared_ptr<Band> band) {
+                  if (stop) return;
+                  if (Status s = writer->write_rows(band->y, band->rows, band->pixels); !s) {
+                    write_error = s.error();
+                    stop = true;
+                  }
+                }));
+    if (read_error) return *read_error;
+    if (write_error) return *write_error;
+    if (Status s = reader->finish(); !s) return s;
+    return writer->commit();
+  });
 }
 
 }  // namespace matbake::image

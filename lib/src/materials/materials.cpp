@@ -65,65 +65,67 @@ std::string_view f0_class_name(F0Class c) {
 }
 
 Result<std::vector<Material>> parse_table(std::string_view toml_text, const std::string& origin) {
-  toml::table doc;
-  try {
-    doc = toml::parse(toml_text, origin);
-  } catch (const toml::parse_error& e) {
-    return Error{origin, "not valid TOML: " + std::string(e.description()) + " (line " +
-                             std::to_string(e.source().begin.line) + ")"};
-  }
-  const toml::array* entries = doc["material"].as_array();
-  if (!entries || entries->empty()) return Error{origin, "no [[material]] entries"};
-  std::vector<Material> table;
-  for (std::size_t i = 0; i < entries->size(); ++i) {
-    const toml::table* entry = (*entries)[i].as_table();
-    const std::string where = "entry " + std::to_string(i + 1);
-    if (!entry) return Error{origin, where + ": not a table"};
-    Material m;
-    m.name = entry->get("name") ? (*entry)["name"].value_or(std::string()) : "";
-    if (m.name.empty()) return Error{origin, where + ": needs a \"name\""};
-    if (find(table, m.name)) return Error{origin, m.name + ": listed twice"};
-    const std::string cls = (*entry)["class"].value_or(std::string());
-    if (cls == "dielectric") {
-      m.material_class = MaterialClass::dielectric;
-    } else if (cls == "gem") {
-      m.material_class = MaterialClass::gem;
-    } else if (cls == "semiconductor") {
-      m.material_class = MaterialClass::semiconductor;
-    } else if (cls == "metal") {
-      m.material_class = MaterialClass::metal;
-    } else {
-      return Error{origin, m.name + ": \"class\" must be dielectric, gem, semiconductor or metal"};
+  return guarded(origin, [&]() -> Result<std::vector<Material>> {
+    toml::table doc;
+    try {
+      doc = toml::parse(toml_text, origin);
+    } catch (const toml::parse_error& e) {
+      return Error{origin, "not valid TOML: " + std::string(e.description()) + " (line " +
+                               std::to_string(e.source().begin.line) + ")"};
     }
-    auto f0 = read_rgb(*entry, "f0", origin, m.name);
-    if (!f0) return f0.error();
-    m.f0 = *f0;
-    for (int c = 0; c < 3; ++c) {
-      if (!(m.f0[c] >= 0 && m.f0[c] <= 1)) return Error{origin, m.name + ": f0 outside [0, 1]"};
-    }
-    if (const toml::array* range = (*entry)["f0_range"].as_array()) {
-      if (range->size() != 2 || !(*range)[0].is_number() || !(*range)[1].is_number()) {
-        return Error{origin, m.name + ": \"f0_range\" must be 2 numbers"};
+    const toml::array* entries = doc["material"].as_array();
+    if (!entries || entries->empty()) return Error{origin, "no [[material]] entries"};
+    std::vector<Material> table;
+    for (std::size_t i = 0; i < entries->size(); ++i) {
+      const toml::table* entry = (*entries)[i].as_table();
+      const std::string where = "entry " + std::to_string(i + 1);
+      if (!entry) return Error{origin, where + ": not a table"};
+      Material m;
+      m.name = entry->get("name") ? (*entry)["name"].value_or(std::string()) : "";
+      if (m.name.empty()) return Error{origin, where + ": needs a \"name\""};
+      if (find(table, m.name)) return Error{origin, m.name + ": listed twice"};
+      const std::string cls = (*entry)["class"].value_or(std::string());
+      if (cls == "dielectric") {
+        m.material_class = MaterialClass::dielectric;
+      } else if (cls == "gem") {
+        m.material_class = MaterialClass::gem;
+      } else if (cls == "semiconductor") {
+        m.material_class = MaterialClass::semiconductor;
+      } else if (cls == "metal") {
+        m.material_class = MaterialClass::metal;
+      } else {
+        return Error{origin, m.name + ": \"class\" must be dielectric, gem, semiconductor or metal"};
       }
-      m.f0_range = std::array<double, 2>{*(*range)[0].value<double>(), *(*range)[1].value<double>()};
+      auto f0 = read_rgb(*entry, "f0", origin, m.name);
+      if (!f0) return f0.error();
+      m.f0 = *f0;
+      for (int c = 0; c < 3; ++c) {
+        if (!(m.f0[c] >= 0 && m.f0[c] <= 1)) return Error{origin, m.name + ": f0 outside [0, 1]"};
+      }
+      if (const toml::array* range = (*entry)["f0_range"].as_array()) {
+        if (range->size() != 2 || !(*range)[0].is_number() || !(*range)[1].is_number()) {
+          return Error{origin, m.name + ": \"f0_range\" must be 2 numbers"};
+        }
+        m.f0_range = std::array<double, 2>{*(*range)[0].value<double>(), *(*range)[1].value<double>()};
+      }
+      if (const toml::array* code = (*entry)["table_code"].as_array()) {
+        for (const auto& c : *code) m.table_code.push_back(int(c.value_or<int64_t>(-1)));
+      }
+      m.ior = (*entry)["ior"].value<double>();
+      if (entry->contains("ior_n") || entry->contains("ior_k")) {
+        auto n = read_rgb(*entry, "ior_n", origin, m.name);
+        if (!n) return n.error();
+        auto k = read_rgb(*entry, "ior_k", origin, m.name);
+        if (!k) return k.error();
+        m.ior_n = *n;
+        m.ior_k = *k;
+      }
+      m.source = (*entry)["source"].value_or(std::string());
+      if (m.source.empty()) return Error{origin, m.name + ": needs a \"source\" (a fact with a citation)"};
+      table.push_back(std::move(m));
     }
-    if (const toml::array* code = (*entry)["table_code"].as_array()) {
-      for (const auto& c : *code) m.table_code.push_back(int(c.value_or<int64_t>(-1)));
-    }
-    m.ior = (*entry)["ior"].value<double>();
-    if (entry->contains("ior_n") || entry->contains("ior_k")) {
-      auto n = read_rgb(*entry, "ior_n", origin, m.name);
-      if (!n) return n.error();
-      auto k = read_rgb(*entry, "ior_k", origin, m.name);
-      if (!k) return k.error();
-      m.ior_n = *n;
-      m.ior_k = *k;
-    }
-    m.source = (*entry)["source"].value_or(std::string());
-    if (m.source.empty()) return Error{origin, m.name + ": needs a \"source\" (a fact with a citation)"};
-    table.push_back(std::move(m));
-  }
-  return table;
+    return table;
+  });
 }
 
 Result<std::vector<Material>> load_table(const std::filesystem::path& path) {

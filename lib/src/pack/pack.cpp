@@ -147,24 +147,26 @@ std::vector<std::string> builtin_layout_names() {
 }
 
 Result<Layout> parse_layout(std::string_view json_text, const std::string& origin) {
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(json_text);
-  } catch (const nlohmann::json::parse_error& e) {
-    return Error{origin, "not a valid layout (JSON): " + std::string(e.what())};
-  }
-  if (!j.is_object() || !j.contains("textures") || !j["textures"].is_array() || j["textures"].empty()) {
-    return Error{origin, "a layout needs a non-empty \"textures\" array"};
-  }
-  Layout layout;
-  layout.name = j.value("name", fs::path(origin).stem().string());
-  layout.description = j.value("description", "");
-  for (std::size_t i = 0; i < j["textures"].size(); ++i) {
-    auto t = parse_texture(j["textures"][i], origin, i);
-    if (!t) return t.error();
-    layout.textures.push_back(std::move(t.value()));
-  }
-  return layout;
+  return guarded(origin, [&]() -> Result<Layout> {
+    nlohmann::json j;
+    try {
+      j = nlohmann::json::parse(json_text);
+    } catch (const nlohmann::json::parse_error& e) {
+      return Error{origin, "not a valid layout (JSON): " + std::string(e.what())};
+    }
+    if (!j.is_object() || !j.contains("textures") || !j["textures"].is_array() || j["textures"].empty()) {
+      return Error{origin, "a layout needs a non-empty \"textures\" array"};
+    }
+    Layout layout;
+    layout.name = j.value("name", fs::path(origin).stem().string());
+    layout.description = j.value("description", "");
+    for (std::size_t i = 0; i < j["textures"].size(); ++i) {
+      auto t = parse_texture(j["textures"][i], origin, i);
+      if (!t) return t.error();
+      layout.textures.push_back(std::move(t.value()));
+    }
+    return layout;
+  });
 }
 
 Result<Layout> find_layout(const std::string& name_or_path) {
@@ -196,90 +198,94 @@ Result<color::Transfer> decode_transfer(const fs::path& path, color::Transfer au
 }
 
 Result<SourceMaps> load_sources(const std::vector<SourceInput>& inputs, const LoadOptions& options) {
-  SourceMaps result;
-  std::map<std::string, std::string> origin;  // source → file, for size errors
-  for (const SourceInput& input : inputs) {
-    const Source* source = find_source(input.name);
-    if (!source) return Error{"", "unknown source \"" + input.name + "\"", true};
-    if (input.file.empty()) continue;
-    color::Transfer decode = color::Transfer::linear;
-    if (source->kind == SourceKind::color) {
-      if (options.input) {
-        decode = *options.input;
-      } else {
-        auto t = decode_transfer(input.file, options.authored);
-        if (!t) return t.error();
-        decode = *t;
+  return guarded("", [&]() -> Result<SourceMaps> {
+    SourceMaps result;
+    std::map<std::string, std::string> origin;  // source → file, for size errors
+    for (const SourceInput& input : inputs) {
+      const Source* source = find_source(input.name);
+      if (!source) return Error{"", "unknown source \"" + input.name + "\"", true};
+      if (input.file.empty()) continue;
+      color::Transfer decode = color::Transfer::linear;
+      if (source->kind == SourceKind::color) {
+        if (options.input) {
+          decode = *options.input;
+        } else {
+          auto t = decode_transfer(input.file, options.authored);
+          if (!t) return t.error();
+          decode = *t;
+        }
       }
+      auto file = options.read ? options.read(input.file, decode) : read_shared(input.file, decode);
+      if (!file) return file.error();
+      result.maps[input.name] = source_from_file(**file, source->kind);
+      origin[input.name] = input.file.string();
     }
-    auto file = options.read ? options.read(input.file, decode) : read_shared(input.file, decode);
-    if (!file) return file.error();
-    result.maps[input.name] = source_from_file(**file, source->kind);
-    origin[input.name] = input.file.string();
-  }
-  // One size for all: the largest by pixel count, the others resized to it or refused.
-  const image::Image* largest = nullptr;
-  for (const auto& [name, map] : result.maps) {
-    if (!largest || std::size_t(map.width) * map.height > std::size_t(largest->width) * largest->height) largest = &map;
-  }
-  if (largest) {
-    result.width = largest->width;
-    result.height = largest->height;
-    for (auto& [name, map] : result.maps) {
-      if (map.width == result.width && map.height == result.height) continue;
-      if (!options.resize) {
-        const auto& first = *std::find_if(result.maps.begin(), result.maps.end(), [&](const auto& m) {
-          return m.second.width == result.width && m.second.height == result.height;
-        });
-        return Error{origin[name], std::to_string(map.width) + "x" + std::to_string(map.height) + ", but " +
-                                       origin[first.first] + " is " + std::to_string(result.width) + "x" +
-                                       std::to_string(result.height) + " (--resize resamples to the largest)"};
+    // One size for all: the largest by pixel count, the others resized to it or refused.
+    const image::Image* largest = nullptr;
+    for (const auto& [name, map] : result.maps) {
+      if (!largest || std::size_t(map.width) * map.height > std::size_t(largest->width) * largest->height) largest = &map;
+    }
+    if (largest) {
+      result.width = largest->width;
+      result.height = largest->height;
+      for (auto& [name, map] : result.maps) {
+        if (map.width == result.width && map.height == result.height) continue;
+        if (!options.resize) {
+          const auto& first = *std::find_if(result.maps.begin(), result.maps.end(), [&](const auto& m) {
+            return m.second.width == result.width && m.second.height == result.height;
+          });
+          return Error{origin[name], std::to_string(map.width) + "x" + std::to_string(map.height) + ", but " +
+                                         origin[first.first] + " is " + std::to_string(result.width) + "x" +
+                                         std::to_string(result.height) + " (--resize resamples to the largest)"};
+        }
+        map = image::resize_image(map, result.width, result.height);
       }
-      map = image::resize_image(map, result.width, result.height);
+    } else {
+      result.width = options.width > 0 ? options.width : 1;
+      result.height = options.height > 0 ? options.height : 1;
     }
-  } else {
-    result.width = options.width > 0 ? options.width : 1;
-    result.height = options.height > 0 ? options.height : 1;
-  }
-  for (const SourceInput& input : inputs) {
-    if (!input.file.empty()) continue;
-    const Source* source = find_source(input.name);
-    const int components = component_count(source->kind);
-    const std::size_t n = input.constant.size();
-    if (!(n == 1 || (n == 3 && source->kind == SourceKind::color))) {
-      return Error{"", option_name(input.name) + ": " + (source->kind == SourceKind::color ? "1 or 3 values" : "one value") +
-                           " expected, got " + std::to_string(n), true};
+    for (const SourceInput& input : inputs) {
+      if (!input.file.empty()) continue;
+      const Source* source = find_source(input.name);
+      const int components = component_count(source->kind);
+      const std::size_t n = input.constant.size();
+      if (!(n == 1 || (n == 3 && source->kind == SourceKind::color))) {
+        return Error{"", option_name(input.name) + ": " + (source->kind == SourceKind::color ? "1 or 3 values" : "one value") +
+                             " expected, got " + std::to_string(n), true};
+      }
+      image::Image map = blank(result.width, result.height, components);
+      for (std::size_t i = 0; i < map.pixels.size(); ++i) {
+        map.pixels[i] = float(input.constant[n == 1 ? 0 : i % std::size_t(components)]);
+      }
+      result.maps[input.name] = std::move(map);
     }
-    image::Image map = blank(result.width, result.height, components);
-    for (std::size_t i = 0; i < map.pixels.size(); ++i) {
-      map.pixels[i] = float(input.constant[n == 1 ? 0 : i % std::size_t(components)]);
-    }
-    result.maps[input.name] = std::move(map);
-  }
-  return result;
+    return result;
+  });
 }
 
 Result<SourceMaps> read_packed(const Layout& layout, const std::vector<std::filesystem::path>& files,
                                std::optional<color::Transfer> input, color::Transfer authored, const ImageReader& read) {
-  if (files.size() != layout.textures.size()) {
-    return Error{"", "layout " + layout.name + " takes " + std::to_string(layout.textures.size()) + " textures, got " +
-                         std::to_string(files.size()), true};
-  }
-  std::vector<image::Image> textures;
-  std::vector<std::string> paths;
-  for (std::size_t t = 0; t < files.size(); ++t) {
-    color::Transfer decode = color::Transfer::linear;
-    if (layout.textures[t].color) {
-      auto d = input ? Result<color::Transfer>(*input) : decode_transfer(files[t], authored);
-      if (!d) return d.error();
-      decode = *d;
+  return guarded("", [&]() -> Result<SourceMaps> {
+    if (files.size() != layout.textures.size()) {
+      return Error{"", "layout " + layout.name + " takes " + std::to_string(layout.textures.size()) + " textures, got " +
+                           std::to_string(files.size()), true};
     }
-    auto image = read ? read(files[t], decode) : read_shared(files[t], decode);
-    if (!image) return image.error();
-    textures.push_back(**image);
-    paths.push_back(files[t].string());
-  }
-  return unpack(layout, textures, paths);
+    std::vector<image::Image> textures;
+    std::vector<std::string> paths;
+    for (std::size_t t = 0; t < files.size(); ++t) {
+      color::Transfer decode = color::Transfer::linear;
+      if (layout.textures[t].color) {
+        auto d = input ? Result<color::Transfer>(*input) : decode_transfer(files[t], authored);
+        if (!d) return d.error();
+        decode = *d;
+      }
+      auto image = read ? read(files[t], decode) : read_shared(files[t], decode);
+      if (!image) return image.error();
+      textures.push_back(**image);
+      paths.push_back(files[t].string());
+    }
+    return unpack(layout, textures, paths);
+  });
 }
 
 std::vector<std::string> layout_sources(const Layout& layout) {
@@ -293,64 +299,68 @@ std::vector<std::string> layout_sources(const Layout& layout) {
 }
 
 Result<std::vector<image::Image>> pack(const Layout& layout, const SourceMaps& sources) {
-  std::vector<image::Image> textures;
-  for (const Texture& t : layout.textures) {
-    image::Image out = blank(sources.width, sources.height, int(t.channels.size()));
-    const std::size_t texels = std::size_t(out.width) * std::size_t(out.height), stride = t.channels.size();
-    for (std::size_t c = 0; c < stride; ++c) {
-      const Channel& channel = t.channels[c];
-      const image::Image* map = channel.source.empty() ? nullptr : sources.find(channel.source);
-      if (!map && !channel.fallback) {
-        return Error{"", "layout " + layout.name + " needs " + channel.source + " (" + option_name(channel.source) + ")",
-                     true};
+  return guarded("", [&]() -> Result<std::vector<image::Image>> {
+    std::vector<image::Image> textures;
+    for (const Texture& t : layout.textures) {
+      image::Image out = blank(sources.width, sources.height, int(t.channels.size()));
+      const std::size_t texels = std::size_t(out.width) * std::size_t(out.height), stride = t.channels.size();
+      for (std::size_t c = 0; c < stride; ++c) {
+        const Channel& channel = t.channels[c];
+        const image::Image* map = channel.source.empty() ? nullptr : sources.find(channel.source);
+        if (!map && !channel.fallback) {
+          return Error{"", "layout " + layout.name + " needs " + channel.source + " (" + option_name(channel.source) + ")",
+                       true};
+        }
+        for (std::size_t i = 0; i < texels; ++i) {
+          const double x = map ? map->pixels[i * std::size_t(map->channels) + std::size_t(channel.component)]
+                               : *channel.fallback;
+          out.pixels[i * stride + c] = float(apply(channel.transform, x));
+        }
       }
-      for (std::size_t i = 0; i < texels; ++i) {
-        const double x = map ? map->pixels[i * std::size_t(map->channels) + std::size_t(channel.component)]
-                             : *channel.fallback;
-        out.pixels[i * stride + c] = float(apply(channel.transform, x));
-      }
+      textures.push_back(std::move(out));
     }
-    textures.push_back(std::move(out));
-  }
-  return textures;
+    return textures;
+  });
 }
 
 Result<SourceMaps> unpack(const Layout& layout, std::span<const image::Image> textures,
                           std::span<const std::string> texture_paths) {
-  if (textures.size() != layout.textures.size()) {
-    return Error{"", "layout " + layout.name + " has " + std::to_string(layout.textures.size()) + " textures, got " +
-                         std::to_string(textures.size()), true};
-  }
-  SourceMaps result;
-  result.width = textures[0].width;
-  result.height = textures[0].height;
-  for (std::size_t t = 0; t < textures.size(); ++t) {
-    const image::Image& in = textures[t];
-    const Texture& spec = layout.textures[t];
-    if (in.width != result.width || in.height != result.height) {
-      return Error{texture_paths[t], std::to_string(in.width) + "x" + std::to_string(in.height) + ", but " +
-                                         texture_paths[0] + " is " + std::to_string(result.width) + "x" +
-                                         std::to_string(result.height)};
+  return guarded("", [&]() -> Result<SourceMaps> {
+    if (textures.size() != layout.textures.size()) {
+      return Error{"", "layout " + layout.name + " has " + std::to_string(layout.textures.size()) + " textures, got " +
+                           std::to_string(textures.size()), true};
     }
-    if (in.channels < int(spec.channels.size())) {
-      return Error{texture_paths[t], std::to_string(in.channels) + " channels; layout " + layout.name + " texture " +
-                                         spec.name + " has " + std::to_string(spec.channels.size())};
-    }
-    const std::size_t texels = std::size_t(in.width) * std::size_t(in.height);
-    for (std::size_t c = 0; c < spec.channels.size(); ++c) {
-      const Channel& channel = spec.channels[c];
-      if (channel.source.empty()) continue;
-      const SourceKind kind = find_source(channel.source)->kind;
-      auto [it, inserted] = result.maps.try_emplace(channel.source);
-      if (inserted) it->second = blank(in.width, in.height, component_count(kind));
-      image::Image& map = it->second;
-      for (std::size_t i = 0; i < texels; ++i) {
-        map.pixels[i * std::size_t(map.channels) + std::size_t(channel.component)] =
-            float(apply(channel.transform, in.pixels[i * std::size_t(in.channels) + c]));
+    SourceMaps result;
+    result.width = textures[0].width;
+    result.height = textures[0].height;
+    for (std::size_t t = 0; t < textures.size(); ++t) {
+      const image::Image& in = textures[t];
+      const Texture& spec = layout.textures[t];
+      if (in.width != result.width || in.height != result.height) {
+        return Error{texture_paths[t], std::to_string(in.width) + "x" + std::to_string(in.height) + ", but " +
+                                           texture_paths[0] + " is " + std::to_string(result.width) + "x" +
+                                           std::to_string(result.height)};
+      }
+      if (in.channels < int(spec.channels.size())) {
+        return Error{texture_paths[t], std::to_string(in.channels) + " channels; layout " + layout.name + " texture " +
+                                           spec.name + " has " + std::to_string(spec.channels.size())};
+      }
+      const std::size_t texels = std::size_t(in.width) * std::size_t(in.height);
+      for (std::size_t c = 0; c < spec.channels.size(); ++c) {
+        const Channel& channel = spec.channels[c];
+        if (channel.source.empty()) continue;
+        const SourceKind kind = find_source(channel.source)->kind;
+        auto [it, inserted] = result.maps.try_emplace(channel.source);
+        if (inserted) it->second = blank(in.width, in.height, component_count(kind));
+        image::Image& map = it->second;
+        for (std::size_t i = 0; i < texels; ++i) {
+          map.pixels[i * std::size_t(map.channels) + std::size_t(channel.component)] =
+              float(apply(channel.transform, in.pixels[i * std::size_t(in.channels) + c]));
+        }
       }
     }
-  }
-  return result;
+    return result;
+  });
 }
 
 image::WriteOptions write_options(bool color, const OutputOptions& options) {
@@ -382,29 +392,31 @@ image::SampleType default_sample_type(const fs::path& path) {
 }
 
 Result<std::vector<fs::path>> write_textures(const Layout& layout, const SourceMaps& sources, const WriteRequest& request) {
-  auto paths = output_paths(layout, request.outputs);
-  if (!paths) return paths.error();
-  for (std::size_t i = 0; i < paths->size(); ++i) {
-    const fs::path& out = (*paths)[i];
-    std::error_code ec;
-    for (const fs::path& in : request.inputs) {
-      if (fs::equivalent(out, in, ec)) return Error{out.string(), "is an input; matbake never overwrites its inputs", true};
-    }
-    for (std::size_t j = 0; j < i; ++j) {
-      if (out.lexically_normal() == (*paths)[j].lexically_normal() || fs::equivalent(out, (*paths)[j], ec)) {
-        return Error{out.string(), "is written twice (textures " + layout.textures[j].name + " and " +
-                                       layout.textures[i].name + ")", true};
+  return guarded("", [&]() -> Result<std::vector<fs::path>> {
+    auto paths = output_paths(layout, request.outputs);
+    if (!paths) return paths.error();
+    for (std::size_t i = 0; i < paths->size(); ++i) {
+      const fs::path& out = (*paths)[i];
+      std::error_code ec;
+      for (const fs::path& in : request.inputs) {
+        if (fs::equivalent(out, in, ec)) return Error{out.string(), "is an input; matbake never overwrites its inputs", true};
+      }
+      for (std::size_t j = 0; j < i; ++j) {
+        if (out.lexically_normal() == (*paths)[j].lexically_normal() || fs::equivalent(out, (*paths)[j], ec)) {
+          return Error{out.string(), "is written twice (textures " + layout.textures[j].name + " and " +
+                                         layout.textures[i].name + ")", true};
+        }
       }
     }
-  }
-  auto images = pack(layout, sources);
-  if (!images) return images.error();
-  for (std::size_t t = 0; t < paths->size(); ++t) {
-    const image::SampleType type = request.type.value_or(default_sample_type((*paths)[t]));
-    const image::WriteOptions options = write_options(layout.textures[t].color, {type, request.transfer});
-    if (Status s = image::write_image((*images)[t], (*paths)[t], options); !s) return s.error();
-  }
-  return paths;
+    auto images = pack(layout, sources);
+    if (!images) return images.error();
+    for (std::size_t t = 0; t < paths->size(); ++t) {
+      const image::SampleType type = request.type.value_or(default_sample_type((*paths)[t]));
+      const image::WriteOptions options = write_options(layout.textures[t].color, {type, request.transfer});
+      if (Status s = image::write_image((*images)[t], (*paths)[t], options); !s) return s.error();
+    }
+    return paths;
+  });
 }
 
 }  // namespace matbake::pack

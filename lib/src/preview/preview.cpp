@@ -76,93 +76,97 @@ Status check(const Material& m) {
 }
 
 Result<std::vector<Material>> load_materials(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  if (!in) return Error{path.string(), "cannot open"};
-  std::vector<Material> materials;
-  try {
-    const nlohmann::json doc = nlohmann::json::parse(in);
-    if (!doc.is_array()) return Error{path.string(), "expected a JSON array of materials"};
-    for (const auto& entry : doc) {
-      const auto colour = [&](const char* key) {
-        const auto& c = entry.at(key);
-        return Vec3(c.at(0).get<double>(), c.at(1).get<double>(), c.at(2).get<double>());
-      };
-      const std::string name = entry.value("name", "material " + std::to_string(materials.size() + 1));
-      Material m;
-      if (entry.contains("base_color")) {
-        m = from_metal_rough(name, colour("base_color"), entry.value("metallic", 0.0), entry.value("roughness", 0.5));
-      } else {
-        m.name = name;
-        m.kd = colour("kd");
-        m.ks = colour("ks");
-        m.gloss = entry.at("gloss").get<double>();
+  return guarded(path.string(), [&]() -> Result<std::vector<Material>> {
+    std::ifstream in(path);
+    if (!in) return Error{path.string(), "cannot open"};
+    std::vector<Material> materials;
+    try {
+      const nlohmann::json doc = nlohmann::json::parse(in);
+      if (!doc.is_array()) return Error{path.string(), "expected a JSON array of materials"};
+      for (const auto& entry : doc) {
+        const auto colour = [&](const char* key) {
+          const auto& c = entry.at(key);
+          return Vec3(c.at(0).get<double>(), c.at(1).get<double>(), c.at(2).get<double>());
+        };
+        const std::string name = entry.value("name", "material " + std::to_string(materials.size() + 1));
+        Material m;
+        if (entry.contains("base_color")) {
+          m = from_metal_rough(name, colour("base_color"), entry.value("metallic", 0.0), entry.value("roughness", 0.5));
+        } else {
+          m.name = name;
+          m.kd = colour("kd");
+          m.ks = colour("ks");
+          m.gloss = entry.at("gloss").get<double>();
+        }
+        if (Status s = check(m); !s) return Error{path.string(), s.error().message};
+        materials.push_back(std::move(m));
       }
-      if (Status s = check(m); !s) return Error{path.string(), s.error().message};
-      materials.push_back(std::move(m));
+    } catch (const nlohmann::json::exception& e) {
+      const std::string what = e.what();
+      return Error{path.string(), "invalid material JSON: " + what.substr(0, what.find('\n'))};
     }
-  } catch (const nlohmann::json::exception& e) {
-    const std::string what = e.what();
-    return Error{path.string(), "invalid material JSON: " + what.substr(0, what.find('\n'))};
-  }
-  if (materials.empty()) return Error{path.string(), "no materials"};
-  return materials;
+    if (materials.empty()) return Error{path.string(), "no materials"};
+    return materials;
+  });
 }
 
 Result<Preview> render(const std::vector<Material>& materials, const Options& options) {
-  const shading::ModelInfo* model = shading::find_model(options.model);
-  if (model == nullptr) return Error{"", "unknown model '" + options.model + "'", true};
-  if (materials.empty()) return Error{"", "no materials to preview", true};
-  if (options.cell_size < 8 || options.cell_size > 4096) return Error{"", "cell size must be 8 to 4096", true};
-  for (const Material& m : materials) {
-    if (Status s = check(m); !s) return s.error();
-  }
-  for (double g : options.glosses) {
-    if (!(g >= 0.0 && g <= 1.0)) return Error{"", "gloss " + std::to_string(g) + " is outside [0, 1]", true};
-  }
-
-  Preview preview;
-  const int columns = options.glosses.empty() ? 1 : int(options.glosses.size());
-  const int size = options.cell_size;
-  for (int row = 0; row < int(materials.size()); ++row) {
-    for (int column = 0; column < columns; ++column) {
-      Material m = materials[row];
-      if (!options.glosses.empty()) m.gloss = options.glosses[column];
-      preview.cells.push_back({row, column, column * size, row * size, size, m});
+  return guarded("", [&]() -> Result<Preview> {
+    const shading::ModelInfo* model = shading::find_model(options.model);
+    if (model == nullptr) return Error{"", "unknown model '" + options.model + "'", true};
+    if (materials.empty()) return Error{"", "no materials to preview", true};
+    if (options.cell_size < 8 || options.cell_size > 4096) return Error{"", "cell size must be 8 to 4096", true};
+    for (const Material& m : materials) {
+      if (Status s = check(m); !s) return s.error();
     }
-  }
-  image::Image& img = preview.image;
-  img.width = columns * size;
-  img.height = int(materials.size()) * size;
-  img.channels = 3;
-  img.channel_names = {"R", "G", "B"};
-  img.pixels.assign(img.sample_count(), float(kBackground));
+    for (double g : options.glosses) {
+      if (!(g >= 0.0 && g <= 1.0)) return Error{"", "gloss " + std::to_string(g) + " is outside [0, 1]", true};
+    }
 
-  // 2×2 samples per pixel: smooth ball edges.
-  constexpr int kSamples = 2;
-  tbb::parallel_for(std::size_t(0), preview.cells.size(), [&](std::size_t index) {
-    const Cell& cell = preview.cells[index];
-    for (int py = 0; py < size; ++py) {
-      for (int px = 0; px < size; ++px) {
-        Vec3 sum(0.0);
-        for (int sy = 0; sy < kSamples; ++sy) {
-          for (int sx = 0; sx < kSamples; ++sx) {
-            const double x = ((px + (sx + 0.5) / kSamples) / size * 2.0 - 1.0) / kBallRadius;
-            const double z = (1.0 - (py + (sy + 0.5) / kSamples) / size * 2.0) / kBallRadius;
-            const double r2 = x * x + z * z;
-            if (r2 >= 1.0) {
-              sum += Vec3(kBackground);
-              continue;
-            }
-            const Vec3 n(x, std::sqrt(1.0 - r2), z);
-            for (int c = 0; c < 3; ++c) sum[c] += shade(*model, n, cell.material.kd[c], cell.material.ks[c], cell.material.gloss, options.sky);
-          }
-        }
-        float* out = &img.pixels[(std::size_t(cell.y + py) * img.width + cell.x + px) * 3];
-        for (int c = 0; c < 3; ++c) out[c] = float(sum[c] / (kSamples * kSamples));
+    Preview preview;
+    const int columns = options.glosses.empty() ? 1 : int(options.glosses.size());
+    const int size = options.cell_size;
+    for (int row = 0; row < int(materials.size()); ++row) {
+      for (int column = 0; column < columns; ++column) {
+        Material m = materials[row];
+        if (!options.glosses.empty()) m.gloss = options.glosses[column];
+        preview.cells.push_back({row, column, column * size, row * size, size, m});
       }
     }
+    image::Image& img = preview.image;
+    img.width = columns * size;
+    img.height = int(materials.size()) * size;
+    img.channels = 3;
+    img.channel_names = {"R", "G", "B"};
+    img.pixels.assign(img.sample_count(), float(kBackground));
+
+    // 2×2 samples per pixel: smooth ball edges.
+    constexpr int kSamples = 2;
+    tbb::parallel_for(std::size_t(0), preview.cells.size(), [&](std::size_t index) {
+      const Cell& cell = preview.cells[index];
+      for (int py = 0; py < size; ++py) {
+        for (int px = 0; px < size; ++px) {
+          Vec3 sum(0.0);
+          for (int sy = 0; sy < kSamples; ++sy) {
+            for (int sx = 0; sx < kSamples; ++sx) {
+              const double x = ((px + (sx + 0.5) / kSamples) / size * 2.0 - 1.0) / kBallRadius;
+              const double z = (1.0 - (py + (sy + 0.5) / kSamples) / size * 2.0) / kBallRadius;
+              const double r2 = x * x + z * z;
+              if (r2 >= 1.0) {
+                sum += Vec3(kBackground);
+                continue;
+              }
+              const Vec3 n(x, std::sqrt(1.0 - r2), z);
+              for (int c = 0; c < 3; ++c) sum[c] += shade(*model, n, cell.material.kd[c], cell.material.ks[c], cell.material.gloss, options.sky);
+            }
+          }
+          float* out = &img.pixels[(std::size_t(cell.y + py) * img.width + cell.x + px) * 3];
+          for (int c = 0; c < 3; ++c) out[c] = float(sum[c] / (kSamples * kSamples));
+        }
+      }
+    });
+    return preview;
   });
-  return preview;
 }
 
 }  // namespace matbake::preview

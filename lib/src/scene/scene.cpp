@@ -167,131 +167,133 @@ glm::dmat4 local_matrix(const tinygltf::Node& node) {
 float Scene::radius() const { return 0.5f * glm::length(bounds_max - bounds_min); }
 
 Result<Scene> load_scene(const fs::path& path) {
-  const std::string file = path.string();
-  tinygltf::Model model;
-  if (Status loaded = gltf::load_model(path, model); !loaded) return loaded.error();
+  return guarded(path.string(), [&]() -> Result<Scene> {
+    const std::string file = path.string();
+    tinygltf::Model model;
+    if (Status loaded = gltf::load_model(path, model); !loaded) return loaded.error();
 
-  Scene scene;
-  const Reader read{model, file};
-  int scene_index = model.defaultScene;
-  if (scene_index < 0) {
-    if (model.scenes.empty()) return Error{file, "no scene to bake"};
-    scene_index = 0;
-    scene.notes.push_back("no default scene: using scene 0");
-  }
-  if (std::size_t(scene_index) >= model.scenes.size()) return Error{file, "the default scene does not exist"};
+    Scene scene;
+    const Reader read{model, file};
+    int scene_index = model.defaultScene;
+    if (scene_index < 0) {
+      if (model.scenes.empty()) return Error{file, "no scene to bake"};
+      scene_index = 0;
+      scene.notes.push_back("no default scene: using scene 0");
+    }
+    if (std::size_t(scene_index) >= model.scenes.size()) return Error{file, "the default scene does not exist"};
 
-  std::vector<bool> on_path(model.nodes.size(), false);
-  std::size_t ignored_primitives = 0;
-  std::function<Status(int, const glm::dmat4&)> visit = [&](int n, const glm::dmat4& parent) -> Status {
-    if (n < 0 || std::size_t(n) >= model.nodes.size()) return Error{file, "node " + std::to_string(n) + " does not exist"};
-    if (on_path[std::size_t(n)]) return Error{file, "node " + std::to_string(n) + " is its own ancestor"};
-    on_path[std::size_t(n)] = true;
-    const tinygltf::Node& node = model.nodes[std::size_t(n)];
-    const glm::dmat4 world = parent * local_matrix(node);
-    if (node.mesh >= 0) {
-      if (std::size_t(node.mesh) >= model.meshes.size()) {
-        return Error{file, "node " + std::to_string(n) + " refers to mesh " + std::to_string(node.mesh) + ", which does not exist"};
-      }
-      const tinygltf::Mesh& mesh = model.meshes[std::size_t(node.mesh)];
-      for (std::size_t p = 0; p < mesh.primitives.size(); ++p) {
-        const tinygltf::Primitive& prim = mesh.primitives[p];
-        const int mode = prim.mode < 0 ? TINYGLTF_MODE_TRIANGLES : prim.mode;
-        if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP && mode != TINYGLTF_MODE_TRIANGLE_FAN) {
-          ++ignored_primitives;
-          continue;
+    std::vector<bool> on_path(model.nodes.size(), false);
+    std::size_t ignored_primitives = 0;
+    std::function<Status(int, const glm::dmat4&)> visit = [&](int n, const glm::dmat4& parent) -> Status {
+      if (n < 0 || std::size_t(n) >= model.nodes.size()) return Error{file, "node " + std::to_string(n) + " does not exist"};
+      if (on_path[std::size_t(n)]) return Error{file, "node " + std::to_string(n) + " is its own ancestor"};
+      on_path[std::size_t(n)] = true;
+      const tinygltf::Node& node = model.nodes[std::size_t(n)];
+      const glm::dmat4 world = parent * local_matrix(node);
+      if (node.mesh >= 0) {
+        if (std::size_t(node.mesh) >= model.meshes.size()) {
+          return Error{file, "node " + std::to_string(n) + " refers to mesh " + std::to_string(node.mesh) + ", which does not exist"};
         }
-        const auto position = prim.attributes.find("POSITION");
-        if (position == prim.attributes.end()) return Error{file, "mesh " + std::to_string(node.mesh) + " primitive " + std::to_string(p) + " has no POSITION"};
-        auto positions = read.floats(position->second, 3);
-        if (!positions) return positions.error();
-        const std::size_t vertices = positions->size() / 3;
-        if (const auto bad = std::find_if(positions->begin(), positions->end(), [](float x) { return !std::isfinite(x); });
-            bad != positions->end()) {
-          return Error{file, "mesh " + std::to_string(node.mesh) + " primitive " + std::to_string(p) + ": POSITION of vertex " +
-                                 std::to_string((bad - positions->begin()) / 3) + " is not finite"};
-        }
-        std::vector<std::uint32_t> order;
-        if (prim.indices >= 0) {
-          auto idx = read.indices(prim.indices, vertices);
-          if (!idx) return idx.error();
-          order = std::move(idx.value());
-        } else {
-          order.resize(vertices);
-          std::iota(order.begin(), order.end(), 0u);
-        }
-        Instance inst;
-        inst.node = n;
-        inst.mesh = node.mesh;
-        inst.primitive = int(p);
-        inst.world = world;
-        inst.triangles = triangles_of(order, mode);
-        const bool mirrored = glm::determinant(glm::dmat3(world)) < 0;
-        if (mirrored) {
-          for (auto& t : inst.triangles) std::swap(t[1], t[2]);
-        }
-        inst.positions.resize(vertices);
-        for (std::size_t v = 0; v < vertices; ++v) {
-          const glm::dvec4 w = world * glm::dvec4((*positions)[3 * v], (*positions)[3 * v + 1], (*positions)[3 * v + 2], 1.0);
-          inst.positions[v] = Vec3(w);
-        }
-        if (const auto normal = prim.attributes.find("NORMAL"); normal != prim.attributes.end()) {
-          auto normals = read.floats(normal->second, 3);
-          if (!normals) return normals.error();
-          if (normals->size() != positions->size()) {
-            return Error{file, "mesh " + std::to_string(node.mesh) + " primitive " + std::to_string(p) + ": NORMAL and POSITION counts differ"};
+        const tinygltf::Mesh& mesh = model.meshes[std::size_t(node.mesh)];
+        for (std::size_t p = 0; p < mesh.primitives.size(); ++p) {
+          const tinygltf::Primitive& prim = mesh.primitives[p];
+          const int mode = prim.mode < 0 ? TINYGLTF_MODE_TRIANGLES : prim.mode;
+          if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP && mode != TINYGLTF_MODE_TRIANGLE_FAN) {
+            ++ignored_primitives;
+            continue;
           }
-          const glm::dmat3 normal_matrix = glm::inverseTranspose(glm::dmat3(world));
-          inst.normals.resize(vertices);
+          const auto position = prim.attributes.find("POSITION");
+          if (position == prim.attributes.end()) return Error{file, "mesh " + std::to_string(node.mesh) + " primitive " + std::to_string(p) + " has no POSITION"};
+          auto positions = read.floats(position->second, 3);
+          if (!positions) return positions.error();
+          const std::size_t vertices = positions->size() / 3;
+          if (const auto bad = std::find_if(positions->begin(), positions->end(), [](float x) { return !std::isfinite(x); });
+              bad != positions->end()) {
+            return Error{file, "mesh " + std::to_string(node.mesh) + " primitive " + std::to_string(p) + ": POSITION of vertex " +
+                                   std::to_string((bad - positions->begin()) / 3) + " is not finite"};
+          }
+          std::vector<std::uint32_t> order;
+          if (prim.indices >= 0) {
+            auto idx = read.indices(prim.indices, vertices);
+            if (!idx) return idx.error();
+            order = std::move(idx.value());
+          } else {
+            order.resize(vertices);
+            std::iota(order.begin(), order.end(), 0u);
+          }
+          Instance inst;
+          inst.node = n;
+          inst.mesh = node.mesh;
+          inst.primitive = int(p);
+          inst.world = world;
+          inst.triangles = triangles_of(order, mode);
+          const bool mirrored = glm::determinant(glm::dmat3(world)) < 0;
+          if (mirrored) {
+            for (auto& t : inst.triangles) std::swap(t[1], t[2]);
+          }
+          inst.positions.resize(vertices);
           for (std::size_t v = 0; v < vertices; ++v) {
-            const glm::dvec3 nv = normal_matrix * glm::dvec3((*normals)[3 * v], (*normals)[3 * v + 1], (*normals)[3 * v + 2]);
-            const double length = glm::length(nv);
-            inst.normals[v] = length > 0 ? Vec3(nv / length) : Vec3(0);
+            const glm::dvec4 w = world * glm::dvec4((*positions)[3 * v], (*positions)[3 * v + 1], (*positions)[3 * v + 2], 1.0);
+            inst.positions[v] = Vec3(w);
           }
+          if (const auto normal = prim.attributes.find("NORMAL"); normal != prim.attributes.end()) {
+            auto normals = read.floats(normal->second, 3);
+            if (!normals) return normals.error();
+            if (normals->size() != positions->size()) {
+              return Error{file, "mesh " + std::to_string(node.mesh) + " primitive " + std::to_string(p) + ": NORMAL and POSITION counts differ"};
+            }
+            const glm::dmat3 normal_matrix = glm::inverseTranspose(glm::dmat3(world));
+            inst.normals.resize(vertices);
+            for (std::size_t v = 0; v < vertices; ++v) {
+              const glm::dvec3 nv = normal_matrix * glm::dvec3((*normals)[3 * v], (*normals)[3 * v + 1], (*normals)[3 * v + 2]);
+              const double length = glm::length(nv);
+              inst.normals[v] = length > 0 ? Vec3(nv / length) : Vec3(0);
+            }
+          }
+          if (const auto color = prim.attributes.find("COLOR_0"); color != prim.attributes.end()) {
+            const int components = color->second >= 0 && std::size_t(color->second) < model.accessors.size()
+                                       ? tinygltf::GetNumComponentsInType(std::uint32_t(model.accessors[std::size_t(color->second)].type))
+                                       : 4;
+            auto colors = read.floats(color->second, components == 3 ? 3 : 4);
+            if (!colors) return colors.error();
+            if (colors->size() / std::size_t(components) != vertices) {
+              return Error{file, "mesh " + std::to_string(node.mesh) + " primitive " + std::to_string(p) + ": COLOR_0 and POSITION counts differ"};
+            }
+            inst.colors_have_alpha = components == 4;
+            inst.colors.resize(vertices);
+            for (std::size_t v = 0; v < vertices; ++v) {
+              const float* c = colors->data() + v * std::size_t(components);
+              inst.colors[v] = glm::vec4(c[0], c[1], c[2], components == 4 ? c[3] : 1.0f);
+            }
+          }
+          scene.instances.push_back(std::move(inst));
         }
-        if (const auto color = prim.attributes.find("COLOR_0"); color != prim.attributes.end()) {
-          const int components = color->second >= 0 && std::size_t(color->second) < model.accessors.size()
-                                     ? tinygltf::GetNumComponentsInType(std::uint32_t(model.accessors[std::size_t(color->second)].type))
-                                     : 4;
-          auto colors = read.floats(color->second, components == 3 ? 3 : 4);
-          if (!colors) return colors.error();
-          if (colors->size() / std::size_t(components) != vertices) {
-            return Error{file, "mesh " + std::to_string(node.mesh) + " primitive " + std::to_string(p) + ": COLOR_0 and POSITION counts differ"};
-          }
-          inst.colors_have_alpha = components == 4;
-          inst.colors.resize(vertices);
-          for (std::size_t v = 0; v < vertices; ++v) {
-            const float* c = colors->data() + v * std::size_t(components);
-            inst.colors[v] = glm::vec4(c[0], c[1], c[2], components == 4 ? c[3] : 1.0f);
-          }
-        }
-        scene.instances.push_back(std::move(inst));
+      }
+      for (int child : node.children) {
+        if (Status s = visit(child, world); !s) return s;
+      }
+      on_path[std::size_t(n)] = false;
+      return success();
+    };
+    for (int root : model.scenes[std::size_t(scene_index)].nodes) {
+      if (Status s = visit(root, glm::dmat4(1.0)); !s) return s.error();
+    }
+    if (ignored_primitives) {
+      scene.notes.push_back(std::to_string(ignored_primitives) + " point or line primitives ignored");
+    }
+    std::size_t triangles = 0;
+    bool first = true;
+    for (const Instance& inst : scene.instances) {
+      triangles += inst.triangles.size();
+      for (const Vec3& p : inst.positions) {
+        scene.bounds_min = first ? p : glm::min(scene.bounds_min, p);
+        scene.bounds_max = first ? p : glm::max(scene.bounds_max, p);
+        first = false;
       }
     }
-    for (int child : node.children) {
-      if (Status s = visit(child, world); !s) return s;
-    }
-    on_path[std::size_t(n)] = false;
-    return success();
-  };
-  for (int root : model.scenes[std::size_t(scene_index)].nodes) {
-    if (Status s = visit(root, glm::dmat4(1.0)); !s) return s.error();
-  }
-  if (ignored_primitives) {
-    scene.notes.push_back(std::to_string(ignored_primitives) + " point or line primitives ignored");
-  }
-  std::size_t triangles = 0;
-  bool first = true;
-  for (const Instance& inst : scene.instances) {
-    triangles += inst.triangles.size();
-    for (const Vec3& p : inst.positions) {
-      scene.bounds_min = first ? p : glm::min(scene.bounds_min, p);
-      scene.bounds_max = first ? p : glm::max(scene.bounds_max, p);
-      first = false;
-    }
-  }
-  if (triangles == 0) return Error{file, "no triangles in the default scene"};
-  return scene;
+    if (triangles == 0) return Error{file, "no triangles in the default scene"};
+    return scene;
+  });
 }
 
 NormalResult vertex_normals(const std::vector<Vec3>& positions, const std::vector<std::array<std::uint32_t, 3>>& triangles,

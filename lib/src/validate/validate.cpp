@@ -349,48 +349,50 @@ std::string flag_names(std::uint8_t flags) {
 }
 
 Result<Report> validate(const Inputs& in, const Options& options) {
-  if (!in.specular) return Error{"", "validation needs a specular map", true};
-  if (Status s = check_size(in.specular, *in.specular, 3, "the specular map"); !s) return s.error();
-  if (Status s = check_size(in.diffuse, *in.specular, 3, "the diffuse map"); !s) return s.error();
-  if (Status s = check_size(in.mask, *in.specular, 1, "the mask"); !s) return s.error();
-  Report report;
-  report.has_diffuse = in.diffuse != nullptr;
-  report.width = in.specular->width;
-  report.height = in.specular->height;
-  report.texels = std::size_t(report.width) * std::size_t(report.height);
-  if (options.class_map) report.class_map.assign(report.texels, 0);
-  const int blocks = (report.height + kRowsPerBlock - 1) / kRowsPerBlock;
-  std::vector<Partial> partials(static_cast<std::size_t>(blocks));
-  tbb::parallel_for(0, blocks, [&](int b) {
-    check_rows(in, options, b * kRowsPerBlock, std::min(report.height, (b + 1) * kRowsPerBlock), partials[std::size_t(b)],
-               options.class_map ? report.class_map.data() : nullptr);
-  });
-  Partial total;
-  for (const Partial& p : partials) {
-    total.masked += p.masked;
-    total.checked += p.checked;
-    total.violations += p.violations;
-    total.material_within += p.material_within;
-    for (std::size_t c = 0; c < 5; ++c) total.class_counts[c] += p.class_counts[c];
-    for (std::size_t f = 0; f < kFlagCount; ++f) total.flag_counts[f] += p.flag_counts[f];
-    total.f0.merge(p.f0);
-    total.diffuse.merge(p.diffuse);
-    for (const Texel& t : p.worst) keep_worst(total.worst, t, options.worst_count);
-  }
-  report.masked = total.masked;
-  report.checked = total.checked;
-  report.violations = total.violations;
-  report.material_within = total.material_within;
-  report.class_counts = total.class_counts;
-  report.flag_counts = total.flag_counts;
-  for (std::size_t c = 0; c < 3; ++c) {
-    report.f0_stats[c] = stats(total.f0.sum[c], total.f0.lo[c], total.f0.hi[c], total.checked);
-    if (in.diffuse) {
-      report.diffuse_stats[c] = stats(total.diffuse.sum[c], total.diffuse.lo[c], total.diffuse.hi[c], total.checked);
+  return guarded("", [&]() -> Result<Report> {
+    if (!in.specular) return Error{"", "validation needs a specular map", true};
+    if (Status s = check_size(in.specular, *in.specular, 3, "the specular map"); !s) return s.error();
+    if (Status s = check_size(in.diffuse, *in.specular, 3, "the diffuse map"); !s) return s.error();
+    if (Status s = check_size(in.mask, *in.specular, 1, "the mask"); !s) return s.error();
+    Report report;
+    report.has_diffuse = in.diffuse != nullptr;
+    report.width = in.specular->width;
+    report.height = in.specular->height;
+    report.texels = std::size_t(report.width) * std::size_t(report.height);
+    if (options.class_map) report.class_map.assign(report.texels, 0);
+    const int blocks = (report.height + kRowsPerBlock - 1) / kRowsPerBlock;
+    std::vector<Partial> partials(static_cast<std::size_t>(blocks));
+    tbb::parallel_for(0, blocks, [&](int b) {
+      check_rows(in, options, b * kRowsPerBlock, std::min(report.height, (b + 1) * kRowsPerBlock), partials[std::size_t(b)],
+                 options.class_map ? report.class_map.data() : nullptr);
+    });
+    Partial total;
+    for (const Partial& p : partials) {
+      total.masked += p.masked;
+      total.checked += p.checked;
+      total.violations += p.violations;
+      total.material_within += p.material_within;
+      for (std::size_t c = 0; c < 5; ++c) total.class_counts[c] += p.class_counts[c];
+      for (std::size_t f = 0; f < kFlagCount; ++f) total.flag_counts[f] += p.flag_counts[f];
+      total.f0.merge(p.f0);
+      total.diffuse.merge(p.diffuse);
+      for (const Texel& t : p.worst) keep_worst(total.worst, t, options.worst_count);
     }
-  }
-  report.worst = std::move(total.worst);
-  return report;
+    report.masked = total.masked;
+    report.checked = total.checked;
+    report.violations = total.violations;
+    report.material_within = total.material_within;
+    report.class_counts = total.class_counts;
+    report.flag_counts = total.flag_counts;
+    for (std::size_t c = 0; c < 3; ++c) {
+      report.f0_stats[c] = stats(total.f0.sum[c], total.f0.lo[c], total.f0.hi[c], total.checked);
+      if (in.diffuse) {
+        report.diffuse_stats[c] = stats(total.diffuse.sum[c], total.diffuse.lo[c], total.diffuse.hi[c], total.checked);
+      }
+    }
+    report.worst = std::move(total.worst);
+    return report;
+  });
 }
 
 std::span<const LegendEntry> heatmap_legend() {

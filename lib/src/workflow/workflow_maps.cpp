@@ -133,70 +133,74 @@ DielectricF0 dielectric_f0(const image::Image& kd, const image::Image& ks) {
 
 Result<pack::SourceMaps> metal_rough_from_spec_gloss(const pack::SourceMaps& in, RoughnessMapping mapping,
                                                      ConversionReport& report) {
-  auto kd = need(in, "kd", "--kd");
-  if (!kd) return kd.error();
-  auto ks = need(in, "ks", "--ks");
-  if (!ks) return ks.error();
-  auto gloss = need(in, "gloss", "--gloss");
-  if (!gloss) return gloss.error();
-  pack::SourceMaps out;
-  out.width = in.width;
-  out.height = in.height;
-  image::Image base = like(**kd, 3), metallic = like(**gloss, 1), roughness = like(**gloss, 1);
-  image::Image khronos_base = base, khronos_metallic = metallic, khronos_roughness = roughness;
-  const std::size_t texels = std::size_t(in.width) * std::size_t(in.height);
-  tbb::parallel_for(std::size_t(0), texels, [&](std::size_t i) {
-    const Vec3 d = colour_at(**kd, i), s = colour_at(**ks, i);
-    const BaseMetallic bm = base_metallic_from_spec_gloss(d, s);
-    store_colour(base, i, bm.base);
-    metallic.pixels[i] = float(bm.metallic);
-    roughness.pixels[i] = float(roughness_from_gloss((*gloss)->pixels[i], mapping, mean_f0(s)));
-    const BaseMetallic k = khronos_base_metallic(d, s);
-    store_colour(khronos_base, i, k.base);
-    khronos_metallic.pixels[i] = float(k.metallic);
-    khronos_roughness.pixels[i] = 1.0f - (*gloss)->pixels[i];  // the Khronos converter's roughness
+  return guarded("", [&]() -> Result<pack::SourceMaps> {
+    auto kd = need(in, "kd", "--kd");
+    if (!kd) return kd.error();
+    auto ks = need(in, "ks", "--ks");
+    if (!ks) return ks.error();
+    auto gloss = need(in, "gloss", "--gloss");
+    if (!gloss) return gloss.error();
+    pack::SourceMaps out;
+    out.width = in.width;
+    out.height = in.height;
+    image::Image base = like(**kd, 3), metallic = like(**gloss, 1), roughness = like(**gloss, 1);
+    image::Image khronos_base = base, khronos_metallic = metallic, khronos_roughness = roughness;
+    const std::size_t texels = std::size_t(in.width) * std::size_t(in.height);
+    tbb::parallel_for(std::size_t(0), texels, [&](std::size_t i) {
+      const Vec3 d = colour_at(**kd, i), s = colour_at(**ks, i);
+      const BaseMetallic bm = base_metallic_from_spec_gloss(d, s);
+      store_colour(base, i, bm.base);
+      metallic.pixels[i] = float(bm.metallic);
+      roughness.pixels[i] = float(roughness_from_gloss((*gloss)->pixels[i], mapping, mean_f0(s)));
+      const BaseMetallic k = khronos_base_metallic(d, s);
+      store_colour(khronos_base, i, k.base);
+      khronos_metallic.pixels[i] = float(k.metallic);
+      khronos_roughness.pixels[i] = 1.0f - (*gloss)->pixels[i];  // the Khronos converter's roughness
+    });
+    const LobeQuadrature q = make_lobe_quadrature(12);
+    const Target target{*kd, *ks, *gloss};
+    report.texels = texels;
+    report.errors = measure(target, {&base, &metallic, &roughness}, q);
+    report.khronos_errors = measure(target, {&khronos_base, &khronos_metallic, &khronos_roughness}, q);
+    report.dielectric = dielectric_f0(**kd, **ks);
+    out.maps["base_color"] = std::move(base);
+    out.maps["metallic"] = std::move(metallic);
+    out.maps["roughness"] = std::move(roughness);
+    pass_through(in, out);
+    return out;
   });
-  const LobeQuadrature q = make_lobe_quadrature(12);
-  const Target target{*kd, *ks, *gloss};
-  report.texels = texels;
-  report.errors = measure(target, {&base, &metallic, &roughness}, q);
-  report.khronos_errors = measure(target, {&khronos_base, &khronos_metallic, &khronos_roughness}, q);
-  report.dielectric = dielectric_f0(**kd, **ks);
-  out.maps["base_color"] = std::move(base);
-  out.maps["metallic"] = std::move(metallic);
-  out.maps["roughness"] = std::move(roughness);
-  pass_through(in, out);
-  return out;
 }
 
 Result<pack::SourceMaps> spec_gloss_from_metal_rough(const pack::SourceMaps& in, RoughnessMapping mapping,
                                                      ConversionReport& report) {
-  auto base = need(in, "base_color", "--base-color");
-  if (!base) return base.error();
-  auto metallic = need(in, "metallic", "--metallic");
-  if (!metallic) return metallic.error();
-  auto roughness = need(in, "roughness", "--roughness");
-  if (!roughness) return roughness.error();
-  pack::SourceMaps out;
-  out.width = in.width;
-  out.height = in.height;
-  image::Image kd = like(**base, 3), ks = like(**base, 3), gloss = like(**roughness, 1);
-  const std::size_t texels = std::size_t(in.width) * std::size_t(in.height);
-  tbb::parallel_for(std::size_t(0), texels, [&](std::size_t i) {
-    const SpecGloss sg = spec_gloss_from_metal_rough(
-        {colour_at(**base, i), (*metallic)->pixels[i], (*roughness)->pixels[i]}, mapping);
-    store_colour(kd, i, sg.kd);
-    store_colour(ks, i, sg.ks);
-    gloss.pixels[i] = float(sg.gloss);
+  return guarded("", [&]() -> Result<pack::SourceMaps> {
+    auto base = need(in, "base_color", "--base-color");
+    if (!base) return base.error();
+    auto metallic = need(in, "metallic", "--metallic");
+    if (!metallic) return metallic.error();
+    auto roughness = need(in, "roughness", "--roughness");
+    if (!roughness) return roughness.error();
+    pack::SourceMaps out;
+    out.width = in.width;
+    out.height = in.height;
+    image::Image kd = like(**base, 3), ks = like(**base, 3), gloss = like(**roughness, 1);
+    const std::size_t texels = std::size_t(in.width) * std::size_t(in.height);
+    tbb::parallel_for(std::size_t(0), texels, [&](std::size_t i) {
+      const SpecGloss sg = spec_gloss_from_metal_rough(
+          {colour_at(**base, i), (*metallic)->pixels[i], (*roughness)->pixels[i]}, mapping);
+      store_colour(kd, i, sg.kd);
+      store_colour(ks, i, sg.ks);
+      gloss.pixels[i] = float(sg.gloss);
+    });
+    // The colours are exact (the same relation both ways); the lobe error is the specular shape's.
+    report.texels = texels;
+    report.errors = measure({&kd, &ks, &gloss}, {*base, *metallic, *roughness}, make_lobe_quadrature(12));
+    out.maps["kd"] = std::move(kd);
+    out.maps["ks"] = std::move(ks);
+    out.maps["gloss"] = std::move(gloss);
+    pass_through(in, out);
+    return out;
   });
-  // The colours are exact (the same relation both ways); the lobe error is the specular shape's.
-  report.texels = texels;
-  report.errors = measure({&kd, &ks, &gloss}, {*base, *metallic, *roughness}, make_lobe_quadrature(12));
-  out.maps["kd"] = std::move(kd);
-  out.maps["ks"] = std::move(ks);
-  out.maps["gloss"] = std::move(gloss);
-  pass_through(in, out);
-  return out;
 }
 
 std::string_view direction_name(Direction d) {
