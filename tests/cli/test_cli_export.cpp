@@ -118,6 +118,39 @@ TEST(CliExport, SpecGlossTexturesConvertTexelByTexel) {
   expect_validator_clean(dir / "out" / "scene.gltf");
 }
 
+// Issue "One request layer": a spec-gloss material replaced by given maps kept its old extension
+// object (and the textures it names) while extensionsUsed dropped it: UNDECLARED_EXTENSION.
+TEST(CliExport, ReplacedSpecGlossMaterialsComeOutClean) {
+  TempDir dir;
+  write_raw(dir / "diffuse.png", 2, 1, 4, "uint8", {200, 100, 50, 255, 0, 0, 0, 255});
+  write_raw(dir / "specgloss.png", 2, 1, 4, "uint8", {56, 56, 56, 128, 255, 200, 87, 191});
+  write_raw(dir / "a.png", 2, 1, 4, "uint8", {20, 120, 220, 255, 40, 50, 60, 255});
+  write_raw(dir / "b.png", 2, 1, 4, "uint8", {30, 30, 30, 100, 40, 40, 40, 200});  // F0 ≈ 0.013, 0.021
+  GltfBuilder b = quad_scene(json::array(
+      {{{"name", "Painted"},
+        {"extensions", {{"KHR_materials_pbrSpecularGlossiness",
+                         {{"diffuseTexture", {{"index", 0}}}, {"specularGlossinessTexture", {{"index", 1}}}}},
+                        {"KHR_materials_ior", {{"ior", 1.3}}}}}},
+       {{"name", "Unused"}}}));
+  b.doc["extensionsUsed"] = {"KHR_materials_pbrSpecularGlossiness", "KHR_materials_ior"};
+  b.doc["textures"] = {{{"source", 0}}, {{"source", 1}}};
+  b.doc["images"] = {{{"uri", "diffuse.png"}}, {{"uri", "specgloss.png"}}};
+  b.write(dir / "in.gltf", {0});
+  fs::create_directories(dir / "out");
+  const json report = export_json({(dir / "in.gltf").string(), "-o", (dir / "out" / "scene.gltf").string(), "--material",
+                                   "Painted=" + (dir / "a.png").string() + "," + (dir / "b.png").string()});
+  ASSERT_FALSE(report.is_null());
+  EXPECT_EQ(report["materials"][0]["action"], "from Schüler maps");
+  const gltf::Document out = read_output(dir / "out" / "scene.gltf");
+  const json material = json::parse(out.json["materials"][0].dump());
+  // The maps' F0 (below 0.04) is said by KHR_materials_specular; the old IOR and spec-gloss are gone.
+  EXPECT_EQ(material["extensions"].size(), 1u) << material.dump();
+  EXPECT_TRUE(material["extensions"].contains("KHR_materials_specular"));
+  EXPECT_EQ(out.json["extensionsUsed"], json({"KHR_materials_specular"}));
+  EXPECT_EQ(out.json["images"].size(), 2u);  // the new base colour and metallic-roughness: the old ones pruned
+  expect_validator_clean(dir / "out" / "scene.gltf");
+}
+
 TEST(CliExport, ConstantMaterialsBecomeFactorsAndCarryTheirF0) {
   TempDir dir;
   // Water-like: F0 0.02, which core glTF cannot say; KHR_materials_specular's factor is 0.02 / 0.04.
@@ -245,6 +278,22 @@ TEST(CliExport, OnlyWhatTheSceneReachesAndTheSameBytesEveryTime) {
   EXPECT_EQ(read_bytes(dir / "a.glb"), read_bytes(dir / "b.glb"));
 }
 
+// Issue "One request layer": export decoded and encoded through a private folder under $TMPDIR
+// (left behind by an interrupt). Now everything happens in memory: an unusable $TMPDIR changes nothing.
+TEST(CliExport, NoTemporaryFolderOutsideTheOutput) {
+  TempDir dir;
+  write_raw(dir / "a.png", 2, 1, 4, "uint8", {20, 120, 220, 255, 40, 50, 60, 128});
+  write_raw(dir / "b.png", 2, 1, 4, "uint8", {30, 30, 30, 100, 250, 200, 40, 200});
+  quad_scene(json::array({{{"name", "M"}}, {{"name", "N"}}})).write(dir / "in.gltf", {0});
+  fs::create_directories(dir / "out");
+  write_bytes(dir / "not-a-folder", "");
+  const RunResult r = matbake({"export", (dir / "in.gltf").string(), "-o", (dir / "out" / "scene.glb").string(),
+                               "--material", "M=" + (dir / "a.png").string() + "," + (dir / "b.png").string()},
+                              {"TMPDIR=" + (dir / "not-a-folder").string()});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(list_folder(dir / "out"), std::vector<std::string>{"scene.glb"});
+}
+
 TEST(CliExport, BadInputIsRefusedAndNothingIsWritten) {
   TempDir dir;
   fs::create_directories(dir / "out");
@@ -270,6 +319,14 @@ TEST(CliExport, BadInputIsRefusedAndNothingIsWritten) {
     b.doc["accessors"][0]["count"] = 400;
     b.write(dir / "range.gltf", {0});
   }
+  {
+    // A spec-gloss factor holding a string: nlohmann's type_error ended the process (exit 134, and
+    // stderr silenced at that moment).
+    GltfBuilder b = quad_scene(json::array(
+        {{{"extensions", {{"KHR_materials_pbrSpecularGlossiness", {{"diffuseFactor", "red"}}}}}}, json::object()}));
+    b.doc["extensionsUsed"] = {"KHR_materials_pbrSpecularGlossiness"};
+    b.write(dir / "factor.gltf", {0});
+  }
   write_bytes(dir / "chunks.glb", std::string("glTF\x02\0\0\0\x40\0\0\0\xff\0\0\0JSON{}", 22) + std::string(42, ' '));
   using Case = std::pair<std::string, std::string>;
   for (const auto& [file, problem] :
@@ -277,7 +334,8 @@ TEST(CliExport, BadInputIsRefusedAndNothingIsWritten) {
         Case{"escape.gltf", "URI '../../etc/passwd' is outside the glTF's folder"},
         Case{"absolute.gltf", "URI '/etc/passwd' is outside the glTF's folder"},
         Case{"broken-data.gltf", "image 0: "}, Case{"range.gltf", "accessor 0 reaches beyond its buffer"},
-        Case{"chunks.glb", "not a valid glTF"}}) {
+        Case{"chunks.glb", "not a valid glTF"},
+        Case{"factor.gltf", "material 0 KHR_materials_pbrSpecularGlossiness.diffuseFactor must be 4 numbers"}}) {
     const RunResult r = matbake({"export", (dir / file).string(), "-o", out});
     EXPECT_EQ(r.exit_code, 1) << file << ": " << r.err;
     expect_one_error_line(r, (dir / file).string(), problem);

@@ -109,6 +109,8 @@ TEST(CliPack, BadInputsAndUsage) {
   write_raw(dir / "big.png", 4, 4, 1, "uint8", std::vector<double>(16, 10));
   write_raw(dir / "small.png", 2, 2, 3, "uint8", std::vector<double>(12, 10));
   write_raw(dir / "nan.exr", 3, 2, 1, "float", {0.5, 0.5, 0.5, 0.5, std::nan(""), 0.5});
+  // Valid JSON of the wrong type: nlohmann's type_error ended `pack` with exit 134.
+  write_bytes(dir / "typed.json", R"({"name": 3, "textures": [{"name": "t", "channels": [{"source": "kd"}]}]})");
   const std::string big = (dir / "big.png").string(), small = (dir / "small.png").string();
   const std::string out = (dir / "o_{texture}.png").string();
   const auto before = list_folder(dir.path());
@@ -127,6 +129,8 @@ TEST(CliPack, BadInputsAndUsage) {
       {{"--kd", "0.5", "--ks", "0.04"}, 2, "", "layout schuler needs gloss (--gloss)"},
       {{"--kd", "0.5,0.5", "--ks", "0.04", "--gloss", "0.5"}, 2, "", "--kd: 1 or 3 values expected, got 2"},
       {{"--layout", "nope", "--kd", "0.5"}, 2, "nope", "no such layout file, and not a preset"},
+      {{"--layout", (dir / "typed.json").string(), "--kd", "0.5"}, 1, (dir / "typed.json").string(),
+       "[json.exception.type_error.302] type must be string, but is number"},
   };
   for (const Case& c : cases) {
     const auto r = matbake(concat(concat({"pack"}, c.args), {"-o", out}));
@@ -144,6 +148,12 @@ TEST(CliPack, BadInputsAndUsage) {
   EXPECT_EQ(clobber.exit_code, 2);
   expect_one_error_line(clobber, big, "is an input; matbake never overwrites its inputs");
   EXPECT_EQ(read_bytes(dir / "big.png"), bytes);
+  // Two outputs that are one file.
+  const auto twice = matbake({"pack", "--kd", "0.5", "--ks", "0.04", "--gloss", "0.5", "-o", (dir / "s.png").string(), "-o",
+                              (dir / "s.png").string()});
+  EXPECT_EQ(twice.exit_code, 2);
+  expect_one_error_line(twice, (dir / "s.png").string(), "is written twice (textures a and b)");
+  EXPECT_FALSE(fs::exists(dir / "s.png"));
 }
 
 TEST(CliWorkflow, ReportsBothConversionsAndConvertsBack) {

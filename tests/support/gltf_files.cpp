@@ -1,8 +1,12 @@
 #include "support/gltf_files.hpp"
 
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <cstring>
 #include <fstream>
+
+#include "lib/src/gltf/document.hpp"
 
 namespace matbake::test {
 
@@ -71,6 +75,20 @@ void GltfBuilder::write(const std::filesystem::path& path, const std::vector<int
   out["scenes"] = {{{"nodes", scene_nodes}}};
   out["scene"] = 0;
   std::ofstream(path) << out.dump(1);
+}
+
+std::vector<float> float_accessor(const gltf::Document& doc, int index) {
+  const gltf::Json& a = doc.json["accessors"][std::size_t(index)];
+  const gltf::Json& view = doc.json["bufferViews"][a["bufferView"].get<std::size_t>()];
+  EXPECT_EQ(a["componentType"], 5126);
+  const std::string type = a["type"];
+  const std::size_t components = type == "SCALAR" ? 1 : type == "VEC2" ? 2 : type == "VEC3" ? 3 : 4;
+  std::vector<float> out(a["count"].get<std::size_t>() * components);
+  const auto& buffer = doc.buffers[view["buffer"].get<std::size_t>()];
+  const std::size_t offset = view.value("byteOffset", std::size_t{0}) + a.value("byteOffset", std::size_t{0});
+  EXPECT_LE(offset + out.size() * 4, buffer.size());
+  if (offset + out.size() * 4 <= buffer.size()) std::memcpy(out.data(), buffer.data() + offset, out.size() * 4);
+  return out;
 }
 
 }  // namespace matbake::test

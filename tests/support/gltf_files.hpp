@@ -8,6 +8,10 @@
 #include <string>
 #include <vector>
 
+namespace matbake::gltf {
+struct Document;
+}
+
 namespace matbake::test {
 
 struct GltfBuilder {
@@ -27,5 +31,8 @@ struct GltfBuilder {
 };
 
 std::string base64(const std::vector<unsigned char>& bytes);
+
+// The floats of a float accessor (SCALAR, VEC2/3/4), read from a document's own bytes.
+std::vector<float> float_accessor(const gltf::Document& doc, int index);
 
 }  // namespace matbake::test

@@ -148,6 +148,7 @@ sources = { kd = "paint.png", ks = 0.04, gloss = 0.5 }
 layout = "gltf-orm"
 [materials.unused]
 sources = { kd = 0.5 }
+validate = { enabled = false }
 [materials.scene_only]
 sources = { kd = "s.png" }
 validate = { enabled = false }
@@ -159,7 +160,8 @@ materials = { "other" = "scene_only" }
   ASSERT_TRUE(m) << m.error().to_string();
   auto plan = build::make_plan(*m);
   ASSERT_TRUE(plan) << plan.error().to_string();
-  // paint: textures + report; unused: no layout, no scene (a warning); scene_only: nothing of its own.
+  // paint: textures + report; unused: no layout, no validation, no scene (a warning); scene_only:
+  // nothing of its own.
   ASSERT_EQ(plan->jobs.size(), 2u);
   const build::Job& paint = plan->jobs[0];
   EXPECT_EQ(paint.name, "material:paint");

@@ -18,25 +18,13 @@ namespace matbake {
 namespace {
 
 namespace fs = std::filesystem;
+using test::float_accessor;
 using test::GltfBuilder;
 using test::TempDir;
 
 const std::vector<float> kFloor = {0, 0, 0, -1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0};
 const std::vector<std::uint32_t> kFan = {0, 1, 2, 0, 2, 3, 0, 3, 4, 0, 4, 1};
 
-// The floats of a float accessor, read from the written document's own bytes.
-std::vector<float> accessor_floats(const gltf::Document& doc, int index) {
-  const gltf::Json& a = doc.json["accessors"][std::size_t(index)];
-  const gltf::Json& view = doc.json["bufferViews"][a["bufferView"].get<std::size_t>()];
-  EXPECT_EQ(a["componentType"], 5126);
-  const std::size_t components = a["type"] == "SCALAR" ? 1 : a["type"] == "VEC3" ? 3 : 4;
-  std::vector<float> out(a["count"].get<std::size_t>() * components);
-  const auto& buffer = doc.buffers[view["buffer"].get<std::size_t>()];
-  const std::size_t offset = view.value("byteOffset", std::size_t{0}) + a.value("byteOffset", std::size_t{0});
-  EXPECT_LE(offset + out.size() * 4, buffer.size());
-  std::memcpy(out.data(), buffer.data() + offset, out.size() * 4);
-  return out;
-}
 
 // A floor whose buffer is an external .bin and which names an image in a subfolder by an
 // escaped URI.
@@ -73,7 +61,7 @@ TEST(GltfDocument, GltfToAnotherFolderMergesBuffersAndCopiesImages) {
   ASSERT_TRUE(back) << back.error().to_string();
   ASSERT_EQ(back->json["buffers"].size(), 1u);
   EXPECT_EQ(back->json["buffers"][0]["uri"], "copy.bin");
-  EXPECT_EQ(accessor_floats(*back, extra), (std::vector<float>{0.25f, 0.5f}));
+  EXPECT_EQ(float_accessor(*back, extra), (std::vector<float>{0.25f, 0.5f}));
   for (const auto& view : back->json["bufferViews"]) EXPECT_EQ(view["byteOffset"].get<std::size_t>() % 4, 0u);
   auto a = scene::load_scene(input), c = scene::load_scene(dir / "out" / "copy.gltf");
   ASSERT_TRUE(a && c);
@@ -165,7 +153,7 @@ TEST(GltfPrune, ExtensionReferencesSurviveAndFollowTheirObjects) {
   EXPECT_EQ(json["materials"][1]["name"], "Variant");
   EXPECT_EQ(json["meshes"][0]["primitives"][0]["extensions"]["KHR_materials_variants"]["mappings"][0]["material"], 1);
   const int translation = json["nodes"][0]["extensions"]["EXT_mesh_gpu_instancing"]["attributes"]["TRANSLATION"];
-  EXPECT_EQ(accessor_floats(*doc, translation), (std::vector<float>{0, 0, 0, 5, 0, 0}));
+  EXPECT_EQ(float_accessor(*doc, translation), (std::vector<float>{0, 0, 0, 5, 0, 0}));
   ASSERT_TRUE(gltf::write_document(*doc, dir / "out.glb"));
   auto s = scene::load_scene(dir / "out.glb");
   ASSERT_TRUE(s) << s.error().to_string();
@@ -272,7 +260,7 @@ TEST(AoGltfOutput, ReplacedColoursAndTheAoAttributeHoldTheValuesExactly) {
   for (std::size_t k = 0; k < 3; ++k) {
     const int mesh = doc->json["nodes"][std::size_t(b.scene.instances[k].node)]["mesh"];
     const gltf::Json& attributes = doc->json["meshes"][std::size_t(mesh)]["primitives"][0]["attributes"];
-    EXPECT_EQ(accessor_floats(*doc, attributes["_AO"].get<int>()), b.bake.values[k]);
+    EXPECT_EQ(float_accessor(*doc, attributes["_AO"].get<int>()), b.bake.values[k]);
     EXPECT_EQ(attributes.contains("COLOR_0"), k != 1);  // the file's own colours stay where they were
   }
 }

@@ -179,8 +179,9 @@ Result<Plan> make_plan(const Manifest& manifest) {
         job.outputs.push_back(materials_folder / (m.name + ".validation.json"));
         if (m.validation.heatmap) job.outputs.push_back(materials_folder / (m.name + "_validation.png"));
       }
-      if (m.layout.empty() && !used[i]) {
-        plan.warnings.push_back("materials." + m.name + ": no layout and no scene uses it, so nothing is built from it");
+      if (m.layout.empty() && !used[i] && !m.validation.enabled) {
+        plan.warnings.push_back("materials." + m.name +
+                                ": no layout, no validation and no scene uses it, so nothing is built from it");
         continue;
       }
       if (job.outputs.empty()) continue;  // used by scenes only, nothing of its own to write

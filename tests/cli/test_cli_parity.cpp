@@ -1,0 +1,255 @@
+// Two front ends, one decision: each operation a manifest can express (pack, workflow, validate,
+// export with AO) run once as a command and once from a manifest with the same settings — the
+// defaults, then each non-default option once — must give the same bytes. One manifest holds every
+// case (one `matbake build`), and each case's command runs beside it.
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <random>
+
+#include "lib/src/gltf/document.hpp"
+#include "support/files.hpp"
+#include "support/gltf_files.hpp"
+#include "support/run.hpp"
+#include "support/temp_dir.hpp"
+
+namespace matbake::test {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+const fs::path kExamples = fs::path(MATBAKE_SOURCE_DIR) / "examples";
+
+// Noise images, so that every code path (sRGB curve, rounding) shows in the bytes.
+void write_noise(const fs::path& path, int size, int channels, unsigned seed, int lo = 0, int hi = 255) {
+  std::mt19937 rng(seed);
+  std::uniform_int_distribution<int> code(lo, hi);
+  std::vector<double> samples(std::size_t(size) * std::size_t(size) * std::size_t(channels));
+  for (double& s : samples) s = code(rng);
+  write_raw(path, size, size, channels, "uint8", samples);
+}
+
+// A command's outputs against the build's, file by file.
+void expect_same_files(const std::vector<fs::path>& from_command, const std::vector<fs::path>& from_build,
+                       const std::string& what) {
+  ASSERT_EQ(from_command.size(), from_build.size()) << what;
+  for (std::size_t i = 0; i < from_command.size(); ++i) {
+    ASSERT_TRUE(fs::exists(from_command[i])) << what << ": " << from_command[i];
+    ASSERT_TRUE(fs::exists(from_build[i])) << what << ": " << from_build[i];
+    EXPECT_TRUE(read_bytes(from_command[i]) == read_bytes(from_build[i]))
+        << what << ": " << from_command[i] << " differs from " << from_build[i];
+  }
+}
+
+struct MaterialCase {
+  std::string name;
+  std::string manifest;                  // the material's keys
+  std::vector<std::string> command;      // the command (without -o)
+  std::vector<std::string> textures;     // the layout's texture names
+  std::string extension = "png";
+};
+
+// The _AO values of a written scene, node by node, primitive by primitive.
+std::vector<float> ao_values(const fs::path& file) {
+  auto doc = gltf::read_document(file);
+  EXPECT_TRUE(doc) << doc.error().to_string();
+  std::vector<float> values;
+  if (!doc) return values;
+  for (const auto& node : doc->json["nodes"]) {
+    if (!node.contains("mesh")) continue;
+    for (const auto& primitive : doc->json["meshes"][node["mesh"].get<std::size_t>()]["primitives"]) {
+      if (!primitive["attributes"].contains("_AO")) continue;
+      const std::vector<float> v = float_accessor(*doc, primitive["attributes"]["_AO"].get<int>());
+      values.insert(values.end(), v.begin(), v.end());
+    }
+  }
+  return values;
+}
+
+class Parity : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    write_noise(dir / "kd.png", 8, 3, 1);
+    write_noise(dir / "gloss.png", 8, 1, 2);
+    write_noise(dir / "gloss16.png", 16, 1, 3);
+    write_noise(dir / "ks.png", 8, 3, 4, 10, 60);  // dielectric-ish F0
+    write_noise(dir / "base.png", 8, 3, 5);
+    write_noise(dir / "rough.png", 8, 1, 6);
+    write_noise(dir / "metal.png", 8, 1, 7);
+    write_noise(dir / "pair_a.png", 8, 4, 8);          // Schüler's A: Kd + mask
+    write_noise(dir / "pair_b.png", 8, 4, 9, 10, 60);  // B: F0 + gloss
+    fs::create_directories(dir / "cli");
+  }
+
+  // Runs a command; its outputs go to cli/.
+  void run_command(std::vector<std::string> args, int expected_exit = 0) {
+    for (std::string& a : args) {
+      if (a.ends_with(".png") && !a.starts_with("cli/") && fs::exists(dir / a)) a = (dir / a).string();
+      if (a.starts_with("cli/")) a = (dir / a).string();
+    }
+    const RunResult r = matbake(args);
+    EXPECT_EQ(r.exit_code, expected_exit) << args[0] << ": " << r.err;
+  }
+
+  json build(const std::string& manifest) {
+    write_bytes(dir / "assets.toml", manifest);
+    const RunResult r = matbake({"--json", "build", (dir / "assets.toml").string()});
+    EXPECT_NE(r.out, "") << r.err;
+    return r.out.empty() ? json() : json::parse(r.out);
+  }
+
+  TempDir dir;
+};
+
+TEST_F(Parity, PackAndWorkflowGiveTheManifestsBytes) {
+  const std::vector<MaterialCase> cases = {
+      {"defaults", "sources = { kd = \"kd.png\", ks = 0.04, gloss = \"gloss.png\" }\nlayout = \"schuler\"",
+       {"pack", "--kd", "kd.png", "--ks", "0.04", "--gloss", "gloss.png"}, {"a", "b"}},
+      {"gamma", "sources = { kd = \"kd.png\", ks = 0.04, gloss = \"gloss.png\" }\nlayout = \"schuler\"\ntransfer = \"gamma2.2\"",
+       {"pack", "--kd", "kd.png", "--ks", "0.04", "--gloss", "gloss.png", "--transfer", "gamma2.2"}, {"a", "b"}},
+      {"bits16", "sources = { kd = \"kd.png\", ks = 0.04, gloss = \"gloss.png\" }\nlayout = \"schuler\"\nbits = \"16\"",
+       {"pack", "--kd", "kd.png", "--ks", "0.04", "--gloss", "gloss.png", "--bits", "16"}, {"a", "b"}},
+      {"exr", "sources = { kd = \"kd.png\", ks = 0.04, gloss = \"gloss.png\" }\nlayout = \"schuler\"\nformat = \"exr\"",
+       {"pack", "--kd", "kd.png", "--ks", "0.04", "--gloss", "gloss.png"}, {"a", "b"}, "exr"},
+      {"resized", "sources = { kd = \"kd.png\", ks = 0.04, gloss = \"gloss16.png\" }\nlayout = \"schuler\"\nresize = true",
+       {"pack", "--kd", "kd.png", "--ks", "0.04", "--gloss", "gloss16.png", "--resize"}, {"a", "b"}},
+      {"decoded", "sources = { kd = \"kd.png\", ks = 0.04, gloss = \"gloss.png\" }\nlayout = \"schuler\"\ndecode = \"linear\"",
+       {"pack", "--kd", "kd.png", "--ks", "0.04", "--gloss", "gloss.png", "--input-transfer", "linear"}, {"a", "b"}},
+      {"orm", "sources = { base_color = \"base.png\", metallic = \"metal.png\", roughness = \"rough.png\" }\nlayout = \"gltf-orm\"",
+       {"pack", "--layout", "gltf-orm", "--base-color", "base.png", "--metallic", "metal.png", "--roughness", "rough.png"},
+       {"base_color", "orm"}},
+      {"packed", "packed = { layout = \"schuler\", files = [\"pair_a.png\", \"pair_b.png\"] }\nlayout = \"unreal-orm\"",
+       {"workflow", "--to", "unreal-orm", "--from", "schuler", "pair_a.png", "pair_b.png"}, {"base_color", "orm"}},
+      {"to_metal_rough", "sources = { kd = \"kd.png\", ks = \"ks.png\", gloss = \"gloss.png\" }\nlayout = \"gltf-orm\"",
+       {"workflow", "--to", "gltf-orm", "--kd", "kd.png", "--ks", "ks.png", "--gloss", "gloss.png"}, {"base_color", "orm"}},
+      {"walter", "sources = { kd = \"kd.png\", ks = \"ks.png\", gloss = \"gloss.png\" }\nlayout = \"gltf-orm\"\nmapping = \"walter\"",
+       {"workflow", "--to", "gltf-orm", "--kd", "kd.png", "--ks", "ks.png", "--gloss", "gloss.png", "--mapping", "walter"},
+       {"base_color", "orm"}},
+      {"to_spec_gloss", "sources = { base_color = \"base.png\", metallic = \"metal.png\", roughness = \"rough.png\" }\nlayout = \"schuler\"",
+       {"workflow", "--to", "schuler", "--base-color", "base.png", "--metallic", "metal.png", "--roughness", "rough.png"},
+       {"a", "b"}},
+  };
+  std::string manifest = "[validate]\nenabled = false\n";
+  for (const MaterialCase& c : cases) manifest += "\n[materials." + c.name + "]\n" + c.manifest + "\n";
+  const json report = build(manifest);
+  ASSERT_EQ(report.value("failed", -1), 0) << report.dump(2);
+  for (const MaterialCase& c : cases) {
+    std::vector<std::string> args = c.command;
+    args.push_back("-o");
+    args.push_back("cli/" + c.name + "_{texture}." + c.extension);
+    run_command(args);
+    std::vector<fs::path> from_command, from_build;
+    for (const std::string& t : c.textures) {
+      from_command.push_back(dir / "cli" / (c.name + "_" + t + "." + c.extension));
+      from_build.push_back(dir / "out" / "materials" / (c.name + "_" + t + "." + c.extension));
+    }
+    expect_same_files(from_command, from_build, c.name);
+  }
+}
+
+TEST_F(Parity, ValidateWritesTheManifestsReportAndHeatmap) {
+  struct Case {
+    std::string name, manifest;
+    std::vector<std::string> command;
+  };
+  const std::vector<Case> cases = {
+      {"defaults", "validate = { heatmap = true }", {}},
+      {"options", "reference = \"gold\"\nvalidate = { tolerance = 0.2, max_violations = 0.5, heatmap = true, worst = 3 }",
+       {"--material", "gold", "--tolerance", "0.2", "--max-violations", "0.5", "--worst", "3"}},
+  };
+  std::string manifest;
+  for (const Case& c : cases) {
+    manifest += "\n[materials." + c.name + "]\nsources = { kd = \"kd.png\", ks = \"ks.png\", gloss = 0.5 }\n" + c.manifest + "\n";
+  }
+  build(manifest);  // jobs whose texels are flagged fail, and write their reports all the same
+  for (const Case& c : cases) {
+    std::vector<std::string> args = {"validate", "--kd", "kd.png", "--ks", "ks.png", "--gloss", "0.5",
+                                     "--report", "cli/" + c.name + ".validation.json",
+                                     "--heatmap", "cli/" + c.name + "_validation.png"};
+    args.insert(args.end(), c.command.begin(), c.command.end());
+    for (std::string& a : args) {
+      if (a == "kd.png" || a == "ks.png") a = (dir / a).string();
+      if (a.starts_with("cli/")) a = (dir / a).string();
+    }
+    const RunResult r = matbake(args);
+    EXPECT_TRUE(r.exit_code == 0 || r.exit_code == 3) << r.err;
+    expect_same_files({dir / "cli" / (c.name + ".validation.json"), dir / "cli" / (c.name + "_validation.png")},
+                      {dir / "out" / "materials" / (c.name + ".validation.json"),
+                       dir / "out" / "materials" / (c.name + "_validation.png")},
+                      c.name);
+  }
+}
+
+TEST_F(Parity, ExportAndAoGiveTheManifestsScene) {
+  for (const char* f : {"showroom.gltf", "showroom.bin"}) fs::copy_file(kExamples / f, dir / f);
+  // One Schüler pair for painted_metal, packed from the test's noise; the other materials as in the file.
+  struct Case {
+    std::string name, manifest;
+    std::vector<std::string> command;
+    std::string mapping;  // of the material (the command's --mapping)
+  };
+  const std::vector<Case> cases = {
+      {"defaults", "", {}, ""},
+      {"dielectric_ior", "dielectric_f0 = \"ior\"", {"--dielectric-f0", "ior"}, ""},
+      {"no_orm", "orm = false", {"--no-orm"}, ""},
+      {"walter", "", {"--mapping", "walter"}, "walter"},
+      {"ao_defaults", "ao = { samples = 8 }", {"--ao-samples", "8"}, ""},
+      {"ao_attribute", "ao = { samples = 8, into = \"_AO\" }", {"--ao-samples", "8", "--ao-into", "_AO"}, ""},
+      {"ao_replace", "ao = { samples = 8, existing_colors = \"replace\" }",
+       {"--ao-samples", "8", "--ao-existing-colors", "replace"}, ""},
+      {"ao_distance", "ao = { samples = 8, distance = 0.1 }", {"--ao-samples", "8", "--ao-relative-distance", "0.1"}, ""},
+      {"ao_absolute", "ao = { samples = 8, absolute_distance = 0.5 }", {"--ao-samples", "8", "--ao-max-distance", "0.5"}, ""},
+      {"ao_tau", "ao = { samples = 8, tau = 2 }", {"--ao-samples", "8", "--ao-tau", "2"}, ""},
+      {"ao_binary", "ao = { samples = 8, falloff = \"none\" }", {"--ao-samples", "8", "--ao-falloff", "none"}, ""},
+      {"ao_bias", "ao = { samples = 8, bias = 1e-3 }", {"--ao-samples", "8", "--ao-bias", "1e-3"}, ""},
+      {"ao_two_sided", "ao = { samples = 8, two_sided = true }", {"--ao-samples", "8", "--ao-two-sided"}, ""},
+      {"ao_seed", "ao = { samples = 8, seed = 3 }", {"--ao-samples", "8", "--ao-seed", "3"}, ""},
+      {"ao_random", "ao = { samples = 8, sampler = \"random\" }", {"--ao-samples", "8", "--ao-sampler", "random"}, ""},
+      {"ao_normals", "ao = { samples = 8, recompute_normals = \"angle\" }",
+       {"--ao-samples", "8", "--ao-recompute-normals", "angle"}, ""},
+      {"ao_fast", "ao = { samples = 8, fast_traversal = true }", {"--ao-samples", "8", "--ao-fast-traversal"}, ""},
+  };
+  std::string manifest;
+  for (const Case& c : cases) {
+    manifest += "\n[materials.pair_" + c.name + "]\npacked = { layout = \"schuler\", files = [\"pair_a.png\", \"pair_b.png\"] }\n" +
+                "validate = { enabled = false }\n" + (c.mapping.empty() ? "" : "mapping = \"" + c.mapping + "\"\n");
+    manifest += "\n[scenes." + c.name + "]\ninput = \"showroom.gltf\"\noutput = \"" + c.name + "/showroom.glb\"\n" +
+                "materials = { painted_metal = \"pair_" + c.name + "\" }\n" + c.manifest + "\n";
+  }
+  const json report = build(manifest);
+  ASSERT_EQ(report.value("failed", -1), 0) << report.dump(2);
+  for (const Case& c : cases) {
+    fs::create_directories(dir / "cli" / c.name);
+    std::vector<std::string> args = {"export", (dir / "showroom.gltf").string(), "-o",
+                                     (dir / "cli" / c.name / "showroom.glb").string(), "--material",
+                                     "painted_metal=" + (dir / "pair_a.png").string() + "," + (dir / "pair_b.png").string()};
+    args.insert(args.end(), c.command.begin(), c.command.end());
+    const RunResult r = matbake(args);
+    EXPECT_EQ(r.exit_code, 0) << c.name << ": " << r.err;
+    expect_same_files({dir / "cli" / c.name / "showroom.glb"}, {dir / "out" / c.name / "showroom.glb"}, c.name);
+  }
+}
+
+// Issue "One request layer": bake-ao was one-sided and export/build two-sided by default (mean AO
+// 0.803 against 0.596 on the showroom). All three now take ao::Options' defaults: the same values.
+TEST_F(Parity, BakeAoExportAndBuildBakeTheSameValues) {
+  for (const char* f : {"showroom.gltf", "showroom.bin"}) fs::copy_file(kExamples / f, dir / f);
+  run_command({"bake-ao", (dir / "showroom.gltf").string(), "--samples", "16", "--into", "_AO", "-o",
+               (dir / "cli" / "baked.glb").string()});
+  run_command({"export", (dir / "showroom.gltf").string(), "--ao-samples", "16", "--ao-into", "_AO", "-o",
+               (dir / "cli" / "exported.glb").string()});
+  build("[scenes.s]\ninput = \"showroom.gltf\"\noutput = \"built.glb\"\nao = { samples = 16, into = \"_AO\" }\n");
+  const std::vector<float> baked = ao_values(dir / "cli" / "baked.glb");
+  ASSERT_FALSE(baked.empty());
+  EXPECT_EQ(ao_values(dir / "cli" / "exported.glb"), baked);
+  EXPECT_EQ(ao_values(dir / "out" / "built.glb"), baked);
+  double mean = 0;
+  for (float v : baked) mean += v;
+  mean /= double(baked.size());
+  EXPECT_GT(mean, 0.7);  // one-sided: the floor's underside does not darken the objects on it
+}
+
+}  // namespace
+}  // namespace matbake::test
