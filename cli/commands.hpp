@@ -48,12 +48,7 @@ int run_convert(const ConvertSettings& settings, const GlobalOptions& global);
 
 struct PreviewSettings {
   std::string output;
-  std::string kd = "0.5";
-  std::string ks = "0.04";
-  double gloss = 0.5;
-  std::string base_color;
-  double metallic = 0;
-  double roughness = 0.5;
+  SourceSettings sources;  // constants or textures, as pack reads them
   std::string materials;
   std::vector<double> gloss_sweep;
   std::string model = "schuler-optimized";

@@ -42,7 +42,7 @@ Result<color::Transfer> parse_transfer(const std::string& name, const char* opti
   return *t;
 }
 
-void add_source_options(CLI::App& cmd, SourceSettings& s) {
+void add_source_options(CLI::App& cmd, SourceSettings& s, bool constant_size) {
   const auto sources = pack::sources();
   for (std::size_t i = 0; i < sources.size(); ++i) {
     const bool colour = sources[i].kind == pack::SourceKind::color;
@@ -58,7 +58,7 @@ void add_source_options(CLI::App& cmd, SourceSettings& s) {
   cmd.add_option("--input-transfer", s.input_transfer,
                  "Curve of every colour input, overriding the rule (8-bit: --transfer; 16-bit, half, float: linear)");
   cmd.add_flag("--resize", s.resize, "Resample sources of different sizes to the largest (in linear light)");
-  cmd.add_option("--size", s.size, "WxH of the output when every source is a constant (default 1x1)");
+  if (constant_size) cmd.add_option("--size", s.size, "WxH of the output when every source is a constant (default 1x1)");
 }
 
 Result<pack::SourceMaps> gather_sources(const SourceSettings& s) {

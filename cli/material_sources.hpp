@@ -21,7 +21,8 @@ struct SourceSettings {
   bool resize = false;
   std::string size;                   // WxH when every source is a constant
 };
-void add_source_options(CLI::App& cmd, SourceSettings& s);
+// `constant_size`: also --size WxH (the size of an output made of constants alone).
+void add_source_options(CLI::App& cmd, SourceSettings& s, bool constant_size = true);
 Result<pack::SourceMaps> gather_sources(const SourceSettings& s);
 // The source maps in `files`, the textures of layout `layout_name` in order: colour decoded with
 // `input` when given, else `authored` for 8-bit files and linear for the rest.

@@ -275,6 +275,21 @@ TEST(CliPreview, WritesPngAndSidecarAndRefusesBadParameters) {
     EXPECT_EQ(r.exit_code, 2) << testing::PrintToString(args) << r.err;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
   }
+  // Textures, as pack reads them (issue "One request layer": `--kd rgba.png` was "not a number").
+  write_raw(dir / "kd.png", 4, 2, 4, "uint8", {200, 20, 20, 255, 20, 200, 20, 255, 20, 20, 200, 255, 90, 90, 90, 255,
+                                               200, 20, 20, 255, 20, 200, 20, 255, 20, 20, 200, 255, 90, 90, 90, 255});
+  write_raw(dir / "b.png", 4, 2, 4, "uint8", std::vector<double>(32, 128));
+  for (const auto& args : std::vector<std::vector<std::string>>{
+           {"--kd", (dir / "kd.png").string(), "--gloss", "0.7"},
+           {"--from", "schuler", (dir / "kd.png").string(), (dir / "b.png").string()},
+           {"--base-color", (dir / "kd.png").string(), "--metallic", "1"}}) {
+    std::vector<std::string> all = {"preview", "-o", (dir / "textured.png").string(), "--size", "16"};
+    all.insert(all.end(), args.begin(), args.end());
+    const auto textured = matbake(all);
+    ASSERT_EQ(textured.exit_code, 0) << textured.err;
+    const auto cells = nlohmann::json::parse(read_bytes(dir / "textured.json"))["cells"];
+    EXPECT_TRUE(cells[0]["textured"]) << args[0];
+  }
   write_bytes(dir / "bad.json", "not json");
   const auto bad = matbake({"preview", "-o", (dir / "x.png").string(), "--materials", (dir / "bad.json").string()});
   EXPECT_EQ(bad.exit_code, 1);

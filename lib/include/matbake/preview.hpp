@@ -2,10 +2,12 @@
 // Material balls: spheres under Schüler's two-hemisphere light plus two directional lights, one
 // cell per (material, gloss), rendered with any catalog model into a linear RGB image.
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "matbake/image.hpp"
+#include "matbake/pack.hpp"
 #include "matbake/result.hpp"
 #include "matbake/shading.hpp"
 
@@ -13,10 +15,19 @@ namespace matbake::preview {
 
 struct Material {
   std::string name;
-  shading::Vec3 kd{0.5};   // diffuse colour, linear
-  shading::Vec3 ks{0.04};  // specular colour (F0), linear
-  double gloss = 0.5;      // g in [0, 1]; e = 2^(12 g)
+  shading::Vec3 kd{0.5};   // diffuse colour, linear (of a texture: its mean)
+  shading::Vec3 ks{0.04};  // specular colour (F0), linear (of a texture: its mean)
+  double gloss = 0.5;      // g in [0, 1]; e = 2^(12 g) (of a texture: its mean)
+  // Schüler maps (kd, ks, gloss, mask; linear) sampled over the ball at its UV: u around the vertical
+  // axis (0.5 faces the camera), v from the top pole (0) to the bottom (1), bilinear, u wrapping.
+  // The mask blends the ball over the background. Absent maps: the constants above.
+  std::shared_ptr<const pack::SourceMaps> textures;
 };
+
+// A material from source maps as `matbake pack` reads them: Schüler's (kd, ks, gloss, mask; the
+// defaults above for those not given) or metal-rough (base_color with metallic 0 and roughness 0.5
+// unless given, converted per texel as from_metal_rough does). 1×1 maps are constants.
+Result<Material> material_from_maps(std::string name, const pack::SourceMaps& maps);
 
 // The metalness workflow's relation (PBR notes): kd = base (1 − m), ks = lerp(0.04, base, m);
 // gloss from glTF roughness by the Walter mapping (workflow::gloss_from_roughness).

@@ -7,12 +7,14 @@
 #include <nlohmann/json.hpp>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <numbers>
 #include <sstream>
 
 #include "matbake/shading_catalog.hpp"
+#include "matbake/workflow_maps.hpp"
 
 namespace matbake::preview {
 namespace {
@@ -43,7 +45,92 @@ double shade(const shading::ModelInfo& model, const Vec3& n, double kd, double k
   return radiance;
 }
 
+// Channel c of `im` at (u, v) ∈ [0, 1]², bilinear between texel centres; u wraps, v clamps.
+double bilinear(const image::Image& im, double u, double v, int c) {
+  const double x = u * im.width - 0.5, y = std::clamp(v * im.height - 0.5, 0.0, double(im.height - 1));
+  const double fx = std::floor(x), fy = std::floor(y);
+  const double tx = x - fx, ty = y - fy;
+  const auto at = [&](double px, double py) {
+    const int ix = int(((long long)(px) % im.width + im.width) % im.width);
+    const int iy = std::min(int(py), im.height - 1);
+    return double(im.pixels[(std::size_t(iy) * std::size_t(im.width) + std::size_t(ix)) * std::size_t(im.channels) + std::size_t(c)]);
+  };
+  return (1 - ty) * ((1 - tx) * at(fx, fy) + tx * at(fx + 1, fy)) + ty * ((1 - tx) * at(fx, fy + 1) + tx * at(fx + 1, fy + 1));
+}
+
+// The material's values at normal n: its textures at the ball's UV where it has them.
+struct Surface {
+  Vec3 kd, ks;
+  double gloss, mask;
+};
+Surface surface_at(const Material& m, const Vec3& n, bool gloss_from_map) {
+  Surface s{m.kd, m.ks, m.gloss, 1.0};
+  if (!m.textures) return s;
+  const double u = 0.5 + std::atan2(n.x, n.y) / (2 * std::numbers::pi);
+  const double v = std::acos(std::clamp(n.z, -1.0, 1.0)) / std::numbers::pi;
+  const pack::SourceMaps& t = *m.textures;
+  if (const image::Image* kd = t.find("kd")) s.kd = Vec3(bilinear(*kd, u, v, 0), bilinear(*kd, u, v, 1), bilinear(*kd, u, v, 2));
+  if (const image::Image* ks = t.find("ks")) s.ks = Vec3(bilinear(*ks, u, v, 0), bilinear(*ks, u, v, 1), bilinear(*ks, u, v, 2));
+  if (const image::Image* g = t.find("gloss"); g && gloss_from_map) s.gloss = bilinear(*g, u, v, 0);
+  if (const image::Image* mask = t.find("mask")) s.mask = std::clamp(bilinear(*mask, u, v, 0), 0.0, 1.0);
+  return s;
+}
+
+// The mean of a map's first `channels` channels.
+Vec3 mean_of(const image::Image& im) {
+  Vec3 sum(0.0);
+  const std::size_t texels = std::size_t(im.width) * std::size_t(im.height);
+  for (std::size_t p = 0; p < texels; ++p) {
+    for (int c = 0; c < 3; ++c) sum[c] += im.pixels[p * std::size_t(im.channels) + std::size_t(std::min(c, im.channels - 1))];
+  }
+  return sum / double(texels);
+}
+
+// A 1×1 map of `value` at the size of `maps`, where `maps` has no map `name`.
+void fill_constant(pack::SourceMaps& maps, const char* name, float value) {
+  if (maps.find(name)) return;
+  image::Image im;
+  im.width = maps.width, im.height = maps.height, im.channels = 1;
+  im.pixels.assign(im.sample_count(), value);
+  maps.maps[name] = std::move(im);
+}
+
 }  // namespace
+
+Result<Material> material_from_maps(std::string name, const pack::SourceMaps& given) {
+  return guarded("", [&]() -> Result<Material> {
+    pack::SourceMaps maps = given;
+    const bool metal_rough = maps.find("base_color") || maps.find("metallic") || maps.find("roughness");
+    if (metal_rough && (maps.find("kd") || maps.find("ks") || maps.find("gloss"))) {
+      return Error{"", "give Schüler maps (kd, ks, gloss) or metal-rough ones (base_color, metallic, roughness), not both", true};
+    }
+    if (metal_rough) {
+      if (!maps.find("base_color")) return Error{"", "metal-rough maps need base_color", true};
+      fill_constant(maps, "metallic", 0.0f);
+      fill_constant(maps, "roughness", 0.5f);
+      workflow::ConversionReport report;
+      auto converted = workflow::spec_gloss_from_metal_rough(maps, workflow::RoughnessMapping::walter, report);
+      if (!converted) return converted.error();
+      maps = std::move(*converted);
+    }
+    Material m;
+    m.name = std::move(name);
+    auto textures = std::make_shared<pack::SourceMaps>();
+    textures->width = maps.width, textures->height = maps.height;
+    for (const char* key : {"kd", "ks", "gloss", "mask"}) {
+      const image::Image* map = maps.find(key);
+      if (!map) continue;
+      const Vec3 mean = mean_of(*map);
+      if (std::string_view(key) == "kd") m.kd = mean;
+      if (std::string_view(key) == "ks") m.ks = mean;
+      if (std::string_view(key) == "gloss") m.gloss = mean.x;
+      if (map->width * map->height > 1 || std::string_view(key) == "mask") textures->maps[key] = *map;
+    }
+    if (!textures->maps.empty()) m.textures = std::move(textures);
+    if (Status s = check(m); !s) return s.error();
+    return m;
+  });
+}
 
 const std::vector<DirectionalLight>& lights() {
   static const std::vector<DirectionalLight> rig = {
@@ -56,7 +143,7 @@ const std::vector<DirectionalLight>& lights() {
 Material from_metal_rough(std::string name, Vec3 base_color, double metallic, double roughness) {
   const workflow::SpecGloss sg =
       workflow::spec_gloss_from_metal_rough({base_color, metallic, roughness}, workflow::RoughnessMapping::walter);
-  return {std::move(name), sg.kd, sg.ks, sg.gloss};
+  return {std::move(name), sg.kd, sg.ks, sg.gloss, nullptr};
 }
 
 Status check(const Material& m) {
@@ -157,7 +244,10 @@ Result<Preview> render(const std::vector<Material>& materials, const Options& op
                 continue;
               }
               const Vec3 n(x, std::sqrt(1.0 - r2), z);
-              for (int c = 0; c < 3; ++c) sum[c] += shade(*model, n, cell.material.kd[c], cell.material.ks[c], cell.material.gloss, options.sky);
+              const Surface s = surface_at(cell.material, n, options.glosses.empty());
+              for (int c = 0; c < 3; ++c) {
+                sum[c] += s.mask * shade(*model, n, s.kd[c], s.ks[c], s.gloss, options.sky) + (1 - s.mask) * kBackground;
+              }
             }
           }
           float* out = &img.pixels[(std::size_t(cell.y + py) * img.width + cell.x + px) * 3];
