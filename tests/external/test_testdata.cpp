@@ -344,5 +344,66 @@ TEST(KhronosModels, ExportedScenesStayValidatorCleanWithTheirCounts) {
   EXPECT_GE(converted, 2);  // BoxTextured's spec-gloss variant and SpecGlossVsMetalRough
 }
 
+// Issue "One request layer": every material of every sample replaced, (b) by a Schüler pair and
+// (c) by metal-rough maps, comes out validator-clean, with no warning its input did not have and no
+// trace of what it replaced. Textures (4×4) where every primitive drawing the material has
+// TEXCOORD_0, else 1×1 files (factors).
+TEST(KhronosModels, EveryMaterialReplacedStaysValidatorClean) {
+  REQUIRE_TESTDATA("gltf");
+#ifdef MATBAKE_SANITIZED
+  GTEST_SKIP() << "a sweep over every sample model: run in the release build";
+#endif
+  test::TempDir dir;
+  const auto noise = [&](const char* name, int size, int channels, int lo, int hi) {
+    std::vector<double> samples;
+    for (int i = 0; i < size * size * channels; ++i) samples.push_back(lo + (i * 37) % (hi - lo + 1));
+    test::write_raw(dir / name, size, size, channels, "uint8", samples);
+    return (dir / name).string();
+  };
+  struct Replacement {
+    std::string kind, textured, constant;  // the --material value after "INDEX="
+  };
+  const std::vector<Replacement> replacements = {
+      {"schuler", noise("a4.png", 4, 4, 0, 255) + "," + noise("b4.png", 4, 4, 5, 250),
+       noise("a1.png", 1, 4, 120, 200) + "," + noise("b1.png", 1, 4, 10, 40)},
+      {"metal-rough", "gltf-metal-rough:" + noise("base4.png", 4, 4, 0, 255) + "," + noise("mr4.png", 4, 3, 0, 255),
+       "gltf-metal-rough:" + noise("base1.png", 1, 4, 50, 250) + "," + noise("mr1.png", 1, 3, 0, 255)}};
+  int checked = 0;
+  for (const fs::path& file : khronos_models()) {
+    MATBAKE_VALIDATE_OR_SKIP(in_report, file);
+    const std::set<std::string> in_codes = codes_of(*in_report);
+    const auto in = gltf::read_document(file);
+    ASSERT_TRUE(in) << in.error().to_string();
+    if (!in->json.contains("materials")) continue;
+    // Materials drawn by a primitive without TEXCOORD_0 take constants.
+    std::set<int> without_uv;
+    for (const auto& mesh : in->json.value("meshes", gltf::Json::array())) {
+      for (const auto& p : mesh["primitives"]) {
+        if (p.contains("material") && !p["attributes"].contains("TEXCOORD_0")) without_uv.insert(p["material"].get<int>());
+      }
+    }
+    for (const Replacement& r : replacements) {
+      const fs::path out = dir / (file.stem().string() + "_" + file.parent_path().filename().string() + "_" + r.kind + ".glb");
+      std::vector<std::string> args = {"export", file.string(), "-o", out.string()};
+      for (std::size_t m = 0; m < in->json["materials"].size(); ++m) {
+        args.push_back("--material");
+        args.push_back(std::to_string(m) + "=" + (without_uv.contains(int(m)) ? r.constant : r.textured));
+      }
+      const auto run = test::matbake(args);
+      ASSERT_EQ(run.exit_code, 0) << file << " " << r.kind << ": " << run.err;
+      MATBAKE_VALIDATE_OR_SKIP(out_report, out);
+      EXPECT_EQ(out_report->errors, 0) << out_report->summary;
+      for (const std::string& code : codes_of(*out_report)) {
+        EXPECT_TRUE(in_codes.contains(code)) << code << " is new in " << out_report->summary;
+      }
+      const auto doc = gltf::read_document(out);
+      ASSERT_TRUE(doc) << doc.error().to_string();
+      EXPECT_EQ(doc->json.dump().find("pbrSpecularGlossiness"), std::string::npos) << out;
+      ++checked;
+    }
+  }
+  EXPECT_GE(checked, 30);
+}
+
 }  // namespace
 }  // namespace matbake
