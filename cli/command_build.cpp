@@ -9,7 +9,7 @@
 
 #include "commands.hpp"
 #include "matbake/atomic_file.hpp"
-#include "matbake/build.hpp"
+#include "matbake/pipeline.hpp"
 #include "progress_bar.hpp"
 #include "silenced_stderr.hpp"
 
@@ -17,17 +17,17 @@ namespace matbake::cli {
 namespace fs = std::filesystem;
 namespace {
 
-std::string_view outcome_name(build::Outcome o) {
+std::string_view outcome_name(pipeline::Outcome o) {
   switch (o) {
-    case build::Outcome::built: return "built";
-    case build::Outcome::up_to_date: return "up_to_date";
-    case build::Outcome::failed: return "failed";
-    case build::Outcome::out_of_date: return "out_of_date";
+    case pipeline::Outcome::built: return "built";
+    case pipeline::Outcome::up_to_date: return "up_to_date";
+    case pipeline::Outcome::failed: return "failed";
+    case pipeline::Outcome::out_of_date: return "out_of_date";
   }
   return "";
 }
 
-nlohmann::json job_json(const build::JobReport& r) {
+nlohmann::json job_json(const pipeline::JobReport& r) {
   std::vector<std::string> inputs, outputs;
   for (const fs::path& p : r.job->inputs) inputs.push_back(p.string());
   for (const fs::path& p : r.job->outputs) outputs.push_back(p.string());
@@ -39,14 +39,14 @@ nlohmann::json job_json(const build::JobReport& r) {
   return j;
 }
 
-std::string job_error(const build::JobReport& r) { return r.error->to_string() + " (" + r.job->name + ")"; }
+std::string job_error(const pipeline::JobReport& r) { return r.error->to_string() + " (" + r.job->name + ")"; }
 
-Result<build::Plan> load(const std::string& manifest_file, const std::string& output_dir, build::Manifest& manifest) {
-  auto m = build::read_manifest(manifest_file);
+Result<pipeline::Plan> load(const std::string& manifest_file, const std::string& output_dir, pipeline::Manifest& manifest) {
+  auto m = pipeline::read_manifest(manifest_file);
   if (!m) return m.error();
   manifest = std::move(*m);
   if (!output_dir.empty()) manifest.output = fs::absolute(output_dir).lexically_normal();
-  return build::make_plan(manifest);
+  return pipeline::make_plan(manifest);
 }
 
 void add_output_dir_option(CLI::App& cmd, std::string& output_dir) {
@@ -84,17 +84,17 @@ CLI::App* setup_plan(CLI::App& app, PlanSettings& s) {
 }
 
 int run_plan(const PlanSettings& s, const GlobalOptions& global) {
-  build::Manifest manifest;
+  pipeline::Manifest manifest;
   auto plan = load(s.manifest, s.output_dir, manifest);
   if (!plan) return report_error(plan.error());
   std::error_code ec;
   const fs::path self = s.matbake.empty() ? fs::read_symlink("/proc/self/exe", ec) : fs::absolute(s.matbake);
-  if (Status st = write_file_atomically(s.output, build::ninja_text(manifest, *plan, self, s.output)); !st) {
+  if (Status st = write_file_atomically(s.output, pipeline::ninja_text(manifest, *plan, self, s.output)); !st) {
     return report_error(st.error());
   }
   if (global.json) {
     nlohmann::json jobs = nlohmann::json::array();
-    for (const build::Job& j : plan->jobs) jobs.push_back(j.name);
+    for (const pipeline::Job& j : plan->jobs) jobs.push_back(j.name);
     std::cout << nlohmann::json{{"command", "plan"}, {"ninja_file", s.output}, {"jobs", jobs}}.dump(2) << "\n";
   } else if (!global.quiet) {
     std::printf("%s: %zu edges\n", s.output.c_str(), plan->jobs.size());
@@ -105,7 +105,7 @@ int run_plan(const PlanSettings& s, const GlobalOptions& global) {
 
 int run_build(const BuildSettings& s, const GlobalOptions& global) {
   const auto start = std::chrono::steady_clock::now();
-  build::Manifest manifest;
+  pipeline::Manifest manifest;
   auto plan = load(s.manifest, s.output_dir, manifest);
   if (!plan) return report_error(plan.error());
   if (!global.quiet) {
@@ -116,12 +116,12 @@ int run_build(const BuildSettings& s, const GlobalOptions& global) {
   const bool terminal = isatty(STDERR_FILENO) != 0;
   std::optional<SilencedStderr> quiet(std::in_place);  // libpng's own messages: each job's error line says it
   ProgressBar bar(terminal && !global.quiet, quiet->original_fd());
-  build::RunOptions options;
+  pipeline::RunOptions options;
   options.force = s.force;
   options.dry_run = s.dry_run;
   options.only = s.only;
-  options.progress = [&](const build::JobReport& r, std::size_t done, std::size_t total) {
-    if (r.outcome == build::Outcome::failed) {
+  options.progress = [&](const pipeline::JobReport& r, std::size_t done, std::size_t total) {
+    if (r.outcome == pipeline::Outcome::failed) {
       bar.print_above("matbake: error: " + job_error(r));
     } else if (!global.quiet && !terminal) {
       char line[64];
@@ -130,23 +130,23 @@ int run_build(const BuildSettings& s, const GlobalOptions& global) {
     }
     bar.update(done, total);
   };
-  auto report = build::run(manifest, *plan, options);
+  auto report = pipeline::run(manifest, *plan, options);
   bar.finish();
   quiet.reset();
   if (!report) return report_error(report.error());
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  const std::size_t failed = report->count(build::Outcome::failed);
+  const std::size_t failed = report->count(pipeline::Outcome::failed);
 
   if (!s.depfile.empty() && !s.dry_run) {
     std::vector<fs::path> targets, inputs = {manifest.file};
-    for (const build::JobReport& r : report->jobs) {
+    for (const pipeline::JobReport& r : report->jobs) {
       targets.insert(targets.end(), r.job->outputs.begin(), r.job->outputs.end());
       for (const fs::path& p : r.job->inputs) {
         if (std::find(inputs.begin(), inputs.end(), p) == inputs.end()) inputs.push_back(p);
       }
     }
     if (!s.stamp.empty()) targets = {fs::absolute(s.stamp).lexically_normal()};
-    if (Status st = write_file_atomically(s.depfile, build::depfile_text(targets, inputs)); !st) return report_error(st.error());
+    if (Status st = write_file_atomically(s.depfile, pipeline::depfile_text(targets, inputs)); !st) return report_error(st.error());
   }
   if (!s.stamp.empty() && !s.dry_run && failed == 0) {
     const std::string text = "matbake build " + manifest.file.string() + ": " + std::to_string(report->jobs.size()) + " jobs\n";
@@ -155,15 +155,15 @@ int run_build(const BuildSettings& s, const GlobalOptions& global) {
 
   if (global.json) {
     nlohmann::json jobs = nlohmann::json::array();
-    for (const build::JobReport& r : report->jobs) jobs.push_back(job_json(r));
+    for (const pipeline::JobReport& r : report->jobs) jobs.push_back(job_json(r));
     std::cout << nlohmann::json{{"command", "build"},
                                 {"manifest", manifest.file.string()},
                                 {"output", manifest.output.string()},
                                 {"dry_run", s.dry_run},
                                 {"jobs", jobs},
-                                {"built", report->count(build::Outcome::built)},
-                                {"up_to_date", report->count(build::Outcome::up_to_date)},
-                                {"out_of_date", report->count(build::Outcome::out_of_date)},
+                                {"built", report->count(pipeline::Outcome::built)},
+                                {"up_to_date", report->count(pipeline::Outcome::up_to_date)},
+                                {"out_of_date", report->count(pipeline::Outcome::out_of_date)},
                                 {"failed", failed},
                                 {"images_decoded", report->images_decoded},
                                 {"seconds", seconds},
@@ -172,15 +172,15 @@ int run_build(const BuildSettings& s, const GlobalOptions& global) {
               << "\n";
   } else if (!global.quiet) {
     if (s.dry_run) {
-      for (const build::JobReport& r : report->jobs) {
-        if (r.outcome == build::Outcome::out_of_date) std::printf("would build %s: %s\n", r.job->name.c_str(), r.reason.c_str());
+      for (const pipeline::JobReport& r : report->jobs) {
+        if (r.outcome == pipeline::Outcome::out_of_date) std::printf("would build %s: %s\n", r.job->name.c_str(), r.reason.c_str());
       }
     }
-    for (const build::JobReport& r : report->jobs) {
+    for (const pipeline::JobReport& r : report->jobs) {
       for (const std::string& w : r.warnings) std::cerr << "matbake: warning: " << r.job->name << ": " << w << "\n";
     }
-    const std::size_t built = report->count(build::Outcome::built), current = report->count(build::Outcome::up_to_date),
-                      pending = report->count(build::Outcome::out_of_date);
+    const std::size_t built = report->count(pipeline::Outcome::built), current = report->count(pipeline::Outcome::up_to_date),
+                      pending = report->count(pipeline::Outcome::out_of_date);
     if (built + failed + pending == 0) {
       std::printf("nothing to do: %zu jobs up to date\n", current);
     } else if (s.dry_run) {

@@ -6,9 +6,9 @@
 #include <string>
 #include <vector>
 
-#include "matbake/build.hpp"
+#include "matbake/pipeline.hpp"
 
-namespace matbake::build {
+namespace matbake::pipeline {
 
 std::string job_file_stem(const Job& job);  // "material-wood": the stamp's and the depfile's name
 
@@ -25,4 +25,4 @@ Status write_stamp(const Job& job, const std::vector<std::filesystem::path>& rea
 // Removes the stamp, so that a failed job runs again next time.
 void remove_stamp(const Job& job, const std::filesystem::path& state_folder);
 
-}  // namespace matbake::build
+}  // namespace matbake::pipeline

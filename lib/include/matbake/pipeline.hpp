@@ -26,7 +26,7 @@
 #include "matbake/validate.hpp"
 #include "matbake/workflow.hpp"
 
-namespace matbake::build {
+namespace matbake::pipeline {
 
 struct ValidationRules {
   bool enabled = true;
@@ -137,4 +137,4 @@ std::string depfile_text(const std::vector<std::filesystem::path>& targets,
 std::string ninja_text(const Manifest& manifest, const Plan& plan, const std::filesystem::path& matbake,
                        const std::filesystem::path& ninja_file);
 
-}  // namespace matbake::build
+}  // namespace matbake::pipeline

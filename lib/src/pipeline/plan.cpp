@@ -5,11 +5,11 @@
 
 #include "../gltf/document.hpp"
 #include "state.hpp"
-#include "matbake/build.hpp"
+#include "matbake/pipeline.hpp"
 #include "matbake/report_json.hpp"
 #include "matbake/version.hpp"
 
-namespace matbake::build {
+namespace matbake::pipeline {
 namespace fs = std::filesystem;
 namespace {
 
@@ -247,4 +247,4 @@ std::string ninja_text(const Manifest& manifest, const Plan& plan, const fs::pat
   return text;
 }
 
-}  // namespace matbake::build
+}  // namespace matbake::pipeline

@@ -9,7 +9,7 @@
 #include <thread>
 
 #include "cli/progress_bar.hpp"
-#include "matbake/build.hpp"
+#include "matbake/pipeline.hpp"
 #include "support/files.hpp"
 #include "support/gltf_files.hpp"
 #include "support/temp_dir.hpp"
@@ -48,12 +48,12 @@ ao = { samples = 32, absolute_distance = 2.5, falloff = "none", into = "_AO", se
 )";
 
 TEST(BuildManifest, EveryKeyReachesItsField) {
-  auto m = build::parse_manifest(kFull, "/project/assets.toml");
+  auto m = pipeline::parse_manifest(kFull, "/project/assets.toml");
   ASSERT_TRUE(m) << m.error().to_string();
   EXPECT_EQ(m->folder, fs::path("/project"));
   EXPECT_EQ(m->output, fs::path("/project/built"));
   ASSERT_EQ(m->materials.size(), 2u);
-  const build::MaterialSpec& brick = m->materials[0];  // tables are sorted by name
+  const pipeline::MaterialSpec& brick = m->materials[0];  // tables are sorted by name
   EXPECT_EQ(brick.name, "brick");
   ASSERT_EQ(brick.sources.size(), 3u);
   EXPECT_EQ(brick.sources[0].name, "gloss");
@@ -67,7 +67,7 @@ TEST(BuildManifest, EveryKeyReachesItsField) {
   EXPECT_EQ(brick.bits, image::SampleType::u16);
   EXPECT_DOUBLE_EQ(brick.validation.options.tolerance, 0.2);
   EXPECT_DOUBLE_EQ(brick.validation.options.max_violations, 0.01);
-  const build::MaterialSpec& gold = m->materials[1];
+  const pipeline::MaterialSpec& gold = m->materials[1];
   EXPECT_EQ(gold.packed_layout, "gltf-orm");
   EXPECT_EQ(gold.packed_files, (std::vector<fs::path>{"/project/a.png", "/project/b.png"}));
   EXPECT_EQ(gold.transfer, color::Transfer::srgb);
@@ -77,7 +77,7 @@ TEST(BuildManifest, EveryKeyReachesItsField) {
   EXPECT_DOUBLE_EQ(gold.validation.options.max_violations, 0.5);
   EXPECT_TRUE(gold.validation.heatmap);
   ASSERT_EQ(m->scenes.size(), 1u);
-  const build::SceneSpec& room = m->scenes[0];
+  const pipeline::SceneSpec& room = m->scenes[0];
   EXPECT_EQ(room.input, fs::path("/project/room.gltf"));
   EXPECT_EQ(room.output, fs::path("sub/room.gltf"));
   EXPECT_EQ(room.materials.at("Bricks"), "brick");
@@ -123,13 +123,13 @@ TEST(BuildManifest, ErrorsSayWhereAndWhat) {
       {"", "m.toml", "nothing to build"},
   };
   for (const Case& c : cases) {
-    auto m = build::parse_manifest(c.text, "m.toml");
+    auto m = pipeline::parse_manifest(c.text, "m.toml");
     ASSERT_FALSE(m) << c.text;
     EXPECT_EQ(m.error().path.rfind(c.where, 0), 0u) << c.text << "\n→ " << m.error().to_string();
     EXPECT_NE(m.error().message.find(c.says), std::string::npos) << c.text << "\n→ " << m.error().to_string();
     EXPECT_EQ(m.error().to_string().find('\n'), std::string::npos);
   }
-  auto missing = build::read_manifest("/nonexistent/m.toml");
+  auto missing = pipeline::read_manifest("/nonexistent/m.toml");
   ASSERT_FALSE(missing);
   EXPECT_EQ(missing.error().path, "/nonexistent/m.toml");
 }
@@ -156,20 +156,20 @@ validate = { enabled = false }
 input = "room.gltf"
 materials = { "other" = "scene_only" }
 )");
-  auto m = build::read_manifest(dir / "build.toml");
+  auto m = pipeline::read_manifest(dir / "build.toml");
   ASSERT_TRUE(m) << m.error().to_string();
-  auto plan = build::make_plan(*m);
+  auto plan = pipeline::make_plan(*m);
   ASSERT_TRUE(plan) << plan.error().to_string();
   // paint: textures + report; unused: no layout, no validation, no scene (a warning); scene_only:
   // nothing of its own.
   ASSERT_EQ(plan->jobs.size(), 2u);
-  const build::Job& paint = plan->jobs[0];
+  const pipeline::Job& paint = plan->jobs[0];
   EXPECT_EQ(paint.name, "material:paint");
   const fs::path out = dir.path() / "out";
   EXPECT_EQ(paint.outputs, (std::vector<fs::path>{out / "materials/paint_base_color.png", out / "materials/paint_orm.png",
                                                  out / "materials/paint.validation.json"}));
   EXPECT_EQ(paint.inputs, std::vector<fs::path>{dir.path() / "paint.png"});
-  const build::Job& room = plan->jobs[1];
+  const pipeline::Job& room = plan->jobs[1];
   EXPECT_EQ(room.name, "scene:room");
   EXPECT_EQ(room.outputs, std::vector<fs::path>{out / "room.glb"});
   // The scene, its image (URI decoded), and the sources of both materials it gets (by name and by the map).
@@ -182,7 +182,7 @@ materials = { "other" = "scene_only" }
   EXPECT_EQ(plan->state_folder, out / ".matbake");
 
   // Ninja: one edge per job with its outputs, inputs and depfile, and the regenerate edge.
-  const std::string ninja = build::ninja_text(*m, *plan, "/usr/bin/matbake", "build.ninja");
+  const std::string ninja = pipeline::ninja_text(*m, *plan, "/usr/bin/matbake", "build.ninja");
   EXPECT_NE(ninja.find("build " + (out / "room.glb").string() + ": matbake $manifest | " + (dir.path() / "room.gltf").string() +
                        " " + (dir.path() / "tex$ a.png").string()),
             std::string::npos)
@@ -195,9 +195,9 @@ TEST(BuildPlan, RefusesToWriteAnInputOrOneFileTwice) {
   TempDir dir;
   write_bytes(dir / "a.toml", "output = \".\"\n[materials.x]\nsources = { kd = \"x.png\" }\nlayout = \"schuler\"\n"
                               "[materials.y]\nsources = { kd = \"materials/x.validation.json\" }\nlayout = \"schuler\"\n");
-  auto m = build::read_manifest(dir / "a.toml");
+  auto m = pipeline::read_manifest(dir / "a.toml");
   ASSERT_TRUE(m) << m.error().to_string();
-  auto plan = build::make_plan(*m);
+  auto plan = pipeline::make_plan(*m);
   ASSERT_FALSE(plan);
   EXPECT_EQ(plan.error().path, (dir.path() / "materials/x.validation.json").string());
   EXPECT_NE(plan.error().message.find("would overwrite an input"), std::string::npos);
@@ -207,15 +207,15 @@ TEST(BuildPlan, RefusesToWriteAnInputOrOneFileTwice) {
   scene.write(dir / "s.gltf", {0});
   write_bytes(dir / "b.toml", "[scenes.one]\ninput = \"s.gltf\"\noutput = \"s.glb\"\n"
                               "[scenes.two]\ninput = \"s.gltf\"\noutput = \"s.glb\"\n");
-  m = build::read_manifest(dir / "b.toml");
+  m = pipeline::read_manifest(dir / "b.toml");
   ASSERT_TRUE(m) << m.error().to_string();
-  plan = build::make_plan(*m);
+  plan = pipeline::make_plan(*m);
   ASSERT_FALSE(plan);
   EXPECT_NE(plan.error().message.find("written by both scene:one and scene:two"), std::string::npos);
 }
 
 TEST(BuildDepfile, MakeSyntaxWithEscapes) {
-  EXPECT_EQ(build::depfile_text({"/o/a b.png", "/o/c.json"}, {"/in/x#1.png", "/in/$y.png", "/in/z.png"}),
+  EXPECT_EQ(pipeline::depfile_text({"/o/a b.png", "/o/c.json"}, {"/in/x#1.png", "/in/$y.png", "/in/z.png"}),
             "/o/a\\ b.png /o/c.json: \\\n  /in/x\\#1.png \\\n  /in/$$y.png \\\n  /in/z.png\n");
 }
 

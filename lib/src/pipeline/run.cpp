@@ -10,14 +10,14 @@
 #include <set>
 
 #include "matbake/atomic_file.hpp"
-#include "matbake/build.hpp"
+#include "matbake/pipeline.hpp"
 #include "matbake/materials.hpp"
 #include "matbake/report_json.hpp"
 #include "matbake/validate.hpp"
 #include "matbake/workflow_maps.hpp"
 #include "state.hpp"
 
-namespace matbake::build {
+namespace matbake::pipeline {
 namespace fs = std::filesystem;
 namespace {
 
@@ -281,4 +281,4 @@ Result<Report> run(const Manifest& manifest, const Plan& plan, const RunOptions&
   return report;
 }
 
-}  // namespace matbake::build
+}  // namespace matbake::pipeline

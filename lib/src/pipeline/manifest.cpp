@@ -1,4 +1,4 @@
-// The TOML manifest (docs/build.md) → build::Manifest. Unknown keys are errors, so that a typo
+// The TOML manifest (docs/build.md) → pipeline::Manifest. Unknown keys are errors, so that a typo
 // does not silently fall back to a default.
 #include <toml++/toml.h>
 
@@ -7,9 +7,9 @@
 #include <set>
 #include <sstream>
 
-#include "matbake/build.hpp"
+#include "matbake/pipeline.hpp"
 
-namespace matbake::build {
+namespace matbake::pipeline {
 namespace fs = std::filesystem;
 namespace {
 
@@ -335,4 +335,4 @@ Result<Manifest> read_manifest(const fs::path& file) {
   return parse_manifest(text.str(), file);
 }
 
-}  // namespace matbake::build
+}  // namespace matbake::pipeline

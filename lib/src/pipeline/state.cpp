@@ -9,7 +9,7 @@
 #include "matbake/atomic_file.hpp"
 #include "matbake/version.hpp"
 
-namespace matbake::build {
+namespace matbake::pipeline {
 namespace fs = std::filesystem;
 namespace {
 
@@ -112,4 +112,4 @@ void remove_stamp(const Job& job, const fs::path& state_folder) {
   fs::remove(stamp_path(job, state_folder), ec);
 }
 
-}  // namespace matbake::build
+}  // namespace matbake::pipeline
