@@ -86,7 +86,7 @@ int run_unpack(const UnpackSettings& s, const GlobalOptions& global) {
         return report_error(Error{path.string(), "is an input; matbake never overwrites its inputs", true});
       }
     }
-    const bool colour = pack::find_source(name)->kind == pack::SourceKind::color;
+    const bool colour = material::find_source(name)->kind == material::SourceKind::color;
     SilencedStderr quiet;
     if (Status st = image::write_image(map, path, pack::write_options(colour, {type, *transfer})); !st) {
       return report_error(st.error());

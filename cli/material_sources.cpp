@@ -43,9 +43,9 @@ Result<color::Transfer> parse_transfer(const std::string& name, const char* opti
 }
 
 void add_source_options(CLI::App& cmd, SourceSettings& s, bool constant_size) {
-  const auto sources = pack::sources();
+  const auto sources = material::sources();
   for (std::size_t i = 0; i < sources.size(); ++i) {
-    const bool colour = sources[i].kind == pack::SourceKind::color;
+    const bool colour = sources[i].kind == material::SourceKind::color;
     cmd.add_option(option_of(sources[i].name), s.values[i],
                    std::string(sources[i].description) + (colour ? ": image, or linear grey / r,g,b" : ": image, or a value"))
         ->group("Sources");
@@ -61,7 +61,7 @@ void add_source_options(CLI::App& cmd, SourceSettings& s, bool constant_size) {
   if (constant_size) cmd.add_option("--size", s.size, "WxH of the output when every source is a constant (default 1x1)");
 }
 
-Result<pack::SourceMaps> gather_sources(const SourceSettings& s) {
+Result<material::Maps> gather_sources(const SourceSettings& s) {
   auto transfer = parse_transfer(s.transfer, "--transfer");
   if (!transfer) return transfer.error();
   pack::LoadOptions options;
@@ -81,7 +81,7 @@ Result<pack::SourceMaps> gather_sources(const SourceSettings& s) {
     }
   }
   std::vector<pack::SourceInput> inputs;
-  const auto sources = pack::sources();
+  const auto sources = material::sources();
   for (std::size_t i = 0; i < sources.size(); ++i) {
     const std::string& text = s.values[i];
     if (text.empty()) continue;
@@ -100,7 +100,7 @@ Result<pack::SourceMaps> gather_sources(const SourceSettings& s) {
     }
     inputs.push_back(std::move(input));
   }
-  pack::SourceMaps maps;
+  material::Maps maps;
   {
     SilencedStderr quiet;
     auto loaded = pack::load_sources(inputs, options);
@@ -121,7 +121,7 @@ Result<pack::SourceMaps> gather_sources(const SourceSettings& s) {
   return unpacked;
 }
 
-Result<pack::SourceMaps> read_packed(const std::string& layout_name, const std::vector<std::string>& files,
+Result<material::Maps> read_packed(const std::string& layout_name, const std::vector<std::string>& files,
                                      std::optional<color::Transfer> input, color::Transfer authored) {
   auto layout = pack::find_layout(layout_name);
   if (!layout) return layout.error();
@@ -138,7 +138,7 @@ void add_output_options(CLI::App& cmd, OutputSettings& o, const std::string& wha
                                    "--transfer in 8-bit and linear otherwise");
 }
 
-Result<std::vector<std::string>> write_textures(const pack::Layout& layout, const pack::SourceMaps& sources,
+Result<std::vector<std::string>> write_textures(const pack::Layout& layout, const material::Maps& sources,
                                                 const OutputSettings& o, const SourceSettings& inputs) {
   auto transfer = parse_transfer(inputs.transfer, "--transfer");
   if (!transfer) return transfer.error();

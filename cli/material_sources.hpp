@@ -13,7 +13,7 @@
 namespace matbake::cli {
 
 struct SourceSettings {
-  std::array<std::string, 9> values;  // by pack::sources() index: a file, or numbers
+  std::array<std::string, 9> values;  // by material::sources() index: a file, or numbers
   std::string from;                   // layout of the packed inputs
   std::vector<std::string> inputs;    // packed inputs, one per texture of `from`
   std::string transfer = "srgb";      // 8-bit colour, read and written
@@ -23,10 +23,10 @@ struct SourceSettings {
 };
 // `constant_size`: also --size WxH (the size of an output made of constants alone).
 void add_source_options(CLI::App& cmd, SourceSettings& s, bool constant_size = true);
-Result<pack::SourceMaps> gather_sources(const SourceSettings& s);
+Result<material::Maps> gather_sources(const SourceSettings& s);
 // The source maps in `files`, the textures of layout `layout_name` in order: colour decoded with
 // `input` when given, else `authored` for 8-bit files and linear for the rest.
-Result<pack::SourceMaps> read_packed(const std::string& layout_name, const std::vector<std::string>& files,
+Result<material::Maps> read_packed(const std::string& layout_name, const std::vector<std::string>& files,
                                      std::optional<color::Transfer> input, color::Transfer authored);
 
 struct OutputSettings {
@@ -36,7 +36,7 @@ struct OutputSettings {
 void add_output_options(CLI::App& cmd, OutputSettings& o, const std::string& what);
 // Writes the layout's textures; returns the paths written. An output that is one of the inputs
 // is refused before anything is written.
-Result<std::vector<std::string>> write_textures(const pack::Layout& layout, const pack::SourceMaps& sources,
+Result<std::vector<std::string>> write_textures(const pack::Layout& layout, const material::Maps& sources,
                                                 const OutputSettings& o, const SourceSettings& inputs);
 Result<color::Transfer> parse_transfer(const std::string& name, const char* option);
 // "0.5" or "0.9,0.6,0.2": the numbers, or nothing when `text` is not a list of numbers.

@@ -14,7 +14,7 @@ namespace {
 using test::TempDir;
 
 // Two texels, every source with different values (and texel 1 different from texel 0).
-SourceMaps all_sources() {
+material::Maps all_sources() {
   std::vector<SourceInput> inputs = {
       {"kd", {}, {0.11, 0.12, 0.13}}, {"ks", {}, {0.21, 0.22, 0.23}}, {"mask", {}, {0.9}},
       {"gloss", {}, {0.35}},          {"base_color", {}, {0.41, 0.42, 0.43}}, {"metallic", {}, {0.7}},
@@ -48,7 +48,7 @@ TEST(Layouts, EveryPresetParses) {
 }
 
 TEST(Layouts, PresetChannelsValueByValue) {
-  const SourceMaps s = all_sources();
+  const material::Maps s = all_sources();
   const auto packed = [&](const char* name) {
     auto images = pack(*find_layout(name), s);
     EXPECT_TRUE(images) << name;
@@ -74,7 +74,7 @@ TEST(Layouts, PresetChannelsValueByValue) {
 }
 
 TEST(Layouts, DefaultsAndMissingSources) {
-  SourceMaps s = all_sources();
+  material::Maps s = all_sources();
   s.maps.erase("occlusion");
   s.maps.erase("mask");
   auto orm = pack(*find_layout("gltf-orm"), s);
@@ -85,11 +85,11 @@ TEST(Layouts, DefaultsAndMissingSources) {
   auto missing = pack(*find_layout("gltf-orm"), s);
   ASSERT_FALSE(missing);
   EXPECT_TRUE(missing.error().usage);
-  EXPECT_EQ(missing.error().message, "layout gltf-orm needs roughness (--roughness)");
+  EXPECT_EQ(missing.error().message, "layout gltf-orm needs roughness");
 }
 
 TEST(Layouts, UnpackInvertsPackIncludingOneMinus) {
-  const SourceMaps s = all_sources();
+  const material::Maps s = all_sources();
   for (const std::string& name : builtin_layout_names()) {
     const Layout layout = *find_layout(name);
     auto textures = pack(layout, s);
@@ -169,7 +169,7 @@ TEST(Sources, DifferentSizesAreAnErrorUnlessResized) {
   ASSERT_FALSE(refused);
   EXPECT_EQ(refused.error().path, (dir / "small.png").string());
   EXPECT_EQ(refused.error().message, "2x2, but " + (dir / "big.png").string() +
-                                         " is 4x4 (--resize resamples to the largest)");
+                                         " is 4x4 (resizing resamples to the largest)");
   LoadOptions resize;
   resize.resize = true;
   auto resized = load_sources(inputs, resize);

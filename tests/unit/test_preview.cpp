@@ -97,8 +97,8 @@ TEST(Preview, MaterialFiles) {
 }
 
 // Source maps of `width` × 1 texels: `kd` per texel (grey), the rest constant.
-pack::SourceMaps grey_maps(const std::vector<float>& kd, float ks, float gloss) {
-  pack::SourceMaps maps;
+material::Maps grey_maps(const std::vector<float>& kd, float ks, float gloss) {
+  material::Maps maps;
   maps.width = int(kd.size()), maps.height = 1;
   const auto map = [&](int channels, const std::vector<float>& per_texel) {
     image::Image im;
@@ -147,7 +147,7 @@ TEST(Preview, TexturesFollowTheBallsUv) {
   const auto pixel = [&](int x, int y) { return result->image.pixels[(std::size_t(y) * 32 + std::size_t(x)) * 3]; };
   EXPECT_LT(pixel(10, 16), 0.05f);  // left of the centre: kd ≈ 0 (only the background-free ball, black)
   EXPECT_GT(pixel(22, 16), 0.3f);   // right: kd ≈ 1
-  pack::SourceMaps masked = grey_maps({0.5f, 0.5f}, 0.04f, 0.5f);
+  material::Maps masked = grey_maps({0.5f, 0.5f}, 0.04f, 0.5f);
   image::Image mask;
   mask.width = 2, mask.height = 1, mask.channels = 1, mask.pixels = {0.0f, 0.0f};
   masked.maps["mask"] = mask;
@@ -159,7 +159,7 @@ TEST(Preview, TexturesFollowTheBallsUv) {
 }
 
 TEST(Preview, MetalRoughMapsAndRefusals) {
-  pack::SourceMaps maps;
+  material::Maps maps;
   maps.width = 1, maps.height = 1;
   image::Image base;
   base.width = 1, base.height = 1, base.channels = 3, base.pixels = {1.0f, 0.78f, 0.34f};

@@ -9,13 +9,13 @@
 namespace matbake::workflow {
 namespace {
 
-pack::SourceMaps maps(const std::vector<pack::SourceInput>& inputs) {
+material::Maps maps(const std::vector<pack::SourceInput>& inputs) {
   auto m = pack::load_sources(inputs, {});
   EXPECT_TRUE(m) << m.error().to_string();
   return *m;
 }
 
-Vec3 colour(const pack::SourceMaps& m, const char* name) {
+Vec3 colour(const material::Maps& m, const char* name) {
   const auto& p = m.find(name)->pixels;
   return {p[0], p[1], p[2]};
 }
@@ -123,7 +123,7 @@ TEST(WorkflowMaps, MissingSourcesAreUsageErrors) {
   auto out = metal_rough_from_spec_gloss(maps({{"kd", {}, {0.5}}, {"ks", {}, {0.04}}}), RoughnessMapping::fitted, report);
   ASSERT_FALSE(out);
   EXPECT_TRUE(out.error().usage);
-  EXPECT_EQ(out.error().message, "the conversion needs gloss (--gloss)");
+  EXPECT_EQ(out.error().message, "the conversion needs gloss");
 }
 
 }  // namespace

@@ -25,7 +25,7 @@ namespace matbake::exporter {
 // extensions included: the maps say what F0 is).
 struct MaterialMaps {
   std::string material;  // the glTF material's name (or its index, as a number)
-  pack::SourceMaps maps;  // kd, ks, gloss (Schüler) or base_color, metallic, roughness; mask, occlusion optional
+  material::Maps maps;  // kd, ks, gloss (Schüler) or base_color, metallic, roughness; mask, occlusion optional
   std::optional<workflow::RoughnessMapping> mapping;  // for Schüler maps; unset: Options::mapping
 };
 

@@ -14,20 +14,10 @@
 #include <vector>
 
 #include "matbake/image.hpp"
+#include "matbake/material.hpp"
 #include "matbake/result.hpp"
 
 namespace matbake::pack {
-
-// Colour sources are RGB and authored with a transfer (sRGB or gamma 2.2 in 8/16-bit files);
-// scalar sources are one linear channel.
-enum class SourceKind { color, scalar };
-struct Source {
-  std::string_view name;  // as layouts and the CLI (--kd, --base-color, ...) name it
-  SourceKind kind;
-  std::string_view description;
-};
-std::span<const Source> sources();
-const Source* find_source(std::string_view name);
 
 enum class Transform { identity, one_minus };
 
@@ -56,17 +46,8 @@ std::vector<std::string> builtin_layout_names();
 Result<Layout> find_layout(const std::string& name_or_path);
 Result<Layout> parse_layout(std::string_view json_text, const std::string& origin);
 
-// Source maps in memory: linear float, colour sources with 3 channels, scalar ones with 1, all
-// the same size.
-struct SourceMaps {
-  int width = 0;
-  int height = 0;
-  std::map<std::string, image::Image, std::less<>> maps;
-  const image::Image* find(std::string_view name) const;
-};
-
 struct SourceInput {
-  std::string name;             // a sources() name
+  std::string name;             // a material::sources() name
   std::filesystem::path file;   // an image, or
   std::vector<double> constant; // linear values: 1 (scalar, or grey) or 3 (colour)
 };
@@ -87,19 +68,19 @@ struct LoadOptions {
 // file is grey, from RGB(A) its RGB; a scalar source is a file's first channel), resizes to the
 // largest (by pixel count) when asked, in linear light with OIIO's default filter, and fills the
 // constants.
-Result<SourceMaps> load_sources(const std::vector<SourceInput>& inputs, const LoadOptions& options);
+Result<material::Maps> load_sources(const std::vector<SourceInput>& inputs, const LoadOptions& options);
 
 // The source maps held by `files`, the textures of `layout` in order: colour textures decoded with
 // `input` when given, else as decode_transfer() says; the others linear.
-Result<SourceMaps> read_packed(const Layout& layout, const std::vector<std::filesystem::path>& files,
+Result<material::Maps> read_packed(const Layout& layout, const std::vector<std::filesystem::path>& files,
                                std::optional<color::Transfer> input, color::Transfer authored,
                                const ImageReader& read = {});
 
 // The sources a layout reads, and which of them it cannot do without (no fallback).
 std::vector<std::string> layout_sources(const Layout& layout);
-Result<std::vector<image::Image>> pack(const Layout& layout, const SourceMaps& sources);
+Result<std::vector<image::Image>> pack(const Layout& layout, const material::Maps& sources);
 // The inverse: source maps from decoded textures (one per layout texture, same size).
-Result<SourceMaps> unpack(const Layout& layout, std::span<const image::Image> textures,
+Result<material::Maps> unpack(const Layout& layout, std::span<const image::Image> textures,
                           std::span<const std::string> texture_paths);
 
 struct OutputOptions {
@@ -121,7 +102,7 @@ struct WriteRequest {
 };
 // Packs `sources` into the layout's textures and writes them (each atomically). An output that is
 // an input, or two outputs that are one file, are refused before anything is written.
-Result<std::vector<std::filesystem::path>> write_textures(const Layout& layout, const SourceMaps& sources,
+Result<std::vector<std::filesystem::path>> write_textures(const Layout& layout, const material::Maps& sources,
                                                           const WriteRequest& request);
 
 // How to decode a file holding colour: `authored` for 8-bit files, linear for 16-bit and float

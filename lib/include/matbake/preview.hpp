@@ -21,13 +21,13 @@ struct Material {
   // Schüler maps (kd, ks, gloss, mask; linear) sampled over the ball at its UV: u around the vertical
   // axis (0.5 faces the camera), v from the top pole (0) to the bottom (1), bilinear, u wrapping.
   // The mask blends the ball over the background. Absent maps: the constants above.
-  std::shared_ptr<const pack::SourceMaps> textures;
+  std::shared_ptr<const material::Maps> textures;
 };
 
 // A material from source maps as `matbake pack` reads them: Schüler's (kd, ks, gloss, mask; the
 // defaults above for those not given) or metal-rough (base_color with metallic 0 and roughness 0.5
 // unless given, converted per texel as from_metal_rough does). 1×1 maps are constants.
-Result<Material> material_from_maps(std::string name, const pack::SourceMaps& maps);
+Result<Material> material_from_maps(std::string name, const material::Maps& maps);
 
 // The metalness workflow's relation (PBR notes): kd = base (1 − m), ks = lerp(0.04, base, m);
 // gloss from glTF roughness by the Walter mapping (workflow::gloss_from_roughness).

@@ -101,7 +101,7 @@ std::span<const LegendEntry> heatmap_legend();
 
 // A material's maps validated: ks (with kd when given) as they are, or F0 and diffuse from base_color
 // and metallic (from_metal_rough); the mask when given. Errors say which maps are missing.
-Result<Report> validate_maps(const pack::SourceMaps& maps, const Options& options);
+Result<Report> validate_maps(const material::Maps& maps, const Options& options);
 
 // F0 and diffuse of metal-rough maps (glTF): F0 = lerp(0.04, base, m), diffuse = base (1 − m).
 struct SpecularDiffuse {

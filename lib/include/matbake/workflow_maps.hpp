@@ -1,5 +1,5 @@
 #pragma once
-// Workflow conversion of whole source maps (pack::SourceMaps), per texel, with the error of the
+// Workflow conversion of whole source maps (material::Maps), per texel, with the error of the
 // result measured against what was asked for.
 #include "matbake/pack.hpp"
 #include "matbake/result.hpp"
@@ -48,10 +48,10 @@ struct ConversionReport {
 
 // Needs kd, ks, gloss; writes base_color, metallic, roughness (and passes mask, occlusion and
 // detail_mask through).
-Result<pack::SourceMaps> metal_rough_from_spec_gloss(const pack::SourceMaps& in, RoughnessMapping mapping,
+Result<material::Maps> metal_rough_from_spec_gloss(const material::Maps& in, RoughnessMapping mapping,
                                                      ConversionReport& report);
 // Needs base_color, metallic, roughness; writes kd, ks, gloss (the same pass-through).
-Result<pack::SourceMaps> spec_gloss_from_metal_rough(const pack::SourceMaps& in, RoughnessMapping mapping,
+Result<material::Maps> spec_gloss_from_metal_rough(const material::Maps& in, RoughnessMapping mapping,
                                                      ConversionReport& report);
 
 // The maps in the workflow a layout reads: converted when they are all of the other workflow
@@ -59,10 +59,10 @@ Result<pack::SourceMaps> spec_gloss_from_metal_rough(const pack::SourceMaps& in,
 enum class Direction { metal_rough_from_spec_gloss, spec_gloss_from_metal_rough };
 std::string_view direction_name(Direction d);  // "spec-gloss to metal-rough", "metal-rough to spec-gloss"
 struct LayoutMaps {
-  pack::SourceMaps maps;
+  material::Maps maps;
   std::optional<Direction> direction;
   ConversionReport report;  // when converted
 };
-Result<LayoutMaps> in_layout_workflow(pack::SourceMaps maps, const pack::Layout& layout, RoughnessMapping mapping);
+Result<LayoutMaps> in_layout_workflow(material::Maps maps, const pack::Layout& layout, RoughnessMapping mapping);
 
 }  // namespace matbake::workflow

@@ -50,7 +50,7 @@ Result<ConversionPlan> plan_conversion(const ConvertOptions& options) {
   if (from || to) {
     // A built-in name says nothing of primaries, so it cannot be matched to an OCIO colour space.
     return Error{"",
-                 "--from and --to mix a built-in transfer with an OCIO colour space; name both from the OCIO "
+                 "from and to mix a built-in transfer with an OCIO colour space; name both from the OCIO "
                  "config (e.g. 'sRGB - Texture' and 'Linear Rec.709 (sRGB)') or neither",
                  true};
   }

@@ -88,19 +88,19 @@ struct Exporter {
 
   // The metal-rough maps written into `material`: factors when they are 1×1 (constants), else a
   // base colour texture (with the mask as alpha) and a metallic-roughness one (ORM with occlusion).
-  Status write_metal_rough(Json& material, const pack::SourceMaps& maps, const std::string& name, Json texture_info,
+  Status write_metal_rough(Json& material, const material::Maps& maps, const std::string& name, Json texture_info,
                            int sampler_of) {
     Json& pbr = material["pbrMetallicRoughness"];
     pbr = Json::object();
-    const image::Image& base = *maps.find("base_color");
-    const image::Image* mask = maps.find("mask");
+    const image::Image& base = *maps.find(material::kBaseColor);
+    const image::Image* mask = maps.find(material::kMask);
     if (maps.width == 1 && maps.height == 1) {
       pbr["baseColorFactor"] = {base.pixels[0], base.pixels[1], base.pixels[2], mask ? mask->pixels[0] : 1.0f};
-      pbr["metallicFactor"] = maps.find("metallic")->pixels[0];
-      pbr["roughnessFactor"] = maps.find("roughness")->pixels[0];
+      pbr["metallicFactor"] = maps.find(material::kMetallic)->pixels[0];
+      pbr["roughnessFactor"] = maps.find(material::kRoughness)->pixels[0];
       return success();
     }
-    const bool orm = maps.find("occlusion") != nullptr;
+    const bool orm = maps.find(material::kOcclusion) != nullptr;
     auto layout = pack::find_layout(orm ? "gltf-orm" : "gltf-metal-rough");
     if (!layout) return layout.error();
     auto images = pack::pack(*layout, maps);
@@ -156,7 +156,7 @@ struct Exporter {
 
   // KHR_materials_pbrSpecularGlossiness's factors and textures as Schüler sources (kd, ks, gloss,
   // and the diffuse alpha as mask), at the size of the larger texture.
-  Result<pack::SourceMaps> spec_gloss_sources(int index, const Json& ext) {
+  Result<material::Maps> spec_gloss_sources(int index, const Json& ext) {
     const std::string where = "material " + std::to_string(index) + " " + kSpecGloss;
     auto diffuse_factor = numbers(ext, "diffuseFactor", {1, 1, 1, 1}, doc.file, where);
     auto specular_factor = numbers(ext, "specularFactor", {1, 1, 1}, doc.file, where);
@@ -180,7 +180,7 @@ struct Exporter {
     }
     const image::Image d = textures[0] ? at_size(*textures[0], width, height) : image::Image{};
     const image::Image s = textures[1] ? at_size(*textures[1], width, height) : image::Image{};
-    pack::SourceMaps maps;
+    material::Maps maps;
     maps.width = width, maps.height = height;
     image::Image kd = blank(width, height, 3), ks = blank(width, height, 3), g = blank(width, height, 1),
                  alpha = blank(width, height, 1);
@@ -239,7 +239,7 @@ struct Exporter {
   }
 
   Status from_maps(int index, Json& material, const MaterialMaps& replacement, MaterialReport& out) {
-    const pack::SourceMaps& given = replacement.maps;
+    const material::Maps& given = replacement.maps;
     // The new maps say what the surface is: what described it before goes (spec-gloss and its
     // textures, a specular or IOR extension that would change the new F0).
     if (material.contains("extensions")) {
@@ -254,7 +254,7 @@ struct Exporter {
       info.erase("index");
     }
     const std::string name = "material" + std::to_string(index);
-    if (given.find("kd")) {
+    if (given.find(material::kKd)) {
       workflow::ConversionReport conversion;
       auto maps = workflow::metal_rough_from_spec_gloss(given, replacement.mapping.value_or(options.mapping), conversion);
       if (!maps) return Error{doc.file, "material " + std::to_string(index) + ": " + maps.error().message};
@@ -266,7 +266,7 @@ struct Exporter {
       if (Status s = write_metal_rough(material, given, name, info, sampler_of); !s) return s;
       out.action = "from metal-rough maps";
     }
-    set_alpha_mode(material, given.find("mask"));
+    set_alpha_mode(material, given.find(material::kMask));
     return success();
   }
 

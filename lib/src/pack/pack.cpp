@@ -11,21 +11,12 @@
 
 namespace matbake::pack {
 namespace fs = std::filesystem;
+using material::component_count;
+using material::find_source;
+using material::Source;
+using material::SourceKind;
 namespace {
 
-constexpr std::array<Source, 9> kSources = {{
-    {"kd", SourceKind::color, "Schüler: diffuse colour"},
-    {"ks", SourceKind::color, "Schüler: specular colour, F0"},
-    {"mask", SourceKind::scalar, "mask / opacity (alpha of pair A and of base colour maps)"},
-    {"gloss", SourceKind::scalar, "Schüler: gloss g, Blinn-Phong exponent 2^(12 g)"},
-    {"base_color", SourceKind::color, "metalness workflow: base colour"},
-    {"metallic", SourceKind::scalar, "metalness workflow: metallic"},
-    {"roughness", SourceKind::scalar, "metalness workflow: perceptual roughness (GGX alpha = roughness^2)"},
-    {"occlusion", SourceKind::scalar, "ambient occlusion"},
-    {"detail_mask", SourceKind::scalar, "Unity HDRP detail mask"},
-}};
-
-int component_count(SourceKind kind) { return kind == SourceKind::color ? 3 : 1; }
 
 double apply(Transform transform, double x) { return transform == Transform::one_minus ? 1.0 - x : x; }
 
@@ -123,22 +114,7 @@ Result<std::shared_ptr<const image::Image>> read_shared(const std::filesystem::p
   return std::make_shared<const image::Image>(std::move(*file));
 }
 
-std::string option_name(std::string_view source) {
-  std::string option = "--" + std::string(source);
-  std::replace(option.begin(), option.end(), '_', '-');
-  return option;
-}
-
 }  // namespace
-
-std::span<const Source> sources() { return kSources; }
-
-const Source* find_source(std::string_view name) {
-  for (const Source& s : kSources) {
-    if (s.name == name) return &s;
-  }
-  return nullptr;
-}
 
 std::vector<std::string> builtin_layout_names() {
   std::vector<std::string> names;
@@ -186,20 +162,15 @@ Result<Layout> find_layout(const std::string& name_or_path) {
   return parse_layout(text.str(), name_or_path);
 }
 
-const image::Image* SourceMaps::find(std::string_view name) const {
-  const auto it = maps.find(name);
-  return it == maps.end() ? nullptr : &it->second;
-}
-
 Result<color::Transfer> decode_transfer(const fs::path& path, color::Transfer authored) {
   auto info = image::probe_image(path);
   if (!info) return info.error();
   return info->stored_type == image::SampleType::u8 ? authored : color::Transfer::linear;
 }
 
-Result<SourceMaps> load_sources(const std::vector<SourceInput>& inputs, const LoadOptions& options) {
-  return guarded("", [&]() -> Result<SourceMaps> {
-    SourceMaps result;
+Result<material::Maps> load_sources(const std::vector<SourceInput>& inputs, const LoadOptions& options) {
+  return guarded("", [&]() -> Result<material::Maps> {
+    material::Maps result;
     std::map<std::string, std::string> origin;  // source → file, for size errors
     for (const SourceInput& input : inputs) {
       const Source* source = find_source(input.name);
@@ -236,7 +207,7 @@ Result<SourceMaps> load_sources(const std::vector<SourceInput>& inputs, const Lo
           });
           return Error{origin[name], std::to_string(map.width) + "x" + std::to_string(map.height) + ", but " +
                                          origin[first.first] + " is " + std::to_string(result.width) + "x" +
-                                         std::to_string(result.height) + " (--resize resamples to the largest)"};
+                                         std::to_string(result.height) + " (resizing resamples to the largest)"};
         }
         map = image::resize_image(map, result.width, result.height);
       }
@@ -250,7 +221,7 @@ Result<SourceMaps> load_sources(const std::vector<SourceInput>& inputs, const Lo
       const int components = component_count(source->kind);
       const std::size_t n = input.constant.size();
       if (!(n == 1 || (n == 3 && source->kind == SourceKind::color))) {
-        return Error{"", option_name(input.name) + ": " + (source->kind == SourceKind::color ? "1 or 3 values" : "one value") +
+        return Error{"", input.name + ": " + (source->kind == SourceKind::color ? "1 or 3 values" : "one value") +
                              " expected, got " + std::to_string(n), true};
       }
       image::Image map = blank(result.width, result.height, components);
@@ -263,9 +234,9 @@ Result<SourceMaps> load_sources(const std::vector<SourceInput>& inputs, const Lo
   });
 }
 
-Result<SourceMaps> read_packed(const Layout& layout, const std::vector<std::filesystem::path>& files,
+Result<material::Maps> read_packed(const Layout& layout, const std::vector<std::filesystem::path>& files,
                                std::optional<color::Transfer> input, color::Transfer authored, const ImageReader& read) {
-  return guarded("", [&]() -> Result<SourceMaps> {
+  return guarded("", [&]() -> Result<material::Maps> {
     if (files.size() != layout.textures.size()) {
       return Error{"", "layout " + layout.name + " takes " + std::to_string(layout.textures.size()) + " textures, got " +
                            std::to_string(files.size()), true};
@@ -298,7 +269,7 @@ std::vector<std::string> layout_sources(const Layout& layout) {
   return names;
 }
 
-Result<std::vector<image::Image>> pack(const Layout& layout, const SourceMaps& sources) {
+Result<std::vector<image::Image>> pack(const Layout& layout, const material::Maps& sources) {
   return guarded("", [&]() -> Result<std::vector<image::Image>> {
     std::vector<image::Image> textures;
     for (const Texture& t : layout.textures) {
@@ -308,8 +279,7 @@ Result<std::vector<image::Image>> pack(const Layout& layout, const SourceMaps& s
         const Channel& channel = t.channels[c];
         const image::Image* map = channel.source.empty() ? nullptr : sources.find(channel.source);
         if (!map && !channel.fallback) {
-          return Error{"", "layout " + layout.name + " needs " + channel.source + " (" + option_name(channel.source) + ")",
-                       true};
+          return Error{"", "layout " + layout.name + " needs " + channel.source, true};
         }
         for (std::size_t i = 0; i < texels; ++i) {
           const double x = map ? map->pixels[i * std::size_t(map->channels) + std::size_t(channel.component)]
@@ -323,14 +293,14 @@ Result<std::vector<image::Image>> pack(const Layout& layout, const SourceMaps& s
   });
 }
 
-Result<SourceMaps> unpack(const Layout& layout, std::span<const image::Image> textures,
+Result<material::Maps> unpack(const Layout& layout, std::span<const image::Image> textures,
                           std::span<const std::string> texture_paths) {
-  return guarded("", [&]() -> Result<SourceMaps> {
+  return guarded("", [&]() -> Result<material::Maps> {
     if (textures.size() != layout.textures.size()) {
       return Error{"", "layout " + layout.name + " has " + std::to_string(layout.textures.size()) + " textures, got " +
                            std::to_string(textures.size()), true};
     }
-    SourceMaps result;
+    material::Maps result;
     result.width = textures[0].width;
     result.height = textures[0].height;
     for (std::size_t t = 0; t < textures.size(); ++t) {
@@ -391,7 +361,7 @@ image::SampleType default_sample_type(const fs::path& path) {
   return path.extension() == ".exr" ? image::SampleType::half : image::SampleType::u8;
 }
 
-Result<std::vector<fs::path>> write_textures(const Layout& layout, const SourceMaps& sources, const WriteRequest& request) {
+Result<std::vector<fs::path>> write_textures(const Layout& layout, const material::Maps& sources, const WriteRequest& request) {
   return guarded("", [&]() -> Result<std::vector<fs::path>> {
     auto paths = output_paths(layout, request.outputs);
     if (!paths) return paths.error();

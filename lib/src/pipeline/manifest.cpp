@@ -179,9 +179,9 @@ Result<MaterialSpec> read_material(const Reader& r, const std::string& name, con
     if (!sources->is_table()) return r.at(*sources, where + ".sources must be a table");
     for (const auto& [key, value] : *sources->as_table()) {
       const std::string source(key.str());
-      if (!pack::find_source(source)) {
+      if (!material::find_source(source)) {
         std::string known;
-        for (const pack::Source& s : pack::sources()) known += (known.empty() ? "" : ", ") + std::string(s.name);
+        for (const material::Source& s : material::sources()) known += (known.empty() ? "" : ", ") + std::string(s.name);
         return r.at(key.source(), where + ".sources: unknown source '" + source + "' (known: " + known + ")");
       }
       pack::SourceInput in{source, {}, {}};

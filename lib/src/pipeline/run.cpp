@@ -98,7 +98,7 @@ std::string layout_reference(const std::string& layout, const Manifest& manifest
   return fs::path(layout).has_extension() ? (manifest.folder / layout).string() : layout;
 }
 
-Result<pack::SourceMaps> load_material(const MaterialSpec& m, const Manifest& manifest, DecodeCache& cache) {
+Result<material::Maps> load_material(const MaterialSpec& m, const Manifest& manifest, DecodeCache& cache) {
   const pack::ImageReader read = [&cache](const fs::path& f, color::Transfer t) { return cache.read(f, t); };
   if (!m.packed_layout.empty()) {
     auto layout = pack::find_layout(layout_reference(m.packed_layout, manifest));
@@ -128,7 +128,7 @@ Status ensure_folder(const fs::path& folder) {
 }
 
 // Validation of the material as authored; a job error when more texels are flagged than allowed.
-Status validate_material(const MaterialSpec& m, const pack::SourceMaps& maps, const JobContext& ctx,
+Status validate_material(const MaterialSpec& m, const material::Maps& maps, const JobContext& ctx,
                          const std::vector<fs::path>& outputs, JobReport& report) {
   validate::Options options = m.validation.options;
   options.class_map = m.validation.heatmap;

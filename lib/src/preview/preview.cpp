@@ -68,11 +68,11 @@ Surface surface_at(const Material& m, const Vec3& n, bool gloss_from_map) {
   if (!m.textures) return s;
   const double u = 0.5 + std::atan2(n.x, n.y) / (2 * std::numbers::pi);
   const double v = std::acos(std::clamp(n.z, -1.0, 1.0)) / std::numbers::pi;
-  const pack::SourceMaps& t = *m.textures;
-  if (const image::Image* kd = t.find("kd")) s.kd = Vec3(bilinear(*kd, u, v, 0), bilinear(*kd, u, v, 1), bilinear(*kd, u, v, 2));
-  if (const image::Image* ks = t.find("ks")) s.ks = Vec3(bilinear(*ks, u, v, 0), bilinear(*ks, u, v, 1), bilinear(*ks, u, v, 2));
-  if (const image::Image* g = t.find("gloss"); g && gloss_from_map) s.gloss = bilinear(*g, u, v, 0);
-  if (const image::Image* mask = t.find("mask")) s.mask = std::clamp(bilinear(*mask, u, v, 0), 0.0, 1.0);
+  const material::Maps& t = *m.textures;
+  if (const image::Image* kd = t.find(material::kKd)) s.kd = Vec3(bilinear(*kd, u, v, 0), bilinear(*kd, u, v, 1), bilinear(*kd, u, v, 2));
+  if (const image::Image* ks = t.find(material::kKs)) s.ks = Vec3(bilinear(*ks, u, v, 0), bilinear(*ks, u, v, 1), bilinear(*ks, u, v, 2));
+  if (const image::Image* g = t.find(material::kGloss); g && gloss_from_map) s.gloss = bilinear(*g, u, v, 0);
+  if (const image::Image* mask = t.find(material::kMask)) s.mask = std::clamp(bilinear(*mask, u, v, 0), 0.0, 1.0);
   return s;
 }
 
@@ -87,7 +87,7 @@ Vec3 mean_of(const image::Image& im) {
 }
 
 // A 1×1 map of `value` at the size of `maps`, where `maps` has no map `name`.
-void fill_constant(pack::SourceMaps& maps, const char* name, float value) {
+void fill_constant(material::Maps& maps, const char* name, float value) {
   if (maps.find(name)) return;
   image::Image im;
   im.width = maps.width, im.height = maps.height, im.channels = 1;
@@ -97,15 +97,15 @@ void fill_constant(pack::SourceMaps& maps, const char* name, float value) {
 
 }  // namespace
 
-Result<Material> material_from_maps(std::string name, const pack::SourceMaps& given) {
+Result<Material> material_from_maps(std::string name, const material::Maps& given) {
   return guarded("", [&]() -> Result<Material> {
-    pack::SourceMaps maps = given;
-    const bool metal_rough = maps.find("base_color") || maps.find("metallic") || maps.find("roughness");
-    if (metal_rough && (maps.find("kd") || maps.find("ks") || maps.find("gloss"))) {
+    material::Maps maps = given;
+    const bool metal_rough = maps.metal_rough();
+    if (metal_rough && maps.spec_gloss()) {
       return Error{"", "give Schüler maps (kd, ks, gloss) or metal-rough ones (base_color, metallic, roughness), not both", true};
     }
     if (metal_rough) {
-      if (!maps.find("base_color")) return Error{"", "metal-rough maps need base_color", true};
+      if (!maps.find(material::kBaseColor)) return Error{"", "metal-rough maps need base_color", true};
       fill_constant(maps, "metallic", 0.0f);
       fill_constant(maps, "roughness", 0.5f);
       workflow::ConversionReport report;
@@ -115,7 +115,7 @@ Result<Material> material_from_maps(std::string name, const pack::SourceMaps& gi
     }
     Material m;
     m.name = std::move(name);
-    auto textures = std::make_shared<pack::SourceMaps>();
+    auto textures = std::make_shared<material::Maps>();
     textures->width = maps.width, textures->height = maps.height;
     for (const char* key : {"kd", "ks", "gloss", "mask"}) {
       const image::Image* map = maps.find(key);

@@ -455,15 +455,15 @@ Result<SpecularDiffuse> from_metal_rough(const image::Image& base, const image::
   return out;
 }
 
-Result<Report> validate_maps(const pack::SourceMaps& maps, const Options& options) {
+Result<Report> validate_maps(const material::Maps& maps, const Options& options) {
   Inputs inputs;
-  inputs.mask = maps.find("mask");
+  inputs.mask = maps.find(material::kMask);
   SpecularDiffuse converted;
-  if (maps.find("ks")) {
-    inputs.specular = maps.find("ks");
-    inputs.diffuse = maps.find("kd");
-  } else if (maps.find("base_color") && maps.find("metallic")) {
-    auto sd = from_metal_rough(*maps.find("base_color"), *maps.find("metallic"));
+  if (maps.find(material::kKs)) {
+    inputs.specular = maps.find(material::kKs);
+    inputs.diffuse = maps.find(material::kKd);
+  } else if (maps.find(material::kBaseColor) && maps.find(material::kMetallic)) {
+    auto sd = from_metal_rough(*maps.find(material::kBaseColor), *maps.find(material::kMetallic));
     if (!sd) return sd.error();
     converted = std::move(*sd);
     inputs.specular = &converted.specular;

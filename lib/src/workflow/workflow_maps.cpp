@@ -45,13 +45,13 @@ ErrorStats statistics(const std::vector<float>& errors, int width) {
   return s;
 }
 
-Result<const image::Image*> need(const pack::SourceMaps& in, std::string_view name, std::string_view option) {
+Result<const image::Image*> need(const material::Maps& in, std::string_view name) {
   const image::Image* map = in.find(name);
-  if (!map) return Error{"", "the conversion needs " + std::string(name) + " (" + std::string(option) + ")", true};
+  if (!map) return Error{"", "the conversion needs " + std::string(name), true};
   return map;
 }
 
-void pass_through(const pack::SourceMaps& in, pack::SourceMaps& out) {
+void pass_through(const material::Maps& in, material::Maps& out) {
   for (const char* name : {"mask", "occlusion", "detail_mask"}) {
     if (const image::Image* m = in.find(name)) out.maps[name] = *m;
   }
@@ -131,16 +131,16 @@ DielectricF0 dielectric_f0(const image::Image& kd, const image::Image& ks) {
 
 }  // namespace
 
-Result<pack::SourceMaps> metal_rough_from_spec_gloss(const pack::SourceMaps& in, RoughnessMapping mapping,
+Result<material::Maps> metal_rough_from_spec_gloss(const material::Maps& in, RoughnessMapping mapping,
                                                      ConversionReport& report) {
-  return guarded("", [&]() -> Result<pack::SourceMaps> {
-    auto kd = need(in, "kd", "--kd");
+  return guarded("", [&]() -> Result<material::Maps> {
+    auto kd = need(in, material::kKd);
     if (!kd) return kd.error();
-    auto ks = need(in, "ks", "--ks");
+    auto ks = need(in, material::kKs);
     if (!ks) return ks.error();
-    auto gloss = need(in, "gloss", "--gloss");
+    auto gloss = need(in, material::kGloss);
     if (!gloss) return gloss.error();
-    pack::SourceMaps out;
+    material::Maps out;
     out.width = in.width;
     out.height = in.height;
     image::Image base = like(**kd, 3), metallic = like(**gloss, 1), roughness = like(**gloss, 1);
@@ -171,16 +171,16 @@ Result<pack::SourceMaps> metal_rough_from_spec_gloss(const pack::SourceMaps& in,
   });
 }
 
-Result<pack::SourceMaps> spec_gloss_from_metal_rough(const pack::SourceMaps& in, RoughnessMapping mapping,
+Result<material::Maps> spec_gloss_from_metal_rough(const material::Maps& in, RoughnessMapping mapping,
                                                      ConversionReport& report) {
-  return guarded("", [&]() -> Result<pack::SourceMaps> {
-    auto base = need(in, "base_color", "--base-color");
+  return guarded("", [&]() -> Result<material::Maps> {
+    auto base = need(in, material::kBaseColor);
     if (!base) return base.error();
-    auto metallic = need(in, "metallic", "--metallic");
+    auto metallic = need(in, material::kMetallic);
     if (!metallic) return metallic.error();
-    auto roughness = need(in, "roughness", "--roughness");
+    auto roughness = need(in, material::kRoughness);
     if (!roughness) return roughness.error();
-    pack::SourceMaps out;
+    material::Maps out;
     out.width = in.width;
     out.height = in.height;
     image::Image kd = like(**base, 3), ks = like(**base, 3), gloss = like(**roughness, 1);
@@ -207,22 +207,19 @@ std::string_view direction_name(Direction d) {
   return d == Direction::metal_rough_from_spec_gloss ? "spec-gloss to metal-rough" : "metal-rough to spec-gloss";
 }
 
-Result<LayoutMaps> in_layout_workflow(pack::SourceMaps maps, const pack::Layout& layout, RoughnessMapping mapping) {
+Result<LayoutMaps> in_layout_workflow(material::Maps maps, const pack::Layout& layout, RoughnessMapping mapping) {
   const std::vector<std::string> read = pack::layout_sources(layout);
   const auto reads = [&](std::initializer_list<std::string_view> names) {
     return std::any_of(names.begin(), names.end(),
                        [&](std::string_view n) { return std::find(read.begin(), read.end(), n) != read.end(); });
   };
-  const auto has = [&](std::initializer_list<std::string_view> names) {
-    return std::any_of(names.begin(), names.end(), [&](std::string_view n) { return maps.find(n) != nullptr; });
-  };
-  const bool spec_gloss = has({"kd", "ks", "gloss"}), metal_rough = has({"base_color", "metallic", "roughness"});
+  const bool spec_gloss = maps.spec_gloss(), metal_rough = maps.metal_rough();
   LayoutMaps out;
-  Result<pack::SourceMaps> converted = Error{};
-  if (reads({"base_color", "metallic", "roughness"}) && spec_gloss && !metal_rough) {
+  Result<material::Maps> converted = Error{};
+  if (reads({material::kBaseColor, material::kMetallic, material::kRoughness}) && spec_gloss && !metal_rough) {
     out.direction = Direction::metal_rough_from_spec_gloss;
     converted = metal_rough_from_spec_gloss(maps, mapping, out.report);
-  } else if (reads({"kd", "ks", "gloss"}) && metal_rough && !spec_gloss) {
+  } else if (reads({material::kKd, material::kKs, material::kGloss}) && metal_rough && !spec_gloss) {
     out.direction = Direction::spec_gloss_from_metal_rough;
     converted = spec_gloss_from_metal_rough(maps, mapping, out.report);
   } else {
