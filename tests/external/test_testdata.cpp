@@ -247,6 +247,12 @@ std::set<std::string> codes_of(const test::ValidatorReport& report) {
   return codes;
 }
 
+// A written file: no validator error, and no warning code its input's report did not have.
+void expect_clean_as_its_input(const test::ValidatorReport& out, const std::set<std::string>& in_codes) {
+  EXPECT_EQ(out.errors, 0) << out.summary;
+  for (const std::string& code : codes_of(out)) EXPECT_TRUE(in_codes.contains(code)) << code << " is new in " << out.summary;
+}
+
 // bake-ao writes every sample model again, as .gltf and as .glb: the validator finds no error and
 // no warning that the input did not already have (those are the models' own: e.g. the
 // NormalTangent models' generated tangent space, the spec-gloss extension the validator does not
@@ -269,10 +275,7 @@ TEST(KhronosModels, BakedAoScenesStayValidatorClean) {
       const auto r = test::matbake({"-q", "bake-ao", file.string(), "-o", out.string(), "--samples", "8"});
       ASSERT_EQ(r.exit_code, 0) << file << ": " << r.err;
       MATBAKE_VALIDATE_OR_SKIP(out_report, out);
-      EXPECT_EQ(out_report->errors, 0) << out_report->summary;
-      for (const std::string& code : codes_of(*out_report)) {
-        EXPECT_TRUE(in_codes.contains(code)) << code << " is new in " << out_report->summary;
-      }
+      expect_clean_as_its_input(*out_report, in_codes);
       const auto written = scene::load_scene(out);
       ASSERT_TRUE(written) << written.error().to_string();
       ASSERT_EQ(written->instances.size(), s.instances.size()) << out;
@@ -312,10 +315,7 @@ TEST(KhronosModels, ExportedScenesStayValidatorCleanWithTheirCounts) {
       const auto r = test::matbake(args);
       ASSERT_EQ(r.exit_code, 0) << file << ": " << r.err;
       MATBAKE_VALIDATE_OR_SKIP(out_report, out);
-      EXPECT_EQ(out_report->errors, 0) << out_report->summary;
-      for (const std::string& code : codes_of(*out_report)) {
-        EXPECT_TRUE(in_codes.contains(code)) << code << " is new in " << out_report->summary;
-      }
+      expect_clean_as_its_input(*out_report, in_codes);
       const auto doc = gltf::read_document(out);
       ASSERT_TRUE(doc) << doc.error().to_string();
       for (const char* key : {"nodes", "meshes", "materials"}) EXPECT_EQ(count(doc->json, key), count(in->json, key)) << out << " " << key;
@@ -392,10 +392,7 @@ TEST(KhronosModels, EveryMaterialReplacedStaysValidatorClean) {
       const auto run = test::matbake(args);
       ASSERT_EQ(run.exit_code, 0) << file << " " << r.kind << ": " << run.err;
       MATBAKE_VALIDATE_OR_SKIP(out_report, out);
-      EXPECT_EQ(out_report->errors, 0) << out_report->summary;
-      for (const std::string& code : codes_of(*out_report)) {
-        EXPECT_TRUE(in_codes.contains(code)) << code << " is new in " << out_report->summary;
-      }
+      expect_clean_as_its_input(*out_report, in_codes);
       const auto doc = gltf::read_document(out);
       ASSERT_TRUE(doc) << doc.error().to_string();
       EXPECT_EQ(doc->json.dump().find("pbrSpecularGlossiness"), std::string::npos) << out;

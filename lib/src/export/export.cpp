@@ -18,7 +18,6 @@ namespace {
 constexpr const char* kSpecGloss = "KHR_materials_pbrSpecularGlossiness";
 constexpr const char* kSpecular = "KHR_materials_specular";
 constexpr const char* kIor = "KHR_materials_ior";
-constexpr double kCoreF0 = 0.04;
 constexpr double kF0Tolerance = 0.001;  // below an 8-bit sRGB step at F0 0.04 (0.0014)
 
 // A channel of a decoded image read as RGBA: grey spreads to RGB, a missing alpha is 1.
@@ -125,7 +124,7 @@ struct Exporter {
   // KHR_materials_specular or KHR_materials_ior for dielectric texels whose F0 is not glTF's 0.04.
   void add_dielectric_f0(Json& material, const workflow::ConversionReport& conversion, MaterialReport& out) {
     const auto& d = conversion.dielectric;
-    if (d.texels == 0 || std::abs(d.mean_f0 - kCoreF0) <= kF0Tolerance || options.dielectric_f0 == DielectricF0::none) return;
+    if (d.texels == 0 || std::abs(d.mean_f0 - workflow::kDielectricF0) <= kF0Tolerance || options.dielectric_f0 == DielectricF0::none) return;
     if (options.dielectric_f0 == DielectricF0::specular) {
       const double f = d.specular_color_factor;
       material["extensions"][kSpecular] = {{"specularColorFactor", {f, f, f}}};
