@@ -15,7 +15,7 @@ void add_ao_options(CLI::App& cmd, AoSettings& s, const std::string& prefix) {
       ->group(group);
   cmd.add_option(p + "tau", o.tau, "Falloff rate τ in units of 1/d_max")->capture_default_str()->group(group);
   add_name_option(cmd, p + "falloff", o.falloff, ao::kFalloffNames,
-                  "exponential (1 − e^(−τx), normalized to 1 at d_max) or none (binary AO)")
+                  "μ(x) (exponential: 1 − e^(−τx), normalized to 1 at d_max; none: binary AO)")
       ->group(group);
   cmd.add_option(p + "bias", o.bias, "Ray-origin offset along the normal × the vertex's mean edge length")
       ->capture_default_str()->group(group);

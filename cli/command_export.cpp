@@ -64,7 +64,9 @@ CLI::App* setup_export(CLI::App& app, ExportSettings& s) {
                          "Keep occlusion and metallic-roughness textures apart");
   add_ao_options(*cmd, s.ao, "ao-");
   // AO is baked when --ao-samples is given (0 keeps it off, as before).
-  cmd->get_option("--ao-samples")->each([&s](const std::string& v) { s.bake_ao = v != "0"; });
+  cmd->get_option("--ao-samples")
+      ->each([&s](const std::string& v) { s.bake_ao = v != "0"; })
+      ->description("Bake per-vertex AO with this many rays per vertex (no AO unless given; 0: none)");
   cmd->add_option("--report", s.report, "Also write the report as JSON to this file");
   return cmd;
 }
