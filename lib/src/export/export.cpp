@@ -358,8 +358,13 @@ Result<Report> export_scene(const fs::path& input, const fs::path& output, const
   return guarded(input.string(), [&]() -> Result<Report> {
     const std::string ext = output.extension().string();
     if (ext != ".gltf" && ext != ".glb") return Error{output.string(), "the output is .gltf or .glb", true};
-    auto scene = scene::load_scene(input);
-    if (!scene) return scene.error();
+    // The flattened scene only when AO is baked: a plain export works on the document alone.
+    std::optional<scene::Scene> scene;
+    if (options.ao) {
+      auto loaded = scene::load_scene(input);
+      if (!loaded) return loaded.error();
+      scene = std::move(*loaded);
+    }
     auto doc = gltf::read_document(input);
     if (!doc) return doc.error();
 

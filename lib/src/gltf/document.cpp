@@ -7,6 +7,7 @@
 #include <iterator>
 
 #include "load_model.hpp"
+#include "matbake/read_file.hpp"
 #include "matbake/atomic_file.hpp"
 
 namespace matbake::gltf {
@@ -16,8 +17,9 @@ namespace {
 static_assert(std::endian::native == std::endian::little, "GLB is little-endian; so are the bytes written as is");
 
 std::string read_bytes(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  std::string bytes;
+  if (!read_whole_file(path, bytes)) bytes.clear();
+  return bytes;
 }
 
 std::uint32_t u32_at(const std::string& bytes, std::size_t offset) {
@@ -44,6 +46,40 @@ std::string mime_type_of(const fs::path& path) {
 }
 
 void append_u32(std::string& out, std::uint32_t v) { out.append(reinterpret_cast<const char*>(&v), 4); }
+
+// Every accessor within its buffer view and every view within its buffer (the bytes a writer copies).
+Status check_accessors(const Document& doc) {
+  const Json empty = Json::array();
+  const Json& views = doc.json.contains("bufferViews") ? doc.json["bufferViews"] : empty;
+  for (std::size_t v = 0; v < views.size(); ++v) {
+    const std::size_t buffer = views[v].value("buffer", std::size_t(-1));
+    const std::size_t end = views[v].value("byteOffset", std::size_t{0}) + views[v].value("byteLength", std::size_t{0});
+    if (buffer >= doc.buffers.size() || end > doc.buffers[buffer].size()) {
+      return Error{doc.file, "buffer view " + std::to_string(v) + " reaches beyond its buffer"};
+    }
+  }
+  if (!doc.json.contains("accessors")) return success();
+  for (std::size_t a = 0; a < doc.json["accessors"].size(); ++a) {
+    const Json& accessor = doc.json["accessors"][a];
+    if (!accessor.contains("bufferView")) continue;  // all zeros (or sparse values alone)
+    const std::size_t view = accessor["bufferView"].get<std::size_t>();
+    if (view >= views.size()) return Error{doc.file, "accessor " + std::to_string(a) + " has no buffer view"};
+    const std::string type = accessor.value("type", "");
+    const std::size_t components = type == "SCALAR" ? 1 : type == "VEC2" ? 2 : type == "VEC3" ? 3 : type == "VEC4" ? 4
+                                   : type == "MAT2" ? 4 : type == "MAT3" ? 9 : type == "MAT4" ? 16 : 0;
+    const int kind = accessor.value("componentType", 0);
+    const std::size_t bytes = kind == 5120 || kind == 5121 ? 1 : kind == 5122 || kind == 5123 ? 2 : kind == 5125 || kind == 5126 ? 4 : 0;
+    if (components == 0 || bytes == 0) return Error{doc.file, "accessor " + std::to_string(a) + " has an unknown type"};
+    const std::size_t element = components * bytes, count = accessor.value("count", std::size_t{0});
+    const std::size_t stride = views[view].value("byteStride", element), length = views[view].value("byteLength", std::size_t{0});
+    const std::size_t offset = accessor.value("byteOffset", std::size_t{0});
+    // offset + stride (count − 1) + element ≤ length, without overflow for a hostile count.
+    const bool fits = count == 0 || (offset <= length && element <= length - offset &&
+                                     (stride == 0 || count - 1 <= (length - offset - element) / stride));
+    if (!fits) return Error{doc.file, "accessor " + std::to_string(a) + " reaches beyond its buffer"};
+  }
+  return success();
+}
 
 }  // namespace
 
@@ -97,13 +133,18 @@ Result<Json> read_json(const fs::path& path) {
   return guarded(path.string(), [&]() -> Result<Json> {
     std::error_code ec;
     if (!fs::is_regular_file(path, ec)) return Error{path.string(), "cannot read the glTF (missing or not a file)"};
-    const std::string bytes = read_bytes(path);
-    std::string text = bytes;
+    return json_of(path, read_bytes(path));
+  });
+}
+
+Result<Json> json_of(const fs::path& path, const std::string& bytes) {
+  return guarded(path.string(), [&]() -> Result<Json> {
+    std::string_view text = bytes;
     if (path.extension() == ".glb") {
       if (bytes.size() < 20) return Error{path.string(), "not a GLB: shorter than its header"};
       const std::size_t json_length = u32_at(bytes, 12);
       if (20 + json_length > bytes.size()) return Error{path.string(), "GLB JSON chunk is truncated"};
-      text = bytes.substr(20, json_length);
+      text = text.substr(20, json_length);
     }
     Json json = Json::parse(text, nullptr, false);
     if (json.is_discarded() || !json.is_object()) return Error{path.string(), "not a valid glTF: the JSON is malformed"};
@@ -128,15 +169,20 @@ std::vector<fs::path> source_files(const fs::path& file, const Json& json, const
 
 Result<Document> read_document(const fs::path& path) {
   return guarded(path.string(), [&]() -> Result<Document> {
+    std::error_code ec;
+    if (!fs::is_regular_file(path, ec)) return Error{path.string(), "no such file"};
+    std::string bytes;  // read once: tinygltf and the JSON as written both come from these
+    if (!read_whole_file(path, bytes)) return Error{path.string(), "cannot be read"};
     tinygltf::Model model;  // tinygltf checks the container, the URIs and the buffer sizes
-    if (Status loaded = load_model(path, model); !loaded) return loaded.error();
+    if (Status loaded = load_model(path, bytes, model); !loaded) return loaded.error();
 
     Document doc;
     doc.file = path.string();
     doc.folder = fs::absolute(path).parent_path();
-    auto json = read_json(path);
+    auto json = json_of(path, bytes);
     if (!json) return json.error();
     doc.json = std::move(*json);
+    std::string().swap(bytes);
     const std::size_t declared = doc.json.contains("buffers") ? doc.json["buffers"].size() : 0;
     if (declared != model.buffers.size()) return Error{doc.file, "not a valid glTF: buffers could not all be read"};
     for (std::size_t i = 0; i < model.buffers.size(); ++i) {
@@ -145,6 +191,7 @@ Result<Document> read_document(const fs::path& path) {
       data.resize(std::min(data.size(), std::size_t(doc.json["buffers"][i].value("byteLength", std::size_t{0}))));
       doc.buffers.push_back(std::move(data));
     }
+    if (Status s = check_accessors(doc); !s) return s.error();
     return doc;
   });
 }
@@ -196,6 +243,9 @@ Result<std::vector<fs::path>> write_document(const Document& doc, const fs::path
     // All buffers become one: each starts 4-byte aligned, the views move with it.
     Json json = doc.json;
     std::string bin;
+    std::size_t total = 0;
+    for (const auto& b : doc.buffers) total += b.size() + 3;
+    bin.reserve(total);  // one allocation for the scene's buffers (images embedded later may add one)
     std::vector<std::size_t> base(doc.buffers.size());
     for (std::size_t i = 0; i < doc.buffers.size(); ++i) {
       pad(bin, 4, '\0');
@@ -268,19 +318,19 @@ Result<std::vector<fs::path>> write_document(const Document& doc, const fs::path
     std::string text = json.dump();
     pad(text, 4, ' ');
     pad(bin, 4, '\0');
-    std::string file;
-    file += "glTF";
-    append_u32(file, 2);
-    append_u32(file, std::uint32_t(12 + 8 + text.size() + (bin.empty() ? 0 : 8 + bin.size())));
-    append_u32(file, std::uint32_t(text.size()));
-    file += "JSON";
-    file += text;
+    std::string header;  // the GLB header and the JSON chunk; the BIN chunk is written from `bin` as it is
+    header += "glTF";
+    append_u32(header, 2);
+    append_u32(header, std::uint32_t(12 + 8 + text.size() + (bin.empty() ? 0 : 8 + bin.size())));
+    append_u32(header, std::uint32_t(text.size()));
+    header += "JSON";
+    header += text;
+    std::string bin_header;
     if (!bin.empty()) {
-      append_u32(file, std::uint32_t(bin.size()));
-      file += std::string("BIN\0", 4);
-      file += bin;
+      append_u32(bin_header, std::uint32_t(bin.size()));
+      bin_header += std::string("BIN\0", 4);
     }
-    if (Status s = write_file_atomically(output, file); !s) return s.error();
+    if (Status s = write_file_atomically(output, {header, bin_header, bin}); !s) return s.error();
     written.push_back(output);
     return written;
   });

@@ -28,8 +28,9 @@ struct Document {
   std::map<std::string, std::string> new_files;
 };
 
-// .gltf or .glb. Buffer and image URIs must stay inside the file's folder; image files must exist
-// (they are copied or embedded on write).
+// .gltf or .glb, read once. Buffer and image URIs must stay inside the file's folder; image files
+// must exist (they are copied or embedded on write); every accessor lies within its buffer view and
+// every view within its buffer.
 Result<Document> read_document(const std::filesystem::path& path);
 
 constexpr int kArrayBuffer = 34962;  // bufferView.target of vertex attributes
@@ -54,6 +55,8 @@ Result<std::string> image_bytes(const Document& doc, std::size_t index);
 
 // The JSON of a .gltf or .glb alone (no buffers read, nothing checked but the container).
 Result<Json> read_json(const std::filesystem::path& path);
+// The same from the file's bytes (`path` says which container, and names it in errors).
+Result<Json> json_of(const std::filesystem::path& path, const std::string& bytes);
 
 // The files a document is read from: `file` itself, then its buffers' and images' URIs that are
 // neither data: URIs nor in `made` (absolute, normalized; whether they exist is not checked).

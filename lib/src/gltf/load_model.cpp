@@ -1,8 +1,11 @@
 #include "load_model.hpp"
 
+#include "matbake/read_file.hpp"
+
 #include <algorithm>
 #include <fstream>
 #include <iterator>
+#include <limits>
 
 namespace matbake::gltf {
 namespace fs = std::filesystem;
@@ -44,9 +47,11 @@ bool read_file(std::vector<unsigned char>* out, std::string* err, const std::str
     if (err) *err += "cannot read " + path + "\n";
     return false;
   }
-  std::ifstream in(path, std::ios::binary);
-  out->assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-  return bool(in) || in.eof();
+  if (!read_whole_file(path, *out)) {
+    if (err) *err += "cannot read " + path + "\n";
+    return false;
+  }
+  return true;
 }
 
 bool refuse_write(std::string* err, const std::string&, const std::vector<unsigned char>&, void*) {
@@ -75,17 +80,26 @@ bool is_inside(const fs::path& base, const fs::path& path) {
 }
 
 Status load_model(const fs::path& path, tinygltf::Model& model) {
-  const std::string file = path.string();
   std::error_code ec;
-  if (!fs::is_regular_file(path, ec)) return Error{file, "no such file"};
+  if (!fs::is_regular_file(path, ec)) return Error{path.string(), "no such file"};
+  std::string bytes;
+  if (!read_whole_file(path, bytes)) return Error{path.string(), "cannot be read"};
+  return load_model(path, bytes, model);
+}
+
+Status load_model(const fs::path& path, const std::string& bytes, tinygltf::Model& model) {
+  const std::string file = path.string();
   ConfinedFolder folder{fs::absolute(path).parent_path(), {}};
   tinygltf::TinyGLTF loader;
   loader.SetFsCallbacks({file_exists, expand_path, read_file, refuse_write, &folder});
   loader.SetImageLoader(skip_image_decoding, nullptr);
+  if (bytes.size() > std::numeric_limits<unsigned>::max()) return Error{file, "larger than 4 GiB, which tinygltf cannot read"};
   std::string err, warn;
-  const std::string absolute = fs::absolute(path).string();
-  const bool ok = path.extension() == ".glb" ? loader.LoadBinaryFromFile(&model, &err, &warn, absolute)
-                                              : loader.LoadASCIIFromFile(&model, &err, &warn, absolute);
+  const std::string base = folder.base.string();
+  const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
+  const bool ok = path.extension() == ".glb"
+                      ? loader.LoadBinaryFromMemory(&model, &err, &warn, data, unsigned(bytes.size()), base)
+                      : loader.LoadASCIIFromString(&model, &err, &warn, bytes.data(), unsigned(bytes.size()), base);
   if (!folder.refused.empty()) return Error{file, folder.refused};
   if (!ok) return Error{file, "not a valid glTF: " + first_line(err)};
   // Compressed geometry would be read as whatever bytes its accessors point at.

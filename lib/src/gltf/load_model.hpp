@@ -12,6 +12,8 @@ namespace matbake::gltf {
 
 // .glb by extension, else .gltf. Errors name `path` as given.
 Status load_model(const std::filesystem::path& path, tinygltf::Model& model);
+// The same from the file's bytes, already read (buffers and images are still looked up beside it).
+Status load_model(const std::filesystem::path& path, const std::string& bytes, tinygltf::Model& model);
 
 // Whether `path` lies inside `base`, lexically.
 bool is_inside(const std::filesystem::path& base, const std::filesystem::path& path);

@@ -238,13 +238,22 @@ std::vector<std::string> prune_unreachable(Document& doc) {
   // One buffer with only the kept views, each 4-byte aligned (no component is larger). A view
   // beyond its buffer (tinygltf lets some through) leaves the buffers as they are.
   bool views_ok = true;
+  std::size_t total = 0;
   for_each_in(json, "bufferViews", [&](Json& view) {
     const std::size_t buffer = view.value("buffer", std::size_t{0});
     views_ok = views_ok && buffer < doc.buffers.size() &&
                view.value("byteOffset", std::size_t{0}) + view.value("byteLength", std::size_t{0}) <= doc.buffers[buffer].size();
+    total += view.value("byteLength", std::size_t{0}) + 3;
   });
   if (!views_ok) return removed;
+  // Every view kept, in one buffer: nothing to compact (a large scene's bytes are not copied).
+  const bool all_views_kept = std::all_of(view_remap.begin(), view_remap.end(), [](int i) { return i >= 0; });
+  if (all_views_kept && doc.buffers.size() == 1 && json.contains("buffers") && json["buffers"].size() == 1) {
+    doc.added_buffer = -1;
+    return removed;
+  }
   std::vector<unsigned char> compact;
+  compact.reserve(total);  // one allocation: a large scene's buffer is copied once, not regrown
   for_each_in(json, "bufferViews", [&](Json& view) {
     const auto& from = doc.buffers[view.value("buffer", std::size_t{0})];
     const auto begin = from.begin() + std::ptrdiff_t(view.value("byteOffset", std::size_t{0}));

@@ -105,11 +105,15 @@ Status AtomicFile::commit() {
 }
 
 Status write_file_atomically(const fs::path& target, std::string_view bytes) {
+  return write_file_atomically(target, {bytes});
+}
+
+Status write_file_atomically(const fs::path& target, std::initializer_list<std::string_view> parts) {
   auto file = AtomicFile::create(target);
   if (!file) return file.error();
   {
     std::ofstream out(file->temp_path(), std::ios::binary);
-    out.write(bytes.data(), std::streamsize(bytes.size()));
+    for (std::string_view bytes : parts) out.write(bytes.data(), std::streamsize(bytes.size()));
     if (!out.flush()) return Error{target.string(), "cannot write"};
   }
   return file->commit();
