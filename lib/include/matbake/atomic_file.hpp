@@ -2,7 +2,7 @@
 // Outputs are written to a temporary file in the target's folder and renamed over the target only
 // when complete, so a failure leaves nothing half-written and never touches an existing output.
 #include <filesystem>
-#include <initializer_list>
+#include <span>
 #include <string_view>
 
 #include "matbake/result.hpp"
@@ -33,7 +33,7 @@ class AtomicFile {
 // The whole of `bytes` as `target`, through a temporary file and a rename.
 Status write_file_atomically(const std::filesystem::path& target, std::string_view bytes);
 // The parts one after the other (a large file written without assembling it in memory first).
-Status write_file_atomically(const std::filesystem::path& target, std::initializer_list<std::string_view> parts);
+Status write_file_atomically(const std::filesystem::path& target, std::span<const std::string_view> parts);
 
 // Removes every temporary file an AtomicFile of this process holds now, and keeps new ones from
 // being made (create() fails from then on): for a SIGINT/SIGTERM handler that is about to _exit,

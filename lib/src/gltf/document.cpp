@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <bit>
 #include <cstring>
+#include <deque>
 #include <fstream>
 #include <iterator>
 
@@ -46,6 +47,22 @@ std::string mime_type_of(const fs::path& path) {
 }
 
 void append_u32(std::string& out, std::uint32_t v) { out.append(reinterpret_cast<const char*>(&v), 4); }
+
+// A file's contents as pieces written one after another: views of bytes that live elsewhere, and
+// the few it owns (padding, embedded images).
+struct Chunks {
+  std::vector<std::string_view> parts;
+  std::deque<std::string> owned;  // stable addresses
+  std::size_t size = 0;
+  void add(std::string_view bytes) {
+    parts.push_back(bytes);
+    size += bytes.size();
+  }
+  void add_owned(std::string bytes) { add(owned.emplace_back(std::move(bytes))); }
+  void pad() {
+    if (size % 4) add_owned(std::string(4 - size % 4, '\0'));
+  }
+};
 
 // Every accessor within its buffer view and every view within its buffer (the bytes a writer copies).
 Status check_accessors(const Document& doc) {
@@ -242,15 +259,12 @@ Result<std::vector<fs::path>> write_document(const Document& doc, const fs::path
 
     // All buffers become one: each starts 4-byte aligned, the views move with it.
     Json json = doc.json;
-    std::string bin;
-    std::size_t total = 0;
-    for (const auto& b : doc.buffers) total += b.size() + 3;
-    bin.reserve(total);  // one allocation for the scene's buffers (images embedded later may add one)
+    Chunks bin;  // the merged buffer as pieces of the document's own bytes: a large scene is not copied
     std::vector<std::size_t> base(doc.buffers.size());
     for (std::size_t i = 0; i < doc.buffers.size(); ++i) {
-      pad(bin, 4, '\0');
-      base[i] = bin.size();
-      bin.append(reinterpret_cast<const char*>(doc.buffers[i].data()), doc.buffers[i].size());
+      bin.pad();
+      base[i] = bin.size;
+      bin.add({reinterpret_cast<const char*>(doc.buffers[i].data()), doc.buffers[i].size()});
     }
     if (json.contains("bufferViews")) {
       for (Json& view : json["bufferViews"]) {
@@ -283,24 +297,24 @@ Result<std::vector<fs::path>> write_document(const Document& doc, const fs::path
         if (mime.empty() && is_data_uri(uri)) mime = uri.substr(5, uri.find(';') - 5);
         if (mime.empty()) mime = mime_type_of(decode_uri(uri));
         if (mime.empty()) return Error{doc.file, "image " + std::to_string(i) + ": unknown type, cannot embed it in a GLB"};
-        pad(bin, 4, '\0');
-        json["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", bin.size()}, {"byteLength", bytes->size()}});
-        bin += *bytes;
+        bin.pad();
+        json["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", bin.size}, {"byteLength", bytes->size()}});
+        bin.add_owned(std::move(*bytes));
         image.erase("uri");
         image["bufferView"] = json["bufferViews"].size() - 1;
         image["mimeType"] = mime;
       }
     }
-    if (bin.empty()) {
+    if (bin.size == 0) {
       json.erase("buffers");
     } else {
-      json["buffers"] = Json::array({{{"byteLength", bin.size()}}});
+      json["buffers"] = Json::array({{{"byteLength", bin.size}}});
       if (!glb) json["buffers"][0]["uri"] = bin_path.filename().string();
     }
 
     std::vector<fs::path> written;
-    if (!glb && !bin.empty()) {
-      if (Status s = write_file_atomically(bin_path, bin); !s) return s.error();
+    if (!glb && bin.size != 0) {
+      if (Status s = write_file_atomically(bin_path, bin.parts); !s) return s.error();
       written.push_back(bin_path);
     }
     for (const auto& [target, bytes] : files) {
@@ -317,20 +331,22 @@ Result<std::vector<fs::path>> write_document(const Document& doc, const fs::path
 
     std::string text = json.dump();
     pad(text, 4, ' ');
-    pad(bin, 4, '\0');
+    bin.pad();
     std::string header;  // the GLB header and the JSON chunk; the BIN chunk is written from `bin` as it is
     header += "glTF";
     append_u32(header, 2);
-    append_u32(header, std::uint32_t(12 + 8 + text.size() + (bin.empty() ? 0 : 8 + bin.size())));
+    append_u32(header, std::uint32_t(12 + 8 + text.size() + (bin.size == 0 ? 0 : 8 + bin.size)));
     append_u32(header, std::uint32_t(text.size()));
     header += "JSON";
     header += text;
     std::string bin_header;
-    if (!bin.empty()) {
-      append_u32(bin_header, std::uint32_t(bin.size()));
+    if (bin.size != 0) {
+      append_u32(bin_header, std::uint32_t(bin.size));
       bin_header += std::string("BIN\0", 4);
     }
-    if (Status s = write_file_atomically(output, {header, bin_header, bin}); !s) return s.error();
+    std::vector<std::string_view> parts = {header, bin_header};
+    parts.insert(parts.end(), bin.parts.begin(), bin.parts.end());
+    if (Status s = write_file_atomically(output, parts); !s) return s.error();
     written.push_back(output);
     return written;
   });

@@ -105,10 +105,10 @@ Status AtomicFile::commit() {
 }
 
 Status write_file_atomically(const fs::path& target, std::string_view bytes) {
-  return write_file_atomically(target, {bytes});
+  return write_file_atomically(target, std::span<const std::string_view>(&bytes, 1));
 }
 
-Status write_file_atomically(const fs::path& target, std::initializer_list<std::string_view> parts) {
+Status write_file_atomically(const fs::path& target, std::span<const std::string_view> parts) {
   auto file = AtomicFile::create(target);
   if (!file) return file.error();
   {
