@@ -48,6 +48,44 @@ std::string mime_type_of(const fs::path& path) {
 
 void append_u32(std::string& out, std::uint32_t v) { out.append(reinterpret_cast<const char*>(&v), 4); }
 
+// A GLB read chunk by chunk: its JSON, and its BIN chunk (empty when it has none).
+struct Glb {
+  Json json;
+  std::vector<unsigned char> bin;
+};
+Result<Glb> read_glb(const fs::path& path) {
+  const auto bad = [&](const std::string& what) { return Error{path.string(), "not a valid glTF: " + what}; };
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
+  if (!in) return Error{path.string(), "cannot be read"};
+  const std::uint64_t size = std::uint64_t(in.tellg());
+  in.seekg(0);
+  std::string header(20, '\0');
+  if (size < 20 || !in.read(header.data(), 20)) return bad("shorter than a GLB header");
+  if (header.compare(0, 4, "glTF") != 0 || u32_at(header, 4) != 2) return bad("not a GLB 2 file");
+  const std::uint64_t json_length = u32_at(header, 12);
+  if (header.compare(16, 4, "JSON") != 0 || 20 + json_length > size) return bad("the GLB's JSON chunk is truncated");
+  std::string text(json_length, '\0');
+  if (!in.read(text.data(), std::streamsize(json_length))) return bad("the GLB's JSON chunk is truncated");
+  Glb glb;
+  glb.json = Json::parse(text, nullptr, false);
+  if (glb.json.is_discarded() || !glb.json.is_object()) return bad("the JSON is malformed");
+  const std::uint64_t bin_at = 20 + (json_length + 3) / 4 * 4;
+  if (bin_at + 8 <= size) {
+    std::string chunk(8, '\0');
+    in.seekg(std::streamoff(bin_at));
+    if (!in.read(chunk.data(), 8)) return bad("the GLB's BIN chunk is truncated");
+    const std::uint64_t bin_length = u32_at(chunk, 0);
+    if (chunk.compare(4, 4, std::string("BIN\0", 4)) == 0) {
+      if (bin_at + 8 + bin_length > size) return bad("the GLB's BIN chunk is truncated");
+      glb.bin.resize(bin_length);
+      if (bin_length && !in.read(reinterpret_cast<char*>(glb.bin.data()), std::streamsize(bin_length))) {
+        return bad("the GLB's BIN chunk is truncated");
+      }
+    }
+  }
+  return glb;
+}
+
 // A file's contents as pieces written one after another: views of bytes that live elsewhere, and
 // the few it owns (padding, embedded images).
 struct Chunks {
@@ -188,18 +226,33 @@ Result<Document> read_document(const fs::path& path) {
   return guarded(path.string(), [&]() -> Result<Document> {
     std::error_code ec;
     if (!fs::is_regular_file(path, ec)) return Error{path.string(), "no such file"};
-    std::string bytes;  // read once: tinygltf and the JSON as written both come from these
-    if (!read_whole_file(path, bytes)) return Error{path.string(), "cannot be read"};
-    tinygltf::Model model;  // tinygltf checks the container, the URIs and the buffer sizes
-    if (Status loaded = load_model(path, bytes, model); !loaded) return loaded.error();
-
     Document doc;
     doc.file = path.string();
     doc.folder = fs::absolute(path).parent_path();
-    auto json = json_of(path, bytes);
-    if (!json) return json.error();
-    doc.json = std::move(*json);
-    std::string().swap(bytes);
+    tinygltf::Model model;  // tinygltf checks the JSON's structure, the URIs and the buffer sizes
+    if (path.extension() == ".glb") {
+      // The BIN chunk is read straight into the buffer tinygltf takes over: a large scene's bytes
+      // are in memory once.
+      auto glb = read_glb(path);
+      if (!glb) return glb.error();
+      doc.json = std::move(glb->json);
+      Json for_tinygltf = doc.json;
+      if (for_tinygltf.contains("buffers") && for_tinygltf["buffers"].is_array() && !for_tinygltf["buffers"].empty() &&
+          for_tinygltf["buffers"][0].is_object() && !for_tinygltf["buffers"][0].contains("uri")) {
+        for_tinygltf["buffers"][0]["uri"] = kGlbBinUri;
+        // The chunk may carry up to 3 bytes of padding beyond the buffer's byteLength.
+        const std::size_t length = for_tinygltf["buffers"][0].value("byteLength", std::size_t{0});
+        if (glb->bin.size() > length) glb->bin.resize(length);
+      }
+      if (Status loaded = load_model_json(path, for_tinygltf.dump(), glb->bin, model); !loaded) return loaded.error();
+    } else {
+      std::string bytes;  // read once: tinygltf and the JSON as written both come from these
+      if (!read_whole_file(path, bytes)) return Error{path.string(), "cannot be read"};
+      if (Status loaded = load_model(path, bytes, model); !loaded) return loaded.error();
+      auto json = json_of(path, bytes);
+      if (!json) return json.error();
+      doc.json = std::move(*json);
+    }
     const std::size_t declared = doc.json.contains("buffers") ? doc.json["buffers"].size() : 0;
     if (declared != model.buffers.size()) return Error{doc.file, "not a valid glTF: buffers could not all be read"};
     for (std::size_t i = 0; i < model.buffers.size(); ++i) {

@@ -14,7 +14,12 @@ namespace {
 struct ConfinedFolder {
   fs::path base;         // absolute
   std::string refused;   // the first URI refused, with the reason
+  std::vector<unsigned char>* glb_bin = nullptr;  // served for kGlbBinUri
 };
+
+bool is_glb_bin(const std::string& path, const ConfinedFolder* folder) {
+  return folder->glb_bin != nullptr && path.ends_with(kGlbBinUri);
+}
 
 // tinygltf asks for the URI joined to the folder ("folder/" + uri, even when the URI is absolute),
 // then for "./" + uri. The URI as written decides: absolute, climbing above the folder with .., or
@@ -22,6 +27,7 @@ struct ConfinedFolder {
 // is the file, and the "./" retry finds nothing.
 std::string expand_path(const std::string& path, void* user) {
   auto* folder = static_cast<ConfinedFolder*>(user);
+  if (is_glb_bin(path, folder)) return path;
   const std::string prefix = folder->base.string() + "/";
   const bool joined = path.rfind(prefix, 0) == 0;
   const std::string uri = joined ? path.substr(prefix.size()) : path.rfind("./", 0) == 0 ? path.substr(2) : path;
@@ -38,11 +44,16 @@ std::string expand_path(const std::string& path, void* user) {
 }
 
 bool file_exists(const std::string& path, void* user) {
+  if (is_glb_bin(path, static_cast<ConfinedFolder*>(user))) return true;
   std::error_code ec;
   return !path.empty() && is_inside(static_cast<ConfinedFolder*>(user)->base, path) && fs::is_regular_file(path, ec);
 }
 
 bool read_file(std::vector<unsigned char>* out, std::string* err, const std::string& path, void* user) {
+  if (auto* folder = static_cast<ConfinedFolder*>(user); is_glb_bin(path, folder)) {
+    out->swap(*folder->glb_bin);
+    return true;
+  }
   if (!file_exists(path, user)) {
     if (err) *err += "cannot read " + path + "\n";
     return false;
@@ -71,6 +82,31 @@ std::string first_line(const std::string& text) {
   return line.empty() ? "unknown error" : line;
 }
 
+Status load(const fs::path& path, const std::string& bytes, bool binary, std::vector<unsigned char>* glb_bin,
+            tinygltf::Model& model) {
+  const std::string file = path.string();
+  ConfinedFolder folder{fs::absolute(path).parent_path(), {}, glb_bin};
+  tinygltf::TinyGLTF loader;
+  loader.SetFsCallbacks({file_exists, expand_path, read_file, refuse_write, &folder});
+  loader.SetImageLoader(skip_image_decoding, nullptr);
+  if (bytes.size() > std::numeric_limits<unsigned>::max()) return Error{file, "larger than 4 GiB, which tinygltf cannot read"};
+  std::string err, warn;
+  const std::string base = folder.base.string();
+  const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
+  const bool ok = binary
+                      ? loader.LoadBinaryFromMemory(&model, &err, &warn, data, unsigned(bytes.size()), base)
+                      : loader.LoadASCIIFromString(&model, &err, &warn, bytes.data(), unsigned(bytes.size()), base);
+  if (!folder.refused.empty()) return Error{file, folder.refused};
+  if (!ok) return Error{file, "not a valid glTF: " + first_line(err)};
+  // Compressed geometry would be read as whatever bytes its accessors point at.
+  for (const std::string& name : model.extensionsRequired) {
+    if (name == "KHR_draco_mesh_compression" || name == "EXT_meshopt_compression") {
+      return Error{file, "uses " + name + ", which matbake does not decode; decompress it first"};
+    }
+  }
+  return success();
+}
+
 }  // namespace
 
 bool is_inside(const fs::path& base, const fs::path& path) {
@@ -88,27 +124,12 @@ Status load_model(const fs::path& path, tinygltf::Model& model) {
 }
 
 Status load_model(const fs::path& path, const std::string& bytes, tinygltf::Model& model) {
-  const std::string file = path.string();
-  ConfinedFolder folder{fs::absolute(path).parent_path(), {}};
-  tinygltf::TinyGLTF loader;
-  loader.SetFsCallbacks({file_exists, expand_path, read_file, refuse_write, &folder});
-  loader.SetImageLoader(skip_image_decoding, nullptr);
-  if (bytes.size() > std::numeric_limits<unsigned>::max()) return Error{file, "larger than 4 GiB, which tinygltf cannot read"};
-  std::string err, warn;
-  const std::string base = folder.base.string();
-  const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
-  const bool ok = path.extension() == ".glb"
-                      ? loader.LoadBinaryFromMemory(&model, &err, &warn, data, unsigned(bytes.size()), base)
-                      : loader.LoadASCIIFromString(&model, &err, &warn, bytes.data(), unsigned(bytes.size()), base);
-  if (!folder.refused.empty()) return Error{file, folder.refused};
-  if (!ok) return Error{file, "not a valid glTF: " + first_line(err)};
-  // Compressed geometry would be read as whatever bytes its accessors point at.
-  for (const std::string& name : model.extensionsRequired) {
-    if (name == "KHR_draco_mesh_compression" || name == "EXT_meshopt_compression") {
-      return Error{file, "uses " + name + ", which matbake does not decode; decompress it first"};
-    }
-  }
-  return success();
+  return load(path, bytes, path.extension() == ".glb", nullptr, model);
+}
+
+Status load_model_json(const fs::path& path, const std::string& json_text, std::vector<unsigned char>& glb_bin,
+                       tinygltf::Model& model) {
+  return load(path, json_text, false, &glb_bin, model);
 }
 
 }  // namespace matbake::gltf

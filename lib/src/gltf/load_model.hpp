@@ -14,6 +14,11 @@ namespace matbake::gltf {
 Status load_model(const std::filesystem::path& path, tinygltf::Model& model);
 // The same from the file's bytes, already read (buffers and images are still looked up beside it).
 Status load_model(const std::filesystem::path& path, const std::string& bytes, tinygltf::Model& model);
+// A GLB's JSON as glTF text, its buffer 0 named kGlbBinUri and `glb_bin` its BIN chunk (at the
+// buffer's byteLength), which tinygltf then takes over without copying it.
+inline constexpr const char* kGlbBinUri = "\x01glb-bin";
+Status load_model_json(const std::filesystem::path& path, const std::string& json_text, std::vector<unsigned char>& glb_bin,
+                       tinygltf::Model& model);
 
 // Whether `path` lies inside `base`, lexically.
 bool is_inside(const std::filesystem::path& base, const std::filesystem::path& path);
