@@ -30,6 +30,7 @@ int run_bake_ao(const BakeAoSettings& s, const GlobalOptions& global) {
     std::cout << nlohmann::json{{"command", "bake-ao"}, {"scene", s.scene}, {"output", s.output}, {"dump", s.dump},
                                 {"instances", report->instances}, {"vertices", report->vertices},
                                 {"rays", report->rays}, {"seconds", report->seconds},
+                                {"setup_seconds", report->setup_seconds}, {"ray_seconds", report->ray_seconds},
                                 {"max_distance", report->max_distance}, {"mean_ao", report->mean},
                                 {"notes", report->notes}}
                      .dump(2)

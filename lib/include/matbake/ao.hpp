@@ -61,6 +61,8 @@ struct Bake {
   std::vector<std::vector<float>> values;  // per scene instance, per vertex: w in [0, 1] (empty: not a target)
   std::uint64_t rays = 0;
   double max_distance = 0;                 // d_max as used (absolute)
+  double setup_seconds = 0;                // normals, edge lengths and Embree's BVH
+  double ray_seconds = 0;                  // casting the rays
 };
 
 // Normals: the instance's own where present, else area-weighted from its faces. Identical for a

@@ -82,7 +82,9 @@ struct BakeAoReport {
   std::size_t instances = 0;
   std::size_t vertices = 0;  // baked
   std::uint64_t rays = 0;
-  double seconds = 0;        // of ray casting
+  double seconds = 0;        // of the bake: setup_seconds + ray_seconds
+  double setup_seconds = 0;  // normals, edge lengths, Embree's BVH
+  double ray_seconds = 0;    // casting the rays
   double max_distance = 0;   // d_max as used
   double mean = 0;           // over baked vertices
   std::vector<std::string> notes;    // the scene's (what was skipped)

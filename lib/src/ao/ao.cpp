@@ -5,6 +5,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <memory>
 #include <numbers>
@@ -161,6 +162,7 @@ std::optional<Into> into_from_names(std::string_view attribute, std::string_view
 
 Result<Bake> bake(const scene::Scene& scene, const Options& options) {
   if (Status s = check(options); !s) return s.error();
+  const auto start = std::chrono::steady_clock::now();
   Device device(rtcNewDevice(nullptr));
   if (!device) return Error{"", "Embree could not start (rtcNewDevice failed)"};
   RtcScene rtc(rtcNewScene(device.get()));
@@ -192,6 +194,7 @@ Result<Bake> bake(const scene::Scene& scene, const Options& options) {
     rtcReleaseGeometry(g);
   }
   rtcCommitScene(rtc.get());
+  const auto built = std::chrono::steady_clock::now();
   if (rtcGetDeviceError(device.get()) != RTC_ERROR_NONE) return Error{"", "Embree could not build the scene"};
 
   Bake result;
@@ -259,6 +262,8 @@ Result<Bake> bake(const scene::Scene& scene, const Options& options) {
     }
   });
   result.rays = std::uint64_t(first.back()) * std::uint64_t(options.samples);
+  result.setup_seconds = std::chrono::duration<double>(built - start).count();
+  result.ray_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - built).count();
   return result;
 }
 

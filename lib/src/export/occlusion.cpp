@@ -1,6 +1,7 @@
 #include "occlusion.hpp"
 
 #include <chrono>
+#include <future>
 
 #include "../gltf/vertex_occlusion.hpp"
 #include "matbake/export.hpp"
@@ -65,6 +66,10 @@ Result<BakeAoReport> bake_ao_file(const fs::path& input, const BakeAoOptions& op
     if (!scene) return scene.error();
     if (Status s = check_outputs(input, options); !s) return s.error();
 
+    // The document the values go into is read while the rays are cast (reading is one thread of
+    // memory copies; the bake is all cores of arithmetic).
+    std::future<Result<gltf::Document>> document;
+    if (!options.output.empty()) document = std::async(std::launch::async, [&] { return gltf::read_document(input); });
     const auto start = std::chrono::steady_clock::now();
     auto baked = ao::bake(*scene, options.ao.options);
     if (!baked) return baked.error();
@@ -75,7 +80,7 @@ Result<BakeAoReport> bake_ao_file(const fs::path& input, const BakeAoOptions& op
       report.written.push_back(options.dump.string());
     }
     if (!options.output.empty()) {
-      auto doc = gltf::read_document(input);
+      auto doc = document.get();
       if (!doc) return doc.error();
       const std::vector<gltf::PlacedValues> placed = placed_values(*scene, *baked);
       gltf::add_vertex_occlusion(*doc, placed, options.ao.into);
@@ -90,6 +95,8 @@ Result<BakeAoReport> bake_ao_file(const fs::path& input, const BakeAoOptions& op
     }
     report.instances = scene->instances.size();
     report.rays = baked->rays;
+  report.setup_seconds = baked->setup_seconds;
+  report.ray_seconds = baked->ray_seconds;
     report.max_distance = baked->max_distance;
     report.mean = report.vertices ? sum / double(report.vertices) : 0.0;
     report.notes = scene->notes;
