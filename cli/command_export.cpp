@@ -73,7 +73,9 @@ CLI::App* setup_export(CLI::App& app, ExportSettings& s) {
 
 int run_export(const ExportSettings& s, const GlobalOptions& global) {
   exporter::Options options = s.options;
-  auto request = ao_request(s.ao, "ao-");
+  AoSettings ao = s.ao;  // checked even when no AO is baked: a misspelt option is still an error
+  if (!s.bake_ao) ao.request.options.samples = ao::Options{}.samples;  // --ao-samples 0: no AO
+  auto request = ao_request(ao, "ao-");
   if (!request) return report_error(request.error());
   if (s.bake_ao) options.ao = *request;
   for (const std::string& text : s.materials) {

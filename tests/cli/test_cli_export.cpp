@@ -294,6 +294,17 @@ TEST(CliExport, NoTemporaryFolderOutsideTheOutput) {
   EXPECT_EQ(list_folder(dir / "out"), std::vector<std::string>{"scene.glb"});
 }
 
+// --ao-samples 0 keeps AO off, as it did before AO took bake-ao's options.
+TEST(CliExport, ZeroAoSamplesBakeNothing) {
+  TempDir dir;
+  quad_scene(json::array({{{"name", "M"}}, {{"name", "N"}}})).write(dir / "in.gltf", {0});
+  const json report = export_json({(dir / "in.gltf").string(), "-o", (dir / "out.glb").string(), "--ao-samples", "0"});
+  ASSERT_FALSE(report.is_null());
+  EXPECT_EQ(report["ao_rays"], 0);
+  const gltf::Document out = read_output(dir / "out.glb");
+  EXPECT_FALSE(out.json["meshes"][0]["primitives"][0]["attributes"].contains("COLOR_0"));
+}
+
 TEST(CliExport, BadInputIsRefusedAndNothingIsWritten) {
   TempDir dir;
   fs::create_directories(dir / "out");
