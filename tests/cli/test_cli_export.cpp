@@ -305,6 +305,27 @@ TEST(CliExport, ZeroAoSamplesBakeNothing) {
   EXPECT_FALSE(out.json["meshes"][0]["primitives"][0]["attributes"].contains("COLOR_0"));
 }
 
+// 100 000 nested nodes (a hostile or generated file): export and its AO walk them without
+// recursion; the mesh at the bottom gets its colours.
+TEST(CliExport, DeepNodeChainExportsWithAo) {
+  TempDir dir;
+  GltfBuilder b = quad_scene(json::array({{{"name", "M"}}, {{"name", "N"}}}));
+  const int depth = 100000;
+  const int first = int(b.doc["nodes"].size());
+  for (int n = 0; n < depth; ++n) {
+    json node = {{"translation", {0.001, 0, 0}}};
+    node["children"] = {n + 1 < depth ? first + n + 1 : 0};
+    b.add_node(node);
+  }
+  b.write(dir / "deep.gltf", {first});
+  const json report = export_json({(dir / "deep.gltf").string(), "-o", (dir / "out.glb").string(), "--ao-samples", "8"});
+  ASSERT_FALSE(report.is_null());
+  EXPECT_EQ(report["ao_rays"], 4 * 8);
+  const gltf::Document out = read_output(dir / "out.glb");
+  EXPECT_EQ(out.json["nodes"].size(), std::size_t(depth + 2));
+  EXPECT_TRUE(out.json["meshes"][0]["primitives"][0]["attributes"].contains("COLOR_0"));
+}
+
 TEST(CliExport, BadInputIsRefusedAndNothingIsWritten) {
   TempDir dir;
   fs::create_directories(dir / "out");

@@ -158,6 +158,37 @@ TEST(SceneLoad, BadFilesAreRefusedWithTheReason) {
     b.write(dir / "cycle.gltf", {a});
     expect_refused(dir / "cycle.gltf", "is its own ancestor");
   }
+  {
+    // Node 2 under two parents: the spec's strict trees; refusing it also keeps a hostile file
+    // from multiplying instances (a chain of shared children doubles them at each level).
+    GltfBuilder b;
+    const int shared = 2;
+    const int a = b.add_node({{"children", {shared}}});
+    const int c = b.add_node({{"children", {shared}}});
+    b.add_node({{"mesh", b.add_mesh(b.add_vec3(kTriangle))}});
+    b.write(dir / "parents.gltf", {a, c});
+    expect_refused(dir / "parents.gltf", "node 2 is its own ancestor or has two parents");
+  }
+}
+
+TEST(SceneLoad, DeepNodeChainIsWalkedWithoutRecursion) {
+  // 200 000 nested nodes, each translating by 1 along x: the triangle at the bottom sits at x = 200 000
+  // (a recursive walk overflows the stack long before).
+  TempDir dir;
+  GltfBuilder b;
+  const int depth = 200000;
+  const int mesh = b.add_mesh(b.add_vec3(kTriangle));
+  for (int n = 0; n < depth; ++n) {
+    nlohmann::json node = {{"translation", {1, 0, 0}}};
+    if (n + 1 < depth) node["children"] = {n + 1};
+    else node["mesh"] = mesh;
+    b.add_node(node);
+  }
+  b.write(dir / "deep.gltf", {0});
+  auto s = load_scene(dir / "deep.gltf");
+  ASSERT_TRUE(s) << s.error().to_string();
+  ASSERT_EQ(s->instances.size(), 1u);
+  expect_vec(s->instances[0].positions[1], {float(depth) + 1, 0, 0});
 }
 
 TEST(VertexNormals, ThreeWeightings) {

@@ -6,7 +6,7 @@
 
 #include "../gltf/document.hpp"
 #include "../gltf/prune.hpp"
-#include "matbake/scene.hpp"
+#include "../scene/from_document.hpp"
 #include "occlusion.hpp"
 #include "texture_files.hpp"
 
@@ -358,15 +358,15 @@ Result<Report> export_scene(const fs::path& input, const fs::path& output, const
   return guarded(input.string(), [&]() -> Result<Report> {
     const std::string ext = output.extension().string();
     if (ext != ".gltf" && ext != ".glb") return Error{output.string(), "the output is .gltf or .glb", true};
+    auto doc = gltf::read_document(input);
+    if (!doc) return doc.error();
     // The flattened scene only when AO is baked: a plain export works on the document alone.
     std::optional<scene::Scene> scene;
     if (options.ao) {
-      auto loaded = scene::load_scene(input);
-      if (!loaded) return loaded.error();
-      scene = std::move(*loaded);
+      auto flattened = scene::scene_from_document(*doc);
+      if (!flattened) return flattened.error();
+      scene = std::move(*flattened);
     }
-    auto doc = gltf::read_document(input);
-    if (!doc) return doc.error();
 
     Report report;
     report.skipped = gltf::prune_unreachable(*doc);  // from here on, everything in doc is reachable

@@ -1,9 +1,9 @@
 #include "occlusion.hpp"
 
 #include <chrono>
-#include <future>
 
 #include "../gltf/vertex_occlusion.hpp"
+#include "../scene/from_document.hpp"
 #include "matbake/export.hpp"
 
 namespace matbake::exporter {
@@ -21,10 +21,8 @@ std::vector<gltf::PlacedValues> placed_values(const scene::Scene& scene, const a
 
 // An output onto a file the scene is read from, or two outputs onto one file, is refused before
 // any work.
-Status check_outputs(const fs::path& input, const BakeAoOptions& options) {
-  auto json = gltf::read_json(input);
-  if (!json) return json.error();
-  const std::vector<fs::path> sources = gltf::source_files(input, *json);
+Status check_outputs(const gltf::Document& doc, const BakeAoOptions& options) {
+  const std::vector<fs::path> sources = gltf::source_files(doc.file, doc.json);
   for (const fs::path* out : {&options.output, &options.dump}) {
     if (out->empty()) continue;
     for (const fs::path& in : sources) {
@@ -62,14 +60,13 @@ Result<BakeAoReport> bake_ao_file(const fs::path& input, const BakeAoOptions& op
       return Error{options.dump.string(), "the dump is .csv or .bin", true};
     }
     if (Status s = ao::check(options.ao.options); !s) return s.error();
-    auto scene = scene::load_scene(input);
+    // Read once: the scene to bake and the document the values go into.
+    auto doc = gltf::read_document(input);
+    if (!doc) return doc.error();
+    if (Status s = check_outputs(*doc, options); !s) return s.error();
+    auto scene = scene::scene_from_document(*doc);
     if (!scene) return scene.error();
-    if (Status s = check_outputs(input, options); !s) return s.error();
 
-    // The document the values go into is read while the rays are cast (reading is one thread of
-    // memory copies; the bake is all cores of arithmetic).
-    std::future<Result<gltf::Document>> document;
-    if (!options.output.empty()) document = std::async(std::launch::async, [&] { return gltf::read_document(input); });
     const auto start = std::chrono::steady_clock::now();
     auto baked = ao::bake(*scene, options.ao.options);
     if (!baked) return baked.error();
@@ -80,8 +77,6 @@ Result<BakeAoReport> bake_ao_file(const fs::path& input, const BakeAoOptions& op
       report.written.push_back(options.dump.string());
     }
     if (!options.output.empty()) {
-      auto doc = document.get();
-      if (!doc) return doc.error();
       const std::vector<gltf::PlacedValues> placed = placed_values(*scene, *baked);
       gltf::add_vertex_occlusion(*doc, placed, options.ao.into);
       auto written = gltf::write_document(*doc, options.output);
@@ -95,8 +90,8 @@ Result<BakeAoReport> bake_ao_file(const fs::path& input, const BakeAoOptions& op
     }
     report.instances = scene->instances.size();
     report.rays = baked->rays;
-  report.setup_seconds = baked->setup_seconds;
-  report.ray_seconds = baked->ray_seconds;
+    report.setup_seconds = baked->setup_seconds;
+    report.ray_seconds = baked->ray_seconds;
     report.max_distance = baked->max_distance;
     report.mean = report.vertices ? sum / double(report.vertices) : 0.0;
     report.notes = scene->notes;

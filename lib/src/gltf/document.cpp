@@ -102,36 +102,44 @@ struct Chunks {
   }
 };
 
-// Every accessor within its buffer view and every view within its buffer (the bytes a writer copies).
+std::size_t components_of(const std::string& type) {
+  if (type == "SCALAR") return 1;
+  if (type == "VEC2") return 2;
+  if (type == "VEC3") return 3;
+  if (type == "VEC4" || type == "MAT2") return 4;
+  if (type == "MAT3") return 9;
+  if (type == "MAT4") return 16;
+  return 0;
+}
+
+std::size_t component_size_of(int type) {
+  switch (type) {
+    case 5120: case 5121: return 1;  // byte, unsigned byte
+    case 5122: case 5123: return 2;  // short, unsigned short
+    case 5125: case 5126: return 4;  // unsigned int, float
+    default: return 0;
+  }
+}
+
+const Json& array_in(const Json& json, const char* key) {
+  static const Json empty = Json::array();
+  return json.contains(key) && json[key].is_array() ? json[key] : empty;
+}
+
+// Every view within its buffer and every accessor with a view within it (the bytes a writer copies).
 Status check_accessors(const Document& doc) {
-  const Json empty = Json::array();
-  const Json& views = doc.json.contains("bufferViews") ? doc.json["bufferViews"] : empty;
+  const Json& views = array_in(doc.json, "bufferViews");
   for (std::size_t v = 0; v < views.size(); ++v) {
     const std::size_t buffer = views[v].value("buffer", std::size_t(-1));
-    const std::size_t end = views[v].value("byteOffset", std::size_t{0}) + views[v].value("byteLength", std::size_t{0});
-    if (buffer >= doc.buffers.size() || end > doc.buffers[buffer].size()) {
+    const std::size_t offset = views[v].value("byteOffset", std::size_t{0}), length = views[v].value("byteLength", std::size_t{0});
+    if (buffer >= doc.buffers.size() || offset > doc.buffers[buffer].size() || length > doc.buffers[buffer].size() - offset) {
       return Error{doc.file, "buffer view " + std::to_string(v) + " reaches beyond its buffer"};
     }
   }
-  if (!doc.json.contains("accessors")) return success();
-  for (std::size_t a = 0; a < doc.json["accessors"].size(); ++a) {
-    const Json& accessor = doc.json["accessors"][a];
-    if (!accessor.contains("bufferView")) continue;  // all zeros (or sparse values alone)
-    const std::size_t view = accessor["bufferView"].get<std::size_t>();
-    if (view >= views.size()) return Error{doc.file, "accessor " + std::to_string(a) + " has no buffer view"};
-    const std::string type = accessor.value("type", "");
-    const std::size_t components = type == "SCALAR" ? 1 : type == "VEC2" ? 2 : type == "VEC3" ? 3 : type == "VEC4" ? 4
-                                   : type == "MAT2" ? 4 : type == "MAT3" ? 9 : type == "MAT4" ? 16 : 0;
-    const int kind = accessor.value("componentType", 0);
-    const std::size_t bytes = kind == 5120 || kind == 5121 ? 1 : kind == 5122 || kind == 5123 ? 2 : kind == 5125 || kind == 5126 ? 4 : 0;
-    if (components == 0 || bytes == 0) return Error{doc.file, "accessor " + std::to_string(a) + " has an unknown type"};
-    const std::size_t element = components * bytes, count = accessor.value("count", std::size_t{0});
-    const std::size_t stride = views[view].value("byteStride", element), length = views[view].value("byteLength", std::size_t{0});
-    const std::size_t offset = accessor.value("byteOffset", std::size_t{0});
-    // offset + stride (count − 1) + element ≤ length, without overflow for a hostile count.
-    const bool fits = count == 0 || (offset <= length && element <= length - offset &&
-                                     (stride == 0 || count - 1 <= (length - offset - element) / stride));
-    if (!fits) return Error{doc.file, "accessor " + std::to_string(a) + " reaches beyond its buffer"};
+  const Json& accessors = array_in(doc.json, "accessors");
+  for (std::size_t a = 0; a < accessors.size(); ++a) {
+    if (!accessors[a].contains("bufferView")) continue;  // all zeros (or sparse values alone)
+    if (auto bytes = accessor_bytes(doc, a); !bytes) return bytes.error();
   }
   return success();
 }
@@ -182,6 +190,40 @@ Result<std::string> image_bytes(const Document& doc, std::size_t index) {
     if (bytes.empty()) return Error{doc.file, what + ": '" + uri + "' cannot be read"};
     return bytes;
   });
+}
+
+Result<AccessorBytes> accessor_bytes(const Document& doc, std::size_t index) {
+  const std::string name = "accessor " + std::to_string(index);
+  const Json& accessors = array_in(doc.json, "accessors");
+  if (index >= accessors.size()) return Error{doc.file, name + " does not exist"};
+  const Json& accessor = accessors[index];
+  const Json& views = array_in(doc.json, "bufferViews");
+  const std::size_t v = accessor.value("bufferView", std::size_t(-1));
+  if (v >= views.size()) return Error{doc.file, name + " has no buffer view"};
+  AccessorBytes out;
+  out.component_type = accessor.value("componentType", 0);
+  out.components = components_of(accessor.value("type", ""));
+  out.component_size = component_size_of(out.component_type);
+  if (out.components == 0 || out.component_size == 0) return Error{doc.file, name + " has an unknown type"};
+  out.count = accessor.value("count", std::size_t{0});
+  out.normalized = accessor.value("normalized", false);
+  out.sparse = accessor.contains("sparse");
+  const Json& view = views[v];
+  const std::size_t buffer = view.value("buffer", std::size_t(-1));
+  const std::size_t view_offset = view.value("byteOffset", std::size_t{0}), length = view.value("byteLength", std::size_t{0});
+  if (buffer >= doc.buffers.size() || view_offset > doc.buffers[buffer].size() ||
+      length > doc.buffers[buffer].size() - view_offset) {
+    return Error{doc.file, "buffer view " + std::to_string(v) + " reaches beyond its buffer"};
+  }
+  const std::size_t element = out.components * out.component_size;
+  out.stride = view.value("byteStride", element);
+  const std::size_t offset = accessor.value("byteOffset", std::size_t{0});
+  // offset + stride (count − 1) + element ≤ length, without overflow for a hostile count.
+  const bool fits = out.count == 0 || (offset <= length && element <= length - offset &&
+                                       (out.stride == 0 || out.count - 1 <= (length - offset - element) / out.stride));
+  if (!fits) return Error{doc.file, name + " reaches beyond its buffer"};
+  out.first = doc.buffers[buffer].data() + view_offset + offset;
+  return out;
 }
 
 Result<Json> read_json(const fs::path& path) {

@@ -33,6 +33,20 @@ struct Document {
 // every view within its buffer.
 Result<Document> read_document(const std::filesystem::path& path);
 
+// Where accessor `index`'s elements lie in doc.buffers, checked against its buffer view and that
+// view against its buffer. Sparse substitutions are not applied (the caller decides whether it
+// reads sparse accessors); an accessor without a buffer view is refused.
+struct AccessorBytes {
+  const unsigned char* first = nullptr;  // element 0
+  std::size_t count = 0, stride = 0;     // stride: bytes from one element to the next
+  int component_type = 0;                // 5120 (byte) ... 5126 (float)
+  std::size_t components = 0;            // 1 (SCALAR) ... 16 (MAT4)
+  std::size_t component_size = 0;        // bytes
+  bool normalized = false;
+  bool sparse = false;
+};
+Result<AccessorBytes> accessor_bytes(const Document& doc, std::size_t index);
+
 constexpr int kArrayBuffer = 34962;  // bufferView.target of vertex attributes
 
 // Appends `bytes` (4-byte aligned) as a new buffer view; returns its index. target 0: none.

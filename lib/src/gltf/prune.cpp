@@ -154,16 +154,23 @@ std::vector<std::string> prune_unreachable(Document& doc) {
   Json& json = doc.json;
   std::vector<std::string> removed;
 
-  // Nodes of the default scene (scene 0 when none is named), depth first; cycles stop.
+  // Nodes of the default scene (scene 0 when none is named), with a stack rather than recursion (a
+  // hostile file may nest a million nodes); cycles stop.
   std::vector<bool> in_scene(count_of(json, "nodes"), false);
   const int scene = json.contains("scene") ? index_in(json, "scenes", json["scene"]) : (count_of(json, "scenes") ? 0 : -1);
-  std::function<void(const Json&)> visit = [&](const Json& n) {
-    const int i = index_in(json, "nodes", n);
-    if (i < 0 || in_scene[std::size_t(i)]) return;
-    in_scene[std::size_t(i)] = true;
-    for_each_in(json["nodes"][std::size_t(i)], "children", [&](Json& child) { visit(child); });
+  std::vector<int> pending;
+  const auto reach = [&](Json& n) {
+    if (const int i = index_in(json, "nodes", n); i >= 0 && !in_scene[std::size_t(i)]) {
+      in_scene[std::size_t(i)] = true;
+      pending.push_back(i);
+    }
   };
-  if (scene >= 0) for_each_in(json["scenes"][std::size_t(scene)], "nodes", [&](Json& n) { visit(n); });
+  if (scene >= 0) for_each_in(json["scenes"][std::size_t(scene)], "nodes", reach);
+  while (!pending.empty()) {
+    const int i = pending.back();
+    pending.pop_back();
+    for_each_in(json["nodes"][std::size_t(i)], "children", reach);
+  }
 
   Marks meshes{"meshes", std::vector<bool>(count_of(json, "meshes"))};
   for (std::size_t n = 0; n < in_scene.size(); ++n) {

@@ -5,13 +5,11 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/quaternion.hpp>
 #include <glm/gtc/type_ptr.hpp>
-#include <tiny_gltf.h>
-
-#include "../gltf/load_model.hpp"
+#include "from_document.hpp"
 
 #include <algorithm>
 #include <cmath>
-#include <functional>
+#include <optional>
 #include <cstring>
 #include <numeric>
 
@@ -19,113 +17,104 @@ namespace matbake::scene {
 namespace fs = std::filesystem;
 namespace {
 
-// --- Accessors --------------------------------------------------------------------------------------
+using Json = gltf::Json;
+
+constexpr int kTriangles = 4, kTriangleStrip = 5, kTriangleFan = 6;
+constexpr int kFloat = 5126, kByte = 5120, kUnsignedByte = 5121, kShort = 5122, kUnsignedShort = 5123, kUnsignedInt = 5125;
+
+float component(const unsigned char* p, int type, bool normalized) {
+  const auto as = [p]<class T>(T) {
+    T v;
+    std::memcpy(&v, p, sizeof v);
+    return v;
+  };
+  switch (type) {
+    case kFloat: return as(float{});
+    case kByte: {
+      const float v = float(as(std::int8_t{}));
+      return normalized ? std::max(v / 127.0f, -1.0f) : v;
+    }
+    case kUnsignedByte: {
+      const float v = float(as(std::uint8_t{}));
+      return normalized ? v / 255.0f : v;
+    }
+    case kShort: {
+      const float v = float(as(std::int16_t{}));
+      return normalized ? std::max(v / 32767.0f, -1.0f) : v;
+    }
+    case kUnsignedShort: {
+      const float v = float(as(std::uint16_t{}));
+      return normalized ? v / 65535.0f : v;
+    }
+    case kUnsignedInt: return float(as(std::uint32_t{}));
+    default: return 0.0f;
+  }
+}
+
+std::uint32_t index_at(const unsigned char* p, int type) {
+  switch (type) {
+    case kUnsignedByte: return *p;
+    case kUnsignedShort: {
+      std::uint16_t v;
+      std::memcpy(&v, p, 2);
+      return v;
+    }
+    default: {
+      std::uint32_t v;
+      std::memcpy(&v, p, 4);
+      return v;
+    }
+  }
+}
+
 struct Reader {
-  const tinygltf::Model& model;
-  std::string file;
+  const gltf::Document& doc;
 
-  Error error(const std::string& what) const { return Error{file, what}; }
+  Error error(const std::string& what) const { return Error{doc.file, what}; }
 
-  // The bytes of each element of an accessor, checked against its buffer view and buffer.
-  Result<std::vector<const unsigned char*>> elements(int index, std::size_t element_size) const {
-    if (index < 0 || std::size_t(index) >= model.accessors.size()) {
-      return error("accessor " + std::to_string(index) + " does not exist");
-    }
-    const tinygltf::Accessor& a = model.accessors[std::size_t(index)];
-    const std::string name = "accessor " + std::to_string(index);
-    if (a.sparse.isSparse) return error(name + " is sparse; matbake does not read sparse accessors");
-    if (a.bufferView < 0 || std::size_t(a.bufferView) >= model.bufferViews.size()) {
-      return error(name + " has no buffer view");
-    }
-    const tinygltf::BufferView& view = model.bufferViews[std::size_t(a.bufferView)];
-    if (view.buffer < 0 || std::size_t(view.buffer) >= model.buffers.size()) {
-      return error("buffer view " + std::to_string(a.bufferView) + " has no buffer");
-    }
-    const std::vector<unsigned char>& data = model.buffers[std::size_t(view.buffer)].data;
-    const std::size_t stride = view.byteStride ? view.byteStride : element_size;
-    const std::size_t needed = a.count == 0 ? 0 : a.byteOffset + stride * (a.count - 1) + element_size;
-    if (view.byteOffset + view.byteLength > data.size() || needed > view.byteLength) {
-      return error(name + " reaches beyond its buffer (" + std::to_string(view.byteOffset + needed) + " bytes of " +
-                   std::to_string(data.size()) + ")");
-    }
-    std::vector<const unsigned char*> out(a.count);
-    for (std::size_t i = 0; i < a.count; ++i) out[i] = data.data() + view.byteOffset + a.byteOffset + i * stride;
-    return out;
+  // A dense accessor's bytes; sparse ones are refused (matbake does not apply their substitutions).
+  Result<gltf::AccessorBytes> dense(int index) const {
+    if (index < 0) return error("accessor " + std::to_string(index) + " does not exist");
+    auto bytes = gltf::accessor_bytes(doc, std::size_t(index));
+    if (!bytes) return bytes.error();
+    if (bytes->sparse) return error("accessor " + std::to_string(index) + " is sparse; matbake does not read sparse accessors");
+    return bytes;
   }
 
-  // `components` floats per element: FLOAT, or integers (KHR_mesh_quantization), normalized or not.
-  Result<std::vector<float>> floats(int index, int components) const {
-    if (index < 0 || std::size_t(index) >= model.accessors.size()) {
-      return error("accessor " + std::to_string(index) + " does not exist");
-    }
-    const tinygltf::Accessor& a = model.accessors[std::size_t(index)];
-    if (tinygltf::GetNumComponentsInType(std::uint32_t(a.type)) != components) {
-      return error("accessor " + std::to_string(index) + " has " +
-                   std::to_string(tinygltf::GetNumComponentsInType(std::uint32_t(a.type))) + " components, expected " +
+  // `components` floats per element (3 or 4): FLOAT, or integers (KHR_mesh_quantization), normalized
+  // or not; each element handed to `use(element, const float*)`.
+  template <class F>
+  Status floats(int index, std::size_t components, F use) const {
+    auto bytes = dense(index);
+    if (!bytes) return bytes.error();
+    if (bytes->components != components) {
+      return error("accessor " + std::to_string(index) + " has " + std::to_string(bytes->components) + " components, expected " +
                    std::to_string(components));
     }
-    const int size = tinygltf::GetComponentSizeInBytes(std::uint32_t(a.componentType));
-    if (size <= 0) return error("accessor " + std::to_string(index) + " has an unknown component type");
-    auto bytes = elements(index, std::size_t(size * components));
-    if (!bytes) return bytes.error();
-    std::vector<float> out(a.count * std::size_t(components));
-    for (std::size_t i = 0; i < a.count; ++i) {
-      for (int c = 0; c < components; ++c) {
-        const unsigned char* p = (*bytes)[i] + c * size;
-        out[i * std::size_t(components) + std::size_t(c)] = component(p, a.componentType, a.normalized);
+    float v[4] = {0, 0, 0, 1};
+    for (std::size_t i = 0; i < bytes->count; ++i) {
+      const unsigned char* element = bytes->first + i * bytes->stride;
+      for (std::size_t c = 0; c < components; ++c) {
+        v[c] = component(element + c * bytes->component_size, bytes->component_type, bytes->normalized);
       }
+      use(i, v);
     }
-    return out;
-  }
-
-  static float component(const unsigned char* p, int type, bool normalized) {
-    const auto as = [p]<class T>(T) {
-      T v;
-      std::memcpy(&v, p, sizeof v);
-      return v;
-    };
-    switch (type) {
-      case TINYGLTF_COMPONENT_TYPE_FLOAT: return as(float{});
-      case TINYGLTF_COMPONENT_TYPE_BYTE: {
-        const float v = float(as(std::int8_t{}));
-        return normalized ? std::max(v / 127.0f, -1.0f) : v;
-      }
-      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: {
-        const float v = float(as(std::uint8_t{}));
-        return normalized ? v / 255.0f : v;
-      }
-      case TINYGLTF_COMPONENT_TYPE_SHORT: {
-        const float v = float(as(std::int16_t{}));
-        return normalized ? std::max(v / 32767.0f, -1.0f) : v;
-      }
-      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
-        const float v = float(as(std::uint16_t{}));
-        return normalized ? v / 65535.0f : v;
-      }
-      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: return float(as(std::uint32_t{}));
-      default: return 0.0f;
-    }
+    return success();
   }
 
   Result<std::vector<std::uint32_t>> indices(int index, std::size_t vertex_count) const {
-    if (index < 0 || std::size_t(index) >= model.accessors.size()) {
-      return error("accessor " + std::to_string(index) + " does not exist");
-    }
-    const tinygltf::Accessor& a = model.accessors[std::size_t(index)];
-    const int type = a.componentType;
-    if (a.type != TINYGLTF_TYPE_SCALAR || (type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
-                                           type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
-                                           type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)) {
+    auto bytes = dense(index);
+    if (!bytes) return bytes.error();
+    const int type = bytes->component_type;
+    if (bytes->components != 1 || (type != kUnsignedByte && type != kUnsignedShort && type != kUnsignedInt)) {
       return error("index accessor " + std::to_string(index) + " is not unsigned byte, short or int scalars");
     }
-    auto bytes = elements(index, std::size_t(tinygltf::GetComponentSizeInBytes(std::uint32_t(type))));
-    if (!bytes) return bytes.error();
-    std::vector<std::uint32_t> out(a.count);
-    for (std::size_t i = 0; i < a.count; ++i) {
-      const auto v = std::uint32_t(component((*bytes)[i], type, false));
+    std::vector<std::uint32_t> out(bytes->count);
+    for (std::size_t i = 0; i < bytes->count; ++i) {
+      const std::uint32_t v = index_at(bytes->first + i * bytes->stride, type);
       if (v >= vertex_count) {
-        return error("index accessor " + std::to_string(index) + ": index " + std::to_string(v) + " at " +
-                     std::to_string(i) + " is beyond the " + std::to_string(vertex_count) + " vertices");
+        return error("index accessor " + std::to_string(index) + ": index " + std::to_string(v) + " at " + std::to_string(i) +
+                     " is beyond the " + std::to_string(vertex_count) + " vertices");
       }
       out[i] = v;
     }
@@ -137,146 +126,183 @@ struct Reader {
 std::vector<std::array<std::uint32_t, 3>> triangles_of(const std::vector<std::uint32_t>& v, int mode) {
   std::vector<std::array<std::uint32_t, 3>> t;
   const std::size_t n = v.size();
-  if (mode == TINYGLTF_MODE_TRIANGLES) {
+  if (mode == kTriangles) {
+    t.reserve(n / 3);
     for (std::size_t i = 0; i + 2 < n; i += 3) t.push_back({v[i], v[i + 1], v[i + 2]});
-  } else if (mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
+  } else if (mode == kTriangleStrip) {
     for (std::size_t i = 0; i + 2 < n; ++i) {
       t.push_back(i % 2 == 0 ? std::array{v[i], v[i + 1], v[i + 2]} : std::array{v[i], v[i + 2], v[i + 1]});
     }
-  } else if (mode == TINYGLTF_MODE_TRIANGLE_FAN) {
+  } else if (mode == kTriangleFan) {
     for (std::size_t i = 1; i + 1 < n; ++i) t.push_back({v[i], v[i + 1], v[0]});
   }
   return t;
 }
 
-glm::dmat4 local_matrix(const tinygltf::Node& node) {
-  if (node.matrix.size() == 16) return glm::make_mat4(node.matrix.data());  // column-major, as glm
+// `count` numbers of json[key], or nothing when the key is absent.
+std::optional<std::vector<double>> numbers(const Json& json, const char* key, std::size_t count) {
+  if (!json.contains(key)) return std::nullopt;
+  const Json& value = json[key];
+  if (!value.is_array() || value.size() != count) return std::nullopt;
+  std::vector<double> out;
+  for (const Json& x : value) {
+    if (!x.is_number()) return std::nullopt;
+    out.push_back(x.get<double>());
+  }
+  return out;
+}
+
+glm::dmat4 local_matrix(const Json& node) {
+  if (auto m = numbers(node, "matrix", 16)) return glm::make_mat4(m->data());  // column-major, as glm
   glm::dmat4 m(1.0);
-  if (node.translation.size() == 3) {
-    m = glm::translate(m, glm::dvec3(node.translation[0], node.translation[1], node.translation[2]));
-  }
-  if (node.rotation.size() == 4) {
-    m *= glm::mat4_cast(glm::dquat(node.rotation[3], node.rotation[0], node.rotation[1], node.rotation[2]));
-  }
-  if (node.scale.size() == 3) m = glm::scale(m, glm::dvec3(node.scale[0], node.scale[1], node.scale[2]));
+  if (auto t = numbers(node, "translation", 3)) m = glm::translate(m, glm::dvec3((*t)[0], (*t)[1], (*t)[2]));
+  if (auto r = numbers(node, "rotation", 4)) m *= glm::mat4_cast(glm::dquat((*r)[3], (*r)[0], (*r)[1], (*r)[2]));
+  if (auto s = numbers(node, "scale", 3)) m = glm::scale(m, glm::dvec3((*s)[0], (*s)[1], (*s)[2]));
   return m;
+}
+
+const Json& array_in(const Json& json, const char* key) {
+  static const Json empty = Json::array();
+  return json.contains(key) && json[key].is_array() ? json[key] : empty;
+}
+
+const Json& object_in(const Json& json, const char* key) {
+  static const Json empty = Json::object();
+  return json.contains(key) && json[key].is_object() ? json[key] : empty;
+}
+
+int integer_in(const Json& json, const char* key, int absent) {
+  if (!json.contains(key)) return absent;
+  const Json& v = json[key];
+  return v.is_number_integer() && v.get<long long>() >= 0 && v.get<long long>() <= INT32_MAX ? v.get<int>() : -2;
+}
+
+// One primitive placed by node `n`: its triangles, world positions, normals and colours.
+Result<Instance> place_primitive(const Reader& read, const Json& primitive, int n, int mesh, int p, const glm::dmat4& world) {
+  const std::string where = "mesh " + std::to_string(mesh) + " primitive " + std::to_string(p);
+  const Json& attributes = object_in(primitive, "attributes");
+  if (!attributes.contains("POSITION")) return read.error(where + " has no POSITION");
+  Instance inst;
+  inst.node = n;
+  inst.mesh = mesh;
+  inst.primitive = p;
+  inst.world = world;
+  const int position = integer_in(attributes, "POSITION", -1);
+  auto position_bytes = read.dense(position);
+  if (!position_bytes) return position_bytes.error();
+  const std::size_t vertices = position_bytes->count;
+  inst.positions.reserve(vertices);
+  std::size_t not_finite = vertices;
+  Status s = read.floats(position, 3, [&](std::size_t v, const float* x) {
+    if (!std::isfinite(x[0]) || !std::isfinite(x[1]) || !std::isfinite(x[2])) not_finite = std::min(not_finite, v);
+    inst.positions.push_back(Vec3(world * glm::dvec4(x[0], x[1], x[2], 1.0)));
+  });
+  if (!s) return s.error();
+  if (not_finite < vertices) return read.error(where + ": POSITION of vertex " + std::to_string(not_finite) + " is not finite");
+
+  std::vector<std::uint32_t> order;
+  if (primitive.contains("indices")) {
+    auto idx = read.indices(integer_in(primitive, "indices", -1), vertices);
+    if (!idx) return idx.error();
+    order = std::move(*idx);
+  } else {
+    order.resize(vertices);
+    std::iota(order.begin(), order.end(), 0u);
+  }
+  inst.triangles = triangles_of(order, integer_in(primitive, "mode", kTriangles));
+  if (glm::determinant(glm::dmat3(world)) < 0) {  // mirrored: keep the faces' facing
+    for (auto& t : inst.triangles) std::swap(t[1], t[2]);
+  }
+
+  if (attributes.contains("NORMAL")) {
+    const int normal = integer_in(attributes, "NORMAL", -1);
+    auto bytes = read.dense(normal);
+    if (!bytes) return bytes.error();
+    if (bytes->count != vertices) return read.error(where + ": NORMAL and POSITION counts differ");
+    const glm::dmat3 normal_matrix = glm::inverseTranspose(glm::dmat3(world));
+    inst.normals.reserve(vertices);
+    s = read.floats(normal, 3, [&](std::size_t, const float* x) {
+      const glm::dvec3 nv = normal_matrix * glm::dvec3(x[0], x[1], x[2]);
+      const double length = glm::length(nv);
+      inst.normals.push_back(length > 0 ? Vec3(nv / length) : Vec3(0));
+    });
+    if (!s) return s.error();
+  }
+  if (attributes.contains("COLOR_0")) {
+    const int color = integer_in(attributes, "COLOR_0", -1);
+    auto bytes = read.dense(color);
+    if (!bytes) return bytes.error();
+    if (bytes->count != vertices) return read.error(where + ": COLOR_0 and POSITION counts differ");
+    inst.colors_have_alpha = bytes->components == 4;
+    inst.colors.reserve(vertices);
+    s = read.floats(color, inst.colors_have_alpha ? 4 : 3,
+                    [&](std::size_t, const float* c) { inst.colors.emplace_back(c[0], c[1], c[2], c[3]); });
+    if (!s) return s.error();
+  }
+  return inst;
 }
 
 }  // namespace
 
 float Scene::radius() const { return 0.5f * glm::length(bounds_max - bounds_min); }
 
-Result<Scene> load_scene(const fs::path& path) {
-  return guarded(path.string(), [&]() -> Result<Scene> {
-    const std::string file = path.string();
-    tinygltf::Model model;
-    if (Status loaded = gltf::load_model(path, model); !loaded) return loaded.error();
-
+Result<Scene> scene_from_document(const gltf::Document& doc) {
+  return guarded(doc.file, [&]() -> Result<Scene> {
+    const Json& json = doc.json;
+    const Reader read{doc};
+    const Json& scenes = array_in(json, "scenes");
+    const Json& nodes = array_in(json, "nodes");
+    const Json& meshes = array_in(json, "meshes");
     Scene scene;
-    const Reader read{model, file};
-    int scene_index = model.defaultScene;
-    if (scene_index < 0) {
-      if (model.scenes.empty()) return Error{file, "no scene to bake"};
+    int scene_index = integer_in(json, "scene", -1);
+    if (scene_index == -1) {
+      if (scenes.empty()) return read.error("no scene to bake");
       scene_index = 0;
       scene.notes.push_back("no default scene: using scene 0");
     }
-    if (std::size_t(scene_index) >= model.scenes.size()) return Error{file, "the default scene does not exist"};
+    if (scene_index < 0 || std::size_t(scene_index) >= scenes.size()) return read.error("the default scene does not exist");
 
-    std::vector<bool> on_path(model.nodes.size(), false);
+    // Depth first without recursion (a hostile file may chain a million nodes). glTF nodes form
+    // strict trees: a node reached twice (a cycle, or two parents) is refused, which also bounds the
+    // instances by the node count.
+    std::vector<bool> reached(nodes.size(), false);
+    std::vector<std::pair<int, glm::dmat4>> pending;  // node, its parent's world matrix
+    const Json& roots = array_in(scenes[std::size_t(scene_index)], "nodes");
+    for (auto root = roots.rbegin(); root != roots.rend(); ++root) {
+      pending.emplace_back(root->is_number_integer() ? root->get<int>() : -1, glm::dmat4(1.0));
+    }
     std::size_t ignored_primitives = 0;
-    std::function<Status(int, const glm::dmat4&)> visit = [&](int n, const glm::dmat4& parent) -> Status {
-      if (n < 0 || std::size_t(n) >= model.nodes.size()) return Error{file, "node " + std::to_string(n) + " does not exist"};
-      if (on_path[std::size_t(n)]) return Error{file, "node " + std::to_string(n) + " is its own ancestor"};
-      on_path[std::size_t(n)] = true;
-      const tinygltf::Node& node = model.nodes[std::size_t(n)];
+    while (!pending.empty()) {
+      const auto [n, parent] = pending.back();
+      pending.pop_back();
+      if (n < 0 || std::size_t(n) >= nodes.size()) return read.error("node " + std::to_string(n) + " does not exist");
+      if (reached[std::size_t(n)]) {
+        return read.error("node " + std::to_string(n) + " is its own ancestor or has two parents (glTF nodes form trees)");
+      }
+      reached[std::size_t(n)] = true;
+      const Json& node = nodes[std::size_t(n)];
       const glm::dmat4 world = parent * local_matrix(node);
-      if (node.mesh >= 0) {
-        if (std::size_t(node.mesh) >= model.meshes.size()) {
-          return Error{file, "node " + std::to_string(n) + " refers to mesh " + std::to_string(node.mesh) + ", which does not exist"};
+      if (node.contains("mesh")) {
+        const int m = integer_in(node, "mesh", -1);
+        if (m < 0 || std::size_t(m) >= meshes.size()) {
+          return read.error("node " + std::to_string(n) + " refers to mesh " + node["mesh"].dump() + ", which does not exist");
         }
-        const tinygltf::Mesh& mesh = model.meshes[std::size_t(node.mesh)];
-        for (std::size_t p = 0; p < mesh.primitives.size(); ++p) {
-          const tinygltf::Primitive& prim = mesh.primitives[p];
-          const int mode = prim.mode < 0 ? TINYGLTF_MODE_TRIANGLES : prim.mode;
-          if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP && mode != TINYGLTF_MODE_TRIANGLE_FAN) {
+        const Json& primitives = array_in(meshes[std::size_t(m)], "primitives");
+        for (std::size_t p = 0; p < primitives.size(); ++p) {
+          const int mode = integer_in(primitives[p], "mode", kTriangles);
+          if (mode != kTriangles && mode != kTriangleStrip && mode != kTriangleFan) {
             ++ignored_primitives;
             continue;
           }
-          const auto position = prim.attributes.find("POSITION");
-          if (position == prim.attributes.end()) return Error{file, "mesh " + std::to_string(node.mesh) + " primitive " + std::to_string(p) + " has no POSITION"};
-          auto positions = read.floats(position->second, 3);
-          if (!positions) return positions.error();
-          const std::size_t vertices = positions->size() / 3;
-          if (const auto bad = std::find_if(positions->begin(), positions->end(), [](float x) { return !std::isfinite(x); });
-              bad != positions->end()) {
-            return Error{file, "mesh " + std::to_string(node.mesh) + " primitive " + std::to_string(p) + ": POSITION of vertex " +
-                                   std::to_string((bad - positions->begin()) / 3) + " is not finite"};
-          }
-          std::vector<std::uint32_t> order;
-          if (prim.indices >= 0) {
-            auto idx = read.indices(prim.indices, vertices);
-            if (!idx) return idx.error();
-            order = std::move(idx.value());
-          } else {
-            order.resize(vertices);
-            std::iota(order.begin(), order.end(), 0u);
-          }
-          Instance inst;
-          inst.node = n;
-          inst.mesh = node.mesh;
-          inst.primitive = int(p);
-          inst.world = world;
-          inst.triangles = triangles_of(order, mode);
-          const bool mirrored = glm::determinant(glm::dmat3(world)) < 0;
-          if (mirrored) {
-            for (auto& t : inst.triangles) std::swap(t[1], t[2]);
-          }
-          inst.positions.resize(vertices);
-          for (std::size_t v = 0; v < vertices; ++v) {
-            const glm::dvec4 w = world * glm::dvec4((*positions)[3 * v], (*positions)[3 * v + 1], (*positions)[3 * v + 2], 1.0);
-            inst.positions[v] = Vec3(w);
-          }
-          if (const auto normal = prim.attributes.find("NORMAL"); normal != prim.attributes.end()) {
-            auto normals = read.floats(normal->second, 3);
-            if (!normals) return normals.error();
-            if (normals->size() != positions->size()) {
-              return Error{file, "mesh " + std::to_string(node.mesh) + " primitive " + std::to_string(p) + ": NORMAL and POSITION counts differ"};
-            }
-            const glm::dmat3 normal_matrix = glm::inverseTranspose(glm::dmat3(world));
-            inst.normals.resize(vertices);
-            for (std::size_t v = 0; v < vertices; ++v) {
-              const glm::dvec3 nv = normal_matrix * glm::dvec3((*normals)[3 * v], (*normals)[3 * v + 1], (*normals)[3 * v + 2]);
-              const double length = glm::length(nv);
-              inst.normals[v] = length > 0 ? Vec3(nv / length) : Vec3(0);
-            }
-          }
-          if (const auto color = prim.attributes.find("COLOR_0"); color != prim.attributes.end()) {
-            const int components = color->second >= 0 && std::size_t(color->second) < model.accessors.size()
-                                       ? tinygltf::GetNumComponentsInType(std::uint32_t(model.accessors[std::size_t(color->second)].type))
-                                       : 4;
-            auto colors = read.floats(color->second, components == 3 ? 3 : 4);
-            if (!colors) return colors.error();
-            if (colors->size() / std::size_t(components) != vertices) {
-              return Error{file, "mesh " + std::to_string(node.mesh) + " primitive " + std::to_string(p) + ": COLOR_0 and POSITION counts differ"};
-            }
-            inst.colors_have_alpha = components == 4;
-            inst.colors.resize(vertices);
-            for (std::size_t v = 0; v < vertices; ++v) {
-              const float* c = colors->data() + v * std::size_t(components);
-              inst.colors[v] = glm::vec4(c[0], c[1], c[2], components == 4 ? c[3] : 1.0f);
-            }
-          }
-          scene.instances.push_back(std::move(inst));
+          auto inst = place_primitive(read, primitives[p], n, m, int(p), world);
+          if (!inst) return inst.error();
+          scene.instances.push_back(std::move(*inst));
         }
       }
-      for (int child : node.children) {
-        if (Status s = visit(child, world); !s) return s;
+      const Json& children = array_in(node, "children");
+      for (auto child = children.rbegin(); child != children.rend(); ++child) {
+        pending.emplace_back(child->is_number_integer() ? child->get<int>() : -1, world);
       }
-      on_path[std::size_t(n)] = false;
-      return success();
-    };
-    for (int root : model.scenes[std::size_t(scene_index)].nodes) {
-      if (Status s = visit(root, glm::dmat4(1.0)); !s) return s.error();
     }
     if (ignored_primitives) {
       scene.notes.push_back(std::to_string(ignored_primitives) + " point or line primitives ignored");
@@ -291,9 +317,15 @@ Result<Scene> load_scene(const fs::path& path) {
         first = false;
       }
     }
-    if (triangles == 0) return Error{file, "no triangles in the default scene"};
+    if (triangles == 0) return read.error("no triangles in the default scene");
     return scene;
   });
+}
+
+Result<Scene> load_scene(const fs::path& path) {
+  auto doc = gltf::read_document(path);
+  if (!doc) return doc.error();
+  return scene_from_document(*doc);
 }
 
 NormalResult vertex_normals(const std::vector<Vec3>& positions, const std::vector<std::array<std::uint32_t, 3>>& triangles,

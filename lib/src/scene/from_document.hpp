@@ -1,0 +1,11 @@
+#pragma once
+// The flattened scene of a glTF document already in memory: export and bake-ao read the file once
+// and take both the scene to bake and the document to write from it.
+#include "../gltf/document.hpp"
+#include "matbake/scene.hpp"
+
+namespace matbake::scene {
+
+Result<Scene> scene_from_document(const gltf::Document& doc);
+
+}  // namespace matbake::scene
