@@ -42,7 +42,9 @@ struct Scene {
 
 // Reads .gltf or .glb. Errors name the file: malformed JSON or GLB, accessors or buffer views out
 // of range, indices beyond the vertex count, sparse accessors (refused), buffer or image URIs that
-// leave the file's folder (absolute or with ..), node cycles, no default scene, no triangles.
+// leave the file's folder (absolute or with ..), a node reached twice (a cycle, or two parents:
+// glTF nodes form strict trees), no default scene, no triangles. Node chains of any depth are
+// walked without recursion.
 Result<Scene> load_scene(const std::filesystem::path& path);
 
 // Vertex normals from faces (ch. 12): the sum over the faces around a vertex of the face normal
