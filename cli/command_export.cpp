@@ -7,6 +7,7 @@
 #include "material_sources.hpp"
 #include "matbake/atomic_file.hpp"
 #include "matbake/export.hpp"
+#include "matbake/output_check.hpp"
 #include "matbake/report_json.hpp"
 #include "silenced_stderr.hpp"
 
@@ -82,6 +83,12 @@ int run_export(const ExportSettings& s, const GlobalOptions& global) {
     auto m = parse_material(text, s.transfer);
     if (!m) return report_error(m.error());
     options.materials.push_back(std::move(*m));
+  }
+  if (!s.report.empty()) {
+    auto inputs = exporter::scene_files(s.scene);
+    if (!inputs) return report_error(inputs.error());
+    const NamedOutput outputs[] = {{s.output, "glTF output"}, {s.report, "report"}};
+    if (Status st = check_outputs(outputs, *inputs); !st) return report_error(st.error());
   }
   Result<exporter::Report> report = Error{"", ""};
   {

@@ -71,28 +71,18 @@ int run_unpack(const UnpackSettings& s, const GlobalOptions& global) {
   if (!sources) return report_error(sources.error());
   auto transfer = parse_transfer(s.transfer, "--transfer");
   if (!transfer) return report_error(transfer.error());
-  auto type = s.bits.empty() ? (s.format == "exr" ? image::SampleType::half : image::SampleType::u8)
-                             : image::sample_type_from_name(s.bits).value_or(image::SampleType::u8);
-  if (!s.bits.empty() && !image::sample_type_from_name(s.bits)) {
-    return report_error(Error{"", "--bits '" + s.bits + "': use 8, 16, half or float", true});
+  pack::UnpackRequest request{s.out_dir, s.format, std::nullopt, *transfer, {s.inputs.begin(), s.inputs.end()}};
+  if (!s.bits.empty()) {
+    request.type = image::sample_type_from_name(s.bits);
+    if (!request.type) return report_error(Error{"", "--bits '" + s.bits + "': use 8, 16, half or float", true});
   }
-  std::error_code ec;
-  fs::create_directories(s.out_dir, ec);
-  std::vector<std::string> written;
-  for (const auto& [name, map] : sources->maps) {
-    const fs::path path = fs::path(s.out_dir) / (name + "." + s.format);
-    for (const std::string& input : s.inputs) {
-      if (fs::equivalent(path, input, ec)) {
-        return report_error(Error{path.string(), "is an input; matbake never overwrites its inputs", true});
-      }
-    }
-    const bool colour = material::find_source(name)->kind == material::SourceKind::color;
-    SilencedStderr quiet;
-    if (Status st = image::write_image(map, path, pack::write_options(colour, {type, *transfer})); !st) {
-      return report_error(st.error());
-    }
-    written.push_back(path.string());
+  Result<std::vector<fs::path>> paths = Error{"", ""};
+  {
+    SilencedStderr quiet;  // libpng's own messages: our error line says it
+    paths = pack::write_maps(*sources, request);
   }
+  if (!paths) return report_error(paths.error());
+  const std::vector<std::string> written(paths->begin(), paths->end());
   if (global.json) {
     std::cout << nlohmann::json{{"command", "unpack"}, {"layout", s.layout}, {"outputs", written}}.dump(2) << "\n";
   } else if (!global.quiet) {

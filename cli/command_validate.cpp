@@ -5,6 +5,7 @@
 
 #include "commands.hpp"
 #include "matbake/materials.hpp"
+#include "matbake/output_check.hpp"
 #include "matbake/report_json.hpp"
 #include "matbake/validate.hpp"
 #include "silenced_stderr.hpp"
@@ -112,13 +113,19 @@ int run_validate(const ValidateSettings& s, const GlobalOptions& global) {
     if (!material) return report_error(material.error());
     options.material = *material;
   }
+  const NamedOutput outputs[] = {{s.heatmap, "heatmap"}, {s.report, "report"}};
+  if (Status st = check_outputs(outputs, input_files(s.sources)); !st) return report_error(st.error());
   auto sources = gather_sources(s.sources);
   if (!sources) return report_error(sources.error());
   auto report = validate::validate_maps(*sources, options);
   if (!report) return report_error(report.error());
   if (!s.heatmap.empty()) {
-    SilencedStderr quiet;
-    if (Status st = validate::write_heatmap(*report, s.heatmap); !st) return report_error(st.error());
+    Status written = success();
+    {
+      SilencedStderr quiet;  // libpng's own messages: our error line says it
+      written = validate::write_heatmap(*report, s.heatmap);
+    }
+    if (!written) return report_error(written.error());
   }
   if (!s.report.empty()) {
     if (Status st = write_validation_report(*report, options, s.report); !st) return report_error(st.error());

@@ -70,7 +70,7 @@ int run_workflow(const WorkflowSettings& s, const GlobalOptions& global) {
                                   "`matbake pack` packs without converting",
                               true});
   }
-  auto written = write_textures(*layout, converted->maps, s.output, s.sources);
+  auto written = write_textures(*layout, converted->maps, s.output, s.sources, {{s.report, "report"}});
   if (!written) return report_error(written.error());
 
   const workflow::ConversionReport& report = converted->report;

@@ -17,6 +17,12 @@ int main(int argc, char** argv) {
   app.add_flag("--json", global.json, "Print a machine-readable result on stdout");
   app.add_flag("-q,--quiet", global.quiet, "Print nothing but errors");
   app.add_option("-j,--jobs", global.jobs, "Worker threads (default: all cores)")->check(CLI::NonNegativeNumber);
+  std::uint64_t max_pixels = matbake::image::kDefaultMaxPixels;
+  app.add_option("--max-pixels", max_pixels,
+                 "Largest image read or made, in pixels (width x height); larger declared sizes are refused before\n"
+                 "anything is allocated")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
   app.add_option("--ocio-config", global.ocio_config,
                  "OpenColorIO config for colour-space names (default: $OCIO, else the shipped presets/ocio/config.ocio)");
 
@@ -58,6 +64,7 @@ int main(int argc, char** argv) {
     threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, global.jobs);
   }
   matbake::image::set_thread_count(global.jobs);
+  matbake::image::set_max_pixels(max_pixels);
 
   // The library turns its dependencies' exceptions into errors at its edges; this is the last net,
   // so that nothing ends in abort (exit 134) without a line saying why.

@@ -138,17 +138,23 @@ void add_output_options(CLI::App& cmd, OutputSettings& o, const std::string& wha
                                    "--transfer in 8-bit and linear otherwise");
 }
 
+std::vector<std::filesystem::path> input_files(const SourceSettings& inputs) {
+  std::vector<std::filesystem::path> files(inputs.inputs.begin(), inputs.inputs.end());
+  for (const std::string& v : inputs.values) {
+    if (!v.empty() && !parse_numbers(v)) files.emplace_back(v);
+  }
+  return files;
+}
+
 Result<std::vector<std::string>> write_textures(const pack::Layout& layout, const material::Maps& sources,
-                                                const OutputSettings& o, const SourceSettings& inputs) {
+                                                const OutputSettings& o, const SourceSettings& inputs,
+                                                std::vector<NamedOutput> also) {
   auto transfer = parse_transfer(inputs.transfer, "--transfer");
   if (!transfer) return transfer.error();
-  pack::WriteRequest request{o.outputs, std::nullopt, *transfer, {inputs.inputs.begin(), inputs.inputs.end()}};
+  pack::WriteRequest request{o.outputs, std::nullopt, *transfer, input_files(inputs), std::move(also)};
   if (!o.bits.empty()) {
     request.type = image::sample_type_from_name(o.bits);
     if (!request.type) return Error{"", "--bits '" + o.bits + "': use 8, 16, half or float", true};
-  }
-  for (const std::string& v : inputs.values) {
-    if (!v.empty() && !parse_numbers(v)) request.inputs.emplace_back(v);
   }
   SilencedStderr quiet;
   auto written = pack::write_textures(layout, sources, request);

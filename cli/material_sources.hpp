@@ -36,8 +36,11 @@ struct OutputSettings {
 void add_output_options(CLI::App& cmd, OutputSettings& o, const std::string& what);
 // Writes the layout's textures; returns the paths written. An output that is one of the inputs
 // is refused before anything is written.
+// The files among the sources (numbers left out), for the rule that no output overwrites them.
+std::vector<std::filesystem::path> input_files(const SourceSettings& inputs);
 Result<std::vector<std::string>> write_textures(const pack::Layout& layout, const material::Maps& sources,
-                                                const OutputSettings& o, const SourceSettings& inputs);
+                                                const OutputSettings& o, const SourceSettings& inputs,
+                                                std::vector<NamedOutput> also = {});
 Result<color::Transfer> parse_transfer(const std::string& name, const char* option);
 // "0.5" or "0.9,0.6,0.2": the numbers, or nothing when `text` is not a list of numbers.
 std::optional<std::vector<double>> parse_numbers(const std::string& text);

@@ -13,8 +13,19 @@ bash "$root/scripts/build.sh" "$root/build" -DMATBAKE_WERROR=ON
 ctest --test-dir "$root/build" --output-on-failure -j "$jobs"
 
 bash "$root/scripts/build.sh" "$root/build-asan" -DMATBAKE_WERROR=ON -DMATBAKE_SANITIZE=ON
-# Full unwinding on malloc so leak suppressions can name the third-party frame.
-export ASAN_OPTIONS=abort_on_error=1:detect_leaks=1:strict_string_checks=1:fast_unwind_on_malloc=0
+# Full unwinding on malloc so leak suppressions can name the third-party frame. Reports go to files
+# (log_path), not stderr: the CLI points stderr at /dev/null while it decodes (libpng's own
+# messages), which would hide a report, and a test that only checks "failed" would pass over one.
+reports=$(mktemp -d)
+trap 'rm -rf "$reports"' EXIT
+export ASAN_OPTIONS=abort_on_error=1:detect_leaks=1:strict_string_checks=1:fast_unwind_on_malloc=0:log_path=$reports/asan
 export LSAN_OPTIONS=suppressions=$root/tests/lsan.supp:print_suppressions=0
-export UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1
-ctest --test-dir "$root/build-asan" --output-on-failure -j "$jobs"
+export UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1:log_path=$reports/ubsan
+status=0
+ctest --test-dir "$root/build-asan" --output-on-failure -j "$jobs" || status=$?
+if compgen -G "$reports/*" >/dev/null; then
+  echo "matbake: sanitizer reports during the test run:" >&2
+  cat "$reports"/* >&2
+  exit 1
+fi
+exit "$status"

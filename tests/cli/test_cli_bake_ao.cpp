@@ -99,7 +99,7 @@ TEST(CliBakeAo, BadScenesAndUsage) {
   using Case = std::pair<std::vector<std::string>, std::string>;
   for (const auto& [args, problem] :
        {Case{{"bake-ao", good}, "bake-ao writes a glTF, a dump or both"},
-        Case{{"bake-ao", good, "-o", good}, good + ": would overwrite an input"},
+        Case{{"bake-ao", good, "-o", good}, good + ": is an input; matbake never overwrites its inputs"},
         Case{{"bake-ao", good, "-o", (dir / "out.obj").string()}, (dir / "out.obj").string() + ": the output is .gltf or .glb"},
         Case{{"bake-ao", good, "-o", (dir / "x.glb").string(), "--into", "COLOR_1"}, "--into 'COLOR_1' --existing-colors 'multiply': use COLOR_0 (with multiply or replace) or _AO"}}) {
     const auto r = matbake(args);

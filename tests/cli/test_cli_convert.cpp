@@ -144,8 +144,8 @@ TEST(CliConvert, BadInputsExitOneWithOneLineNamingTheFile) {
 
   // Output path equal to the input.
   const auto same = matbake({"convert", (dir / "good.png").string(), "-o", (dir / "good.png").string()});
-  EXPECT_EQ(same.exit_code, 1);
-  expect_one_error_line(same, (dir / "good.png").string(), "output is the input file");
+  EXPECT_EQ(same.exit_code, 2);  // a usage error, as for every command
+  expect_one_error_line(same, (dir / "good.png").string(), "is an input; matbake never overwrites its inputs");
   // Output folder missing, or a file.
   const auto no_folder = matbake({"convert", (dir / "good.png").string(), "-o", (dir / "none/x.exr").string()});
   EXPECT_EQ(no_folder.exit_code, 1);

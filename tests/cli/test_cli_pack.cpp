@@ -152,7 +152,7 @@ TEST(CliPack, BadInputsAndUsage) {
   const auto twice = matbake({"pack", "--kd", "0.5", "--ks", "0.04", "--gloss", "0.5", "-o", (dir / "s.png").string(), "-o",
                               (dir / "s.png").string()});
   EXPECT_EQ(twice.exit_code, 2);
-  expect_one_error_line(twice, (dir / "s.png").string(), "is written twice (textures a and b)");
+  expect_one_error_line(twice, (dir / "s.png").string(), "is written twice (texture a and texture b)");
   EXPECT_FALSE(fs::exists(dir / "s.png"));
 }
 

@@ -69,7 +69,11 @@ int GltfBuilder::add_node(nlohmann::json node) {
 
 void GltfBuilder::write(const std::filesystem::path& path, const std::vector<int>& scene_nodes) {
   nlohmann::json out = doc;
-  if (!bytes.empty()) {
+  if (!bytes.empty() && external_bin) {
+    const std::string bin = path.stem().string() + ".bin";
+    std::ofstream(path.parent_path() / bin, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+    out["buffers"] = {{{"byteLength", bytes.size()}, {"uri", bin}}};
+  } else if (!bytes.empty()) {
     out["buffers"] = {{{"byteLength", bytes.size()}, {"uri", "data:application/octet-stream;base64," + base64(bytes)}}};
   }
   out["scenes"] = {{{"nodes", scene_nodes}}};

@@ -26,7 +26,8 @@ struct GltfBuilder {
   // A mesh with one primitive; returns the mesh index.
   int add_mesh(int positions, int indices = -1, int mode = 4, int normals = -1);
   int add_node(nlohmann::json node);
-  // Finishes the buffer (a data: URI) and writes the file; `scene_nodes` become scene 0, the default.
+  bool external_bin = false;  // the buffer as <stem>.bin beside the file, else a data: URI
+  // Finishes the buffer and writes the file; `scene_nodes` become scene 0, the default.
   void write(const std::filesystem::path& path, const std::vector<int>& scene_nodes);
 };
 

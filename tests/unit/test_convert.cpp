@@ -100,7 +100,7 @@ TEST(ConvertFile, RefusalsLeaveNothingBehind) {
 
   auto same = convert_file(*plan, dir / "gray.png", dir / "gray.png", builtin);
   ASSERT_FALSE(same);
-  EXPECT_EQ(same.error().message, "output is the input file; matbake never overwrites an input");
+  EXPECT_EQ(same.error().message, "is an input; matbake never overwrites its inputs");
 
   ConvertOptions eight_bit_exr = builtin;
   eight_bit_exr.type = SampleType::u8;

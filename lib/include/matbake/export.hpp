@@ -70,6 +70,9 @@ struct Report {
 Result<Report> export_scene(const std::filesystem::path& input, const std::filesystem::path& output,
                             const Options& options);
 
+// The files a glTF is read from (itself, its buffers' and images' files): what no output may be.
+Result<std::vector<std::filesystem::path>> scene_files(const std::filesystem::path& gltf);
+
 // `matbake bake-ao`: a scene's per-vertex AO written into the scene again (everything else kept as
 // written: nothing pruned or converted) and/or dumped as raw values (ao::write_dump). Neither output
 // may be a file the scene is read from.

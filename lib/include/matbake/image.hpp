@@ -2,6 +2,7 @@
 // Images in memory are float, interleaved, linear (decoded at read, encoded at write) and keep
 // alpha unassociated: OIIO is told so on both sides (../shared/design/DEBIAN-NOTES.md).
 #include <cstddef>
+#include <cstdint>
 #include <filesystem>
 #include <functional>
 #include <span>
@@ -20,6 +21,16 @@ enum class SampleType { u8, u16, half, f32 };
 std::optional<SampleType> sample_type_from_name(std::string_view name);  // "8", "16", "half", "float"
 std::string_view sample_type_name(SampleType type);
 bool is_integer(SampleType type);
+
+// The largest image matbake holds, in pixels (width × height), for every image it reads or makes:
+// a size beyond it is refused before anything is allocated, so a 100-byte file that declares
+// 100000 × 100000 costs nothing. Default 2^28 (16384 × 16384: up to 4 GiB as float RGBA). Process-wide,
+// like OIIO's own limits; the CLI's --max-pixels sets it.
+inline constexpr std::uint64_t kDefaultMaxPixels = std::uint64_t{1} << 28;
+void set_max_pixels(std::uint64_t pixels);
+std::uint64_t max_pixels();
+// Refuses (naming `file`) a size of 0 or one beyond max_pixels().
+Status check_image_size(const std::string& file, std::int64_t width, std::int64_t height);
 
 // Size and channel layout of an image, without its pixels.
 struct ImageLayout {

@@ -15,6 +15,7 @@
 
 #include "matbake/image.hpp"
 #include "matbake/material.hpp"
+#include "matbake/output_check.hpp"
 #include "matbake/result.hpp"
 
 namespace matbake::pack {
@@ -99,11 +100,23 @@ struct WriteRequest {
   std::optional<image::SampleType> type;   // unset: default_sample_type of each path
   color::Transfer transfer = color::Transfer::srgb;  // colour channels of 8-bit outputs
   std::vector<std::filesystem::path> inputs;         // files the maps were read from: never written over
+  std::vector<NamedOutput> also;                     // the run's other outputs (a report): checked with the textures
 };
 // Packs `sources` into the layout's textures and writes them (each atomically). An output that is
 // an input, or two outputs that are one file, are refused before anything is written.
 Result<std::vector<std::filesystem::path>> write_textures(const Layout& layout, const material::Maps& sources,
                                                           const WriteRequest& request);
+
+// `matbake unpack`'s writing: each source map as <folder>/<source name>.<format> ("kd.png"), the
+// folder made when missing; an output that is an input is refused before anything is written.
+struct UnpackRequest {
+  std::filesystem::path folder;
+  std::string format = "png";               // the extension, without its dot
+  std::optional<image::SampleType> type;    // unset: default_sample_type of the format
+  color::Transfer transfer = color::Transfer::srgb;
+  std::vector<std::filesystem::path> inputs;
+};
+Result<std::vector<std::filesystem::path>> write_maps(const material::Maps& maps, const UnpackRequest& request);
 
 // How to decode a file holding colour: `authored` for 8-bit files, linear for 16-bit and float
 // ones (the rule write_options follows).

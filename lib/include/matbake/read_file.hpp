@@ -6,9 +6,13 @@
 
 namespace matbake {
 
-// `out` (a std::string or std::vector of bytes) becomes the file's bytes; false when it cannot be read.
+// `out` (a std::string or std::vector of bytes) becomes the file's bytes; false when it cannot be
+// read or is not a regular file (a folder opens as a stream of "infinite" size; a FIFO or a device
+// never ends).
 template <class Bytes>
 bool read_whole_file(const std::filesystem::path& path, Bytes& out) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) return false;
   std::ifstream in(path, std::ios::binary | std::ios::ate);
   if (!in) return false;
   const std::streamoff size = in.tellg();

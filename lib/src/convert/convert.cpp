@@ -1,4 +1,5 @@
 #include "matbake/convert.hpp"
+#include "matbake/output_check.hpp"
 
 #include <algorithm>
 #include <cctype>
@@ -93,10 +94,8 @@ Result<ConvertReport> convert_file(const ConversionPlan& plan, const fs::path& i
                        " samples (EXR: half or float; PNG: 8 or 16)",
                    true};
     }
-    std::error_code ec;
-    if (fs::exists(output, ec) && fs::equivalent(input, output, ec)) {
-      return Error{output.string(), "output is the input file; matbake never overwrites an input"};
-    }
+    const NamedOutput outputs[] = {{output, "output"}};
+    if (Status s = check_outputs(outputs, std::span(&input, 1)); !s) return s.error();
 
     // Without --bits the output type depends on the input's, known only once the input is open.
     image::ReadInfo info;

@@ -354,6 +354,12 @@ Status check_texture_coordinates(const gltf::Document& doc) {
 
 }  // namespace
 
+Result<std::vector<fs::path>> scene_files(const fs::path& gltf) {
+  auto json = gltf::read_json(gltf);
+  if (!json) return json.error();
+  return gltf::source_files(gltf, *json);
+}
+
 Result<Report> export_scene(const fs::path& input, const fs::path& output, const Options& options) {
   return guarded(input.string(), [&]() -> Result<Report> {
     const std::string ext = output.extension().string();

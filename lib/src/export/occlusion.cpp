@@ -5,6 +5,7 @@
 #include "../gltf/vertex_occlusion.hpp"
 #include "../scene/from_document.hpp"
 #include "matbake/export.hpp"
+#include "matbake/output_check.hpp"
 
 namespace matbake::exporter {
 namespace fs = std::filesystem;
@@ -22,22 +23,8 @@ std::vector<gltf::PlacedValues> placed_values(const scene::Scene& scene, const a
 // An output onto a file the scene is read from, or two outputs onto one file, is refused before
 // any work.
 Status check_outputs(const gltf::Document& doc, const BakeAoOptions& options) {
-  const std::vector<fs::path> sources = gltf::source_files(doc.file, doc.json);
-  for (const fs::path* out : {&options.output, &options.dump}) {
-    if (out->empty()) continue;
-    for (const fs::path& in : sources) {
-      std::error_code ec;
-      if (fs::equivalent(*out, in, ec)) {
-        return Error{out->string(), "would overwrite an input", true};
-      }
-    }
-  }
-  std::error_code ec;
-  if (!options.output.empty() && !options.dump.empty() &&
-      (options.output.lexically_normal() == options.dump.lexically_normal() || fs::equivalent(options.output, options.dump, ec))) {
-    return Error{options.dump.string(), "is also the glTF output", true};
-  }
-  return success();
+  const NamedOutput outputs[] = {{options.output, "glTF output"}, {options.dump, "dump"}};
+  return check_outputs(outputs, gltf::source_files(doc.file, doc.json));
 }
 
 }  // namespace

@@ -186,6 +186,9 @@ Result<std::string> image_bytes(const Document& doc, std::size_t index) {
     }
     const fs::path path = doc.folder / decode_uri(uri);
     if (!is_inside(doc.folder, path)) return Error{doc.file, what + ": URI '" + uri + "' is outside the glTF's folder"};
+    if (!is_really_inside(doc.folder, path)) {
+      return Error{doc.file, what + ": '" + uri + "' is a link to a file outside the glTF's folder"};
+    }
     std::string bytes = read_bytes(path);
     if (bytes.empty()) return Error{doc.file, what + ": '" + uri + "' cannot be read"};
     return bytes;

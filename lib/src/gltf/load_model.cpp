@@ -45,8 +45,17 @@ std::string expand_path(const std::string& path, void* user) {
 
 bool file_exists(const std::string& path, void* user) {
   if (is_glb_bin(path, static_cast<ConfinedFolder*>(user))) return true;
+  auto* folder = static_cast<ConfinedFolder*>(user);
+  if (path.empty() || !is_inside(folder->base, path)) return false;
+  if (!is_really_inside(folder->base, path)) {
+    if (folder->refused.empty()) {
+      folder->refused = "'" + fs::path(path).lexically_relative(folder->base).string() +
+                        "' is a link to a file outside the glTF's folder; only files beside it are read";
+    }
+    return false;
+  }
   std::error_code ec;
-  return !path.empty() && is_inside(static_cast<ConfinedFolder*>(user)->base, path) && fs::is_regular_file(path, ec);
+  return fs::is_regular_file(path, ec);
 }
 
 bool read_file(std::vector<unsigned char>* out, std::string* err, const std::string& path, void* user) {
@@ -113,6 +122,14 @@ bool is_inside(const fs::path& base, const fs::path& path) {
   const fs::path b = base.lexically_normal(), q = path.lexically_normal();
   auto [bi, qi] = std::mismatch(b.begin(), b.end(), q.begin(), q.end());
   return bi == b.end() || (std::next(bi) == b.end() && bi->empty());  // "dir/" ends in an empty element
+}
+
+bool is_really_inside(const fs::path& base, const fs::path& path) {
+  std::error_code ec;
+  const fs::path real_base = fs::weakly_canonical(base, ec);
+  if (ec) return false;
+  const fs::path real = fs::weakly_canonical(path, ec);
+  return !ec && is_inside(real_base, real);
 }
 
 Status load_model(const fs::path& path, tinygltf::Model& model) {

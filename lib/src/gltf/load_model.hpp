@@ -1,7 +1,8 @@
 #pragma once
 // tinygltf behind one call that keeps it inside the folder of the file being loaded: buffer and
 // image URIs that are absolute, climb above the folder with .. or name another scheme are refused,
-// and the error says which URI. Images must exist but are not decoded.
+// and the error says which URI; a file whose real path (symbolic links followed) leaves the folder
+// is not read. Images must exist but are not decoded.
 #include <tiny_gltf.h>
 
 #include <filesystem>
@@ -22,5 +23,8 @@ Status load_model_json(const std::filesystem::path& path, const std::string& jso
 
 // Whether `path` lies inside `base`, lexically.
 bool is_inside(const std::filesystem::path& base, const std::filesystem::path& path);
+// The same for the real paths (symbolic links followed): a link beside the glTF to a file elsewhere
+// is outside.
+bool is_really_inside(const std::filesystem::path& base, const std::filesystem::path& path);
 
 }  // namespace matbake::gltf

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstring>
 #include <memory>
 #include <optional>
 #include <string>
@@ -22,6 +23,8 @@ using OIIO::TypeDesc;
 
 namespace matbake::image {
 namespace {
+
+std::atomic<std::uint64_t> g_max_pixels{kDefaultMaxPixels};
 
 std::string first_line(const std::string& text) {
   const std::string line = text.substr(0, text.find('\n'));
@@ -106,6 +109,7 @@ class RowReader {
                                       " channels; matbake reads 1 to 4 (gray, gray+alpha, RGB, RGBA)"};
     }
     if (spec.depth > 1) return Error{path.string(), "volume images are not supported"};
+    if (Status s = check_image_size(path.string(), spec.width, spec.height); !s) return s.error();
     return RowReader(path, std::move(in), colour);
   }
 
@@ -155,14 +159,33 @@ class RowReader {
     stored_ = stored_type_of(spec);
   }
 
+  // Rows [y, y + rows) as stored. Tiled files (mip-mapped EXR, TIFF) are read whole at level 0 on
+  // the first call: OIIO 2.4's read_scanlines on them can divide by zero (SIGFPE), and read_tiles
+  // wants tile-aligned bands.
+  Status read_stored(int y, int rows, void* samples, std::size_t sample_size) {
+    const ImageSpec& spec = in_->spec();
+    if (spec.tile_width <= 0) {
+      if (!in_->read_scanlines(0, 0, spec.y + y, spec.y + y + rows, 0, 0, spec.nchannels, type_desc(stored_), samples)) {
+        return Error{path_.string(), "cannot read pixels: " + first_line(in_->geterror())};
+      }
+      return success();
+    }
+    const std::size_t row_bytes = std::size_t(spec.width) * std::size_t(spec.nchannels) * sample_size;
+    if (tiled_whole_.empty()) {
+      tiled_whole_.resize(row_bytes * std::size_t(spec.height));
+      if (!in_->read_image(0, 0, 0, spec.nchannels, type_desc(stored_), tiled_whole_.data())) {
+        return Error{path_.string(), "cannot read pixels: " + first_line(in_->geterror())};
+      }
+    }
+    std::memcpy(samples, tiled_whole_.data() + std::size_t(y) * row_bytes, std::size_t(rows) * row_bytes);
+    return success();
+  }
+
   template <class T>
   Status read_and_decode(int y, int rows, std::span<float> out) {
     raw_.resize(out.size() * sizeof(T));
     T* samples = reinterpret_cast<T*>(raw_.data());
-    const ImageSpec& spec = in_->spec();
-    if (!in_->read_scanlines(0, 0, spec.y + y, spec.y + y + rows, 0, 0, spec.nchannels, type_desc(stored_), samples)) {
-      return Error{path_.string(), "cannot read pixels: " + first_line(in_->geterror())};
-    }
+    if (Status s = read_stored(y, rows, samples, sizeof(T)); !s) return s;
     const std::span<const T> in(samples, out.size());
     const std::size_t first_index = std::size_t(y) * std::size_t(layout_.width) * std::size_t(layout_.channels);
     if constexpr (std::is_same_v<T, float>) {
@@ -192,6 +215,7 @@ class RowReader {
   std::vector<color::Transfer> transfers_;
   SampleType stored_ = SampleType::u8;
   std::vector<std::byte> raw_;
+  std::vector<std::byte> tiled_whole_;  // a tiled file's level 0, as stored
   NonFinite bad_;
   std::size_t overflow_ = 0;
 };
@@ -310,8 +334,16 @@ Result<Image> read_whole(RowReader& reader, ReadInfo* info) {
   if (info != nullptr) *info = reader.info();
   Image image;
   static_cast<ImageLayout&>(image) = reader.layout();
-  image.pixels.resize(image.sample_count());
-  if (Status s = reader.read_rows(0, image.height, image.pixels); !s) return s.error();
+  // Reserved (address space only) and filled band by band: a file that declares more rows than it
+  // holds fails at the first missing one, before the rest of its size is touched.
+  image.pixels.reserve(image.sample_count());
+  const std::size_t row_samples = std::size_t(image.width) * std::size_t(image.channels);
+  for (int y = 0; y < image.height; y += kBandRows) {
+    const int rows = std::min(kBandRows, image.height - y);
+    image.pixels.resize(image.pixels.size() + row_samples * std::size_t(rows));
+    const std::span band(image.pixels.data() + row_samples * std::size_t(y), row_samples * std::size_t(rows));
+    if (Status s = reader.read_rows(y, rows, band); !s) return s.error();
+  }
   if (Status s = reader.finish(); !s) return s.error();
   return image;
 }
@@ -325,6 +357,22 @@ Status write_whole(RowWriter& writer, const Image& image) {
 }
 
 }  // namespace
+
+void set_max_pixels(std::uint64_t pixels) { g_max_pixels = pixels; }
+std::uint64_t max_pixels() { return g_max_pixels; }
+
+Status check_image_size(const std::string& file, std::int64_t width, std::int64_t height) {
+  if (width <= 0 || height <= 0) {
+    return Error{file, "declares a size of " + std::to_string(width) + "x" + std::to_string(height)};
+  }
+  const std::uint64_t limit = max_pixels();
+  // width ≤ limit first, so the product cannot overflow.
+  if (std::uint64_t(width) > limit || std::uint64_t(height) > limit / std::uint64_t(width)) {
+    return Error{file, std::to_string(width) + "x" + std::to_string(height) + " is more than the limit of " +
+                           std::to_string(limit) + " pixels (--max-pixels raises it)"};
+  }
+  return success();
+}
 
 std::optional<SampleType> sample_type_from_name(std::string_view name) {
   if (name == "8") return SampleType::u8;

@@ -214,6 +214,7 @@ Result<material::Maps> load_sources(const std::vector<SourceInput>& inputs, cons
     } else {
       result.width = options.width > 0 ? options.width : 1;
       result.height = options.height > 0 ? options.height : 1;
+      if (Status s = image::check_image_size("", result.width, result.height); !s) return s.error();
     }
     for (const SourceInput& input : inputs) {
       if (!input.file.empty()) continue;
@@ -365,19 +366,10 @@ Result<std::vector<fs::path>> write_textures(const Layout& layout, const materia
   return guarded("", [&]() -> Result<std::vector<fs::path>> {
     auto paths = output_paths(layout, request.outputs);
     if (!paths) return paths.error();
-    for (std::size_t i = 0; i < paths->size(); ++i) {
-      const fs::path& out = (*paths)[i];
-      std::error_code ec;
-      for (const fs::path& in : request.inputs) {
-        if (fs::equivalent(out, in, ec)) return Error{out.string(), "is an input; matbake never overwrites its inputs", true};
-      }
-      for (std::size_t j = 0; j < i; ++j) {
-        if (out.lexically_normal() == (*paths)[j].lexically_normal() || fs::equivalent(out, (*paths)[j], ec)) {
-          return Error{out.string(), "is written twice (textures " + layout.textures[j].name + " and " +
-                                         layout.textures[i].name + ")", true};
-        }
-      }
-    }
+    std::vector<NamedOutput> outputs;
+    for (std::size_t i = 0; i < paths->size(); ++i) outputs.push_back({(*paths)[i], "texture " + layout.textures[i].name});
+    outputs.insert(outputs.end(), request.also.begin(), request.also.end());
+    if (Status s = check_outputs(outputs, request.inputs); !s) return s.error();
     auto images = pack(layout, sources);
     if (!images) return images.error();
     for (std::size_t t = 0; t < paths->size(); ++t) {
@@ -386,6 +378,26 @@ Result<std::vector<fs::path>> write_textures(const Layout& layout, const materia
       if (Status s = image::write_image((*images)[t], (*paths)[t], options); !s) return s.error();
     }
     return paths;
+  });
+}
+
+Result<std::vector<fs::path>> write_maps(const material::Maps& maps, const UnpackRequest& request) {
+  return guarded(request.folder.string(), [&]() -> Result<std::vector<fs::path>> {
+    std::vector<NamedOutput> outputs;
+    for (const auto& [name, map] : maps.maps) outputs.push_back({request.folder / (name + "." + request.format), name});
+    if (Status s = check_outputs(outputs, request.inputs); !s) return s.error();
+    std::error_code ec;
+    fs::create_directories(request.folder, ec);
+    std::vector<fs::path> written;
+    for (const NamedOutput& out : outputs) {
+      const bool colour = material::find_source(out.role)->kind == material::SourceKind::color;
+      const image::SampleType type = request.type.value_or(default_sample_type(out.path));
+      if (Status s = image::write_image(maps.maps.at(out.role), out.path, write_options(colour, {type, request.transfer})); !s) {
+        return s.error();
+      }
+      written.push_back(out.path);
+    }
+    return written;
   });
 }
 
