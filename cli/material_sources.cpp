@@ -90,7 +90,7 @@ Result<material::Maps> gather_sources(const SourceSettings& s) {
     auto numbers = parse_numbers(text);
     if (numbers && !fs::exists(text, ec)) {
       for (double v : *numbers) {
-        if (!(v >= 0.0 && v <= 1.0)) {
+        if (!material::is_valid_constant(v)) {
           return Error{"", option_of(sources[i].name) + " '" + text + "': values are in [0, 1]", true};
         }
       }

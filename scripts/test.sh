@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # README command 2: installs what is missing, builds matbake and runs the whole test suite twice:
 # a release build (build/) and an AddressSanitizer + UndefinedBehaviorSanitizer build
-# (build-asan/), where any sanitizer report fails the run.
+# (build-asan/), where any sanitizer report fails the run; then each fuzz target for a short smoke
+# run (build-fuzz/, clang: scripts/fuzz.sh).
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 jobs=$(nproc)
@@ -23,6 +24,9 @@ export LSAN_OPTIONS=suppressions=$root/tests/lsan.supp:print_suppressions=0
 export UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1:log_path=$reports/ubsan
 status=0
 ctest --test-dir "$root/build-asan" --output-on-failure -j "$jobs" || status=$?
+# The fuzz targets (clang, libFuzzer, ASan + UBSan) for a short smoke run each from their seeds;
+# libFuzzer reports on its own stderr, so the options above are not passed on.
+(unset ASAN_OPTIONS LSAN_OPTIONS UBSAN_OPTIONS; bash "$root/scripts/fuzz.sh" --smoke "${MATBAKE_FUZZ_SMOKE_SECONDS:-15}") || status=$?
 if compgen -G "$reports/*" >/dev/null; then
   echo "matbake: sanitizer reports during the test run:" >&2
   cat "$reports"/* >&2

@@ -6,6 +6,8 @@
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
 
+#include <sys/stat.h>
+
 #include <cmath>
 #include <cstdint>
 #include <fstream>
@@ -218,6 +220,23 @@ TEST(Hostile, EveryOutputOptionRefusesAnInput) {
   expect_refused({"export", gltf, "-o", out + "/x.glb", "--report", out + "/x.glb"}, kUsage, out + "/x.glb",
                  "is written twice (glTF output and report)", dir / "out", scene_files);
   expect_refused({"bake-ao", gltf, "--dump", bin}, kUsage, bin, is_input, dir / "out", scene_files);
+}
+
+// Sources that never end (a FIFO, /dev/zero) are refused, not read: only regular files are images.
+TEST(Hostile, SourcesMustBeRegularFiles) {
+  TempDir dir;
+  ASSERT_EQ(mkfifo((dir / "fifo.png").c_str(), 0600), 0);
+  for (const std::string& source : {std::string("fifo.png"), std::string("/dev/zero")}) {
+    write_bytes(dir / "m.toml", "output = \"out\"\n[materials.a]\nsources = { kd = \"" + source +
+                                    "\", ks = 0.04, gloss = 0.5 }\nlayout = \"schuler\"\n");
+    const RunResult r = matbake({"build", (dir / "m.toml").string()});
+    EXPECT_EQ(r.exit_code, 1) << r.err;
+    const std::string path = source[0] == '/' ? source : (dir / source).string();
+    EXPECT_NE(r.err.find("matbake: error: " + path + ": is not a regular file"), std::string::npos) << r.err;
+  }
+  const RunResult direct = matbake({"validate", "--ks", "/dev/zero"});
+  EXPECT_EQ(direct.exit_code, 1);
+  expect_one_error_line(direct, "/dev/zero", "is not a regular file");
 }
 
 }  // namespace

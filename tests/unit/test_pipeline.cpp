@@ -120,6 +120,11 @@ TEST(BuildManifest, ErrorsSayWhereAndWhat) {
       {"[scenes.s]\ninput = \"a.gltf\"\nmaterials = { \"X\" = \"nope\" }\n", "m.toml", "no [materials.nope]"},
       {"[validate]\nmax_violations = 2.0\n[materials.a]\nsources = { kd = 0.5 }\n", "m.toml:1:", "max_violations in [0, 1]"},
       {"output = 3\n", "m.toml:1:", "output: a string expected"},
+      // Constants hold texel values, as on the command line (issue "Hostile input").
+      {"[materials.a]\nsources = { kd = 0.5, ks = nan }\n", "m.toml:2:28", "materials.a.sources.ks: values are in [0, 1]"},
+      {"[materials.a]\nsources = { kd = inf }\n", "m.toml:2:", "materials.a.sources.kd: values are in [0, 1]"},
+      {"[materials.a]\nsources = { ks = -0.5 }\n", "m.toml:2:", "materials.a.sources.ks: values are in [0, 1]"},
+      {"[materials.a]\nsources = { kd = [0.5, 1.5, 0.5] }\n", "m.toml:2:", "materials.a.sources.kd: values are in [0, 1]"},
       {"", "m.toml", "nothing to build"},
   };
   for (const Case& c : cases) {

@@ -32,6 +32,8 @@ struct Source {
 std::span<const Source> sources();
 const Source* find_source(std::string_view name);
 inline int component_count(SourceKind kind) { return kind == SourceKind::color ? 3 : 1; }
+// A source given as a number holds a texel value: finite and in [0, 1] (NaN fails both).
+inline bool is_valid_constant(double value) { return value >= 0.0 && value <= 1.0; }
 
 struct Maps {
   int width = 0;

@@ -84,6 +84,8 @@ class RowReader {
     std::error_code ec;
     if (!fs::exists(path, ec)) return Error{path.string(), "no such file"};
     if (fs::is_directory(path, ec)) return Error{path.string(), "is a folder, not an image"};
+    // A FIFO or a device (/dev/zero) never ends: only regular files are read.
+    if (!fs::is_regular_file(path, ec)) return Error{path.string(), "is not a regular file"};
     return open(path, colour, nullptr);
   }
 
@@ -338,8 +340,10 @@ Result<Image> read_whole(RowReader& reader, ReadInfo* info) {
   // holds fails at the first missing one, before the rest of its size is touched.
   image.pixels.reserve(image.sample_count());
   const std::size_t row_samples = std::size_t(image.width) * std::size_t(image.channels);
-  for (int y = 0; y < image.height; y += kBandRows) {
-    const int rows = std::min(kBandRows, image.height - y);
+  // About a million samples a band: few calls into OIIO (each may allocate its own buffer).
+  const int band_rows = int(std::max<std::size_t>(kBandRows, (std::size_t{1} << 20) / row_samples));
+  for (int y = 0; y < image.height; y += band_rows) {
+    const int rows = std::min(band_rows, image.height - y);
     image.pixels.resize(image.pixels.size() + row_samples * std::size_t(rows));
     const std::span band(image.pixels.data() + row_samples * std::size_t(y), row_samples * std::size_t(rows));
     if (Status s = reader.read_rows(y, rows, band); !s) return s.error();

@@ -188,11 +188,13 @@ Result<MaterialSpec> read_material(const Reader& r, const std::string& name, con
       if (auto file = value.value<std::string>()) {
         in.file = m.folder / *file;
       } else if (auto number = value.value<double>()) {
+        if (!material::is_valid_constant(*number)) return r.at(value, where + ".sources." + source + ": values are in [0, 1]");
         in.constant = {*number};
       } else if (const toml::array* list = value.as_array()) {
         for (const toml::node& n : *list) {
           auto x = n.value<double>();
           if (!x) return r.at(n, where + ".sources." + source + ": numbers expected");
+          if (!material::is_valid_constant(*x)) return r.at(n, where + ".sources." + source + ": values are in [0, 1]");
           in.constant.push_back(*x);
         }
       } else {

@@ -1,0 +1,78 @@
+#!/usr/bin/env bash
+# Builds matbake's libFuzzer targets (build-fuzz/: clang 14, ASan + UBSan) and runs them.
+#   scripts/fuzz.sh TARGET SECONDS [libFuzzer flags...]   one target for SECONDS
+#   scripts/fuzz.sh --smoke SECONDS                        every target for SECONDS each (the test
+#                                                          command's smoke run)
+# Targets: image (our reader over OIIO), gltf and glb (document + flattened scene), manifest,
+# layout, materials. Seeds: the repository's presets and examples, plus ../shared/testdata when it
+# is there (pngsuite, libpng-testpngs, openexr, the Khronos models). The growing corpus stays in
+# build-fuzz/corpus/TARGET; a crash is written to build-fuzz/artifacts/TARGET/ and fails the run.
+set -euo pipefail
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+testdata=$root/../shared/testdata
+build=$root/build-fuzz
+targets=(image gltf glb manifest layout materials)
+
+if [ $# -lt 2 ]; then
+  echo "usage: scripts/fuzz.sh TARGET|--smoke SECONDS [libFuzzer flags...]  (targets: ${targets[*]})" >&2
+  exit 2
+fi
+bash "$root/scripts/deps.sh"
+CXX=clang++-14 cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMATBAKE_FUZZ=ON \
+  -DMATBAKE_BUILD_TESTS=OFF -DMATBAKE_BUILD_BENCH=OFF >/dev/null
+cmake --build "$build" >/dev/null
+
+# Seeds: copies of the matching files, flat (libFuzzer reads every file of a folder it is given).
+seed() {  # target, then find arguments
+  local target=$1; shift
+  local dir=$build/seeds/$target
+  rm -rf "$dir" && mkdir -p "$dir"
+  for place in "$root/presets" "$root/examples" "$testdata"; do
+    [ -d "$place" ] || continue
+    find "$place" -type f "$@" -size -2M -print0 | while IFS= read -r -d '' f; do
+      cp "$f" "$dir/$(echo "$f" | md5sum | cut -c1-12)-$(basename "$f")"
+    done
+  done
+  echo "$dir"
+}
+
+run() {  # target, seconds, extra flags
+  local target=$1 seconds=$2; shift 2
+  local seeds
+  case $target in
+    # Leak checks off for images: OIIO 2.4's PNG reader leaks a string when libpng longjmps out of
+    # its read callback (tests/lsan.supp), and naming that frame needs full unwinding on every
+    # malloc, which slows the run a hundredfold. The sanitizer test build checks leaks with it.
+    image) seeds=$(seed image \( -name '*.png' -o -name '*.exr' -o -name '*.jpg' -o -name '*.tif' \))
+      export ASAN_OPTIONS=detect_leaks=0
+      set -- -detect_leaks=0 "$@" ;;
+    gltf) seeds=$(seed gltf -name '*.gltf') ;;
+    glb) seeds=$(seed glb -name '*.glb') ;;
+    manifest) seeds=$(seed manifest -name '*.toml' ! -name 'materials.toml') ;;
+    layout) seeds=$(seed layout -path '*layouts*' -name '*.json') ;;
+    materials) seeds=$(seed materials -name 'materials*.toml') ;;
+    *) echo "scripts/fuzz.sh: unknown target '$target' (${targets[*]})" >&2; exit 2 ;;
+  esac
+  mkdir -p "$build/corpus/$target" "$build/artifacts/$target"
+  local log=$build/fuzz-$target.log
+  # -rss_limit_mb: a decoder's legitimate peak stays far below; -max_len: large seeds are kept whole.
+  if ! "$build/tests/fuzz/fuzz_$target" "$build/corpus/$target" "$seeds" -max_total_time="$seconds" \
+      -rss_limit_mb=4096 -max_len=1048576 -print_final_stats=1 -artifact_prefix="$build/artifacts/$target/" \
+      "$@" >"$log" 2>&1; then
+    tail -n 60 "$log" >&2
+    echo "matbake: fuzz target $target failed; the input is in $build/artifacts/$target/" >&2
+    return 1
+  fi
+  printf "fuzz %-9s %10s runs in %4s s, corpus %s files\n" "$target" \
+    "$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$')" "$seconds" \
+    "$(find "$build/corpus/$target" -type f | wc -l)"
+}
+
+export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1}
+export LSAN_OPTIONS=suppressions=$root/tests/lsan.supp:print_suppressions=0
+if [ "$1" = --smoke ]; then
+  for t in "${targets[@]}"; do run "$t" "$2"; done
+else
+  target=$1 seconds=$2; shift 2
+  run "$target" "$seconds" "$@"
+fi
