@@ -239,5 +239,32 @@ TEST(Hostile, SourcesMustBeRegularFiles) {
   expect_one_error_line(direct, "/dev/zero", "is not a regular file");
 }
 
+// build writes nowhere but inside the output folder's real path: a link inside it to another
+// folder (out/materials, out/.matbake) is refused, and nothing lands where it points.
+TEST(Hostile, BuildDoesNotWriteThroughLinksInTheOutputFolder) {
+  TempDir dir;
+  fs::create_directories(dir / "out");
+  fs::create_directories(dir / "elsewhere");
+  const std::string manifest = (dir / "m.toml").string();
+  write_bytes(manifest, "output = \"out\"\n[materials.a]\nsources = { kd = 0.5, ks = 0.04, gloss = 0.5 }\nlayout = \"schuler\"\n");
+  fs::create_directory_symlink(dir / "elsewhere", dir / "out" / "materials");
+  const RunResult r = matbake({"build", manifest});
+  EXPECT_EQ(r.exit_code, 1);
+  expect_one_error_line(r, (dir / "out" / "materials" / "a_a.png").string(), "material:a would be written outside the output folder");
+  fs::remove(dir / "out" / "materials");
+  fs::create_directory_symlink(dir / "elsewhere", dir / "out" / ".matbake");
+  const RunResult state = matbake({"build", manifest});
+  EXPECT_EQ(state.exit_code, 1);
+  expect_one_error_line(state, (dir / "out" / ".matbake").string(), "is a link out of the output folder");
+  EXPECT_TRUE(list_folder(dir / "elsewhere").empty());
+  // The output folder itself may be a link: its real path is where everything goes.
+  fs::remove(dir / "out" / ".matbake");
+  fs::remove(dir / "out");
+  fs::create_directory_symlink(dir / "elsewhere", dir / "out");
+  const RunResult linked = matbake({"-q", "build", manifest});
+  EXPECT_EQ(linked.exit_code, 0) << linked.err;
+  EXPECT_TRUE(fs::exists(dir / "elsewhere" / "materials" / "a_a.png"));
+}
+
 }  // namespace
 }  // namespace matbake::test

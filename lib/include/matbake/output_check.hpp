@@ -20,6 +20,10 @@ struct NamedOutput {
 // yet) or, when both exist, the same inode.
 bool same_file(const std::filesystem::path& a, const std::filesystem::path& b);
 
+// Whether `path`'s real location (symbolic links in it followed; its last part may not exist yet)
+// lies inside `folder`'s real location.
+bool is_really_inside(const std::filesystem::path& folder, const std::filesystem::path& path);
+
 // Errors (usage errors, naming the output): "is an input; matbake never overwrites its inputs",
 // "is written twice (<role> and <role>)".
 Status check_outputs(std::span<const NamedOutput> outputs, std::span<const std::filesystem::path> inputs);

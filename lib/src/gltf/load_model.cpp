@@ -124,13 +124,7 @@ bool is_inside(const fs::path& base, const fs::path& path) {
   return bi == b.end() || (std::next(bi) == b.end() && bi->empty());  // "dir/" ends in an empty element
 }
 
-bool is_really_inside(const fs::path& base, const fs::path& path) {
-  std::error_code ec;
-  const fs::path real_base = fs::weakly_canonical(base, ec);
-  if (ec) return false;
-  const fs::path real = fs::weakly_canonical(path, ec);
-  return !ec && is_inside(real_base, real);
-}
+
 
 Status load_model(const fs::path& path, tinygltf::Model& model) {
   std::error_code ec;

@@ -7,6 +7,7 @@
 
 #include <filesystem>
 
+#include "matbake/output_check.hpp"
 #include "matbake/result.hpp"
 
 namespace matbake::gltf {
@@ -23,8 +24,7 @@ Status load_model_json(const std::filesystem::path& path, const std::string& jso
 
 // Whether `path` lies inside `base`, lexically.
 bool is_inside(const std::filesystem::path& base, const std::filesystem::path& path);
-// The same for the real paths (symbolic links followed): a link beside the glTF to a file elsewhere
-// is outside.
-bool is_really_inside(const std::filesystem::path& base, const std::filesystem::path& path);
+// (matbake::is_really_inside, output_check.hpp, judges real paths: a link beside the glTF to a file
+// elsewhere is outside.)
 
 }  // namespace matbake::gltf

@@ -1,5 +1,7 @@
 #include "matbake/output_check.hpp"
 
+#include <algorithm>
+
 namespace matbake {
 namespace fs = std::filesystem;
 
@@ -11,6 +13,16 @@ bool same_file(const fs::path& a, const fs::path& b) {
   ec.clear();
   const bool equivalent = fs::equivalent(a, b, ec);  // hard links; false when either is missing
   return !ec && equivalent;
+}
+
+bool is_really_inside(const fs::path& folder, const fs::path& path) {
+  std::error_code ec;
+  const fs::path real_folder = fs::weakly_canonical(fs::absolute(folder, ec), ec);
+  if (ec) return false;
+  const fs::path real = fs::weakly_canonical(fs::absolute(path, ec), ec);
+  if (ec) return false;
+  const auto [f, p] = std::mismatch(real_folder.begin(), real_folder.end(), real.begin(), real.end());
+  return f == real_folder.end() || (std::next(f) == real_folder.end() && f->empty());
 }
 
 Status check_outputs(std::span<const NamedOutput> outputs, std::span<const fs::path> inputs) {

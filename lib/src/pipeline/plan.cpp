@@ -5,6 +5,7 @@
 
 #include "../gltf/document.hpp"
 #include "state.hpp"
+#include "matbake/output_check.hpp"
 #include "matbake/pipeline.hpp"
 #include "matbake/report_json.hpp"
 #include "matbake/version.hpp"
@@ -189,14 +190,28 @@ Result<Plan> make_plan(const Manifest& manifest) {
     }
     for (Job& s : scenes) plan.jobs.push_back(std::move(s));
 
-    // No file written twice, and no input written at all.
+    // No file written twice, no input written at all (both by real path: links followed), and
+    // nothing written outside the output folder's real path (a link inside it to elsewhere).
+    const auto real = [](const fs::path& p) {
+      std::error_code ec;
+      const fs::path r = fs::weakly_canonical(p, ec);
+      return ec ? p : r;
+    };
     std::map<fs::path, std::string> writers;
     std::set<fs::path> inputs;
-    for (const Job& job : plan.jobs) inputs.insert(job.inputs.begin(), job.inputs.end());
-    inputs.insert(manifest.file);
+    for (const Job& job : plan.jobs) {
+      for (const fs::path& in : job.inputs) inputs.insert(real(in));
+    }
+    inputs.insert(real(manifest.file));
+    if (!is_really_inside(manifest.output, plan.state_folder)) {
+      return Error{plan.state_folder.string(), "is a link out of the output folder; matbake writes only inside it"};
+    }
     for (const Job& job : plan.jobs) {
       for (const fs::path& out : job.outputs) {
-        if (inputs.count(out)) return Error{out.string(), job.name + " would overwrite an input; matbake never does"};
+        if (!is_really_inside(manifest.output, out)) {
+          return Error{out.string(), job.name + " would be written outside the output folder (through a link); matbake writes only inside it"};
+        }
+        if (inputs.count(real(out))) return Error{out.string(), job.name + " would overwrite an input; matbake never does"};
         if (const auto [it, added] = writers.emplace(out, job.name); !added) {
           return Error{out.string(), "written by both " + it->second + " and " + job.name};
         }
