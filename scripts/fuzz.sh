@@ -5,7 +5,8 @@
 #                                                          command's smoke run)
 # Targets: image (our reader over OIIO), gltf and glb (document + flattened scene), manifest,
 # layout, materials. Seeds: the repository's presets and examples, plus ../shared/testdata when it
-# is there (pngsuite, libpng-testpngs, openexr, the Khronos models). The growing corpus stays in
+# is there (pngsuite, libpng-testpngs, openexr, the Khronos models), and tests/fuzz/regressions/ (inputs
+# that once failed, replayed first by every run). The growing corpus stays in
 # build-fuzz/corpus/TARGET; a crash is written to build-fuzz/artifacts/TARGET/ and fails the run.
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
@@ -27,7 +28,8 @@ seed() {  # target, then find arguments
   local target=$1; shift
   local dir=$build/seeds/$target
   rm -rf "$dir" && mkdir -p "$dir"
-  for place in "$root/presets" "$root/examples" "$testdata"; do
+  # tests/fuzz/regressions/TARGET: inputs that once failed (each run starts by replaying them).
+  for place in "$root/presets" "$root/examples" "$testdata" "$root/tests/fuzz/regressions/$target"; do
     [ -d "$place" ] || continue
     find "$place" -type f "$@" -size -2M -print0 | while IFS= read -r -d '' f; do
       cp "$f" "$dir/$(echo "$f" | md5sum | cut -c1-12)-$(basename "$f")"

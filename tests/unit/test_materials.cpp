@@ -95,6 +95,16 @@ TEST(MaterialTable, ParseErrorsNameTheEntry) {
   }
 }
 
+// table_code holds 8-bit codes as printed: integers 0-255 kept, anything else (a float such as
+// 2e52, which toml++ would cast unchecked; found by fuzzing) is -1, "no code".
+TEST(MaterialTable, TableCodesAreIntegersOrNone) {
+  auto t = parse_table("[[material]]\nname = 'x'\nclass = 'metal'\nf0 = [1, 1, 1]\nsource = 's'\n"
+                       "table_code = [2e52, 255, 256, -3, 12.0, 7]\n",
+                       "mine.toml");
+  ASSERT_TRUE(t) << t.error().to_string();
+  EXPECT_EQ(t->at(0).table_code, (std::vector<int>{-1, 255, -1, -1, -1, 7}));
+}
+
 TEST(MaterialTable, NearNames) {
   EXPECT_EQ(near_names(builtin_table(), "gld").front(), "gold");
   EXPECT_EQ(near_names(builtin_table(), "stainless").front(), "stainless-steel");

@@ -125,6 +125,8 @@ TEST(BuildManifest, ErrorsSayWhereAndWhat) {
       {"[materials.a]\nsources = { kd = inf }\n", "m.toml:2:", "materials.a.sources.kd: values are in [0, 1]"},
       {"[materials.a]\nsources = { ks = -0.5 }\n", "m.toml:2:", "materials.a.sources.ks: values are in [0, 1]"},
       {"[materials.a]\nsources = { kd = [0.5, 1.5, 0.5] }\n", "m.toml:2:", "materials.a.sources.kd: values are in [0, 1]"},
+      // A float where an integer goes: refused, never cast (toml++ casts 2e52 to int64 unchecked; fuzzing).
+      {"[scenes.s]\ninput = \"a.gltf\"\nao = { samples = 2e52 }\n", "m.toml:3:", "samples: an integer expected"},
       {"", "m.toml", "nothing to build"},
   };
   for (const Case& c : cases) {

@@ -1,3 +1,4 @@
+#include "matbake/read_file.hpp"
 #include "matbake/materials.hpp"
 
 #include <toml++/toml.h>
@@ -109,7 +110,12 @@ Result<std::vector<Material>> parse_table(std::string_view toml_text, const std:
         m.f0_range = std::array<double, 2>{*(*range)[0].value<double>(), *(*range)[1].value<double>()};
       }
       if (const toml::array* code = (*entry)["table_code"].as_array()) {
-        for (const auto& c : *code) m.table_code.push_back(int(c.value_or<int64_t>(-1)));
+        // Integer nodes only (toml++ 3.3 casts a float such as 2e52 to int64 unchecked, undefined
+        // behaviour found by fuzzing); a code is 0 to 255, anything else is -1 (no code).
+        for (const auto& c : *code) {
+          const std::int64_t v = c.is_integer() ? c.as_integer()->get() : -1;
+          m.table_code.push_back(v >= 0 && v <= 255 ? int(v) : -1);
+        }
       }
       m.ior = (*entry)["ior"].value<double>();
       if (entry->contains("ior_n") || entry->contains("ior_k")) {
@@ -129,11 +135,9 @@ Result<std::vector<Material>> parse_table(std::string_view toml_text, const std:
 }
 
 Result<std::vector<Material>> load_table(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  if (!in) return Error{path.string(), "cannot read"};
-  std::stringstream text;
-  text << in.rdbuf();
-  return parse_table(text.str(), path.string());
+  std::string text;
+  if (!read_whole_file(path, text)) return Error{path.string(), "cannot read (missing, unreadable or not a file)"};
+  return parse_table(text, path.string());
 }
 
 const std::vector<Material>& builtin_table() {

@@ -7,6 +7,7 @@
 #include <set>
 #include <sstream>
 
+#include "matbake/read_file.hpp"
 #include "matbake/pipeline.hpp"
 
 namespace matbake::pipeline {
@@ -59,7 +60,10 @@ struct Reader {
       }
       return at(*node, where + "." + std::string(key) + ": a number expected");
     } else {
-      if (auto v = node->value<T>()) {
+      // Integers only from integer nodes: toml++ 3.3 converts a float by a cast that is undefined
+      // beyond the integer's range (found by fuzzing: samples = 2e52).
+      const bool convertible = !std::is_integral_v<T> || std::is_same_v<T, bool> || node->is_integer();
+      if (auto v = convertible ? node->value<T>() : std::nullopt) {
         out = *v;
         return success();
       }
@@ -330,11 +334,9 @@ Result<Manifest> parse_manifest(std::string_view toml_text, const fs::path& file
 }
 
 Result<Manifest> read_manifest(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) return Error{file.string(), "cannot read the manifest (missing or unreadable)"};
-  std::ostringstream text;
-  text << in.rdbuf();
-  return parse_manifest(text.str(), file);
+  std::string text;
+  if (!read_whole_file(file, text)) return Error{file.string(), "cannot read the manifest (missing, unreadable or not a file)"};
+  return parse_manifest(text, file);
 }
 
 }  // namespace matbake::pipeline

@@ -1,3 +1,4 @@
+#include "matbake/read_file.hpp"
 #include "state.hpp"
 
 #include <OpenImageIO/hash.h>
@@ -32,10 +33,8 @@ FileState state_of(const fs::path& p) {
 }
 
 std::string content_hash(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream bytes;
-  bytes << in.rdbuf();
-  const std::string b = bytes.str();
+  std::string b;  // a source that is not a regular file hashes as empty (its read refuses it)
+  if (!read_whole_file(p, b)) b.clear();
   char hex[17];
   std::snprintf(hex, sizeof hex, "%016llx", OIIO::xxhash::XXH64(b.data(), b.size(), 0));
   return hex;

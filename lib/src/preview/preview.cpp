@@ -1,3 +1,4 @@
+#include "matbake/read_file.hpp"
 #include "matbake/preview.hpp"
 #include "matbake/workflow.hpp"
 
@@ -164,11 +165,11 @@ Status check(const Material& m) {
 
 Result<std::vector<Material>> load_materials(const std::filesystem::path& path) {
   return guarded(path.string(), [&]() -> Result<std::vector<Material>> {
-    std::ifstream in(path);
-    if (!in) return Error{path.string(), "cannot open"};
+    std::string text;
+    if (!read_whole_file(path, text)) return Error{path.string(), "cannot open (missing, unreadable or not a file)"};
     std::vector<Material> materials;
     try {
-      const nlohmann::json doc = nlohmann::json::parse(in);
+      const nlohmann::json doc = nlohmann::json::parse(text);
       if (!doc.is_array()) return Error{path.string(), "expected a JSON array of materials"};
       for (const auto& entry : doc) {
         const auto colour = [&](const char* key) {
