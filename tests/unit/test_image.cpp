@@ -2,6 +2,9 @@
 // odd size, non-finite input rejected, atomic writes.
 #include <gtest/gtest.h>
 
+#include <Imath/half.h>
+#include <OpenImageIO/imageio.h>
+
 #include <cmath>
 #include <limits>
 
@@ -82,6 +85,47 @@ TEST(ImageIo, SixteenBitCodesRoundTripThroughFloat) {
   EXPECT_EQ(read_raw(dir / "out.png").samples, codes);
 }
 
+// Samples not stored as we keep them are converted by us, band by band: a channel type each
+// (half colour, float alpha) over more than one band, and 32-bit integers.
+TEST(ImageIo, PerChannelAndWideTypesAreConvertedExactly) {
+  TempDir dir;
+  const int w = 300, h = 1000;  // 1.2 M samples: two bands of rows
+  OIIO::ImageSpec spec(w, h, 4, OIIO::TypeDesc::FLOAT);
+  spec.channelformats = {OIIO::TypeDesc::HALF, OIIO::TypeDesc::HALF, OIIO::TypeDesc::HALF, OIIO::TypeDesc::FLOAT};
+  spec.alpha_channel = 3;
+  std::vector<float> values(std::size_t(w) * h * 4);
+  for (std::size_t i = 0; i < values.size(); ++i) values[i] = float(i % 4093) / 4093.0f;
+  const auto mixed = dir / "mixed.exr";
+  {
+    auto out = OIIO::ImageOutput::create(mixed.string());
+    ASSERT_TRUE(out && out->open(mixed.string(), spec));
+    ASSERT_TRUE(out->write_image(OIIO::TypeDesc::FLOAT, values.data()) && out->close());
+  }
+  auto image = read_image(mixed, Transfer::linear);
+  ASSERT_TRUE(image) << image.error().to_string();
+  ASSERT_EQ(image->pixels.size(), values.size());
+  std::size_t wrong = 0;
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    const float stored = i % 4 == 3 ? values[i] : float(Imath::half(values[i]));
+    wrong += image->pixels[i] != stored;
+  }
+  EXPECT_EQ(wrong, 0u);
+
+  {
+    const auto integers = dir / "uint32.tif";
+    OIIO::ImageSpec spec32(3, 1, 1, OIIO::TypeDesc::UINT32);
+    const std::uint32_t codes[3] = {0, 1u << 30, 0xffffffffu};
+    auto out = OIIO::ImageOutput::create(integers.string());
+    ASSERT_TRUE(out && out->open(integers.string(), spec32));
+    ASSERT_TRUE(out->write_image(OIIO::TypeDesc::UINT32, codes) && out->close());
+    auto read = read_image(integers, Transfer::linear);
+    ASSERT_TRUE(read) << read.error().to_string();
+    EXPECT_EQ(read->pixels[0], 0.0f);
+    EXPECT_NEAR(read->pixels[1], 0.25, 1e-7);
+    EXPECT_EQ(read->pixels[2], 1.0f);
+  }
+}
+
 TEST(ImageIo, NonFiniteSamplesAreRejectedAndCounted) {
   TempDir dir;
   const double nan = std::nan(""), inf = std::numeric_limits<double>::infinity();
@@ -128,6 +172,75 @@ TEST(ImageIo, MissingAndNonImageFilesAreErrors) {
   ASSERT_FALSE(text);
   EXPECT_EQ(text.error().message.rfind("not a readable image", 0), 0u) << text.error().message;
   EXPECT_EQ(text.error().message.find('\n'), std::string::npos);
+}
+
+// An OpenEXR attribute: name, type, the size it declares and the bytes that follow.
+std::string exr_attribute(const std::string& name, const std::string& type, std::uint32_t declared,
+                          const std::string& value) {
+  std::string bytes = name + '\0' + type + '\0';
+  for (int shift = 0; shift < 32; shift += 8) bytes += char((declared >> shift) & 0xff);
+  return bytes + value;
+}
+
+std::string exr_start(std::uint32_t version) {
+  std::string bytes = "\x76\x2f\x31\x01";
+  for (int shift = 0; shift < 32; shift += 8) bytes += char((version >> shift) & 0xff);
+  return bytes;
+}
+
+// OpenEXR allocates what an attribute declares before reading it: a 40-byte file declaring 2 GB
+// would cost 2 GB and seconds. Refused from the header, by content whatever the name, from a file
+// or from memory, in any part of a multi-part file.
+TEST(ImageIo, ExrHeaderDeclaringMoreThanTheFileHoldsIsRefused) {
+  TempDir dir;
+  const std::string single = exr_start(2) + exr_attribute("owner", "string", 0x7fffff00u, "abc");
+  const std::string expected = "not a readable image: its OpenEXR header's attribute 'owner' declares 2147483392 "
+                               "bytes, more than the 3 that follow it";
+  for (const char* name : {"big.exr", "big.png"}) {
+    test::write_bytes(dir / name, single);
+    auto image = read_image(dir / name, Transfer::linear);
+    ASSERT_FALSE(image);
+    EXPECT_EQ(image.error().message, expected);
+    const std::span bytes(reinterpret_cast<const unsigned char*>(single.data()), single.size());
+    auto decoded = decode_image(bytes, name, Transfer::linear);
+    ASSERT_FALSE(decoded);
+    EXPECT_EQ(decoded.error().message, expected);
+  }
+  const std::string negative = exr_start(2) + exr_attribute("comments", "string", 0x80000000u, "");
+  test::write_bytes(dir / "negative.exr", negative);
+  auto refused = read_image(dir / "negative.exr", Transfer::linear);
+  ASSERT_FALSE(refused);
+  EXPECT_EQ(refused.error().message, "not a readable image: its OpenEXR header's attribute 'comments' declares "
+                                     "-2147483648 bytes, more than the 0 that follow it");
+
+  // Multi-part (version bit 12): the second part's header is walked too.
+  const std::string parts = exr_start(2 | 0x1000) + exr_attribute("name", "string", 2, "p0") + '\0' +
+                            exr_attribute("owner", "string", 1000, "x") + '\0' + '\0';
+  test::write_bytes(dir / "parts.exr", parts);
+  auto second = read_image(dir / "parts.exr", Transfer::linear);
+  ASSERT_FALSE(second);
+  EXPECT_EQ(second.error().message, "not a readable image: its OpenEXR header's attribute 'owner' declares 1000 "
+                                    "bytes, more than the 3 that follow it");
+
+  // A real multi-part file (two subimages, written by OIIO) is read: its first part.
+  // (Parts share their display window, as OpenEXR requires.)
+  OIIO::ImageSpec specs[2] = {OIIO::ImageSpec(3, 2, 3, OIIO::TypeDesc::HALF), OIIO::ImageSpec(1, 1, 1, OIIO::TypeDesc::FLOAT)};
+  specs[1].full_width = 3;
+  specs[1].full_height = 2;
+  const std::vector<float> first = {0.0f, 0.25f, 0.5f, 1.0f, 2.0f, 4.0f, 0.125f, 0.75f, 8.0f,
+                                    16.0f, 0.0625f, 0.375f, 0.5f, 0.5f, 0.5f, 1.0f, 1.0f, 1.0f};
+  const float other = 3.0f;
+  const auto real = dir / "real-parts.exr";
+  auto out = OIIO::ImageOutput::create(real.string());
+  ASSERT_TRUE(out && out->supports("multiimage"));
+  ASSERT_TRUE(out->open(real.string(), 2, specs)) << out->geterror();
+  ASSERT_TRUE(out->write_image(OIIO::TypeDesc::FLOAT, first.data()));
+  ASSERT_TRUE(out->open(real.string(), specs[1], OIIO::ImageOutput::AppendSubimage));
+  ASSERT_TRUE(out->write_image(OIIO::TypeDesc::FLOAT, &other) && out->close());
+  ASSERT_NE(test::read_bytes(real).find("name"), std::string::npos);  // it is multi-part: parts are named
+  auto read = read_image(real, Transfer::linear);
+  ASSERT_TRUE(read) << read.error().to_string();
+  EXPECT_EQ(read->pixels, first);
 }
 
 TEST(ImageIo, FailedWriteLeavesTheExistingOutputAndNoTemporaryFile) {

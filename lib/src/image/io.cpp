@@ -16,6 +16,7 @@
 #include "matbake/atomic_file.hpp"
 #include "matbake/image.hpp"
 #include "matbake/pixels.hpp"
+#include "exr_header.hpp"
 
 namespace fs = std::filesystem;
 using OIIO::ImageSpec;
@@ -75,6 +76,20 @@ void count_half(std::span<const uint16_t> bits, std::size_t first_index, NonFini
   }
 }
 
+// Refuses an OpenEXR file whose header declares more bytes than it holds (exr_header.hpp), judged
+// by content as OIIO's readers are, whatever the name.
+Status check_exr_header(const fs::path& path, OIIO::Filesystem::IOProxy* proxy) {
+  std::optional<std::string> problem;
+  if (proxy != nullptr) {
+    problem = exr_header_problem(*proxy);
+  } else {
+    OIIO::Filesystem::IOFile file(path.string(), OIIO::Filesystem::IOProxy::Read);
+    if (file.opened()) problem = exr_header_problem(file);
+  }
+  if (problem) return Error{path.string(), "not a readable image: " + *problem};
+  return success();
+}
+
 // Decodes bands of rows in order. Non-finite samples are bad input and finite ones the decode
 // overflows (sRGB/gamma 2.2 of values above about 1e16) are too; both are counted over the whole
 // file, so the error gives the totals, and reported by finish().
@@ -103,6 +118,7 @@ class RowReader {
     config.attribute("oiio:UnassociatedAlpha", 1);
     // The readers of OIIO 2.4 look for the proxy in the configuration hint.
     if (proxy) config.attribute("oiio:ioproxy", TypeDesc::PTR, &proxy);
+    if (Status s = check_exr_header(path, proxy); !s) return s.error();
     auto in = OIIO::ImageInput::open(path.string(), &config, proxy);
     if (!in) return Error{path.string(), "not a readable image: " + first_line(OIIO::geterror())};
     const ImageSpec& spec = in->spec();
@@ -167,9 +183,12 @@ class RowReader {
   Status read_stored(int y, int rows, void* samples, std::size_t sample_size) {
     const ImageSpec& spec = in_->spec();
     if (spec.tile_width <= 0) {
-      if (!in_->read_scanlines(0, 0, spec.y + y, spec.y + y + rows, 0, 0, spec.nchannels, type_desc(stored_), samples)) {
-        return Error{path_.string(), "cannot read pixels: " + first_line(in_->geterror())};
-      }
+      // Read as stored into our buffer: OIIO 2.4's read_scanlines allocates (and frees) a 64 MB
+      // staging buffer on every call, even when no conversion is needed.
+      const bool as_stored = spec.channelformats.empty() && spec.format == type_desc(stored_);
+      const bool read = as_stored ? in_->read_native_scanlines(0, 0, spec.y + y, spec.y + y + rows, 0, samples)
+                                  : read_converted(y, rows, samples);
+      if (!read) return Error{path_.string(), "cannot read pixels: " + first_line(in_->geterror())};
       return success();
     }
     const std::size_t row_bytes = std::size_t(spec.width) * std::size_t(spec.nchannels) * sample_size;
@@ -181,6 +200,29 @@ class RowReader {
     }
     std::memcpy(samples, tiled_whole_.data() + std::size_t(y) * row_bytes, std::size_t(rows) * row_bytes);
     return success();
+  }
+
+  // Files stored in another type (double, 32-bit integers) or in a type per channel (an EXR with
+  // half colour and float depth) are read as stored, and each channel is converted into `samples`.
+  bool read_converted(int y, int rows, void* samples) {
+    const ImageSpec& spec = in_->spec();
+    const std::size_t pixel_bytes = spec.pixel_bytes(true);
+    stored_band_.resize(pixel_bytes * std::size_t(spec.width) * std::size_t(rows));
+    if (!in_->read_native_scanlines(0, 0, spec.y + y, spec.y + y + rows, 0, stored_band_.data())) return false;
+    const TypeDesc to = type_desc(stored_);
+    const auto to_pixel = OIIO::stride_t(to.size()) * spec.nchannels;
+    std::size_t offset = 0;
+    for (int c = 0; c < spec.nchannels; ++c) {
+      const TypeDesc from = spec.channelformat(c);
+      if (!OIIO::convert_image(1, spec.width, rows, 1, stored_band_.data() + offset, from, OIIO::stride_t(pixel_bytes),
+                               OIIO::stride_t(pixel_bytes) * spec.width, OIIO::AutoStride,
+                               static_cast<char*>(samples) + std::size_t(c) * to.size(), to, to_pixel,
+                               to_pixel * spec.width, OIIO::AutoStride)) {
+        return false;
+      }
+      offset += from.size();
+    }
+    return true;
   }
 
   template <class T>
@@ -218,6 +260,7 @@ class RowReader {
   SampleType stored_ = SampleType::u8;
   std::vector<std::byte> raw_;
   std::vector<std::byte> tiled_whole_;  // a tiled file's level 0, as stored
+  std::vector<char> stored_band_;       // a band as stored, before read_converted converts it
   NonFinite bad_;
   std::size_t overflow_ = 0;
 };
@@ -340,7 +383,7 @@ Result<Image> read_whole(RowReader& reader, ReadInfo* info) {
   // holds fails at the first missing one, before the rest of its size is touched.
   image.pixels.reserve(image.sample_count());
   const std::size_t row_samples = std::size_t(image.width) * std::size_t(image.channels);
-  // About a million samples a band: few calls into OIIO (each may allocate its own buffer).
+  // About a million samples a band: few calls into OIIO.
   const int band_rows = int(std::max<std::size_t>(kBandRows, (std::size_t{1} << 20) / row_samples));
   for (int y = 0; y < image.height; y += band_rows) {
     const int rows = std::min(band_rows, image.height - y);
