@@ -121,11 +121,6 @@ std::size_t component_size_of(int type) {
   }
 }
 
-const Json& array_in(const Json& json, const char* key) {
-  static const Json empty = Json::array();
-  return json.contains(key) && json[key].is_array() ? json[key] : empty;
-}
-
 // Every view within its buffer and every accessor with a view within it (the bytes a writer copies).
 Status check_accessors(const Document& doc) {
   const Json& views = array_in(doc.json, "bufferViews");
@@ -145,6 +140,11 @@ Status check_accessors(const Document& doc) {
 }
 
 }  // namespace
+
+const Json& array_in(const Json& json, const char* key) {
+  static const Json empty = Json::array();
+  return json.contains(key) && json[key].is_array() ? json[key] : empty;
+}
 
 std::string decode_uri(const std::string& uri) {
   std::string out;

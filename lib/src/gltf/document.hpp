@@ -67,6 +67,9 @@ Result<std::vector<std::filesystem::path>> write_document(const Document& doc, c
 // one of new_files.
 Result<std::string> image_bytes(const Document& doc, std::size_t index);
 
+// json[key] when it is an array, else an empty array: a glTF's optional lists read without checks.
+const Json& array_in(const Json& json, const char* key);
+
 // The JSON of a .gltf or .glb alone (no buffers read, nothing checked but the container).
 Result<Json> read_json(const std::filesystem::path& path);
 // The same from the file's bytes (`path` says which container, and names it in errors).

@@ -18,6 +18,7 @@ namespace fs = std::filesystem;
 namespace {
 
 using Json = gltf::Json;
+using gltf::array_in;
 
 constexpr int kTriangles = 4, kTriangleStrip = 5, kTriangleFan = 6;
 constexpr int kFloat = 5126, kByte = 5120, kUnsignedByte = 5121, kShort = 5122, kUnsignedShort = 5123, kUnsignedInt = 5125;
@@ -159,11 +160,6 @@ glm::dmat4 local_matrix(const Json& node) {
   if (auto r = numbers(node, "rotation", 4)) m *= glm::mat4_cast(glm::dquat((*r)[3], (*r)[0], (*r)[1], (*r)[2]));
   if (auto s = numbers(node, "scale", 3)) m = glm::scale(m, glm::dvec3((*s)[0], (*s)[1], (*s)[2]));
   return m;
-}
-
-const Json& array_in(const Json& json, const char* key) {
-  static const Json empty = Json::array();
-  return json.contains(key) && json[key].is_array() ? json[key] : empty;
 }
 
 const Json& object_in(const Json& json, const char* key) {
