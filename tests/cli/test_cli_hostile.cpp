@@ -90,6 +90,26 @@ TEST(Hostile, DeclaredSizesBeyondThePixelLimitAreRefusedBeforeAllocating) {
   EXPECT_EQ(matbake({"--max-pixels", "16", "-q", "validate", "--ks", (dir / "small.png").string()}).exit_code, 0);
 }
 
+// Found by fuzzing: a 296-byte EXR declaring a 2 GB attribute (2.2 GB and 7.5 s before), and a
+// PNG whose damaged ICC profile made OIIO 2.4 read out of bounds (exit 139 before), in the
+// commands that read images, with any extension.
+TEST(Hostile, ExrHeaderSizesAndDamagedIccProfilesAreErrors) {
+  TempDir dir;
+  const fs::path regressions = fs::path(MATBAKE_SOURCE_DIR) / "tests/fuzz/regressions/image";
+  const fs::path exr = dir / "texture.png", icc = dir / "icc.png";
+  fs::copy_file(regressions / "exr-attribute-declares-2GB.exr", exr);
+  fs::copy_file(regressions / "png-damaged-icc-profile.png", icc);
+  const fs::path out = dir / "out";
+  fs::create_directories(out);
+  const std::string too_long = "not a readable image: its OpenEXR header's attribute 'owner' declares 2147483392 bytes, "
+                               "more than the 3 that follow it";
+  expect_refused({"convert", exr.string(), "-o", (out / "c.exr").string()}, kFailed, exr.string(), too_long, out, {exr});
+  expect_refused({"validate", "--ks", exr.string()}, kFailed, exr.string(), too_long, out, {exr});
+  expect_refused({"convert", icc.string(), "-o", (out / "c.exr").string()}, kFailed, icc.string(), "cannot read pixels", out, {icc});
+  expect_refused({"pack", "--kd", icc.string(), "--ks", "0.04", "--gloss", "0.5", "-o", (out / "p_{texture}.png").string()},
+                 kFailed, icc.string(), "cannot read pixels", out, {icc});
+}
+
 // A tiled, mip-mapped EXR (as maketx writes textures): its level 0 is read, texel for texel.
 TEST(Hostile, TiledMipMappedExrIsReadAtLevelZero) {
   TempDir dir;

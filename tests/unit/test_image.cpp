@@ -243,6 +243,36 @@ TEST(ImageIo, ExrHeaderDeclaringMoreThanTheFileHoldsIsRefused) {
   EXPECT_EQ(read->pixels, first);
 }
 
+// Inputs found by tests/fuzz/fuzz_image that made OIIO 2.4 read out of bounds (oiio_guards.cpp):
+// a PNG whose ICC profile's text tags point past it (SIGSEGV in release) and an EXR decoded from
+// memory whose line offsets point before the buffer (an ASan report). Both are now plain errors.
+TEST(ImageIo, OutOfBoundsOffsetsInsideFilesAreErrorsNotCrashes) {
+  const std::filesystem::path regressions = std::filesystem::path(MATBAKE_SOURCE_DIR) / "tests/fuzz/regressions/image";
+  const auto png = regressions / "png-damaged-icc-profile.png";
+  auto from_file = read_image(png, Transfer::srgb);
+  ASSERT_FALSE(from_file);
+  EXPECT_EQ(from_file.error().path, png.string());
+  const auto exr = regressions / "exr-line-offset-outside-file.exr";
+  const std::string bytes = test::read_bytes(exr);
+  ASSERT_FALSE(bytes.empty());
+  auto from_memory = decode_image(std::span(reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size()),
+                                  "texture.exr", Transfer::linear);
+  ASSERT_FALSE(from_memory);
+  EXPECT_EQ(from_memory.error().message.rfind("cannot read pixels", 0), 0u) << from_memory.error().message;
+}
+
+// The guard is the ICC decoder in effect: OIIO's own would add ICCProfile:copyright and
+// ICCProfile:dscm from this file's profile (as oiiotool shows); the profile's bytes stay.
+TEST(ImageIo, OiioIccDecoderIsReplacedByTheGuard) {
+  const auto png = std::filesystem::path(MATBAKE_TESTDATA_DIR) / "gltf/BoxTextured/glTF-pbrSpecularGlossiness/CesiumLogoFlat.png";
+  auto in = OIIO::ImageInput::open(png.string());
+  ASSERT_TRUE(in) << OIIO::geterror();
+  ASSERT_NE(in->spec().find_attribute("ICCProfile"), nullptr);
+  EXPECT_EQ(in->spec().find_attribute("ICCProfile")->type().size(), 2008u);
+  EXPECT_EQ(in->spec().find_attribute("ICCProfile:copyright"), nullptr);
+  EXPECT_EQ(in->spec().find_attribute("ICCProfile:dscm"), nullptr);
+}
+
 TEST(ImageIo, FailedWriteLeavesTheExistingOutputAndNoTemporaryFile) {
   TempDir dir;
   write_raw(dir / "in.png", 2, 2, 3, "uint8", std::vector<double>(12, 200));

@@ -17,6 +17,7 @@
 #include "matbake/image.hpp"
 #include "matbake/pixels.hpp"
 #include "exr_header.hpp"
+#include "oiio_guards.hpp"
 
 namespace fs = std::filesystem;
 using OIIO::ImageSpec;
@@ -106,7 +107,7 @@ class RowReader {
 
   // An image in memory: `name`'s extension picks the reader; `bytes` must outlive the reader.
   static Result<RowReader> open_memory(std::span<const unsigned char> bytes, const fs::path& name, color::Transfer colour) {
-    auto proxy = std::make_unique<OIIO::Filesystem::IOMemReader>(bytes.data(), bytes.size());
+    auto proxy = std::make_unique<CheckedMemReader>(bytes.data(), bytes.size());
     auto reader = open(name, colour, proxy.get());
     if (reader) reader->proxy_ = std::move(proxy);
     return reader;
