@@ -5,7 +5,7 @@
 #include <cstring>
 #include <span>
 
-#include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/openexr_base.h>
 #include <OpenImageIO/imageio.h>
 
 #include "matbake/image.hpp"
@@ -28,11 +28,11 @@ extern "C" int LLVMFuzzerInitialize(int*, char***) {
   // under ASan near a millisecond, so the run explores rather than decodes the largest seeds (the
   // reader's code paths do not depend on the size below a band of rows).
   matbake::image::set_max_pixels(std::uint64_t{1} << 14);
-  // OpenEXR sizes its line and tile buffers from the declared window while opening, before our
-  // limit sees the size; under ASan each such buffer is cleared and quarantined. Windows above
-  // 1024 on a side (only thin ones pass the pixel limit) are refused by OpenEXR itself here.
-  Imf::Header::setMaxImageSize(1024, 1024);
-  Imf::Header::setMaxTileSize(1024, 1024);
+  // OpenEXR's core sizes its chunk table from the declared window while opening, before our limit
+  // sees the size (8 bytes a scanline chunk: up to gigabytes for a tall window, cleared, and under
+  // ASan poisoned and quarantined). Windows above 1024 on a side are refused by OpenEXR here.
+  exr_set_default_maximum_image_size(1024, 1024);
+  exr_set_default_maximum_tile_size(1024, 1024);
   matbake::image::set_thread_count(1);
   // Only the reader the leading bytes name: after a failed open OIIO would otherwise try each of its
   // ~40 readers on every mutated input, and the run would measure them instead of ours.

@@ -120,6 +120,12 @@ class RowReader {
     // The readers of OIIO 2.4 look for the proxy in the configuration hint.
     if (proxy) config.attribute("oiio:ioproxy", TypeDesc::PTR, &proxy);
     if (Status s = check_exr_header(path, proxy); !s) return s.error();
+    // OpenEXR files are read through OpenEXR's C core rather than its C++ library, whose header
+    // reader parses typed attributes (channel lists) by their content and not by their declared
+    // size, so no walk of the header can foresee what it allocates; the core reads every attribute
+    // by its declared size, as check_exr_header walks them.
+    static const bool exr_core = OIIO::attribute("openexr:core", 1);
+    (void)exr_core;
     auto in = OIIO::ImageInput::open(path.string(), &config, proxy);
     if (!in) return Error{path.string(), "not a readable image: " + first_line(OIIO::geterror())};
     const ImageSpec& spec = in->spec();
