@@ -28,9 +28,9 @@ extern "C" int LLVMFuzzerInitialize(int*, char***) {
   // under ASan near a millisecond, so the run explores rather than decodes the largest seeds (the
   // reader's code paths do not depend on the size below a band of rows).
   matbake::image::set_max_pixels(std::uint64_t{1} << 14);
-  // OpenEXR's core sizes its chunk table from the declared window while opening, before our limit
-  // sees the size (8 bytes a scanline chunk: up to gigabytes for a tall window, cleared, and under
-  // ASan poisoned and quarantined). Windows above 1024 on a side are refused by OpenEXR here.
+  // OpenEXR sizes its line buffers from the declared window while opening, before our limit sees
+  // the size (under ASan each is cleared and quarantined). Windows above 1024 on a side are refused
+  // here by the header check (OpenEXR's core: exr_header.cpp).
   exr_set_default_maximum_image_size(1024, 1024);
   exr_set_default_maximum_tile_size(1024, 1024);
   matbake::image::set_thread_count(1);

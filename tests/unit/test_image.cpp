@@ -188,47 +188,36 @@ std::string exr_start(std::uint32_t version) {
   return bytes;
 }
 
-// OpenEXR allocates what an attribute declares before reading it: a 40-byte file declaring 2 GB
-// would cost 2 GB and seconds. Refused from the header, by content whatever the name, from a file
-// or from memory, in any part of a multi-part file.
+// OpenEXR's C++ header reader allocates what an attribute declares before reading it: a 40-byte
+// file declaring 2 GB cost 2.2 GB and 7.5 s before "Unexpected end of file". OpenEXR's C core
+// checks the header first (exr_header.cpp), by content whatever the name, from a file or memory.
 TEST(ImageIo, ExrHeaderDeclaringMoreThanTheFileHoldsIsRefused) {
   TempDir dir;
   const std::string single = exr_start(2) + exr_attribute("owner", "string", 0x7fffff00u, "abc");
-  const std::string expected = "not a readable image: its OpenEXR header's attribute 'owner' declares 2147483392 "
-                               "bytes, more than the 3 that follow it";
-  for (const char* name : {"big.exr", "big.png"}) {
-    test::write_bytes(dir / name, single);
-    auto image = read_image(dir / name, Transfer::linear);
-    ASSERT_FALSE(image);
-    EXPECT_EQ(image.error().message, expected);
-    const std::span bytes(reinterpret_cast<const unsigned char*>(single.data()), single.size());
-    auto decoded = decode_image(bytes, name, Transfer::linear);
-    ASSERT_FALSE(decoded);
-    EXPECT_EQ(decoded.error().message, expected);
-  }
-  const std::string negative = exr_start(2) + exr_attribute("comments", "string", 0x80000000u, "");
-  test::write_bytes(dir / "negative.exr", negative);
+  const std::string expected = "not a readable image: OpenEXR header: Attribute 'owner', type 'string': Invalid size 2147483392";
+  test::write_bytes(dir / "big.exr", single);
+  auto image = read_image(dir / "big.exr", Transfer::linear);
+  ASSERT_FALSE(image);
+  EXPECT_EQ(image.error().message, expected);
+  const std::span bytes(reinterpret_cast<const unsigned char*>(single.data()), single.size());
+  auto decoded = decode_image(bytes, "big.png", Transfer::linear);
+  ASSERT_FALSE(decoded);
+  EXPECT_EQ(decoded.error().message, expected);
+
+  test::write_bytes(dir / "negative.exr", exr_start(2) + exr_attribute("comments", "string", 0x80000000u, ""));
   auto refused = read_image(dir / "negative.exr", Transfer::linear);
   ASSERT_FALSE(refused);
-  EXPECT_EQ(refused.error().message, "not a readable image: its OpenEXR header's attribute 'comments' declares "
-                                     "-2147483648 bytes, more than the 0 that follow it");
+  EXPECT_EQ(refused.error().message,
+            "not a readable image: OpenEXR header: Attribute 'comments', type 'string': Invalid negative size -2147483648");
 
-  // Multi-part (version bit 12): the second part's header is walked too.
-  const std::string parts = exr_start(2 | 0x1000) + exr_attribute("name", "string", 2, "p0") + '\0' +
-                            exr_attribute("owner", "string", 1000, "x") + '\0' + '\0';
-  test::write_bytes(dir / "parts.exr", parts);
-  auto second = read_image(dir / "parts.exr", Transfer::linear);
-  ASSERT_FALSE(second);
-  EXPECT_EQ(second.error().message, "not a readable image: its OpenEXR header's attribute 'owner' declares 1000 "
-                                    "bytes, more than the 3 that follow it");
-
-  // Found by fuzzing: a 1.3 GB opaque attribute in a 0.7 KB file. When OpenEXR's core could not
-  // allocate it (a memory limit), OIIO 2.4 went on to divide by zero (exit 136).
+  // Found by fuzzing: a 1.3 GB opaque attribute in a 0.7 KB file, which the C++ reader allocated
+  // and cleared (and OIIO's reader on the C core divided by zero when that allocation failed).
   const auto opaque = std::filesystem::path(MATBAKE_SOURCE_DIR) / "tests/fuzz/regressions/image/exr-opaque-attribute-declares-1.3GB.exr";
   auto fuzzed = read_image(opaque, Transfer::linear);
   ASSERT_FALSE(fuzzed);
-  EXPECT_EQ(fuzzed.error().message, "not a readable image: its OpenEXR header's attribute 'chnanels' declares "
-                                    "1351155785 bytes, more than the 550 that follow it");
+  EXPECT_EQ(fuzzed.error().message.rfind("not a readable image: OpenEXR header: Attribute 'chnanels'", 0), 0u)
+      << fuzzed.error().message;
+  EXPECT_NE(fuzzed.error().message.find("Invalid size 1351155785"), std::string::npos) << fuzzed.error().message;
 
   // A real multi-part file (two subimages, written by OIIO) is read: its first part.
   // (Parts share their display window, as OpenEXR requires.)

@@ -77,8 +77,8 @@ void count_half(std::span<const uint16_t> bits, std::size_t first_index, NonFini
   }
 }
 
-// Refuses an OpenEXR file whose header declares more bytes than it holds (exr_header.hpp), judged
-// by content as OIIO's readers are, whatever the name.
+// Refuses an OpenEXR file whose header OpenEXR's C core refuses (exr_header.hpp), judged by
+// content as OIIO's readers are, whatever the name.
 Status check_exr_header(const fs::path& path, OIIO::Filesystem::IOProxy* proxy) {
   std::optional<std::string> problem;
   if (proxy != nullptr) {
@@ -87,7 +87,7 @@ Status check_exr_header(const fs::path& path, OIIO::Filesystem::IOProxy* proxy) 
     OIIO::Filesystem::IOFile file(path.string(), OIIO::Filesystem::IOProxy::Read);
     if (file.opened()) problem = exr_header_problem(file);
   }
-  if (problem) return Error{path.string(), "not a readable image: " + *problem};
+  if (problem) return Error{path.string(), "not a readable image: OpenEXR header: " + *problem};
   return success();
 }
 
@@ -120,12 +120,6 @@ class RowReader {
     // The readers of OIIO 2.4 look for the proxy in the configuration hint.
     if (proxy) config.attribute("oiio:ioproxy", TypeDesc::PTR, &proxy);
     if (Status s = check_exr_header(path, proxy); !s) return s.error();
-    // OpenEXR files are read through OpenEXR's C core rather than its C++ library, whose header
-    // reader parses typed attributes (channel lists) by their content and not by their declared
-    // size, so no walk of the header can foresee what it allocates; the core reads every attribute
-    // by its declared size, as check_exr_header walks them.
-    static const bool exr_core = OIIO::attribute("openexr:core", 1);
-    (void)exr_core;
     auto in = OIIO::ImageInput::open(path.string(), &config, proxy);
     if (!in) return Error{path.string(), "not a readable image: " + first_line(OIIO::geterror())};
     const ImageSpec& spec = in->spec();
