@@ -218,6 +218,10 @@ TEST(ImageIo, ExrHeaderDeclaringMoreThanTheFileHoldsIsRefused) {
   EXPECT_EQ(fuzzed.error().message.rfind("not a readable image: OpenEXR header: Attribute 'chnanels'", 0), 0u)
       << fuzzed.error().message;
   EXPECT_NE(fuzzed.error().message.find("Invalid size 1351155785"), std::string::npos) << fuzzed.error().message;
+  // And one without a data window, on which OIIO's reader over the core divided by zero.
+  auto no_window = read_image(opaque.parent_path() / "exr-core-reader-divides-by-zero.exr", Transfer::linear);
+  ASSERT_FALSE(no_window);
+  EXPECT_EQ(no_window.error().message, "not a readable image: OpenEXR header: 'dataWindow' attribute not found");
 
   // A real multi-part file (two subimages, written by OIIO) is read: its first part.
   // (Parts share their display window, as OpenEXR requires.)
