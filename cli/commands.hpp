@@ -72,6 +72,7 @@ struct UnpackSettings {
   std::string format = "png";
   std::string bits;
   std::string transfer = "srgb";
+  int png_level = image::kPngLevelDefault;
 };
 CLI::App* setup_unpack(CLI::App& app, UnpackSettings& settings);
 int run_unpack(const UnpackSettings& settings, const GlobalOptions& global);

@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "commands.hpp"
+#include "option_names.hpp"
 #include "silenced_stderr.hpp"
 
 namespace fs = std::filesystem;
@@ -136,6 +137,7 @@ void add_output_options(CLI::App& cmd, OutputSettings& o, const std::string& wha
       ->required();
   cmd.add_option("--bits", o.bits, "8, 16, half or float (default: 8; half for .exr). Colour is encoded with "
                                    "--transfer in 8-bit and linear otherwise");
+  add_png_compression_option(cmd, o.png_level);
 }
 
 std::vector<std::filesystem::path> input_files(const SourceSettings& inputs) {
@@ -151,7 +153,7 @@ Result<std::vector<std::string>> write_textures(const pack::Layout& layout, cons
                                                 std::vector<NamedOutput> also) {
   auto transfer = parse_transfer(inputs.transfer, "--transfer");
   if (!transfer) return transfer.error();
-  pack::WriteRequest request{o.outputs, std::nullopt, *transfer, input_files(inputs), std::move(also)};
+  pack::WriteRequest request{o.outputs, std::nullopt, *transfer, input_files(inputs), std::move(also), o.png_level};
   if (!o.bits.empty()) {
     request.type = image::sample_type_from_name(o.bits);
     if (!request.type) return Error{"", "--bits '" + o.bits + "': use 8, 16, half or float", true};

@@ -3,6 +3,8 @@
 find_package(PkgConfig REQUIRED)
 pkg_check_modules(OIIO REQUIRED IMPORTED_TARGET OpenImageIO)
 pkg_check_modules(OCIO REQUIRED IMPORTED_TARGET OpenColorIO)
+# 8/16-bit PNG is deflated by libdeflate (lib/src/image/png_encode.cpp); libspng reads it.
+pkg_check_modules(deflate REQUIRED IMPORTED_TARGET libdeflate)
 find_package(OpenEXR CONFIG REQUIRED)
 find_package(Imath CONFIG REQUIRED)
 find_package(glm CONFIG REQUIRED)

@@ -4,6 +4,9 @@
 
 #include <Imath/half.h>
 
+#include <bit>
+#include <cmath>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -23,6 +26,36 @@ TEST(Pixels, EightBitDecodeUsesOneTablePerChannel) {
   EXPECT_EQ(out[2], decode_table(Transfer::srgb, 8)[64]);
   EXPECT_EQ(out[3], float(128.0 / 255.0));  // alpha: linear
   EXPECT_EQ(out[7], float(3.0 / 255.0));
+}
+
+// The branch-free 8-bit kernel (per channel count) against rounding the float64 formula: every
+// 509th float in [0, 1] (2.1M, all binades), the floats around every code boundary, and values
+// outside [0, 1], NaN and Inf. bench/float_sweep checks every float in [0, 1].
+TEST(Pixels, EightBitEncodeEqualsRoundingTheFloat64FormulaForEveryChannelCount) {
+  std::vector<float> in;
+  for (uint32_t b = 0; b <= std::bit_cast<uint32_t>(1.0f); b += 509) in.push_back(std::bit_cast<float>(b));
+  for (Transfer t : {Transfer::linear, Transfer::srgb, Transfer::gamma22}) {
+    for (int k = 1; k <= 255; ++k) {
+      float x = float(linear_from_encoded(t, (k - 0.5) / 255));
+      for (int step = 0; step < 3; ++step) x = std::nextafter(x, 0.0f);
+      for (int step = 0; step < 6; ++step, x = std::nextafter(x, 2.0f)) in.push_back(x);
+    }
+  }
+  for (float v : {-1e30f, -1.0f, -0.0f, 1.0f, 1.0000001f, 3.0f, 1e30f, std::numeric_limits<float>::infinity(),
+                  -std::numeric_limits<float>::infinity(), std::nanf("")}) {
+    in.push_back(v);
+  }
+  for (std::size_t channels = 1; channels <= 4; ++channels) {
+    const std::vector<Transfer> transfers = {Transfer::srgb, Transfer::gamma22, Transfer::linear, Transfer::srgb};
+    const std::span<const Transfer> used(transfers.data(), channels);
+    const std::vector<float> samples(in.begin(), in.begin() + std::ptrdiff_t(in.size() / channels * channels));
+    std::vector<uint8_t> codes(samples.size());
+    encode_pixels(samples, codes, used);
+    for (std::size_t i = 0; i < samples.size(); ++i) {
+      ASSERT_EQ(codes[i], quantize_reference(used[i % channels], 8, samples[i]))
+          << channels << " channels, x = " << samples[i] << ", " << transfer_name(used[i % channels]);
+    }
+  }
 }
 
 TEST(Pixels, EveryChannelCountRoundTripsEightBitCodes) {

@@ -47,6 +47,7 @@ struct MaterialSpec {
   std::string layout;          // textures to write (a preset or layout file); empty: none
   std::string format = "png";  // png, exr, tif
   std::optional<image::SampleType> bits;  // unset: pack::default_sample_type (half for exr, else 8)
+  int png_level = image::kPngLevelDefault;  // png_compression: deflate effort of PNG outputs
   workflow::RoughnessMapping mapping = workflow::kDefaultRoughnessMapping;
   std::string reference;  // a material table entry to validate against
   ValidationRules validation;

@@ -112,16 +112,39 @@ void decode_pixels(std::span<const float> in, std::span<float> out, ChannelTrans
   });
 }
 
+// One-step quantizers (every 8-bit one) with the channel count known: no branch per sample, and
+// the channel loop unrolled. 4.5x the general loop on RGBA (bench_convert_kernels).
+template <int Channels, class Code>
+void quantize_one_step(const float* in, Code* out, std::size_t begin, std::size_t end,
+                       const std::array<QuantizerView, 4>& views) {
+  const std::array<QuantizerView, 4> local = views;  // in registers: the byte stores may alias anything
+  for (std::size_t p = begin; p < end; ++p) {
+    for (int c = 0; c < Channels; ++c) out[p * Channels + c] = Code(local[c].code_of_one_step(in[p * Channels + c]));
+  }
+}
+
 // The quantizers are fetched once per call, so the per-sample work inlines to a few loads.
 template <class Code>
 void quantize_pixels(std::span<const float> in, std::span<Code> out, ChannelTransfers transfers, int bits) {
   std::array<QuantizerView, 4> views{};
-  for (std::size_t c = 0; c < transfers.size(); ++c) views[c] = quantizer(transfers[c], bits).view();
+  bool one_step = true;
+  for (std::size_t c = 0; c < transfers.size(); ++c) {
+    views[c] = quantizer(transfers[c], bits).view();
+    one_step = one_step && views[c].one_step;
+  }
   const std::size_t channels = transfers.size();
   for_pixel_ranges(in.size() / channels, [&, views](std::size_t b, std::size_t e) {
+    if (one_step) {
+      switch (channels) {
+        case 1: return quantize_one_step<1>(in.data(), out.data(), b, e, views);
+        case 2: return quantize_one_step<2>(in.data(), out.data(), b, e, views);
+        case 3: return quantize_one_step<3>(in.data(), out.data(), b, e, views);
+        default: return quantize_one_step<4>(in.data(), out.data(), b, e, views);
+      }
+    }
     const std::array<QuantizerView, 4> local = views;
     for (std::size_t p = b; p < e; ++p) {
-      for (std::size_t c = 0; c < channels; ++c) out[p * channels + c] = Code(local[c].code_of(in[p * channels + c]));
+      for (std::size_t c = 0; c < channels; ++c) out[p * channels + c] = Code(local[c].code_of_any(in[p * channels + c]));
     }
   });
 }

@@ -49,8 +49,9 @@ Quantizer build_quantizer(Transfer transfer, int bits) {
   const int max = max_code(bits);
   Quantizer q;
   q.max = max;
-  q.threshold.assign(std::size_t(max) + 1, 0.0f);
   constexpr float kInf = std::numeric_limits<float>::infinity();
+  q.threshold.assign(std::size_t(max) + 2, 0.0f);
+  q.threshold[std::size_t(max) + 1] = kInf;
   for (int k = 1; k <= max; ++k) {
     float x = float(linear_from_encoded(transfer, (k - 0.5) / max));
     while (quantize_reference(transfer, bits, x) >= k) x = std::nextafter(x, -kInf);
@@ -60,6 +61,13 @@ Quantizer build_quantizer(Transfer transfer, int bits) {
   const uint32_t last_bucket = std::bit_cast<uint32_t>(1.0f) >> QuantizerView::kBucketShift;
   for (uint32_t b = 0; b <= last_bucket; ++b) {
     q.bucket_code.push_back(quantize_reference(transfer, bits, std::bit_cast<float>(b << QuantizerView::kBucketShift)));
+  }
+  // The codes of a bucket's first and last floats: one_step holds when they never differ by more
+  // than one (code_of_one_step is then exact).
+  q.one_step = true;
+  for (uint32_t b = 0; b < last_bucket; ++b) {
+    const float last = std::bit_cast<float>(((b + 1) << QuantizerView::kBucketShift) - 1);
+    q.one_step = q.one_step && quantize_reference(transfer, bits, last) - q.bucket_code[b] <= 1;
   }
   return q;
 }

@@ -6,8 +6,11 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cctype>
+#include <charconv>
 #include <cmath>
 #include <cstring>
+#include <fstream>
 #include <memory>
 #include <optional>
 #include <string>
@@ -18,6 +21,7 @@
 #include "matbake/pixels.hpp"
 #include "exr_header.hpp"
 #include "oiio_guards.hpp"
+#include "png_encode.hpp"
 
 namespace fs = std::filesystem;
 using OIIO::ImageSpec;
@@ -266,8 +270,15 @@ class RowReader {
   std::size_t overflow_ = 0;
 };
 
+bool is_png_name(const fs::path& path) {
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  return ext == ".png";
+}
+
 // Encodes and writes bands of rows in order into a temporary file; commit() renames it over the
-// target. Half output beyond the half range is refused (it would round to Inf), counted over all
+// target. 8- and 16-bit PNG goes through our PngEncoder (libdeflate), every other format through
+// OIIO. Half output beyond the half range is refused (it would round to Inf), counted over all
 // bands.
 class RowWriter {
  public:
@@ -281,18 +292,27 @@ class RowWriter {
   // Into `bytes`: `name`'s extension picks the writer.
   static Result<RowWriter> open_memory(std::vector<unsigned char>& bytes, const fs::path& name, const ImageLayout& layout,
                                        const WriteOptions& options) {
-    auto proxy = std::make_unique<OIIO::Filesystem::IOVecOutput>(bytes);
-    auto writer = open(name, name, std::nullopt, proxy.get(), layout, options);
-    if (writer) writer->proxy_ = std::move(proxy);
-    return writer;
+    return open(name, name, std::nullopt, &bytes, layout, options);
   }
 
  private:
   static Result<RowWriter> open(const fs::path& path, const fs::path& written, std::optional<AtomicFile> file,
-                                OIIO::Filesystem::IOProxy* proxy, const ImageLayout& layout, const WriteOptions& options) {
-    auto out = OIIO::ImageOutput::create(written.string());
-    if (!out) return Error{path.string(), "no image writer for this extension: " + first_line(OIIO::geterror())};
-    if (proxy && !out->set_ioproxy(proxy)) return Error{path.string(), "this format cannot be written to memory"};
+                                std::vector<unsigned char>* memory, const ImageLayout& layout, const WriteOptions& options) {
+    if (options.png_level < 0 || options.png_level > kPngLevelSmallest) {
+      return Error{path.string(), "PNG compression level " + std::to_string(options.png_level) + " is not 0 to 12"};
+    }
+    RowWriter writer(path, written, std::move(file), memory, layout, options);
+    if (is_png_name(written) && is_integer(options.type)) {
+      writer.png_ = std::make_unique<PngEncoder>(layout, options.type == SampleType::u8 ? 8 : 16, options.png_level,
+                                                 options.colorspace);
+      return writer;
+    }
+    writer.out_ = OIIO::ImageOutput::create(written.string());
+    if (!writer.out_) return Error{path.string(), "no image writer for this extension: " + first_line(OIIO::geterror())};
+    if (memory) {
+      writer.proxy_ = std::make_unique<OIIO::Filesystem::IOVecOutput>(*memory);
+      if (!writer.out_->set_ioproxy(writer.proxy_.get())) return Error{path.string(), "this format cannot be written to memory"};
+    }
 
     ImageSpec spec(layout.width, layout.height, layout.channels, type_desc(options.type));
     if (layout.channel_names.size() == std::size_t(layout.channels)) spec.channelnames = layout.channel_names;
@@ -303,10 +323,12 @@ class RowWriter {
     spec.attribute("DateTime", "");
     if (!options.colorspace.empty()) spec.attribute("oiio:ColorSpace", options.colorspace);
     std::string compression = options.compression;
-    if (compression.empty() && std::string_view(out->format_name()) == "openexr") compression = "zip";
+    if (compression.empty() && std::string_view(writer.out_->format_name()) == "openexr") compression = "zip";
     if (!compression.empty()) spec.attribute("compression", compression);
-    if (!out->open(written.string(), spec)) return Error{path.string(), "cannot write: " + first_line(out->geterror())};
-    return RowWriter(path, std::move(file), std::move(out), layout, options);
+    if (!writer.out_->open(written.string(), spec)) {
+      return Error{path.string(), "cannot write: " + first_line(writer.out_->geterror())};
+    }
+    return writer;
   }
 
  public:
@@ -325,14 +347,26 @@ class RowWriter {
       return Error{path_.string(),
                    std::to_string(beyond_half_) + " samples exceed the half-float range (65504); use float samples"};
     }
-    if (!out_->close()) return Error{path_.string(), "cannot write: " + first_line(out_->geterror())};
+    if (png_) {
+      const std::string bytes = png_->finish();
+      if (memory_) {
+        memory_->assign(bytes.begin(), bytes.end());
+        return success();
+      }
+      std::ofstream file(written_, std::ios::binary | std::ios::trunc);
+      file.write(bytes.data(), std::streamsize(bytes.size()));
+      file.close();
+      if (!file) return Error{path_.string(), "cannot write (disk full or not writable?)"};
+    } else if (!out_->close()) {
+      return Error{path_.string(), "cannot write: " + first_line(out_->geterror())};
+    }
     return file_ ? file_->commit() : success();
   }
 
  private:
-  RowWriter(fs::path path, std::optional<AtomicFile> file, std::unique_ptr<OIIO::ImageOutput> out, const ImageLayout& layout,
-            const WriteOptions& options)
-      : path_(std::move(path)), file_(std::move(file)), out_(std::move(out)), options_(options),
+  RowWriter(fs::path path, fs::path written, std::optional<AtomicFile> file, std::vector<unsigned char>* memory,
+            const ImageLayout& layout, const WriteOptions& options)
+      : path_(std::move(path)), written_(std::move(written)), file_(std::move(file)), memory_(memory), options_(options),
         transfers_(channel_transfers(layout, options.colour)) {}
 
   template <class T>
@@ -348,6 +382,12 @@ class RowWriter {
       }
     }
     if (beyond_half_ > 0) return success();  // keep counting; commit() refuses
+    if constexpr (!std::is_same_v<T, float>) {
+      if (png_) {
+        png_->add_rows(std::span<const T>(samples));
+        return success();
+      }
+    }
     if (!out_->write_scanlines(y, y + rows, 0, scanline_type<T>(), samples.data())) {
       return Error{path_.string(), "cannot write: " + first_line(out_->geterror())};
     }
@@ -362,9 +402,12 @@ class RowWriter {
   }
 
   fs::path path_;
-  std::optional<AtomicFile> file_;  // none when writing to memory
+  fs::path written_;                  // the temporary file (or, in memory, the name)
+  std::optional<AtomicFile> file_;    // none when writing to memory
+  std::vector<unsigned char>* memory_ = nullptr;
   std::unique_ptr<OIIO::Filesystem::IOProxy> proxy_;  // declared before out_: outlives it
-  std::unique_ptr<OIIO::ImageOutput> out_;
+  std::unique_ptr<OIIO::ImageOutput> out_;            // every format but 8/16-bit PNG
+  std::unique_ptr<PngEncoder> png_;                   // 8/16-bit PNG
   WriteOptions options_;
   std::vector<color::Transfer> transfers_;
   std::vector<std::byte> encoded_;
@@ -438,6 +481,16 @@ std::string_view sample_type_name(SampleType type) {
     case SampleType::f32: return "float";
   }
   return "?";
+}
+
+std::optional<int> png_level_from_name(std::string_view name) {
+  if (name == "fast") return kPngLevelFast;
+  if (name == "default") return kPngLevelDefault;
+  if (name == "small") return kPngLevelSmallest;
+  int level = -1;
+  const auto [end, ec] = std::from_chars(name.data(), name.data() + name.size(), level);
+  if (ec != std::errc() || end != name.data() + name.size() || level < 0 || level > kPngLevelSmallest) return std::nullopt;
+  return level;
 }
 
 bool is_integer(SampleType type) { return type == SampleType::u8 || type == SampleType::u16; }

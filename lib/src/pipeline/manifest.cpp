@@ -98,6 +98,21 @@ Status read_validation(const Reader& r, const toml::table& t, const std::string&
   return success();
 }
 
+// png_compression = "fast" | "default" | "small" | a level 0 to 12 (as --png-compression takes it).
+Status read_png_compression(const Reader& r, const toml::table& t, const std::string& where, int& level) {
+  const toml::node* node = t.get("png_compression");
+  if (!node) return success();
+  std::optional<int> parsed;
+  if (auto name = node->value<std::string>()) {
+    parsed = image::png_level_from_name(*name);
+  } else if (auto number = node->is_integer() ? node->value<std::int64_t>() : std::nullopt) {
+    if (*number >= 0 && *number <= image::kPngLevelSmallest) parsed = int(*number);
+  }
+  if (!parsed) return r.at(*node, where + "png_compression: \"fast\", \"default\", \"small\" or a level 0 to 12");
+  level = *parsed;
+  return success();
+}
+
 // `ao = { ... }` of a scene: every field of ao::Request, by the names the command line uses.
 Result<ao::Request> read_ao(const Reader& r, const toml::node& node, const std::string& where) {
   const toml::table* t = node.as_table();
@@ -138,7 +153,8 @@ Result<ao::Request> read_ao(const Reader& r, const toml::node& node, const std::
 }
 
 Result<MaterialSpec> read_material(const Reader& r, const std::string& name, const toml::node& node,
-                                   const Manifest& m, color::Transfer transfer, const ValidationRules& rules) {
+                                   const Manifest& m, color::Transfer transfer, const ValidationRules& rules,
+                                   int png_level) {
   const std::string where = "materials." + name;
   const toml::table* t = node.as_table();
   if (!t) return r.at(node, where + " must be a table");
@@ -146,7 +162,7 @@ Result<MaterialSpec> read_material(const Reader& r, const std::string& name, con
     return r.at(node, "material name '" + name + "': letters, digits, '_', '-' and '.' only (it names files)");
   }
   if (Status s = r.known_keys(*t, where, {"sources", "packed", "transfer", "decode", "resize", "layout", "format", "bits",
-                                          "mapping", "reference", "validate"});
+                                          "png_compression", "mapping", "reference", "validate"});
       !s) {
     return s.error();
   }
@@ -154,6 +170,8 @@ Result<MaterialSpec> read_material(const Reader& r, const std::string& name, con
   spec.name = name;
   spec.transfer = transfer;
   spec.validation = rules;
+  spec.png_level = png_level;
+  if (Status s = read_png_compression(r, *t, where + ".", spec.png_level); !s) return s.error();
   std::string bits;
   for (Status s : {r.get_name(*t, "transfer", where, color::kTransferNames, spec.transfer),
                    r.get_name(*t, "decode", where, color::kTransferNames, spec.decode),
@@ -287,7 +305,7 @@ Result<Manifest> parse_manifest(std::string_view toml_text, const fs::path& file
                        std::to_string(e.source().begin.column),
                    "not valid TOML: " + std::string(e.description())};
     }
-    if (Status s = r.known_keys(doc, "the manifest", {"output", "table", "transfer", "validate", "materials", "scenes"}); !s) {
+    if (Status s = r.known_keys(doc, "the manifest", {"output", "table", "transfer", "png_compression", "validate", "materials", "scenes"}); !s) {
       return s.error();
     }
     std::string output = "out", table;
@@ -297,6 +315,8 @@ Result<Manifest> parse_manifest(std::string_view toml_text, const fs::path& file
     if (!table.empty()) m.table = m.folder / table;
     color::Transfer transfer = MaterialSpec{}.transfer;
     if (Status s = r.get_name(doc, "transfer", "manifest", color::kTransferNames, transfer); !s) return s.error();
+    int png_level = MaterialSpec{}.png_level;
+    if (Status s = read_png_compression(r, doc, "", png_level); !s) return s.error();
     ValidationRules rules;
     if (const toml::node* v = doc.get("validate")) {
       if (!v->is_table()) return r.at(*v, "validate must be a table");
@@ -305,7 +325,7 @@ Result<Manifest> parse_manifest(std::string_view toml_text, const fs::path& file
     if (const toml::node* mats = doc.get("materials")) {
       if (!mats->is_table()) return r.at(*mats, "materials must be a table of tables: [materials.NAME]");
       for (const auto& [key, value] : *mats->as_table()) {
-        auto spec = read_material(r, std::string(key.str()), value, m, transfer, rules);
+        auto spec = read_material(r, std::string(key.str()), value, m, transfer, rules, png_level);
         if (!spec) return spec.error();
         m.materials.push_back(std::move(*spec));
       }

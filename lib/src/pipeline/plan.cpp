@@ -35,6 +35,7 @@ nlohmann::json material_options(const MaterialSpec& m, const Manifest& manifest)
           {"layout", m.layout},
           {"format", m.format},
           {"bits", m.bits ? image::sample_type_name(*m.bits) : "default"},
+          {"png_level", m.png_level},
           {"mapping", workflow::roughness_mapping_name(m.mapping)},
           {"reference", m.reference},
           {"table", manifest.table.string()},

@@ -183,7 +183,7 @@ Status run_material(const Job& job, const JobContext& ctx, JobReport& report) {
                                         {"errors", to_json(in_workflow->report.errors)}};
       }
       const std::vector<std::string> outputs(job.outputs.begin(), job.outputs.begin() + std::ptrdiff_t(layout->textures.size()));
-      auto written = pack::write_textures(*layout, in_workflow->maps, {outputs, m.bits, m.transfer, decoded_files(m), {}});
+      auto written = pack::write_textures(*layout, in_workflow->maps, {outputs, m.bits, m.transfer, decoded_files(m), {}, m.png_level});
       if (!written) return written.error();
     }
     if (m.validation.enabled) return validate_material(m, *maps, ctx, job.outputs, report);
