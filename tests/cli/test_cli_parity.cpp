@@ -127,6 +127,11 @@ TEST_F(Parity, PackAndWorkflowGiveTheManifestsBytes) {
       {"walter", "sources = { kd = \"kd.png\", ks = \"ks.png\", gloss = \"gloss.png\" }\nlayout = \"gltf-orm\"\nmapping = \"walter\"",
        {"workflow", "--to", "gltf-orm", "--kd", "kd.png", "--ks", "ks.png", "--gloss", "gloss.png", "--mapping", "walter"},
        {"base_color", "orm"}},
+      {"stored", "sources = { kd = \"kd.png\", ks = 0.04, gloss = \"gloss.png\" }\nlayout = \"schuler\"\npng_compression = 0",
+       {"pack", "--kd", "kd.png", "--ks", "0.04", "--gloss", "gloss.png", "--png-compression", "0"}, {"a", "b"}},
+      {"small", "sources = { kd = \"kd.png\", ks = \"ks.png\", gloss = \"gloss.png\" }\nlayout = \"gltf-orm\"\npng_compression = \"small\"",
+       {"workflow", "--to", "gltf-orm", "--kd", "kd.png", "--ks", "ks.png", "--gloss", "gloss.png", "--png-compression", "small"},
+       {"base_color", "orm"}},
       {"to_spec_gloss", "sources = { base_color = \"base.png\", metallic = \"metal.png\", roughness = \"rough.png\" }\nlayout = \"schuler\"",
        {"workflow", "--to", "schuler", "--base-color", "base.png", "--metallic", "metal.png", "--roughness", "rough.png"},
        {"a", "b"}},
@@ -147,6 +152,16 @@ TEST_F(Parity, PackAndWorkflowGiveTheManifestsBytes) {
     }
     expect_same_files(from_command, from_build, c.name);
   }
+  // The level reaches the file: the zlib header's FLEVEL (its second byte) says fastest, default or
+  // maximum compression (noise this small deflates to the same size at every level).
+  auto zlib_level_byte = [&](const std::string& file) {
+    const std::string bytes = read_bytes(dir / "out" / "materials" / file);
+    const std::size_t idat = bytes.find("IDAT");
+    return idat == std::string::npos ? -1 : int(std::uint8_t(bytes[idat + 5]));
+  };
+  EXPECT_EQ(zlib_level_byte("stored_a.png"), 0x01);
+  EXPECT_EQ(zlib_level_byte("defaults_a.png"), 0x9c);
+  EXPECT_EQ(zlib_level_byte("small_orm.png"), 0xda);
 }
 
 TEST_F(Parity, ValidateWritesTheManifestsReportAndHeatmap) {

@@ -128,6 +128,9 @@ TEST(BuildManifest, ErrorsSayWhereAndWhat) {
       // A float where an integer goes: refused, never cast (toml++ casts 2e52 to int64 unchecked; fuzzing).
       {"[scenes.s]\ninput = \"a.gltf\"\nao = { samples = 2e52 }\n", "m.toml:3:", "samples: an integer expected"},
       {"", "m.toml", "nothing to build"},
+      {"png_compression = 13\n[materials.a]\nsources = { kd = 0.5 }\n", "m.toml:1:", "png_compression: \"fast\""},
+      {"[materials.a]\nsources = { kd = 0.5 }\npng_compression = \"quick\"\n", "m.toml:3:", "materials.a.png_compression"},
+      {"[materials.a]\nsources = { kd = 0.5 }\npng_compression = 6.0\n", "m.toml:3:", "or a level 0 to 12"},
   };
   for (const Case& c : cases) {
     auto m = pipeline::parse_manifest(c.text, "m.toml");
