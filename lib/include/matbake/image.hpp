@@ -49,6 +49,10 @@ struct Image : ImageLayout {
   std::vector<float> pixels;  // width * height * channels, row-major, interleaved
 };
 
+// Reserves room for `samples` in `pixels` (before they are written), in 2 MiB pages where the
+// kernel allows: for every large image a module makes, so that filling it costs few page faults.
+void reserve_pixels(std::vector<float>& pixels, std::size_t samples);
+
 // Per-channel transfers: `colour` for colour channels, linear for alpha.
 std::vector<color::Transfer> channel_transfers(const ImageLayout& layout, color::Transfer colour);
 

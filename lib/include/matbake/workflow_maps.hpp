@@ -64,5 +64,7 @@ struct LayoutMaps {
   ConversionReport report;  // when converted
 };
 Result<LayoutMaps> in_layout_workflow(material::Maps maps, const pack::Layout& layout, RoughnessMapping mapping);
+// The conversion in_layout_workflow makes, if any.
+std::optional<Direction> layout_direction(const material::Maps& maps, const pack::Layout& layout);
 
 }  // namespace matbake::workflow

@@ -30,6 +30,7 @@ float rgba(const image::Image& im, std::size_t pixel, int c) {
 image::Image blank(int width, int height, int channels) {
   image::Image im;
   im.width = width, im.height = height, im.channels = channels;
+  image::reserve_pixels(im.pixels, im.sample_count());
   im.pixels.assign(im.sample_count(), 0.0f);
   return im;
 }

@@ -20,6 +20,7 @@
 #include "matbake/image.hpp"
 #include "matbake/pixels.hpp"
 #include "exr_header.hpp"
+#include "huge_pages.hpp"
 #include "oiio_guards.hpp"
 #include "png_encode.hpp"
 
@@ -371,6 +372,7 @@ class RowWriter {
 
   template <class T>
   Status encode_and_write(int y, int rows, std::span<const float> pixels) {
+    reserve_advised(encoded_, pixels.size() * sizeof(T));
     encoded_.resize(pixels.size() * sizeof(T));
     const std::span<T> samples(reinterpret_cast<T*>(encoded_.data()), pixels.size());
     color::encode_pixels(pixels, samples, transfers_);
@@ -425,7 +427,7 @@ Result<Image> read_whole(RowReader& reader, ReadInfo* info) {
   static_cast<ImageLayout&>(image) = reader.layout();
   // Reserved (address space only) and filled band by band: a file that declares more rows than it
   // holds fails at the first missing one, before the rest of its size is touched.
-  image.pixels.reserve(image.sample_count());
+  reserve_pixels(image.pixels, image.sample_count());
   const std::size_t row_samples = std::size_t(image.width) * std::size_t(image.channels);
   // About a million samples a band: few calls into OIIO.
   const int band_rows = int(std::max<std::size_t>(kBandRows, (std::size_t{1} << 20) / row_samples));

@@ -8,6 +8,8 @@
 #include <memory>
 #include <new>
 
+#include "huge_pages.hpp"
+
 namespace matbake::image {
 namespace {
 
@@ -99,7 +101,7 @@ PngEncoder::PngEncoder(const ImageLayout& layout, int bits, int level, std::stri
     : width_(layout.width), height_(layout.height), channels_(layout.channels), bits_(bits), level_(level),
       colorspace_(colorspace), row_bytes_(std::size_t(layout.width) * std::size_t(layout.channels) * std::size_t(bits / 8)),
       pixel_bytes_(std::size_t(layout.channels) * std::size_t(bits / 8)) {
-  filtered_.reserve((row_bytes_ + 1) * std::size_t(height_));
+  reserve_advised(filtered_, (row_bytes_ + 1) * std::size_t(height_));
   previous_.assign(row_bytes_, 0);
   current_.resize(row_bytes_);
   candidate_.resize(row_bytes_ * kFilterCount);
@@ -139,8 +141,12 @@ void PngEncoder::add_rows(std::span<const std::uint16_t> samples) {
 std::string PngEncoder::finish() {
   std::unique_ptr<libdeflate_compressor, CompressorDeleter> compressor(libdeflate_alloc_compressor(level_));
   if (!compressor) throw std::bad_alloc();
-  std::string zlib(libdeflate_zlib_compress_bound(compressor.get(), filtered_.size()), '\0');
-  zlib.resize(libdeflate_zlib_compress(compressor.get(), filtered_.data(), filtered_.size(), zlib.data(), zlib.size()));
+  // Not zero-filled: libdeflate writes it, and only what it writes is read.
+  const std::size_t bound = libdeflate_zlib_compress_bound(compressor.get(), filtered_.size());
+  const std::unique_ptr<char[]> zlib_bytes(new char[bound]);
+  advise_huge_pages(zlib_bytes.get(), bound);
+  const std::string_view zlib(zlib_bytes.get(), libdeflate_zlib_compress(compressor.get(), filtered_.data(),
+                                                                         filtered_.size(), zlib_bytes.get(), bound));
   std::vector<std::uint8_t>().swap(filtered_);
 
   constexpr int kColourType[5] = {0, 0, 4, 2, 6};  // by channel count: gray, gray+alpha, RGB, RGBA
@@ -151,11 +157,12 @@ std::string PngEncoder::finish() {
   constexpr std::size_t kIdatBytes = std::size_t{1} << 20;
   std::string png;
   png.reserve(zlib.size() + zlib.size() / kIdatBytes * 12 + 256);
+  advise_huge_pages(png.data(), png.capacity());
   png.append("\x89PNG\r\n\x1a\n", 8);
   put_chunk(png, "IHDR", header);
   put_colour_chunks(png, colorspace_);
   for (std::size_t at = 0; at < zlib.size(); at += kIdatBytes) {
-    put_chunk(png, "IDAT", std::string_view(zlib).substr(at, kIdatBytes));
+    put_chunk(png, "IDAT", zlib.substr(at, kIdatBytes));
   }
   put_chunk(png, "IEND", {});
   return png;

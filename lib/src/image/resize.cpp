@@ -16,6 +16,7 @@ Image resize_image(const Image& image, int width, int height) {
   static_cast<ImageLayout&>(out) = image;
   out.width = width;
   out.height = height;
+  reserve_pixels(out.pixels, out.sample_count());
   out.pixels.resize(out.sample_count());
   resized.get_pixels(OIIO::ROI::All(), OIIO::TypeDesc::FLOAT, out.pixels.data());
   return out;

@@ -89,6 +89,7 @@ image::Image blank(int width, int height, int channels) {
       {{}, {"Y"}, {"Y", "A"}, {"R", "G", "B"}, {"R", "G", "B", "A"}}};
   image.channel_names = kNames[std::size_t(channels)];
   image.alpha_channel = channels == 2 ? 1 : channels == 4 ? 3 : -1;
+  image::reserve_pixels(image.pixels, image.sample_count());
   image.pixels.assign(image.sample_count(), 0.0f);
   return image;
 }

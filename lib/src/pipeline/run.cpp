@@ -174,8 +174,12 @@ Status run_material(const Job& job, const JobContext& ctx, JobReport& report) {
     if (!m.layout.empty()) {
       auto layout = pack::find_layout(layout_reference(m.layout, ctx.manifest));
       if (!layout) return layout.error();
-      auto in_workflow = workflow::in_layout_workflow(*maps, *layout, m.mapping);
+      // Validation reads the maps as loaded: the workflow gets a copy only when it converts them
+      // (else it hands them back, and validation reads them there).
+      const bool converts = workflow::layout_direction(*maps, *layout).has_value();
+      auto in_workflow = workflow::in_layout_workflow(converts ? material::Maps(*maps) : std::move(*maps), *layout, m.mapping);
       if (!in_workflow) return in_workflow.error();
+      if (!converts) *maps = std::move(in_workflow->maps);
       if (const auto& d = in_workflow->direction) {
         report.details["conversion"] = {{"direction", workflow::direction_name(*d)},
                                         {"mapping", workflow::roughness_mapping_name(m.mapping)},
@@ -183,7 +187,8 @@ Status run_material(const Job& job, const JobContext& ctx, JobReport& report) {
                                         {"errors", to_json(in_workflow->report.errors)}};
       }
       const std::vector<std::string> outputs(job.outputs.begin(), job.outputs.begin() + std::ptrdiff_t(layout->textures.size()));
-      auto written = pack::write_textures(*layout, in_workflow->maps, {outputs, m.bits, m.transfer, decoded_files(m), {}, m.png_level});
+      auto written = pack::write_textures(*layout, converts ? in_workflow->maps : *maps,
+                                          {outputs, m.bits, m.transfer, decoded_files(m), {}, m.png_level});
       if (!written) return written.error();
     }
     if (m.validation.enabled) return validate_material(m, *maps, ctx, job.outputs, report);

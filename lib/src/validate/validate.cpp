@@ -415,6 +415,7 @@ image::Image heatmap(const Report& report) {
   out.height = report.height;
   out.channels = 3;
   out.channel_names = {"R", "G", "B"};
+  image::reserve_pixels(out.pixels, out.sample_count());
   out.pixels.resize(out.sample_count());
   const auto legend = heatmap_legend();
   // The legend is in 8-bit sRGB; the image is linear like every image in memory.

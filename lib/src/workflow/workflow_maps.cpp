@@ -23,6 +23,7 @@ image::Image like(const image::Image& shape, int channels) {
   m.height = shape.height;
   m.channels = channels;
   m.channel_names = channels == 3 ? std::vector<std::string>{"R", "G", "B"} : std::vector<std::string>{"Y"};
+  image::reserve_pixels(m.pixels, m.sample_count());
   m.pixels.assign(m.sample_count(), 0.0f);
   return m;
 }
@@ -207,25 +208,32 @@ std::string_view direction_name(Direction d) {
   return d == Direction::metal_rough_from_spec_gloss ? "spec-gloss to metal-rough" : "metal-rough to spec-gloss";
 }
 
-Result<LayoutMaps> in_layout_workflow(material::Maps maps, const pack::Layout& layout, RoughnessMapping mapping) {
+std::optional<Direction> layout_direction(const material::Maps& maps, const pack::Layout& layout) {
   const std::vector<std::string> read = pack::layout_sources(layout);
   const auto reads = [&](std::initializer_list<std::string_view> names) {
     return std::any_of(names.begin(), names.end(),
                        [&](std::string_view n) { return std::find(read.begin(), read.end(), n) != read.end(); });
   };
   const bool spec_gloss = maps.spec_gloss(), metal_rough = maps.metal_rough();
-  LayoutMaps out;
-  Result<material::Maps> converted = Error{};
   if (reads({material::kBaseColor, material::kMetallic, material::kRoughness}) && spec_gloss && !metal_rough) {
-    out.direction = Direction::metal_rough_from_spec_gloss;
-    converted = metal_rough_from_spec_gloss(maps, mapping, out.report);
-  } else if (reads({material::kKd, material::kKs, material::kGloss}) && metal_rough && !spec_gloss) {
-    out.direction = Direction::spec_gloss_from_metal_rough;
-    converted = spec_gloss_from_metal_rough(maps, mapping, out.report);
-  } else {
+    return Direction::metal_rough_from_spec_gloss;
+  }
+  if (reads({material::kKd, material::kKs, material::kGloss}) && metal_rough && !spec_gloss) {
+    return Direction::spec_gloss_from_metal_rough;
+  }
+  return std::nullopt;
+}
+
+Result<LayoutMaps> in_layout_workflow(material::Maps maps, const pack::Layout& layout, RoughnessMapping mapping) {
+  LayoutMaps out;
+  out.direction = layout_direction(maps, layout);
+  if (!out.direction) {
     out.maps = std::move(maps);
     return out;
   }
+  Result<material::Maps> converted = *out.direction == Direction::metal_rough_from_spec_gloss
+                                               ? metal_rough_from_spec_gloss(maps, mapping, out.report)
+                                               : spec_gloss_from_metal_rough(maps, mapping, out.report);
   if (!converted) return converted.error();
   out.maps = std::move(*converted);
   return out;
