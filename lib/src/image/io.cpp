@@ -20,7 +20,6 @@
 #include "matbake/image.hpp"
 #include "matbake/pixels.hpp"
 #include "exr_header.hpp"
-#include "huge_pages.hpp"
 #include "oiio_guards.hpp"
 #include "png_encode.hpp"
 
@@ -372,7 +371,6 @@ class RowWriter {
 
   template <class T>
   Status encode_and_write(int y, int rows, std::span<const float> pixels) {
-    reserve_advised(encoded_, pixels.size() * sizeof(T));
     encoded_.resize(pixels.size() * sizeof(T));
     const std::span<T> samples(reinterpret_cast<T*>(encoded_.data()), pixels.size());
     color::encode_pixels(pixels, samples, transfers_);
@@ -445,7 +443,14 @@ Status write_whole(RowWriter& writer, const Image& image) {
   if (image.channels < 1 || image.channels > 4 || image.pixels.size() != image.sample_count()) {
     return Error{"", "internal: inconsistent image"};
   }
-  if (Status s = writer.write_rows(0, image.height, image.pixels); !s) return s;
+  // In bands, so the encoded samples of one band are all the writer holds (and stay in cache).
+  const std::size_t row_samples = std::size_t(image.width) * std::size_t(image.channels);
+  const int band_rows = int(std::max<std::size_t>(kBandRows, (std::size_t{1} << 18) / row_samples));
+  for (int y = 0; y < image.height; y += band_rows) {
+    const int rows = std::min(band_rows, image.height - y);
+    const std::span<const float> band(image.pixels.data() + row_samples * std::size_t(y), row_samples * std::size_t(rows));
+    if (Status s = writer.write_rows(y, rows, band); !s) return s;
+  }
   return writer.commit();
 }
 

@@ -1,6 +1,7 @@
 #include "matbake/validate.hpp"
 
 #include <emmintrin.h>
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -442,17 +443,27 @@ Result<SpecularDiffuse> from_metal_rough(const image::Image& base, const image::
     return Error{"", "base colour " + std::to_string(base.width) + "x" + std::to_string(base.height) + ", metallic " +
                          std::to_string(metallic.width) + "x" + std::to_string(metallic.height)};
   }
-  SpecularDiffuse out{base, base};
+  // Shaped like the base colour; every sample is written below, so none is filled first.
+  const auto shaped_like_base = [&] {
+    image::Image image;
+    static_cast<image::ImageLayout&>(image) = base;
+    image::reserve_pixels(image.pixels, base.pixels.size());
+    image.pixels.resize(base.pixels.size());
+    return image;
+  };
+  SpecularDiffuse out{shaped_like_base(), shaped_like_base()};
   const std::size_t texels = std::size_t(base.width) * std::size_t(base.height);
-  for (std::size_t i = 0; i < texels; ++i) {
-    const double m = metallic.pixels[i * std::size_t(metallic.channels)];
-    const Vec3 b(base.pixels[i * 3], base.pixels[i * 3 + 1], base.pixels[i * 3 + 2]);
-    const Vec3 f0 = workflow::specular_from_metal_rough(b, m), diffuse = workflow::diffuse_from_metal_rough(b, m);
-    for (int c = 0; c < 3; ++c) {
-      out.specular.pixels[i * 3 + std::size_t(c)] = float(f0[c]);
-      out.diffuse.pixels[i * 3 + std::size_t(c)] = float(diffuse[c]);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, texels, 16384), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t i = r.begin(); i < r.end(); ++i) {
+      const double m = metallic.pixels[i * std::size_t(metallic.channels)];
+      const Vec3 b(base.pixels[i * 3], base.pixels[i * 3 + 1], base.pixels[i * 3 + 2]);
+      const Vec3 f0 = workflow::specular_from_metal_rough(b, m), diffuse = workflow::diffuse_from_metal_rough(b, m);
+      for (int c = 0; c < 3; ++c) {
+        out.specular.pixels[i * 3 + std::size_t(c)] = float(f0[c]);
+        out.diffuse.pixels[i * 3 + std::size_t(c)] = float(diffuse[c]);
+      }
     }
-  }
+  });
   return out;
 }
 
