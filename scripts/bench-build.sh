@@ -1,9 +1,11 @@
 #!/usr/bin/env bash
 # Benchmark of `matbake build` at scale (not part of the test run): N generated materials of
 # SIZE² (default 200 of 2048²), each a metal-rough base colour and roughness PNG packed into
-# glTF ORM textures and validated, built with --jobs 1 and then --jobs 2 (each from scratch).
-# Prints wall time, speed-up, peak RSS, and the time of a second run (nothing to do). The sources are generated once into WORK (default
-# /tmp/matbake-bench-build, about 3 GB for 200 × 2048²) and kept for later runs.
+# glTF ORM textures and validated, built with --jobs 1 and then --jobs 2 (each from scratch), then
+# with png_compression = "fast" (--jobs 2). Prints wall time, speed-up, peak RSS and the size of
+# the PNGs written, and the time of a second run (nothing to do). Stops at the first failing run.
+# The sources are generated once into WORK (default /tmp/matbake-bench-build, about 3 GB for
+# 200 × 2048²) and kept for later runs.
 #   scripts/bench-build.sh [N [SIZE [WORK]]]
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
@@ -42,16 +44,31 @@ if [ "$(cat "$work/made" 2>/dev/null)" != "$n $size" ]; then
   echo "$n $size" >"$work/made"
 fi
 
+# png_compression = "fast" for iteration builds: the same manifest with the key on top.
+{ echo 'png_compression = "fast"'; cat "$work/materials.toml"; } >"$work/materials-fast.toml"
+
 declare -A seconds rss
-for jobs in 1 2; do
+run() {  # name manifest jobs
   rm -rf "$work/out"
   sync
-  /usr/bin/time -f "%e %M" -o "$work/time.txt" "$matbake" build "$work/materials.toml" --jobs "$jobs" --quiet
-  read -r seconds[$jobs] rss[$jobs] <"$work/time.txt"
-  awk -v j="$jobs" -v s="${seconds[$jobs]}" -v n="$n" -v kb="${rss[$jobs]}" \
-    'BEGIN { printf "jobs %d: %6.1f s  %.2f materials/s  peak RSS %d MB\n", j, s, n / s, kb / 1024 }'
-done
-awk -v a="${seconds[1]}" -v b="${seconds[2]}" 'BEGIN { printf "speed-up with 2 jobs: %.2fx\n", a / b }'
+  if ! /usr/bin/time -f "%e %M" -o "$work/time.txt" "$matbake" build "$2" --jobs "$3" --quiet; then
+    echo "bench-build: matbake build $2 --jobs $3 failed" >&2
+    exit 1
+  fi
+  local s kb
+  read -r s kb <"$work/time.txt"
+  seconds[$1]=$s
+  rss[$1]=$kb
+  local bytes
+  bytes=$(find "$work/out" -name '*.png' -printf '%s\n' | awk '{ s += $1 } END { print s }')
+  awk -v name="$1" -v s="${seconds[$1]}" -v n="$n" -v kb="${rss[$1]}" -v bytes="$bytes" \
+    'BEGIN { printf "%-22s %6.1f s  %.2f materials/s  peak RSS %d MB  PNG output %.1f MB\n", name, s, n / s, kb / 1024, bytes / 1e6 }'
+}
+run "jobs 1" "$work/materials.toml" 1
+run "jobs 2" "$work/materials.toml" 2
+awk -v a="${seconds[jobs 1]}" -v b="${seconds[jobs 2]}" 'BEGIN { printf "speed-up with 2 jobs: %.2fx\n", a / b }'
+run "jobs 2, png fast" "$work/materials-fast.toml" 2
+run "jobs 2" "$work/materials.toml" 2  # last: the second run below finds these outputs
 # A second run finds everything up to date (stamps only; no decoding, no hashing).
 /usr/bin/time -f "%e" -o "$work/time.txt" "$matbake" build "$work/materials.toml"
 echo "second run: $(cat "$work/time.txt") s"
