@@ -2,8 +2,7 @@
 
 #include <libdeflate.h>
 
-#include <algorithm>
-#include <array>
+#include <cstdlib>
 #include <cstring>
 #include <memory>
 #include <new>
@@ -120,7 +119,6 @@ void PngEncoder::filter_row(const std::uint8_t* row) {
   const std::uint8_t* chosen = candidate_.data() + std::size_t(best) * row_bytes_;
   filtered_.insert(filtered_.end(), chosen, chosen + row_bytes_);
   std::memcpy(previous_.data(), row, row_bytes_);
-  ++rows_done_;
 }
 
 void PngEncoder::add_rows(std::span<const std::uint8_t> samples) {

@@ -34,7 +34,6 @@ class PngEncoder {
   std::vector<std::uint8_t> filtered_;  // filter byte + filtered row, per row so far
   std::vector<std::uint8_t> previous_, current_;  // raw rows, for the filters (Up, Average, Paeth)
   std::vector<std::uint8_t> candidate_;  // one filtered row per filter type
-  int rows_done_ = 0;
 };
 
 }  // namespace matbake::image
