@@ -53,7 +53,10 @@ TEST(GltfDocument, GltfToAnotherFolderMergesBuffersAndCopiesImages) {
   EXPECT_EQ(doc->buffers[0].size(), test::read_bytes(dir / "in" / "geometry.bin").size());
 
   const int extra = gltf::add_float_accessor(*doc, {0.25f, 0.5f}, 2, "SCALAR");  // a second buffer
-  ASSERT_TRUE(gltf::write_document(*doc, dir / "out" / "copy.gltf"));
+  {
+    auto written = gltf::write_document(*doc, dir / "out" / "copy.gltf");
+    ASSERT_TRUE(written) << written.error().to_string();
+  }
   EXPECT_EQ(test::list_folder(dir / "out"), (std::vector<std::string>{"copy.bin", "copy.gltf", "tex"}));
   EXPECT_EQ(test::read_bytes(dir / "out" / "tex" / "a b.png"), test::read_bytes(dir / "in" / "tex" / "a b.png"));
 
@@ -274,6 +277,51 @@ TEST(AoGltfOutput, SameBytesEveryTime) {
   EXPECT_EQ(test::read_bytes(dir / "a.glb"), test::read_bytes(dir / "b.glb"));
   EXPECT_EQ(test::list_folder(dir.path()),
             (std::vector<std::string>{"a.bin", "a.glb", "a.gltf", "b.glb", "instanced.gltf"}));
+}
+
+}  // namespace
+}  // namespace matbake
+
+namespace matbake {
+namespace {
+
+// Integers of a glTF given as floats beyond every integer type (found by fuzzing: nlohmann converts
+// them with undefined behaviour, which UBSan reports): each is an error naming the file, and
+// integer_in keeps in-range integers and refuses floats, negatives and out-of-range values.
+TEST(GltfDocument, HugeFloatIntegersAreErrorsNotUndefinedBehaviour) {
+  TempDir dir;
+  // 12 bytes of buffer (one float VEC3), as a data: URI.
+  const std::string buffer = "data:application/octet-stream;base64,AAAAAAAAAAAAAAAA";
+  const char* cases[][2] = {
+      {R"("byteOffset": 2.3e45)", R"("bufferView": 0)"},
+      {R"("byteOffset": 0)", R"("bufferView": 1e300)"},
+      {R"("count": 1e30)", R"("bufferView": 0)"},
+      {R"("byteOffset": -4)", R"("bufferView": 0)"},
+  };
+  for (const auto& c : cases) {
+    const std::string accessor_fields = std::string(c[0]) + ", " + c[1];
+    const bool count_given = std::string(c[0]).find("count") != std::string::npos;
+    const std::string json = R"({"asset": {"version": "2.0"}, "buffers": [{"byteLength": 12, "uri": ")" + buffer +
+                             R"("}], "bufferViews": [{"buffer": 0, "byteLength": 12}], "accessors": [{)" + accessor_fields +
+                             (count_given ? "" : R"(, "count": 1)") + R"(, "componentType": 5126, "type": "VEC3"}]})";
+    std::ofstream(dir / "bad.gltf") << json;
+    auto doc = gltf::read_document(dir / "bad.gltf");
+    ASSERT_FALSE(doc) << json;
+    EXPECT_NE(doc.error().path.find("bad.gltf"), std::string::npos) << doc.error().to_string();
+  }
+  const gltf::Json values = gltf::Json::parse(R"({"a": 7, "b": 2.5, "c": -3, "d": 5000000000, "e": 1e45})");
+  EXPECT_EQ(gltf::integer_in<int>(values, "a", -1, 99), 7);
+  EXPECT_EQ(gltf::integer_in<int>(values, "missing", -1, 99), -1);
+  EXPECT_EQ(gltf::integer_in<int>(values, "b", -1, 99), 99);
+  EXPECT_EQ(gltf::integer_in<int>(values, "c", -1, 99), -3);
+  EXPECT_EQ(gltf::integer_in<int>(values, "d", -1, 99), 99);
+  EXPECT_EQ(gltf::integer_in<int>(values, "e", -1, 99), 99);
+  EXPECT_EQ(gltf::size_in(values, "c", 0), SIZE_MAX);
+  EXPECT_EQ(gltf::size_in(values, "d", 0), std::size_t{5000000000});
+  EXPECT_EQ(gltf::size_in(values, "e", 0), SIZE_MAX);
+  const gltf::Json made = {{"n", int(12)}, {"m", std::int64_t(-1)}};  // signed storage, as code sets it
+  EXPECT_EQ(gltf::size_in(made, "n", 0), 12u);
+  EXPECT_EQ(gltf::size_in(made, "m", 0), SIZE_MAX);
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 
 #include "../gltf/document.hpp"
@@ -14,6 +15,12 @@ namespace matbake::exporter {
 namespace fs = std::filesystem;
 using gltf::Json;
 namespace {
+
+// An integer of the glTF (a texture index, a texCoord set) read safely: INT_MAX, which no texture
+// or set has, when it is not an int (gltf::integer_in).
+int int_in(const gltf::Json& object, const char* key, int fallback) {
+  return gltf::integer_in(object, key, fallback, std::numeric_limits<int>::max());
+}
 
 constexpr const char* kSpecGloss = "KHR_materials_pbrSpecularGlossiness";
 constexpr const char* kSpecular = "KHR_materials_specular";
@@ -116,7 +123,7 @@ struct Exporter {
     if (orm) {
       Json occlusion = material.value("occlusionTexture", Json::object());
       occlusion["index"] = *mr_texture;
-      occlusion["texCoord"] = texture_info.value("texCoord", 0);
+      occlusion["texCoord"] = int_in(texture_info, "texCoord", 0);
       material["occlusionTexture"] = occlusion;
     }
     return success();
@@ -173,7 +180,7 @@ struct Exporter {
     for (int t = 0; t < 2; ++t) {
       if (!ext.contains(keys[t])) continue;
       // Both store colour sRGB-encoded and alpha (opacity, gloss) linear.
-      auto im = cache.texture(ext[keys[t]].value("index", -1), color::Transfer::srgb);
+      auto im = cache.texture(int_in(ext[keys[t]], "index", -1), color::Transfer::srgb);
       if (!im) return im.error();
       textures[t] = *im;
       if (std::size_t((*im)->width) * (*im)->height > std::size_t(width) * height) width = (*im)->width, height = (*im)->height;
@@ -223,7 +230,7 @@ struct Exporter {
     if (!maps) return Error{doc.file, "material " + std::to_string(index) + ": " + maps.error().message};
     Json info = ext.contains("diffuseTexture") ? ext["diffuseTexture"] : Json::object();
     info.erase("index");
-    const int sampler_of = ext.contains("diffuseTexture") ? ext["diffuseTexture"].value("index", -1) : -1;
+    const int sampler_of = ext.contains("diffuseTexture") ? int_in(ext["diffuseTexture"], "index", -1) : -1;
     if (Status s = write_metal_rough(material, *maps, "material" + std::to_string(index), info, sampler_of); !s) return s;
     add_dielectric_f0(material, conversion, out);
     out.conversion = conversion;
@@ -250,7 +257,7 @@ struct Exporter {
     int sampler_of = -1;
     if (material.contains("pbrMetallicRoughness") && material["pbrMetallicRoughness"].contains("baseColorTexture")) {
       info = material["pbrMetallicRoughness"]["baseColorTexture"];
-      sampler_of = info.value("index", -1);
+      sampler_of = int_in(info, "index", -1);
       info.erase("index");
     }
     const std::string name = "material" + std::to_string(index);
@@ -278,8 +285,8 @@ struct Exporter {
     }
     Json& mr = material["pbrMetallicRoughness"]["metallicRoughnessTexture"];
     Json& occlusion = material["occlusionTexture"];
-    const int mr_index = mr.value("index", -1), occlusion_index = occlusion.value("index", -1);
-    if (mr_index == occlusion_index || mr.value("texCoord", 0) != occlusion.value("texCoord", 0) ||
+    const int mr_index = int_in(mr, "index", -1), occlusion_index = int_in(occlusion, "index", -1);
+    if (mr_index == occlusion_index || int_in(mr, "texCoord", 0) != int_in(occlusion, "texCoord", 0) ||
         mr.contains("extensions") || occlusion.contains("extensions")) {
       return success();  // already one texture, or mapped differently: nothing to pack
     }
@@ -333,7 +340,7 @@ Status check_texture_coordinates(const gltf::Document& doc) {
       const Json& material = doc.json["materials"][primitive["material"].get<std::size_t>()];
       std::string missing;
       const auto check = [&](const Json& info) {
-        const std::string set = "TEXCOORD_" + std::to_string(info.value("texCoord", 0));
+        const std::string set = "TEXCOORD_" + std::to_string(int_in(info, "texCoord", 0));
         if (!primitive["attributes"].contains(set)) missing = set;
       };
       if (material.contains("pbrMetallicRoughness")) {

@@ -125,8 +125,8 @@ std::size_t component_size_of(int type) {
 Status check_accessors(const Document& doc) {
   const Json& views = array_in(doc.json, "bufferViews");
   for (std::size_t v = 0; v < views.size(); ++v) {
-    const std::size_t buffer = views[v].value("buffer", std::size_t(-1));
-    const std::size_t offset = views[v].value("byteOffset", std::size_t{0}), length = views[v].value("byteLength", std::size_t{0});
+    const std::size_t buffer = size_in(views[v], "buffer", SIZE_MAX);
+    const std::size_t offset = size_in(views[v], "byteOffset", 0), length = size_in(views[v], "byteLength", 0);
     if (buffer >= doc.buffers.size() || offset > doc.buffers[buffer].size() || length > doc.buffers[buffer].size() - offset) {
       return Error{doc.file, "buffer view " + std::to_string(v) + " reaches beyond its buffer"};
     }
@@ -168,8 +168,8 @@ Result<std::string> image_bytes(const Document& doc, std::size_t index) {
       const std::size_t v = image["bufferView"].get<std::size_t>();
       if (!doc.json.contains("bufferViews") || v >= doc.json["bufferViews"].size()) return Error{doc.file, what + ": no such buffer view"};
       const Json& view = doc.json["bufferViews"][v];
-      const std::size_t buffer = view.value("buffer", std::size_t{0}), offset = view.value("byteOffset", std::size_t{0}),
-                        length = view.value("byteLength", std::size_t{0});
+      const std::size_t buffer = size_in(view, "buffer", 0), offset = size_in(view, "byteOffset", 0),
+                        length = size_in(view, "byteLength", 0);
       if (buffer >= doc.buffers.size() || offset + length > doc.buffers[buffer].size()) {
         return Error{doc.file, what + ": its buffer view reaches beyond its buffer"};
       }
@@ -201,26 +201,26 @@ Result<AccessorBytes> accessor_bytes(const Document& doc, std::size_t index) {
   if (index >= accessors.size()) return Error{doc.file, name + " does not exist"};
   const Json& accessor = accessors[index];
   const Json& views = array_in(doc.json, "bufferViews");
-  const std::size_t v = accessor.value("bufferView", std::size_t(-1));
+  const std::size_t v = size_in(accessor, "bufferView", SIZE_MAX);
   if (v >= views.size()) return Error{doc.file, name + " has no buffer view"};
   AccessorBytes out;
-  out.component_type = accessor.value("componentType", 0);
+  out.component_type = integer_in(accessor, "componentType", 0, 0);  // 0: an unknown type
   out.components = components_of(accessor.value("type", ""));
   out.component_size = component_size_of(out.component_type);
   if (out.components == 0 || out.component_size == 0) return Error{doc.file, name + " has an unknown type"};
-  out.count = accessor.value("count", std::size_t{0});
+  out.count = size_in(accessor, "count", 0);
   out.normalized = accessor.value("normalized", false);
   out.sparse = accessor.contains("sparse");
   const Json& view = views[v];
-  const std::size_t buffer = view.value("buffer", std::size_t(-1));
-  const std::size_t view_offset = view.value("byteOffset", std::size_t{0}), length = view.value("byteLength", std::size_t{0});
+  const std::size_t buffer = size_in(view, "buffer", SIZE_MAX);
+  const std::size_t view_offset = size_in(view, "byteOffset", 0), length = size_in(view, "byteLength", 0);
   if (buffer >= doc.buffers.size() || view_offset > doc.buffers[buffer].size() ||
       length > doc.buffers[buffer].size() - view_offset) {
     return Error{doc.file, "buffer view " + std::to_string(v) + " reaches beyond its buffer"};
   }
   const std::size_t element = out.components * out.component_size;
-  out.stride = view.value("byteStride", element);
-  const std::size_t offset = accessor.value("byteOffset", std::size_t{0});
+  out.stride = size_in(view, "byteStride", element);
+  const std::size_t offset = size_in(accessor, "byteOffset", 0);
   // offset + stride (count − 1) + element ≤ length, without overflow for a hostile count.
   const bool fits = out.count == 0 || (offset <= length && element <= length - offset &&
                                        (out.stride == 0 || out.count - 1 <= (length - offset - element) / out.stride));
@@ -286,7 +286,7 @@ Result<Document> read_document(const fs::path& path) {
           for_tinygltf["buffers"][0].is_object() && !for_tinygltf["buffers"][0].contains("uri")) {
         for_tinygltf["buffers"][0]["uri"] = kGlbBinUri;
         // The chunk may carry up to 3 bytes of padding beyond the buffer's byteLength.
-        const std::size_t length = for_tinygltf["buffers"][0].value("byteLength", std::size_t{0});
+        const std::size_t length = size_in(for_tinygltf["buffers"][0], "byteLength", 0);
         if (glb->bin.size() > length) glb->bin.resize(length);
       }
       if (Status loaded = load_model_json(path, for_tinygltf.dump(), glb->bin, model); !loaded) return loaded.error();
@@ -303,7 +303,7 @@ Result<Document> read_document(const fs::path& path) {
     for (std::size_t i = 0; i < model.buffers.size(); ++i) {
       std::vector<unsigned char> data = std::move(model.buffers[i].data);
       // A GLB's BIN chunk may carry up to 3 bytes of padding beyond the buffer's byteLength.
-      data.resize(std::min(data.size(), std::size_t(doc.json["buffers"][i].value("byteLength", std::size_t{0}))));
+      data.resize(std::min(data.size(), std::size_t(size_in(doc.json["buffers"][i], "byteLength", 0))));
       doc.buffers.push_back(std::move(data));
     }
     if (Status s = check_accessors(doc); !s) return s.error();
@@ -366,10 +366,10 @@ Result<std::vector<fs::path>> write_document(const Document& doc, const fs::path
     }
     if (json.contains("bufferViews")) {
       for (Json& view : json["bufferViews"]) {
-        const std::size_t buffer = view.value("buffer", std::size_t{0});
+        const std::size_t buffer = size_in(view, "buffer", 0);
         if (buffer >= base.size()) return Error{doc.file, "a buffer view names a buffer that does not exist"};
         view["buffer"] = 0;
-        view["byteOffset"] = base[buffer] + view.value("byteOffset", std::size_t{0});
+        view["byteOffset"] = base[buffer] + size_in(view, "byteOffset", 0);
       }
     }
 

@@ -6,6 +6,8 @@
 #include <nlohmann/json.hpp>
 
 #include <cstdint>
+#include <limits>
+#include <type_traits>
 #include <filesystem>
 #include <map>
 #include <span>
@@ -69,6 +71,30 @@ Result<std::string> image_bytes(const Document& doc, std::size_t index);
 
 // json[key] when it is an array, else an empty array: a glTF's optional lists read without checks.
 const Json& array_in(const Json& json, const char* key);
+
+// object[key] as an integer of type T: `fallback` when absent, `invalid` when it is not an integer
+// T holds. nlohmann's value() converts a float such as 2e45 to an integer type with undefined
+// behaviour (found by fuzzing), so every integer of a glTF is read through this.
+template <class T>
+T integer_in(const Json& object, const char* key, T fallback, T invalid) {
+  const auto it = object.find(key);
+  if (it == object.end()) return fallback;
+  if (it->is_number_unsigned()) {
+    const std::uint64_t v = it->get<std::uint64_t>();
+    return v <= std::uint64_t(std::numeric_limits<T>::max()) ? T(v) : invalid;
+  }
+  if (it->is_number_integer()) {  // signed storage (parsed negatives, or set from an int)
+    const std::int64_t v = it->get<std::int64_t>();
+    if constexpr (std::is_signed_v<T>) return v >= std::numeric_limits<T>::min() && v <= std::numeric_limits<T>::max() ? T(v) : invalid;
+    return v >= 0 && std::uint64_t(v) <= std::uint64_t(std::numeric_limits<T>::max()) ? T(v) : invalid;
+  }
+  return invalid;
+}
+
+// A size, offset or index: SIZE_MAX (which every bounds check refuses) when not a valid integer.
+inline std::size_t size_in(const Json& object, const char* key, std::size_t fallback) {
+  return integer_in<std::size_t>(object, key, fallback, SIZE_MAX);
+}
 
 // The JSON of a .gltf or .glb alone (no buffers read, nothing checked but the container).
 Result<Json> read_json(const std::filesystem::path& path);

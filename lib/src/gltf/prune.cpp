@@ -247,10 +247,10 @@ std::vector<std::string> prune_unreachable(Document& doc) {
   bool views_ok = true;
   std::size_t total = 0;
   for_each_in(json, "bufferViews", [&](Json& view) {
-    const std::size_t buffer = view.value("buffer", std::size_t{0});
+    const std::size_t buffer = size_in(view, "buffer", 0);
     views_ok = views_ok && buffer < doc.buffers.size() &&
-               view.value("byteOffset", std::size_t{0}) + view.value("byteLength", std::size_t{0}) <= doc.buffers[buffer].size();
-    total += view.value("byteLength", std::size_t{0}) + 3;
+               size_in(view, "byteOffset", 0) + size_in(view, "byteLength", 0) <= doc.buffers[buffer].size();
+    total += size_in(view, "byteLength", 0) + 3;
   });
   if (!views_ok) return removed;
   // Every view kept, in one buffer: nothing to compact (a large scene's bytes are not copied).
@@ -262,12 +262,12 @@ std::vector<std::string> prune_unreachable(Document& doc) {
   std::vector<unsigned char> compact;
   compact.reserve(total);  // one allocation: a large scene's buffer is copied once, not regrown
   for_each_in(json, "bufferViews", [&](Json& view) {
-    const auto& from = doc.buffers[view.value("buffer", std::size_t{0})];
-    const auto begin = from.begin() + std::ptrdiff_t(view.value("byteOffset", std::size_t{0}));
+    const auto& from = doc.buffers[size_in(view, "buffer", 0)];
+    const auto begin = from.begin() + std::ptrdiff_t(size_in(view, "byteOffset", 0));
     compact.resize((compact.size() + 3) / 4 * 4, 0);
     view["buffer"] = 0;
     view["byteOffset"] = compact.size();
-    compact.insert(compact.end(), begin, begin + std::ptrdiff_t(view.value("byteLength", std::size_t{0})));
+    compact.insert(compact.end(), begin, begin + std::ptrdiff_t(size_in(view, "byteLength", 0)));
   });
   doc.buffers.clear();
   json.erase("buffers");
