@@ -12,6 +12,7 @@
 #include <cstring>
 #include <fstream>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <thread>
@@ -19,6 +20,7 @@
 #include "matbake/atomic_file.hpp"
 #include "matbake/image.hpp"
 #include "matbake/pixels.hpp"
+#include "exr_encode.hpp"
 #include "exr_header.hpp"
 #include "oiio_guards.hpp"
 #include "png_encode.hpp"
@@ -270,16 +272,28 @@ class RowReader {
   std::size_t overflow_ = 0;
 };
 
-bool is_png_name(const fs::path& path) {
+// `extension` in lower case, with its dot.
+bool has_extension(const fs::path& path, std::string_view extension) {
   std::string ext = path.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-  return ext == ".png";
+  return ext == extension;
 }
 
+// A band of rows encoded for the file: samples as stored (PNG, OIIO's formats) or, for the EXR
+// that matbake writes, its chunks.
+struct EncodedBand {
+  int y = 0;
+  int rows = 0;
+  std::vector<std::byte> samples;
+  std::vector<ExrChunk> chunks;
+  std::size_t beyond_half = 0;  // samples that half cannot hold
+};
+
 // Encodes and writes bands of rows in order into a temporary file; commit() renames it over the
-// target. 8- and 16-bit PNG goes through our PngEncoder (libdeflate), every other format through
-// OIIO. Half output beyond the half range is refused (it would round to Inf), counted over all
-// bands.
+// target. 8- and 16-bit PNG goes through our PngEncoder (libdeflate), scanline EXR (half or float;
+// none, zip or zips) through our ExrEncoder, every other format through OIIO. Bands may be encoded
+// in parallel (encode_rows) and are written in order (write_band). Half output beyond the half
+// range is refused (it would round to Inf), counted over all bands.
 class RowWriter {
  public:
   static Result<RowWriter> open(const fs::path& path, const ImageLayout& layout, const WriteOptions& options) {
@@ -302,9 +316,22 @@ class RowWriter {
       return Error{path.string(), "PNG compression level " + std::to_string(options.png_level) + " is not 0 to 12"};
     }
     RowWriter writer(path, written, std::move(file), memory, layout, options);
-    if (is_png_name(written) && is_integer(options.type)) {
+    if (has_extension(written, ".png") && is_integer(options.type)) {
       writer.png_ = std::make_unique<PngEncoder>(layout, options.type == SampleType::u8 ? 8 : 16, options.png_level,
                                                  options.colorspace);
+      return writer;
+    }
+    const bool exr = has_extension(written, ".exr");
+    const auto exr_compression = exr_compression_from_name(options.compression.empty() ? "zip" : options.compression);
+    if (exr && !is_integer(options.type) && exr_compression) {
+      ImageLayout named = layout;  // unnamed channels get OIIO's names, as OIIO would write them
+      if (named.channel_names.size() != std::size_t(layout.channels)) {
+        named.channel_names = ImageSpec(layout.width, layout.height, layout.channels).channelnames;
+      }
+      auto encoder = ExrEncoder::open(written, path.string(), memory, named, options.type, *exr_compression,
+                                      options.colorspace);
+      if (!encoder) return encoder.error();
+      writer.exr_ = std::make_unique<ExrEncoder>(std::move(*encoder));
       return writer;
     }
     writer.out_ = OIIO::ImageOutput::create(written.string());
@@ -332,12 +359,35 @@ class RowWriter {
   }
 
  public:
-  Status write_rows(int y, int rows, std::span<const float> pixels) {
+  // The first row of every band but the last is a multiple of this (EXR's chunks).
+  int band_alignment() const { return exr_ ? exr_->chunk_rows() : 1; }
+
+  // Into `band` (its storage reused). Thread-safe: bands may be encoded in parallel.
+  void encode_rows(int y, int rows, std::span<const float> pixels, EncodedBand& band) const {
+    band.y = y;
+    band.rows = rows;
+    band.beyond_half = 0;
     switch (options_.type) {
-      case SampleType::u8: return encode_and_write<uint8_t>(y, rows, pixels);
-      case SampleType::u16: return encode_and_write<uint16_t>(y, rows, pixels);
+      case SampleType::u8: encode_samples<uint8_t>(pixels, band); break;
+      case SampleType::u16: encode_samples<uint16_t>(pixels, band); break;
       case SampleType::half:
-      case SampleType::f32: return encode_and_write<float>(y, rows, pixels);  // OIIO rounds to half, nearest even
+      case SampleType::f32: encode_samples<float>(pixels, band); break;  // to half when written, nearest even
+    }
+    if (exr_ && band.beyond_half == 0) {
+      exr_->encode(y, rows, {reinterpret_cast<const float*>(band.samples.data()), pixels.size()}, band.chunks);
+    }
+  }
+
+  // In order of rows.
+  Status write_band(const EncodedBand& band) {
+    beyond_half_ += band.beyond_half;
+    if (beyond_half_ > 0) return success();  // keep counting; commit() refuses
+    if (exr_) return exr_->write(band.chunks);
+    switch (options_.type) {
+      case SampleType::u8: return write_samples<uint8_t>(band);
+      case SampleType::u16: return write_samples<uint16_t>(band);
+      case SampleType::half:
+      case SampleType::f32: return write_samples<float>(band);  // OIIO rounds to half, nearest even
     }
     return success();
   }
@@ -357,6 +407,8 @@ class RowWriter {
       file.write(bytes.data(), std::streamsize(bytes.size()));
       file.close();
       if (!file) return Error{path_.string(), "cannot write (disk full or not writable?)"};
+    } else if (exr_) {
+      if (Status s = exr_->finish(); !s) return s;
     } else if (!out_->close()) {
       return Error{path_.string(), "cannot write: " + first_line(out_->geterror())};
     }
@@ -370,25 +422,29 @@ class RowWriter {
         transfers_(channel_transfers(layout, options.colour)) {}
 
   template <class T>
-  Status encode_and_write(int y, int rows, std::span<const float> pixels) {
-    encoded_.resize(pixels.size() * sizeof(T));
-    const std::span<T> samples(reinterpret_cast<T*>(encoded_.data()), pixels.size());
+  void encode_samples(std::span<const float> pixels, EncodedBand& band) const {
+    band.samples.resize(pixels.size() * sizeof(T));
+    const std::span<T> samples(reinterpret_cast<T*>(band.samples.data()), pixels.size());
     color::encode_pixels(pixels, samples, transfers_);
     if constexpr (std::is_same_v<T, float>) {
       if (options_.type == SampleType::half) {
         constexpr float kHalfOverflow = 65520.0f;  // from here on, rounding to half gives Inf
-        beyond_half_ += std::size_t(
+        band.beyond_half = std::size_t(
             std::count_if(samples.begin(), samples.end(), [](float v) { return std::abs(v) >= kHalfOverflow; }));
       }
     }
-    if (beyond_half_ > 0) return success();  // keep counting; commit() refuses
+  }
+
+  template <class T>
+  Status write_samples(const EncodedBand& band) {
+    const std::span<const T> samples(reinterpret_cast<const T*>(band.samples.data()), band.samples.size() / sizeof(T));
     if constexpr (!std::is_same_v<T, float>) {
       if (png_) {
-        png_->add_rows(std::span<const T>(samples));
+        png_->add_rows(samples);
         return success();
       }
     }
-    if (!out_->write_scanlines(y, y + rows, 0, scanline_type<T>(), samples.data())) {
+    if (!out_->write_scanlines(band.y, band.y + band.rows, 0, scanline_type<T>(), samples.data())) {
       return Error{path_.string(), "cannot write: " + first_line(out_->geterror())};
     }
     return success();
@@ -406,11 +462,11 @@ class RowWriter {
   std::optional<AtomicFile> file_;    // none when writing to memory
   std::vector<unsigned char>* memory_ = nullptr;
   std::unique_ptr<OIIO::Filesystem::IOProxy> proxy_;  // declared before out_: outlives it
-  std::unique_ptr<OIIO::ImageOutput> out_;            // every format but 8/16-bit PNG
+  std::unique_ptr<OIIO::ImageOutput> out_;            // every other format
   std::unique_ptr<PngEncoder> png_;                   // 8/16-bit PNG
+  std::unique_ptr<ExrEncoder> exr_;                   // scanline EXR: half or float, none/zip/zips
   WriteOptions options_;
   std::vector<color::Transfer> transfers_;
-  std::vector<std::byte> encoded_;
   std::size_t beyond_half_ = 0;
 };
 
@@ -439,18 +495,92 @@ Result<Image> read_whole(RowReader& reader, ReadInfo* info) {
   return image;
 }
 
+// A band of rows on its way to the writer.
+struct Band {
+  int y = 0;
+  int rows = 0;
+  std::vector<float> pixels;     // the band's own pixels, when decoded into it (stream_image)
+  std::span<const float> view;   // the pixels to encode: `pixels` or rows of a whole image
+  EncodedBand encoded;
+};
+
+// Bands through `writer`: `next` (called in order, one call at a time) fills each band's rows and
+// pixels and returns false after the last; `prepare` (a transform) and the encoding run on several
+// bands at once, and the bands are written in order, so decoding, transforming and compressing
+// overlap on the cores. The bands' buffers go round (a written band is the next one filled): fresh
+// pages cost more than a fast deflate. Once `stop` is set nothing more is prepared, encoded or
+// written. Returns the first write error.
+Status write_bands(RowWriter& writer, const std::function<bool(Band&)>& next, const std::function<void(Band&)>& prepare,
+                   std::atomic<bool>& stop) {
+  std::optional<Error> write_error;
+  std::mutex spare_mutex;
+  std::vector<std::shared_ptr<Band>> spare;
+  const std::size_t tokens = 2 * std::max(1u, std::thread::hardware_concurrency());
+  tbb::parallel_pipeline(
+      tokens,
+      tbb::make_filter<void, std::shared_ptr<Band>>(tbb::filter_mode::serial_in_order,
+                                                    [&](tbb::flow_control& fc) -> std::shared_ptr<Band> {
+                                                      std::shared_ptr<Band> band;
+                                                      {
+                                                        std::lock_guard lock(spare_mutex);
+                                                        if (!spare.empty()) {
+                                                          band = std::move(spare.back());
+                                                          spare.pop_back();
+                                                        }
+                                                      }
+                                                      if (!band) band = std::make_shared<Band>();
+                                                      if (!next(*band)) {
+                                                        fc.stop();
+                                                        return nullptr;
+                                                      }
+                                                      return band;
+                                                    }) &
+          tbb::make_filter<std::shared_ptr<Band>, std::shared_ptr<Band>>(
+              tbb::filter_mode::parallel,
+              [&](std::shared_ptr<Band> band) {
+                if (stop) return band;
+                if (prepare) prepare(*band);
+                writer.encode_rows(band->y, band->rows, band->view, band->encoded);
+                return band;
+              }) &
+          tbb::make_filter<std::shared_ptr<Band>, void>(tbb::filter_mode::serial_in_order, [&](std::shared_ptr<Band> band) {
+            if (!stop) {
+              if (Status s = writer.write_band(band->encoded); !s) {
+                write_error = s.error();
+                stop = true;
+              }
+            }
+            std::lock_guard lock(spare_mutex);
+            spare.push_back(std::move(band));
+          }));
+  if (write_error) return *write_error;
+  return success();
+}
+
+// `rows` rounded up to a multiple of the writer's alignment (EXR chunks).
+int aligned_band_rows(const RowWriter& writer, std::size_t rows) {
+  const std::size_t alignment = std::size_t(writer.band_alignment());
+  return int((rows + alignment - 1) / alignment * alignment);
+}
+
 Status write_whole(RowWriter& writer, const Image& image) {
   if (image.channels < 1 || image.channels > 4 || image.pixels.size() != image.sample_count()) {
     return Error{"", "internal: inconsistent image"};
   }
-  // In bands, so the encoded samples of one band are all the writer holds (and stay in cache).
+  // In bands, so the encoded samples of a few bands are all the writer holds (and stay in cache).
   const std::size_t row_samples = std::size_t(image.width) * std::size_t(image.channels);
-  const int band_rows = int(std::max<std::size_t>(kBandRows, (std::size_t{1} << 18) / row_samples));
-  for (int y = 0; y < image.height; y += band_rows) {
-    const int rows = std::min(band_rows, image.height - y);
-    const std::span<const float> band(image.pixels.data() + row_samples * std::size_t(y), row_samples * std::size_t(rows));
-    if (Status s = writer.write_rows(y, rows, band); !s) return s;
-  }
+  const int band_rows = aligned_band_rows(writer, std::max<std::size_t>(kBandRows, (std::size_t{1} << 18) / row_samples));
+  int next_row = 0;
+  std::atomic<bool> stop{false};
+  const auto next = [&](Band& band) {
+    if (next_row >= image.height) return false;
+    band.y = next_row;
+    band.rows = std::min(band_rows, image.height - next_row);
+    band.view = {image.pixels.data() + row_samples * std::size_t(band.y), row_samples * std::size_t(band.rows)};
+    next_row += band.rows;
+    return true;
+  };
+  if (Status s = write_bands(writer, next, {}, stop); !s) return s;
   return writer.commit();
 }
 
@@ -574,54 +704,30 @@ Status stream_image(const fs::path& input, color::Transfer decode, const fs::pat
     auto writer = RowWriter::open(output, layout, options);
     if (!writer) return writer.error();
 
-    struct Band {
-      int y = 0;
-      int rows = 0;
-      std::vector<float> pixels;
-    };
-    // Stage 1 alone touches the reader and read_error, stage 3 alone the writer and write_error; the
-    // atomic flag is all they share. After bad input the rest is still read (so the error counts it
-    // all) but nothing more is transformed or written.
-    std::optional<Error> read_error, write_error;
+    // After bad input the rest is still read (so the error counts it all) but nothing more is
+    // transformed or written.
+    std::optional<Error> read_error;
     std::atomic<bool> stop{false};
     int next_row = 0;
     const std::size_t row_samples = std::size_t(layout.width) * layout.channels;
-    // Read in order, transform in parallel, write in order: decoding, OCIO and compression overlap.
-    const std::size_t tokens = 2 * std::max(1u, std::thread::hardware_concurrency());
-    tbb::parallel_pipeline(
-        tokens,
-        tbb::make_filter<void, std::shared_ptr<Band>>(
-            tbb::filter_mode::serial_in_order,
-            [&](tbb::flow_control& fc) -> std::shared_ptr<Band> {
-              if (read_error || next_row >= layout.height) {
-                fc.stop();
-                return nullptr;
-              }
-              auto band = std::make_shared<Band>();
-              band->y = next_row;
-              band->rows = std::min(kBandRows, layout.height - next_row);
-              band->pixels.resize(row_samples * band->rows);
-              next_row += band->rows;
-              if (Status s = reader->read_rows(band->y, band->rows, band->pixels); !s) read_error = s.error();
-              if (read_error || reader->failed()) stop = true;
-              return band;
-            }) &
-            tbb::make_filter<std::shared_ptr<Band>, std::shared_ptr<Band>>(
-                tbb::filter_mode::parallel,
-                [&](std::shared_ptr<Band> band) {
-                  if (transform.apply && !stop) transform.apply(band->pixels, layout);
-                  return band;
-                }) &
-            tbb::make_filter<std::shared_ptr<Band>, void>(
-                tbb::filter_mode::serial_in_order, [&](std::shared_ptr<Band> band) {
-                  if (stop) return;
-                  if (Status s = writer->write_rows(band->y, band->rows, band->pixels); !s) {
-                    write_error = s.error();
-                    stop = true;
-                  }
-                }));
+    const int band_rows = aligned_band_rows(*writer, kBandRows);
+    const auto next = [&](Band& band) {
+      if (read_error || next_row >= layout.height) return false;
+      band.y = next_row;
+      band.rows = std::min(band_rows, layout.height - next_row);
+      band.pixels.resize(row_samples * std::size_t(band.rows));
+      band.view = band.pixels;
+      next_row += band.rows;
+      if (Status s = reader->read_rows(band.y, band.rows, band.pixels); !s) read_error = s.error();
+      if (read_error || reader->failed()) stop = true;
+      return true;
+    };
+    const auto prepare = [&](Band& band) {
+      if (transform.apply) transform.apply(band.pixels, layout);
+    };
+    const Status written = write_bands(*writer, next, prepare, stop);
     if (read_error) return *read_error;
-    if (write_error) return *write_error;
+    if (!written) return written;
     if (Status s = reader->finish(); !s) return s;
     return writer->commit();
   });
