@@ -78,26 +78,16 @@ libdeflate_compressor* compressor_for(int level) {
   return compressor.get();
 }
 
-// EXR's ZIP: the chunk's bytes split into its even and odd bytes (the low and high bytes of half
-// samples apart), each then stored as its difference to the one before plus 128, and the result
-// deflated in a zlib stream. A chunk that does not get smaller stays raw, which readers know from
-// its size. `chunk` holds the raw bytes and gets the stored ones.
-void zip_chunk(std::vector<std::uint8_t>& chunk, int level) {
-  thread_local std::vector<std::uint8_t> split, packed;  // reused: fresh pages cost more than the deflate
-  const std::size_t n = chunk.size();
-  if (n < 2) return;
-  split.resize(n);
-  packed.resize(n);
-  const std::size_t half = (n + 1) / 2;
-  for (std::size_t i = 0; i < n / 2; ++i) {
-    split[i] = chunk[2 * i];
-    split[half + i] = chunk[2 * i + 1];
-  }
-  if (n % 2 == 1) split[half - 1] = chunk[n - 1];
-  for (std::size_t i = n; i-- > 1;) split[i] = std::uint8_t(split[i] - split[i - 1] + 128);
-  const std::size_t size = libdeflate_zlib_compress(compressor_for(level), split.data(), n, packed.data(), n - 1);
-  if (size == 0) return;  // did not fit in fewer bytes than raw
-  chunk.assign(packed.begin(), packed.begin() + std::ptrdiff_t(size));
+// EXR's ZIP stores a chunk's bytes split into its even and odd bytes (the low and high bytes of
+// each 16-bit word apart), each then as its difference to the one before plus 128, deflated in a
+// zlib stream. `split` holds the split bytes; the differences are taken in place. Returns the
+// stored size in `out` (room for split.size() - 1), or 0 when the chunk does not get smaller:
+// it is then stored raw, which readers know from its size.
+std::size_t zip_split_bytes(std::vector<std::uint8_t>& split, std::uint8_t* out, int level) {
+  const std::size_t n = split.size();
+  if (n < 2) return 0;
+  for (std::size_t i = n - 1; i > 0; --i) split[i] = std::uint8_t(split[i] - split[i - 1] + 128);
+  return libdeflate_zlib_compress(compressor_for(level), split.data(), n, out, n - 1);
 }
 
 std::optional<int> level_suffix(std::string_view rest) {
@@ -210,39 +200,67 @@ ExrEncoder::~ExrEncoder() {
   }
 }
 
+// Calls put(w, word) for the 16-bit words of rows [first, first + count) as a chunk stores them:
+// row by row, one channel after the other (file order), a half sample one word, a float its low
+// word then its high word.
+template <class Put>
+void for_each_word(const float* samples, std::size_t width, std::size_t channels, const std::vector<int>& file_order,
+                   bool to_half, int first, int count, Put put) {
+  std::size_t w = 0;
+  for (int row = first; row < first + count; ++row) {
+    const float* pixels = samples + std::size_t(row) * width * channels;
+    for (const int c : file_order) {
+      const float* channel = pixels + std::size_t(c);
+      if (to_half) {
+        for (std::size_t x = 0; x < width; ++x) put(w++, half(channel[x * channels]).bits());  // nearest, ties to even
+      } else {
+        for (std::size_t x = 0; x < width; ++x) {
+          std::uint32_t bits = 0;
+          std::memcpy(&bits, &channel[x * channels], 4);
+          put(w++, std::uint16_t(bits));
+          put(w++, std::uint16_t(bits >> 16));
+        }
+      }
+    }
+  }
+}
+
 void ExrEncoder::encode(int y, int rows, std::span<const float> samples, std::vector<ExrChunk>& chunks) const {
   const std::size_t width = std::size_t(width_), channels = std::size_t(channels_);
   const std::size_t sample_bytes = half_ ? 2 : 4;
+  thread_local std::vector<std::uint8_t> split;  // reused: fresh pages cost more than the deflate
   chunks.resize(std::size_t((rows + chunk_rows_ - 1) / chunk_rows_));
   for (int first = 0; first < rows; first += chunk_rows_) {
     const int count = std::min(chunk_rows_, rows - first);
     ExrChunk& chunk = chunks[std::size_t(first / chunk_rows_)];
     chunk.y = y + first;
-    // The chunk as stored: row by row, and in each row one channel after the other (file order).
-    chunk.bytes.resize(std::size_t(count) * width * channels * sample_bytes);
-    std::uint8_t* out = chunk.bytes.data();
-    for (int row = first; row < first + count; ++row) {
-      const float* pixels = samples.data() + std::size_t(row) * width * channels;
-      for (const int c : file_order_) {
-        if (half_) {
-          for (std::size_t x = 0; x < width; ++x, out += 2) {
-            const std::uint16_t bits = half(pixels[x * channels + std::size_t(c)]).bits();  // nearest, ties to even
-            out[0] = std::uint8_t(bits);
-            out[1] = std::uint8_t(bits >> 8);
-          }
-        } else {
-          for (std::size_t x = 0; x < width; ++x, out += 4) {
-            std::uint32_t bits = 0;
-            std::memcpy(&bits, &pixels[x * channels + std::size_t(c)], 4);
-            out[0] = std::uint8_t(bits);
-            out[1] = std::uint8_t(bits >> 8);
-            out[2] = std::uint8_t(bits >> 16);
-            out[3] = std::uint8_t(bits >> 24);
-          }
-        }
-      }
+    const std::size_t n = std::size_t(count) * width * channels * sample_bytes;
+    chunk.bytes.resize(n);
+    const auto pack_raw = [&] {
+      std::uint8_t* out = chunk.bytes.data();
+      for_each_word(samples.data(), width, channels, file_order_, half_, first, count, [out](std::size_t w, std::uint16_t v) {
+        out[2 * w] = std::uint8_t(v);  // little-endian
+        out[2 * w + 1] = std::uint8_t(v >> 8);
+      });
+    };
+    if (!compress_) {
+      pack_raw();
+      continue;
     }
-    if (compress_) zip_chunk(chunk.bytes, level_);
+    // Packed straight into ZIP's split order: low bytes in the first half, high bytes in the second.
+    split.resize(n);
+    std::uint8_t* low = split.data();
+    std::uint8_t* high = split.data() + n / 2;
+    for_each_word(samples.data(), width, channels, file_order_, half_, first, count, [low, high](std::size_t w, std::uint16_t v) {
+      low[w] = std::uint8_t(v);
+      high[w] = std::uint8_t(v >> 8);
+    });
+    const std::size_t stored = zip_split_bytes(split, chunk.bytes.data(), level_);
+    if (stored > 0) {
+      chunk.bytes.resize(stored);
+    } else {
+      pack_raw();
+    }
   }
 }
 
