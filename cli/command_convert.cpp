@@ -66,7 +66,8 @@ CLI::App* setup_convert(CLI::App& app, ConvertSettings& s) {
                   "Output samples: 8, 16 (PNG, TIFF), half, float (EXR, TIFF). Default: half for EXR; for PNG/TIFF "
                   "16 when the target is linear, else the input's depth")
       ->check(CLI::IsMember({"8", "16", "half", "float"}));
-  cmd->add_option("--compression", s.options.compression, "EXR/TIFF: OIIO compression name (default: zip for EXR)");
+  cmd->add_option("--compression", s.options.compression,
+                  "EXR/TIFF: OIIO compression name, e.g. none, zip, zips, zip:1..9, piz, dwaa (default: zip for EXR)");
   add_png_compression_option(*cmd, s.options.png_level);
   return cmd;
 }
