@@ -211,5 +211,16 @@ TEST(Exr, ColourSpaceTagAndHalfRangeAsBefore) {
   EXPECT_FALSE(std::filesystem::exists(dir / "h.exr"));
 }
 
+TEST(Exr, RepeatedChannelNamesAreAnErrorAndLeaveNothing) {
+  test::TempDir dir;
+  Image image = test_image(3, 3, 2, 4);
+  image.channel_names = {"R", "R"};
+  auto refused = write_image(image, dir / "r.exr", WriteOptions{});
+  ASSERT_FALSE(refused);
+  EXPECT_EQ(refused.error().path, (dir / "r.exr").string());
+  EXPECT_EQ(refused.error().to_string().find('\n'), std::string::npos);
+  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir.path()), std::filesystem::directory_iterator()), 0);
+}
+
 }  // namespace
 }  // namespace matbake::image

@@ -55,12 +55,21 @@ int64_t write_at(exr_const_context_t, void* user, const void* buffer, uint64_t s
   return int64_t(size);
 }
 
-void keep_first_error(exr_const_context_t context, exr_result_t, const char* message) {
-  void* user = nullptr;
-  if (exr_get_user_data(context, &user) == EXR_ERR_SUCCESS && user != nullptr) {
-    auto* stream = static_cast<ExrStream*>(user);
-    if (stream->first_error.empty()) stream->first_error = message;
-  }
+// The core calls its error handler with the context locked, so the handler cannot ask the context
+// for its user data (exr_get_user_data would wait on that lock for ever): the stream whose call is
+// under way, in this thread, is named here instead.
+thread_local ExrStream* t_reporting_stream = nullptr;
+
+struct ReportingTo {
+  explicit ReportingTo(ExrStream* stream) { t_reporting_stream = stream; }
+  ~ReportingTo() { t_reporting_stream = nullptr; }
+  ReportingTo(const ReportingTo&) = delete;
+  ReportingTo& operator=(const ReportingTo&) = delete;
+};
+
+void keep_first_error(exr_const_context_t, exr_result_t, const char* message) {
+  ExrStream* stream = t_reporting_stream;
+  if (stream != nullptr && stream->first_error.empty()) stream->first_error = message;
 }
 
 // A libdeflate compressor per thread and level, kept: making one allocates several hundred KB.
@@ -144,6 +153,7 @@ Result<ExrEncoder> ExrEncoder::open(const fs::path& file, const std::string& nam
   init.write_fn = write_at;
   init.error_handler_fn = keep_first_error;
   exr_context_t context = nullptr;
+  const ReportingTo reporting(encoder.stream_);
   exr_result_t result = exr_start_write(&context, name.c_str(), EXR_WRITE_FILE_DIRECTLY, &init);
   encoder.context_ = context;
   if (result != EXR_ERR_SUCCESS) return encoder.failure(result);
@@ -192,6 +202,7 @@ ExrEncoder::ExrEncoder(ExrEncoder&& other) noexcept
 ExrEncoder::~ExrEncoder() {
   if (context_ != nullptr) {
     auto context = static_cast<exr_context_t>(context_);
+    const ReportingTo reporting(stream_);
     exr_finish(&context);
   }
   if (stream_ != nullptr) {
@@ -266,6 +277,7 @@ void ExrEncoder::encode(int y, int rows, std::span<const float> samples, std::ve
 
 Status ExrEncoder::write(const std::vector<ExrChunk>& chunks) {
   auto context = static_cast<exr_context_t>(context_);
+  const ReportingTo reporting(stream_);
   for (const ExrChunk& chunk : chunks) {
     const exr_result_t result = exr_write_scanline_chunk(context, 0, chunk.y, chunk.bytes.data(), chunk.bytes.size());
     if (result != EXR_ERR_SUCCESS) return failure(result);
@@ -275,6 +287,7 @@ Status ExrEncoder::write(const std::vector<ExrChunk>& chunks) {
 
 Status ExrEncoder::finish() {
   auto context = static_cast<exr_context_t>(context_);
+  const ReportingTo reporting(stream_);
   context_ = nullptr;
   const exr_result_t result = exr_finish(&context);
   if (result != EXR_ERR_SUCCESS || !stream_->first_error.empty()) return failure(result);
