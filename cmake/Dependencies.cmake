@@ -5,6 +5,9 @@ pkg_check_modules(OIIO REQUIRED IMPORTED_TARGET OpenImageIO)
 pkg_check_modules(OCIO REQUIRED IMPORTED_TARGET OpenColorIO)
 # 8/16-bit PNG is deflated by libdeflate (lib/src/image/png_encode.cpp); libspng reads it.
 pkg_check_modules(deflate REQUIRED IMPORTED_TARGET libdeflate)
+pkg_check_modules(spng REQUIRED IMPORTED_TARGET spng)
+# Content hashes of the build's inputs (XXH64, as OIIO's copy computed them before).
+pkg_check_modules(xxhash REQUIRED IMPORTED_TARGET libxxhash)
 find_package(OpenEXR CONFIG REQUIRED)
 find_package(Imath CONFIG REQUIRED)
 find_package(glm CONFIG REQUIRED)

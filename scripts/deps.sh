@@ -9,7 +9,7 @@ packages=(
   libopencolorio-dev opencolorio-tools
   libopenexr-dev libimath-dev libglm-dev libtinygltf-dev libembree-dev
   libcli11-dev nlohmann-json3-dev libtbb-dev libtomlplusplus-dev
-  libgtest-dev libbenchmark-dev zlib1g-dev libdeflate-dev time
+  libgtest-dev libbenchmark-dev zlib1g-dev libdeflate-dev libspng-dev libxxhash-dev time
   clang-14 libclang-rt-14-dev llvm-14
 )
 

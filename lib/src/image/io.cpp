@@ -1,7 +1,7 @@
-// All image file I/O goes through OpenImageIO here, and only here. Reading and writing work in
-// bands of rows (RowReader, RowWriter); whole-image reads and writes are one band.
-#include <OpenImageIO/filesystem.h>
-#include <OpenImageIO/imageio.h>
+// All image file I/O goes through here. Reading and writing work in bands of rows (RowReader,
+// RowWriter); whole-image reads and writes are one band. PNG (read and 8/16-bit written) and
+// scanline EXR written as half or float (none, zip, zips) are matbake's own codecs; every other
+// format is OpenImageIO's, from the module loaded on first need (oiio_module.hpp).
 #include <tbb/parallel_pipeline.h>
 
 #include <algorithm>
@@ -21,42 +21,16 @@
 #include "matbake/image.hpp"
 #include "matbake/pixels.hpp"
 #include "exr_encode.hpp"
-#include "exr_header.hpp"
-#include "oiio_guards.hpp"
+#include "oiio_module.hpp"
+#include "png_decode.hpp"
 #include "png_encode.hpp"
 
 namespace fs = std::filesystem;
-using OIIO::ImageSpec;
-using OIIO::TypeDesc;
 
 namespace matbake::image {
 namespace {
 
 std::atomic<std::uint64_t> g_max_pixels{kDefaultMaxPixels};
-
-std::string first_line(const std::string& text) {
-  const std::string line = text.substr(0, text.find('\n'));
-  return line.empty() ? "unknown error" : line;
-}
-
-SampleType stored_type_of(const ImageSpec& spec) {
-  switch (spec.format.basetype) {
-    case TypeDesc::UINT8: return SampleType::u8;
-    case TypeDesc::UINT16: return SampleType::u16;
-    case TypeDesc::HALF: return SampleType::half;
-    default: return SampleType::f32;  // float, double and other integer widths read as float
-  }
-}
-
-TypeDesc type_desc(SampleType type) {
-  switch (type) {
-    case SampleType::u8: return TypeDesc::UINT8;
-    case SampleType::u16: return TypeDesc::UINT16;
-    case SampleType::half: return TypeDesc::HALF;
-    case SampleType::f32: return TypeDesc::FLOAT;
-  }
-  return TypeDesc::FLOAT;
-}
 
 // Non-finite samples, counted, and where the first one is (its sample index in the file).
 struct NonFinite {
@@ -83,18 +57,10 @@ void count_half(std::span<const uint16_t> bits, std::size_t first_index, NonFini
   }
 }
 
-// Refuses an OpenEXR file whose header OpenEXR's C core refuses (exr_header.hpp), judged by
-// content as OIIO's readers are, whatever the name.
-Status check_exr_header(const fs::path& path, OIIO::Filesystem::IOProxy* proxy) {
-  std::optional<std::string> problem;
-  if (proxy != nullptr) {
-    problem = exr_header_problem(*proxy);
-  } else {
-    OIIO::Filesystem::IOFile file(path.string(), OIIO::Filesystem::IOProxy::Read);
-    if (file.opened()) problem = exr_header_problem(file);
-  }
-  if (problem) return Error{path.string(), "not a readable image: OpenEXR header: " + *problem};
-  return success();
+Result<std::unique_ptr<StoredReader>> open_with_oiio(const fs::path& path, std::span<const unsigned char> memory) {
+  auto oiio = oiio_codecs(path.string());
+  if (!oiio) return oiio.error();
+  return (*oiio)->open_reader(path, memory);
 }
 
 // Decodes bands of rows in order. Non-finite samples are bad input and finite ones the decode
@@ -108,43 +74,40 @@ class RowReader {
     if (fs::is_directory(path, ec)) return Error{path.string(), "is a folder, not an image"};
     // A FIFO or a device (/dev/zero) never ends: only regular files are read.
     if (!fs::is_regular_file(path, ec)) return Error{path.string(), "is not a regular file"};
-    return open(path, colour, nullptr);
+    unsigned char start[8] = {};
+    std::ifstream(path, std::ios::binary).read(reinterpret_cast<char*>(start), sizeof start);
+    return open(path, colour, start, {});
   }
 
-  // An image in memory: `name`'s extension picks the reader; `bytes` must outlive the reader.
+  // An image in memory: `name` names it (and its extension is OIIO's first guess); `bytes` must
+  // outlive the reader.
   static Result<RowReader> open_memory(std::span<const unsigned char> bytes, const fs::path& name, color::Transfer colour) {
-    auto proxy = std::make_unique<CheckedMemReader>(bytes.data(), bytes.size());
-    auto reader = open(name, colour, proxy.get());
-    if (reader) reader->proxy_ = std::move(proxy);
-    return reader;
+    if (bytes.empty()) return Error{name.string(), "not a readable image: empty"};
+    return open(name, colour, bytes, bytes);
   }
 
  private:
-  static Result<RowReader> open(const fs::path& path, color::Transfer colour, OIIO::Filesystem::IOProxy* proxy) {
-    ImageSpec config;
-    config.attribute("oiio:UnassociatedAlpha", 1);
-    // The readers of OIIO 2.4 look for the proxy in the configuration hint.
-    if (proxy) config.attribute("oiio:ioproxy", TypeDesc::PTR, &proxy);
-    if (Status s = check_exr_header(path, proxy); !s) return s.error();
-    auto in = OIIO::ImageInput::open(path.string(), &config, proxy);
-    if (!in) return Error{path.string(), "not a readable image: " + first_line(OIIO::geterror())};
-    const ImageSpec& spec = in->spec();
-    if (spec.nchannels < 1 || spec.nchannels > 4) {
-      return Error{path.string(), std::to_string(spec.nchannels) +
+  // PNG by its signature, whatever the name; everything else by OIIO.
+  static Result<RowReader> open(const fs::path& path, color::Transfer colour, std::span<const unsigned char> start,
+                                std::span<const unsigned char> memory) {
+    auto stored = has_png_signature(start) ? open_png(path.string(), memory) : open_with_oiio(path, memory);
+    if (!stored) return stored.error();
+    const ImageLayout& layout = (*stored)->format().layout;
+    if (layout.channels < 1 || layout.channels > 4) {
+      return Error{path.string(), std::to_string(layout.channels) +
                                       " channels; matbake reads 1 to 4 (gray, gray+alpha, RGB, RGBA)"};
     }
-    if (spec.depth > 1) return Error{path.string(), "volume images are not supported"};
-    if (Status s = check_image_size(path.string(), spec.width, spec.height); !s) return s.error();
-    return RowReader(path, std::move(in), colour);
+    if (Status s = check_image_size(path.string(), layout.width, layout.height); !s) return s.error();
+    return RowReader(path, std::move(*stored), colour);
   }
 
  public:
-  const ImageLayout& layout() const { return layout_; }
-  ReadInfo info() const { return {stored_, in_->format_name()}; }
+  const ImageLayout& layout() const { return stored_->format().layout; }
+  ReadInfo info() const { return {stored_->format().stored, stored_->format().format_name}; }
 
   // Rows [y, y + rows) into `out`, decoded.
   Status read_rows(int y, int rows, std::span<float> out) {
-    switch (stored_) {
+    switch (stored_->format().stored) {
       case SampleType::u8: return read_and_decode<uint8_t>(y, rows, out);
       case SampleType::u16: return read_and_decode<uint16_t>(y, rows, out);
       case SampleType::half: return read_and_decode<uint16_t>(y, rows, out);  // bit patterns
@@ -155,7 +118,7 @@ class RowReader {
 
   Status finish() const {
     if (bad_.any()) {
-      const std::size_t channels = std::size_t(layout_.channels), row = std::size_t(layout_.width) * channels;
+      const std::size_t channels = std::size_t(layout().channels), row = std::size_t(layout().width) * channels;
       const std::size_t x = bad_.first % row / channels, y = bad_.first / row, c = bad_.first % channels;
       return Error{path_.string(), "contains " + std::to_string(bad_.nan) + " NaN and " + std::to_string(bad_.inf) +
                                        " Inf samples (the first at x " + std::to_string(x) + ", y " +
@@ -172,78 +135,22 @@ class RowReader {
   bool failed() const { return bad_.any() || overflow_ > 0; }
 
  private:
-  RowReader(fs::path path, std::unique_ptr<OIIO::ImageInput> in, color::Transfer colour)
-      : path_(std::move(path)), in_(std::move(in)), colour_(colour) {
-    const ImageSpec& spec = in_->spec();
-    layout_.width = spec.width;
-    layout_.height = spec.height;
-    layout_.channels = spec.nchannels;
-    layout_.channel_names = spec.channelnames;
-    layout_.alpha_channel = spec.alpha_channel;
-    transfers_ = channel_transfers(layout_, colour);
-    stored_ = stored_type_of(spec);
-  }
-
-  // Rows [y, y + rows) as stored. Tiled files (mip-mapped EXR, TIFF) are read whole at level 0 on
-  // the first call: OIIO 2.4's read_scanlines on them can divide by zero (SIGFPE), and read_tiles
-  // wants tile-aligned bands.
-  Status read_stored(int y, int rows, void* samples, std::size_t sample_size) {
-    const ImageSpec& spec = in_->spec();
-    if (spec.tile_width <= 0) {
-      // Read as stored into our buffer: OIIO 2.4's read_scanlines allocates (and frees) a 64 MB
-      // staging buffer on every call, even when no conversion is needed.
-      const bool as_stored = spec.channelformats.empty() && spec.format == type_desc(stored_);
-      const bool read = as_stored ? in_->read_native_scanlines(0, 0, spec.y + y, spec.y + y + rows, 0, samples)
-                                  : read_converted(y, rows, samples);
-      if (!read) return Error{path_.string(), "cannot read pixels: " + first_line(in_->geterror())};
-      return success();
-    }
-    const std::size_t row_bytes = std::size_t(spec.width) * std::size_t(spec.nchannels) * sample_size;
-    if (tiled_whole_.empty()) {
-      tiled_whole_.resize(row_bytes * std::size_t(spec.height));
-      if (!in_->read_image(0, 0, 0, spec.nchannels, type_desc(stored_), tiled_whole_.data())) {
-        return Error{path_.string(), "cannot read pixels: " + first_line(in_->geterror())};
-      }
-    }
-    std::memcpy(samples, tiled_whole_.data() + std::size_t(y) * row_bytes, std::size_t(rows) * row_bytes);
-    return success();
-  }
-
-  // Files stored in another type (double, 32-bit integers) or in a type per channel (an EXR with
-  // half colour and float depth) are read as stored, and each channel is converted into `samples`.
-  bool read_converted(int y, int rows, void* samples) {
-    const ImageSpec& spec = in_->spec();
-    const std::size_t pixel_bytes = spec.pixel_bytes(true);
-    stored_band_.resize(pixel_bytes * std::size_t(spec.width) * std::size_t(rows));
-    if (!in_->read_native_scanlines(0, 0, spec.y + y, spec.y + y + rows, 0, stored_band_.data())) return false;
-    const TypeDesc to = type_desc(stored_);
-    const auto to_pixel = OIIO::stride_t(to.size()) * spec.nchannels;
-    std::size_t offset = 0;
-    for (int c = 0; c < spec.nchannels; ++c) {
-      const TypeDesc from = spec.channelformat(c);
-      if (!OIIO::convert_image(1, spec.width, rows, 1, stored_band_.data() + offset, from, OIIO::stride_t(pixel_bytes),
-                               OIIO::stride_t(pixel_bytes) * spec.width, OIIO::AutoStride,
-                               static_cast<char*>(samples) + std::size_t(c) * to.size(), to, to_pixel,
-                               to_pixel * spec.width, OIIO::AutoStride)) {
-        return false;
-      }
-      offset += from.size();
-    }
-    return true;
-  }
+  RowReader(fs::path path, std::unique_ptr<StoredReader> stored, color::Transfer colour)
+      : path_(std::move(path)), stored_(std::move(stored)), colour_(colour),
+        transfers_(channel_transfers(stored_->format().layout, colour)) {}
 
   template <class T>
   Status read_and_decode(int y, int rows, std::span<float> out) {
     raw_.resize(out.size() * sizeof(T));
     T* samples = reinterpret_cast<T*>(raw_.data());
-    if (Status s = read_stored(y, rows, samples, sizeof(T)); !s) return s;
+    if (Status s = stored_->read(y, rows, samples); !s) return s;
     const std::span<const T> in(samples, out.size());
-    const std::size_t first_index = std::size_t(y) * std::size_t(layout_.width) * std::size_t(layout_.channels);
+    const std::size_t first_index = std::size_t(y) * std::size_t(layout().width) * std::size_t(layout().channels);
     if constexpr (std::is_same_v<T, float>) {
       count_float(in, first_index, bad_);
       color::decode_pixels(in, out, transfers_);
     } else if constexpr (std::is_same_v<T, uint16_t>) {
-      if (stored_ == SampleType::half) {
+      if (stored_->format().stored == SampleType::half) {
         count_half(in, first_index, bad_);
         color::decode_half_pixels(in, out, transfers_);
       } else {
@@ -259,15 +166,10 @@ class RowReader {
   }
 
   fs::path path_;
-  std::unique_ptr<OIIO::Filesystem::IOProxy> proxy_;  // the bytes of an image in memory (declared first: outlives in_)
-  std::unique_ptr<OIIO::ImageInput> in_;
+  std::unique_ptr<StoredReader> stored_;
   color::Transfer colour_;
-  ImageLayout layout_;
   std::vector<color::Transfer> transfers_;
-  SampleType stored_ = SampleType::u8;
   std::vector<std::byte> raw_;
-  std::vector<std::byte> tiled_whole_;  // a tiled file's level 0, as stored
-  std::vector<char> stored_band_;       // a band as stored, before read_converted converts it
   NonFinite bad_;
   std::size_t overflow_ = 0;
 };
@@ -326,7 +228,7 @@ class RowWriter {
     if (exr && !is_integer(options.type) && exr_compression) {
       ImageLayout named = layout;  // unnamed channels get OIIO's names, as OIIO would write them
       if (named.channel_names.size() != std::size_t(layout.channels)) {
-        named.channel_names = ImageSpec(layout.width, layout.height, layout.channels).channelnames;
+        named.channel_names = default_channel_names(layout.channels);
       }
       auto encoder = ExrEncoder::open(written, path.string(), memory, named, options.type, *exr_compression,
                                       options.colorspace);
@@ -334,27 +236,11 @@ class RowWriter {
       writer.exr_ = std::make_unique<ExrEncoder>(std::move(*encoder));
       return writer;
     }
-    writer.out_ = OIIO::ImageOutput::create(written.string());
-    if (!writer.out_) return Error{path.string(), "no image writer for this extension: " + first_line(OIIO::geterror())};
-    if (memory) {
-      writer.proxy_ = std::make_unique<OIIO::Filesystem::IOVecOutput>(*memory);
-      if (!writer.out_->set_ioproxy(writer.proxy_.get())) return Error{path.string(), "this format cannot be written to memory"};
-    }
-
-    ImageSpec spec(layout.width, layout.height, layout.channels, type_desc(options.type));
-    if (layout.channel_names.size() == std::size_t(layout.channels)) spec.channelnames = layout.channel_names;
-    spec.alpha_channel = layout.alpha_channel;
-    spec.attribute("oiio:UnassociatedAlpha", 1);  // write colour as given, never divided by alpha
-    // OIIO stamps the current time (EXR capDate, TIFF DateTime) unless told a value; an empty one
-    // keeps output bytes a function of the inputs alone.
-    spec.attribute("DateTime", "");
-    if (!options.colorspace.empty()) spec.attribute("oiio:ColorSpace", options.colorspace);
-    std::string compression = options.compression;
-    if (compression.empty() && std::string_view(writer.out_->format_name()) == "openexr") compression = "zip";
-    if (!compression.empty()) spec.attribute("compression", compression);
-    if (!writer.out_->open(written.string(), spec)) {
-      return Error{path.string(), "cannot write: " + first_line(writer.out_->geterror())};
-    }
+    auto oiio = oiio_codecs(path.string());
+    if (!oiio) return oiio.error();
+    auto other = (*oiio)->open_writer(path, written, memory, layout, options);
+    if (!other) return other.error();
+    writer.other_ = std::move(*other);
     return writer;
   }
 
@@ -387,7 +273,7 @@ class RowWriter {
       case SampleType::u8: return write_samples<uint8_t>(band);
       case SampleType::u16: return write_samples<uint16_t>(band);
       case SampleType::half:
-      case SampleType::f32: return write_samples<float>(band);  // OIIO rounds to half, nearest even
+      case SampleType::f32: return write_samples<float>(band);
     }
     return success();
   }
@@ -409,8 +295,8 @@ class RowWriter {
       if (!file) return Error{path_.string(), "cannot write (disk full or not writable?)"};
     } else if (exr_) {
       if (Status s = exr_->finish(); !s) return s;
-    } else if (!out_->close()) {
-      return Error{path_.string(), "cannot write: " + first_line(out_->geterror())};
+    } else if (Status s = other_->close(); !s) {
+      return s;
     }
     return file_ ? file_->commit() : success();
   }
@@ -444,27 +330,17 @@ class RowWriter {
         return success();
       }
     }
-    if (!out_->write_scanlines(band.y, band.y + band.rows, 0, scanline_type<T>(), samples.data())) {
-      return Error{path_.string(), "cannot write: " + first_line(out_->geterror())};
-    }
-    return success();
-  }
-
-  template <class T>
-  static TypeDesc scanline_type() {
-    if constexpr (std::is_same_v<T, uint8_t>) return TypeDesc::UINT8;
-    else if constexpr (std::is_same_v<T, uint16_t>) return TypeDesc::UINT16;
-    else return TypeDesc::FLOAT;
+    const SampleType type = std::is_same_v<T, uint8_t> ? SampleType::u8 : std::is_same_v<T, uint16_t> ? SampleType::u16 : SampleType::f32;
+    return other_->write(band.y, band.rows, type, samples.data());
   }
 
   fs::path path_;
   fs::path written_;                  // the temporary file (or, in memory, the name)
   std::optional<AtomicFile> file_;    // none when writing to memory
   std::vector<unsigned char>* memory_ = nullptr;
-  std::unique_ptr<OIIO::Filesystem::IOProxy> proxy_;  // declared before out_: outlives it
-  std::unique_ptr<OIIO::ImageOutput> out_;            // every other format
-  std::unique_ptr<PngEncoder> png_;                   // 8/16-bit PNG
-  std::unique_ptr<ExrEncoder> exr_;                   // scanline EXR: half or float, none/zip/zips
+  std::unique_ptr<StoredWriter> other_;  // every other format: OIIO's
+  std::unique_ptr<PngEncoder> png_;      // 8/16-bit PNG
+  std::unique_ptr<ExrEncoder> exr_;      // scanline EXR: half or float, none/zip/zips
   WriteOptions options_;
   std::vector<color::Transfer> transfers_;
   std::size_t beyond_half_ = 0;
@@ -640,7 +516,11 @@ std::vector<color::Transfer> channel_transfers(const ImageLayout& layout, color:
   return transfers;
 }
 
-void set_thread_count(int threads) { OIIO::attribute("threads", threads); }
+std::vector<std::string> default_channel_names(int channels) {
+  if (channels == 1) return {"Y"};
+  static const char* const kNames[] = {"R", "G", "B", "A"};
+  return {kNames, kNames + std::min(channels, 4)};
+}
 
 Result<ReadInfo> probe_image(const fs::path& path) {
   return guarded(path.string(), [&]() -> Result<ReadInfo> {

@@ -1,8 +1,8 @@
 #include "matbake/read_file.hpp"
 #include "state.hpp"
 
-#include <OpenImageIO/hash.h>
 #include <nlohmann/json.hpp>
+#include <xxhash.h>
 
 #include <fstream>
 #include <sstream>
@@ -36,7 +36,7 @@ std::string content_hash(const fs::path& p) {
   std::string b;  // a source that is not a regular file hashes as empty (its read refuses it)
   if (!read_whole_file(p, b)) b.clear();
   char hex[17];
-  std::snprintf(hex, sizeof hex, "%016llx", OIIO::xxhash::XXH64(b.data(), b.size(), 0));
+  std::snprintf(hex, sizeof hex, "%016llx", (unsigned long long)XXH64(b.data(), b.size(), 0));
   return hex;
 }
 

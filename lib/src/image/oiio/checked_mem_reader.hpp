@@ -1,4 +1,4 @@
-// Guards around out-of-bounds reads in OIIO 2.4's readers (oiio_guards.cpp).
+// OIIO 2.4's in-memory reader with its offsets checked (checked_mem_reader.cpp).
 #pragma once
 
 #include <OpenImageIO/filesystem.h>
