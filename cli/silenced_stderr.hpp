@@ -1,6 +1,7 @@
 #pragma once
-// libpng (under OIIO 2.4) prints its own "libpng error: ..." line before OIIO returns the same
-// problem as an error, which matbake then reports in its one-line form. While a file is processed,
+// The libraries under OIIO 2.4's readers may print their own line about a bad file before OIIO
+// returns the same problem as an error, which matbake then reports in its one-line form (libpng's
+// "libpng error: ..." did, before matbake read PNG with libspng, which prints nothing). While a file is processed,
 // the CLI points fd 2 at /dev/null and prints only after restoring it, so each problem is said
 // once. MATBAKE_LIBRARY_MESSAGES=1 keeps the libraries' own messages (for debugging).
 #include <fcntl.h>
