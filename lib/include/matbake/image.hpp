@@ -58,10 +58,11 @@ std::vector<color::Transfer> channel_transfers(const ImageLayout& layout, color:
 
 struct ReadInfo {
   SampleType stored_type = SampleType::u8;  // the closest of ours to what the file holds
-  std::string format_name;                  // OIIO's name: "png", "openexr", "tiff", "jpeg", ...
+  std::string format_name;                  // OIIO's names: "png", "openexr", "tiff", "jpeg", ...
 };
 
-// Reads any image OIIO can and decodes colour channels with `colour` (alpha stays linear).
+// Reads any image OIIO can (PNG with libspng, other formats with OIIO, loaded on first need) and
+// decodes colour channels with `colour` (alpha stays linear).
 // Errors: missing or unreadable file, 0 or more than 4 channels, NaN or Inf samples (counted),
 // and finite samples that overflow float when decoded.
 Result<Image> read_image(const std::filesystem::path& path, color::Transfer colour,
@@ -114,7 +115,8 @@ Status stream_image(const std::filesystem::path& input, color::Transfer decode, 
 // shrinking), on the values as they are: pass linear data to filter in linear light.
 Image resize_image(const Image& image, int width, int height);
 
-// Threads OIIO may use (EXR compression above all); 0: one per core.
+// Threads OIIO may use (its EXR compressions other than none/zip/zips above all); 0: one per core.
+// Applied when OIIO is loaded, if it is not yet.
 void set_thread_count(int threads);
 
 }  // namespace matbake::image
