@@ -114,7 +114,7 @@ int run_build(const BuildSettings& s, const GlobalOptions& global) {
 
   // Progress: a bar on a terminal; elsewhere (build logs) one line per finished job.
   const bool terminal = isatty(STDERR_FILENO) != 0;
-  std::optional<SilencedStderr> quiet(std::in_place);  // libpng's own messages: each job's error line says it
+  std::optional<SilencedStderr> quiet(std::in_place);  // the image libraries' own messages: each job's error line says it
   ProgressBar bar(terminal && !global.quiet, quiet->original_fd());
   pipeline::RunOptions options;
   options.force = s.force;

@@ -92,7 +92,7 @@ int run_export(const ExportSettings& s, const GlobalOptions& global) {
   }
   Result<exporter::Report> report = Error{"", ""};
   {
-    SilencedStderr quiet;  // libpng's own messages on a bad texture: our error line says it
+    SilencedStderr quiet;  // the image libraries' own messages on a bad texture: our error line says it
     report = exporter::export_scene(s.scene, s.output, options);
   }
   if (!report) return report_error(report.error());

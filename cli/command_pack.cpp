@@ -80,7 +80,7 @@ int run_unpack(const UnpackSettings& s, const GlobalOptions& global) {
   }
   Result<std::vector<fs::path>> paths = Error{"", ""};
   {
-    SilencedStderr quiet;  // libpng's own messages: our error line says it
+    SilencedStderr quiet;  // the image libraries' own messages: our error line says it
     paths = pack::write_maps(*sources, request);
   }
   if (!paths) return report_error(paths.error());

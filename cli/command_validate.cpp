@@ -122,7 +122,7 @@ int run_validate(const ValidateSettings& s, const GlobalOptions& global) {
   if (!s.heatmap.empty()) {
     Status written = success();
     {
-      SilencedStderr quiet;  // libpng's own messages: our error line says it
+      SilencedStderr quiet;  // the image libraries' own messages: our error line says it
       written = validate::write_heatmap(*report, s.heatmap);
     }
     if (!written) return report_error(written.error());

@@ -10,6 +10,7 @@
 
 #include "matbake/image.hpp"
 #include "support/files.hpp"
+#include "support/run.hpp"
 #include "support/temp_dir.hpp"
 
 namespace matbake::image {
@@ -244,7 +245,8 @@ TEST(ImageIo, ExrHeaderDeclaringMoreThanTheFileHoldsIsRefused) {
   EXPECT_EQ(read->pixels, first);
 }
 
-// Inputs found by tests/fuzz/fuzz_image that made OIIO 2.4 read out of bounds (oiio_guards.cpp):
+// Inputs found by tests/fuzz/fuzz_image that made OIIO 2.4 read out of bounds (oiio_icc_override.cpp,
+// oiio/checked_mem_reader.cpp; the PNG is read by libspng now, which ignores the profile):
 // a PNG whose ICC profile's text tags point past it (SIGSEGV in release) and an EXR decoded from
 // memory whose line offsets point before the buffer (an ASan report with OpenEXR's C++ reader;
 // the C core refuses its header). Both are plain errors.
@@ -273,6 +275,21 @@ TEST(ImageIo, OiioIccDecoderIsReplacedByTheGuard) {
   EXPECT_EQ(in->spec().find_attribute("ICCProfile")->type().size(), 2008u);
   EXPECT_EQ(in->spec().find_attribute("ICCProfile:copyright"), nullptr);
   EXPECT_EQ(in->spec().find_attribute("ICCProfile:dscm"), nullptr);
+}
+
+// The same in the CLI, which does not link OIIO: its module is loaded RTLD_LOCAL on first need, and
+// libmatbake's replacement must still be the one OIIO's readers call. The damaged profile of the
+// PNG above, moved into a TIFF (whose reader decodes profiles too; PNG is read by libspng now):
+// oiiotool aborts on it, and with the replacement disabled the CLI did too (SIGSEGV in OIIO's
+// decode_icc_profile, under ASan).
+TEST(ImageIo, CliWithOiioLoadedOnDemandStillUsesTheIccGuard) {
+  TempDir dir;
+  const auto tif = std::filesystem::path(MATBAKE_SOURCE_DIR) / "tests/fuzz/regressions/image/tiff-damaged-icc-profile.tif";
+  const auto r = test::matbake({"convert", tif.string(), "-o", (dir / "out.exr").string()});
+  EXPECT_EQ(r.exit_code, 0) << r.err;  // the profile is kept as bytes; the pixels are fine
+  auto out = read_image(dir / "out.exr", Transfer::linear);
+  ASSERT_TRUE(out) << out.error().to_string();
+  EXPECT_EQ(out->sample_count(), 12u);
 }
 
 TEST(ImageIo, FailedWriteLeavesTheExistingOutputAndNoTemporaryFile) {
