@@ -180,7 +180,24 @@ TEST(PngDecode, DamagedAndHostileHeadersAreOneLineErrors) {
   bad_data[8 + 25 + 8 + 3] ^= 0x55;  // inside the deflate stream
   std::string bad_filter_raw = rgb_rows();
   bad_filter_raw[0] = 9;  // filter types are 0 to 4
+  std::string bad_idat_crc = valid_png();
+  bad_idat_crc[8 + 25 + idat.size() - 4] ^= 1;  // IDAT's CRC (PngSuite's xcsn0g01)
+  std::string signature_byte = valid_png(), lf_mangled = valid_png(), cr_mangled = valid_png();
+  signature_byte[1] = 'Q';     // not a PNG signature: goes to OIIO, which refuses it (xs1n0g01)
+  lf_mangled.erase(4, 1);      // the signature's "\r\n" -> "\n": a text-mode copy to Unix
+  cr_mangled.insert(7, "\r");  // its last "\n" -> "\r\n": a text-mode copy to DOS (xcrn0g04)
+  // PngSuite's corrupt x*.png files (not in ../shared/testdata) made again by hand, with the
+  // other damages of libpng's crashers and fuzzers.
   const std::vector<std::pair<std::string, std::string>> cases = {
+      {"signature-byte", signature_byte},
+      {"signature-lf", lf_mangled},
+      {"signature-cr", cr_mangled},
+      {"colour-type-1", kSignature + ihdr(3, 2, 8, 1) + idat + iend},
+      {"colour-type-9", kSignature + ihdr(3, 2, 8, 9) + idat + iend},
+      {"depth-0", kSignature + ihdr(3, 2, 0, 2) + idat + iend},
+      {"depth-3", kSignature + ihdr(3, 2, 3, 2) + idat + iend},
+      {"depth-99", kSignature + ihdr(3, 2, 99, 2) + idat + iend},
+      {"bad-idat-crc", bad_idat_crc},
       {"bad-ihdr-crc", bad_crc},
       {"huge-size", kSignature + ihdr(100000, 100000, 8, 2) + idat + iend},
       {"zero-width", kSignature + ihdr(0, 2, 8, 2) + idat + iend},
