@@ -91,6 +91,73 @@ struct Request {
   Into into = Into::color_multiply;
 };
 
+// --- Texture-space bake -------------------------------------------------------------------------------
+// Occlusion over a mesh's UVs, as Blender's, xNormal's or Substance's bakers make it: one texture per
+// target, each texel the estimator above at the surface point that its centre maps to.
+// Texels, in texture space with texel centres at ((i + ½)/W, (j + ½)/H) and row 0 at v = 0 (glTF's
+// top row):
+// - covered: the centre lies in a triangle's UV image. A centre on an edge shared by two triangles
+//   belongs to one of them (a tie rule on the edge's direction), so a seamless layout maps every
+//   centre once.
+// - touched: the centre lies outside every triangle but within half a texel diagonal of one; it is
+//   sampled at the nearest point of the nearest such triangle, so texels along UV seams hold the
+//   surface's value rather than the background.
+// - padded: within `padding` texels of a covered or touched one; takes the value of the nearest
+//   (ties averaged), so bilinear filtering and mipmaps do not read the background.
+// - the rest hold 1 and are never traced.
+// A texel mapped by several surfaces (overlapping islands, stacked copies, UVs wrapping past [0, 1],
+// a mesh placed by several nodes) holds their mean, and is counted as overlapped.
+
+enum class Wrap { repeat, mirrored_repeat, clamp_to_edge };  // a glTF sampler's wrapS / wrapT
+
+// One texture: the triangles of some instances through one UV set.
+struct TextureTarget {
+  std::vector<std::size_t> instances;  // indices into scene.instances
+  int texcoord = 0;                    // TEXCOORD_n; an instance without it is skipped and counted
+  Wrap wrap_s = Wrap::repeat, wrap_t = Wrap::repeat;  // how the texture will be sampled past [0, 1]
+};
+
+struct TextureOptions {
+  int width = 1024, height = 1024;
+  int padding = -1;       // texels; -1: kDefaultPadding at 1024, scaled with the larger side
+  int texel_samples = 1;  // surface points per texel, stratified over its footprint; the rays are
+                          // shared among them (1 to the sample count)
+};
+constexpr int kDefaultPadding = 16;
+constexpr int kMaxTextureSide = 16384;
+int padding_for(const TextureOptions& options);  // the padding used
+Status check(const TextureOptions& options, const Options& estimator);
+
+struct TextureBake {
+  int width = 0, height = 0;
+  std::vector<float> values;  // width × height, row-major; 1 where nothing maps
+  // Texel counts.
+  std::size_t covered = 0;     // centre inside a triangle
+  std::size_t touched = 0;     // centre outside, within half a diagonal of one (nearest point)
+  std::size_t overlapped = 0;  // covered by more than one surface
+  std::size_t padded = 0;
+  // Triangle counts.
+  std::size_t triangles = 0;            // rasterized
+  std::size_t degenerate_uv = 0;        // zero area in UV (or not finite): skipped
+  std::size_t wrapped = 0;              // reaching outside [0, 1]: sampled with the wrap mode
+  std::size_t instances_without_uv = 0; // instances of the target lacking its UV set
+  std::uint64_t rays = 0;
+};
+
+struct TextureBakes {
+  std::vector<TextureBake> textures;  // one per target, in order
+  std::uint64_t rays = 0;
+  double max_distance = 0;
+  double setup_seconds = 0;   // normals, edge lengths and Embree's BVH
+  double texel_seconds = 0;   // rasterizing the UVs, padding
+  double ray_seconds = 0;
+};
+
+// Deterministic for a given seed whatever the thread count. options.targets is ignored (every
+// instance occludes; the targets say what is baked).
+Result<TextureBakes> bake_textures(const scene::Scene& scene, const Options& options,
+                                   const std::vector<TextureTarget>& targets, const TextureOptions& texture);
+
 // Sample i of the per-vertex sequence, in [0, 1)².
 struct Sample2 {
   float u, v;

@@ -3,6 +3,7 @@
 // scene's node graph, in world space. Only what the scene references is read: nodes outside it,
 // images and animations are not loaded.
 #include <glm/mat4x4.hpp>
+#include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
 
@@ -24,6 +25,7 @@ using Vec3 = glm::vec3;
 // One primitive placed by one node (a mesh instanced by two nodes gives two).
 struct Instance {
   int node = -1, mesh = -1, primitive = -1;
+  int material = -1;                              // the primitive's material; -1: none
   glm::dmat4 world{1.0};                          // node to world
   std::vector<Vec3> positions;                    // world space, one per vertex of the primitive
   std::vector<Vec3> normals;                      // world space, unit; empty when the file has none
@@ -31,6 +33,14 @@ struct Instance {
   bool colors_have_alpha = false;                 // empty when the file has none
   std::vector<std::array<std::uint32_t, 3>> triangles;  // strips and fans converted; facing kept
                                                          // under mirroring transforms
+  // TEXCOORD_n as floats (n the index; an empty entry: the file has no set n). Read only when
+  // SceneContent::texcoords asks: a per-vertex bake does not need them.
+  std::vector<std::vector<glm::vec2>> texcoords;
+};
+
+// What a load reads beyond positions, normals, colours and triangles.
+struct SceneContent {
+  bool texcoords = false;
 };
 
 struct Scene {
@@ -45,7 +55,7 @@ struct Scene {
 // leave the file's folder (absolute or with ..), a node reached twice (a cycle, or two parents:
 // glTF nodes form strict trees), no default scene, no triangles. Node chains of any depth are
 // walked without recursion.
-Result<Scene> load_scene(const std::filesystem::path& path);
+Result<Scene> load_scene(const std::filesystem::path& path, const SceneContent& content = {});
 
 // Vertex normals from faces (ch. 12): the sum over the faces around a vertex of the face normal
 // weighted equally (12.31), by face area (12.32) or by the face's angle at the vertex (12.33).

@@ -6,6 +6,6 @@
 
 namespace matbake::scene {
 
-Result<Scene> scene_from_document(const gltf::Document& doc);
+Result<Scene> scene_from_document(const gltf::Document& doc, const SceneContent& content = {});
 
 }  // namespace matbake::scene

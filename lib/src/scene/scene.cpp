@@ -82,7 +82,7 @@ struct Reader {
     return bytes;
   }
 
-  // `components` floats per element (3 or 4): FLOAT, or integers (KHR_mesh_quantization), normalized
+  // `components` floats per element (2 to 4): FLOAT, or integers (KHR_mesh_quantization), normalized
   // or not; each element handed to `use(element, const float*)`.
   template <class F>
   Status floats(int index, std::size_t components, F use) const {
@@ -174,7 +174,8 @@ int integer_in(const Json& json, const char* key, int absent) {
 }
 
 // One primitive placed by node `n`: its triangles, world positions, normals and colours.
-Result<Instance> place_primitive(const Reader& read, const Json& primitive, int n, int mesh, int p, const glm::dmat4& world) {
+Result<Instance> place_primitive(const Reader& read, const Json& primitive, int n, int mesh, int p, const glm::dmat4& world,
+                                 const SceneContent& content) {
   const std::string where = "mesh " + std::to_string(mesh) + " primitive " + std::to_string(p);
   const Json& attributes = object_in(primitive, "attributes");
   if (!attributes.contains("POSITION")) return read.error(where + " has no POSITION");
@@ -183,6 +184,7 @@ Result<Instance> place_primitive(const Reader& read, const Json& primitive, int 
   inst.mesh = mesh;
   inst.primitive = p;
   inst.world = world;
+  inst.material = integer_in(primitive, "material", -1);
   const int position = integer_in(attributes, "POSITION", -1);
   auto position_bytes = read.dense(position);
   if (!position_bytes) return position_bytes.error();
@@ -235,6 +237,21 @@ Result<Instance> place_primitive(const Reader& read, const Json& primitive, int 
                     [&](std::size_t, const float* c) { inst.colors.emplace_back(c[0], c[1], c[2], c[3]); });
     if (!s) return s.error();
   }
+  if (content.texcoords) {
+    // TEXCOORD_0, _1, ... as far as the file numbers them without a gap (as the spec requires).
+    for (int set = 0;; ++set) {
+      const std::string name = "TEXCOORD_" + std::to_string(set);
+      if (!attributes.contains(name)) break;
+      const int texcoord = integer_in(attributes, name.c_str(), -1);
+      auto bytes = read.dense(texcoord);
+      if (!bytes) return bytes.error();
+      if (bytes->count != vertices) return read.error(where + ": " + name + " and POSITION counts differ");
+      std::vector<glm::vec2>& uv = inst.texcoords.emplace_back();
+      uv.reserve(vertices);
+      s = read.floats(texcoord, 2, [&](std::size_t, const float* x) { uv.emplace_back(x[0], x[1]); });
+      if (!s) return s.error();
+    }
+  }
   return inst;
 }
 
@@ -242,7 +259,7 @@ Result<Instance> place_primitive(const Reader& read, const Json& primitive, int 
 
 float Scene::radius() const { return 0.5f * glm::length(bounds_max - bounds_min); }
 
-Result<Scene> scene_from_document(const gltf::Document& doc) {
+Result<Scene> scene_from_document(const gltf::Document& doc, const SceneContent& content) {
   return guarded(doc.file, [&]() -> Result<Scene> {
     const Json& json = doc.json;
     const Reader read{doc};
@@ -290,7 +307,7 @@ Result<Scene> scene_from_document(const gltf::Document& doc) {
             ++ignored_primitives;
             continue;
           }
-          auto inst = place_primitive(read, primitives[p], n, m, int(p), world);
+          auto inst = place_primitive(read, primitives[p], n, m, int(p), world, content);
           if (!inst) return inst.error();
           scene.instances.push_back(std::move(*inst));
         }
@@ -318,10 +335,10 @@ Result<Scene> scene_from_document(const gltf::Document& doc) {
   });
 }
 
-Result<Scene> load_scene(const fs::path& path) {
+Result<Scene> load_scene(const fs::path& path, const SceneContent& content) {
   auto doc = gltf::read_document(path);
   if (!doc) return doc.error();
-  return scene_from_document(*doc);
+  return scene_from_document(*doc, content);
 }
 
 NormalResult vertex_normals(const std::vector<Vec3>& positions, const std::vector<std::array<std::uint32_t, 3>>& triangles,

@@ -1,0 +1,265 @@
+#include "texels.hpp"
+
+#include <glm/geometric.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace matbake::ao::texels {
+namespace {
+
+using glm::dvec2;
+
+double cross(const dvec2& a, const dvec2& b) { return a.x * b.y - a.y * b.x; }
+
+// The edge function of a → b at p, evaluated from the lexicographically smaller endpoint so that
+// the two triangles sharing an edge get exactly opposite values (the tie rule needs exact zeros).
+double edge(const dvec2& a, const dvec2& b, const dvec2& p) {
+  const bool forward = a.x < b.x || (a.x == b.x && a.y < b.y);
+  const dvec2& lo = forward ? a : b;
+  const dvec2& hi = forward ? b : a;
+  const double e = cross(hi - lo, p - lo);
+  return forward ? e : -e;
+}
+
+// A centre exactly on an edge belongs to the triangle that traverses the edge in a half-open half
+// circle of directions: the neighbour across it traverses it the other way, so exactly one of them
+// owns it (and, around a shared vertex, exactly one of the fan).
+bool owns(const dvec2& a, const dvec2& b) {
+  const dvec2 d = b - a;
+  return d.y > 0 || (d.y == 0 && d.x < 0);
+}
+
+bool inside(const UvTriangle& t, const dvec2& p) {
+  const double e[3] = {edge(t.a, t.b, p), edge(t.b, t.c, p), edge(t.c, t.a, p)};
+  const bool own[3] = {owns(t.a, t.b), owns(t.b, t.c), owns(t.c, t.a)};
+  for (int k = 0; k < 3; ++k) {
+    if (e[k] < 0 || (e[k] == 0 && !own[k])) return false;
+  }
+  return true;
+}
+
+long long wrap(long long i, long long size, Wrap mode) {
+  switch (mode) {
+    case Wrap::repeat: return ((i % size) + size) % size;
+    case Wrap::mirrored_repeat: {
+      const long long m = ((i % (2 * size)) + 2 * size) % (2 * size);
+      return m < size ? m : 2 * size - 1 - m;
+    }
+    case Wrap::clamp_to_edge: return std::clamp(i, 0LL, size - 1);
+  }
+  return 0;
+}
+
+// Squared distance transform of one row or column (Felzenszwalb and Huttenlocher 2012): the lower
+// envelope of the parabolas (q − r)² + f(r), in place. Unmapped samples hold kFar, a finite stand-in
+// for infinity that keeps the envelope's intersections finite.
+constexpr double kFar = 1e20;
+void distance_1d(double* f, std::size_t n, std::size_t stride, std::vector<double>& d, std::vector<int>& v,
+                 std::vector<double>& z) {
+  const auto at = [&](long q) { return f[std::size_t(q) * stride]; };
+  std::size_t k = 0;
+  v[0] = 0;
+  z[0] = -std::numeric_limits<double>::infinity();
+  z[1] = std::numeric_limits<double>::infinity();
+  const auto meet = [&](long q, long r) {  // where q's parabola passes below r's
+    return ((at(q) + double(q) * double(q)) - (at(r) + double(r) * double(r))) / (2.0 * double(q - r));
+  };
+  for (long q = 1; q < long(n); ++q) {
+    double s = meet(q, v[k]);
+    while (s <= z[k]) s = meet(q, v[--k]);  // z[0] = −∞ stops it
+    ++k;
+    v[k] = int(q), z[k] = s, z[k + 1] = std::numeric_limits<double>::infinity();
+  }
+  k = 0;
+  for (long q = 0; q < long(n); ++q) {
+    while (z[k + 1] < double(q)) ++k;
+    const long r = v[k];
+    d[std::size_t(q)] = double(q - r) * double(q - r) + at(r);
+  }
+  for (std::size_t q = 0; q < n; ++q) f[q * stride] = d[q];
+}
+
+}  // namespace
+
+UvTriangle uv_triangle(const scene::Instance& inst, int texcoord, std::size_t triangle, int width, int height) {
+  const auto& uv = inst.texcoords[std::size_t(texcoord)];
+  const auto& t = inst.triangles[triangle];
+  const auto texel = [&](std::uint32_t v) { return dvec2(double(uv[v].x) * width - 0.5, double(uv[v].y) * height - 0.5); };
+  return {texel(t[0]), texel(t[1]), texel(t[2])};
+}
+
+// Ericson, Real-Time Collision Detection 5.1.5, in barycentric form.
+glm::dvec3 nearest_weights(const UvTriangle& t, const dvec2& p) {
+  const dvec2 ab = t.b - t.a, ac = t.c - t.a, ap = p - t.a;
+  const double d1 = glm::dot(ab, ap), d2 = glm::dot(ac, ap);
+  if (d1 <= 0 && d2 <= 0) return {1, 0, 0};
+  const dvec2 bp = p - t.b;
+  const double d3 = glm::dot(ab, bp), d4 = glm::dot(ac, bp);
+  if (d3 >= 0 && d4 <= d3) return {0, 1, 0};
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) {
+    const double v = d1 / (d1 - d3);
+    return {1 - v, v, 0};
+  }
+  const dvec2 cp = p - t.c;
+  const double d5 = glm::dot(ab, cp), d6 = glm::dot(ac, cp);
+  if (d6 >= 0 && d5 <= d6) return {0, 0, 1};
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) {
+    const double w = d2 / (d2 - d6);
+    return {1 - w, 0, w};
+  }
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
+    const double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+    return {0, 1 - w, w};
+  }
+  const double denominator = 1 / (va + vb + vc);
+  const double v = vb * denominator, w = vc * denominator;
+  return {1 - v - w, v, w};
+}
+
+Result<Coverage> cover(const scene::Scene& scene, const TextureTarget& target, int width, int height) {
+  Coverage out;
+  struct Touch {
+    std::uint32_t texel;
+    double distance;
+    SurfacePoint point;
+  };
+  std::vector<Touch> touches;
+  const double reach = std::sqrt(0.5);  // half a texel diagonal
+  // A triangle's bounding box may cover the texture a few times over (wrapping UVs); beyond this it
+  // is a broken layout, and would cost unbounded time.
+  const double max_cells = 16.0 * double(width) * double(height) + 1024;
+  for (std::size_t k : target.instances) {
+    const scene::Instance& inst = scene.instances[k];
+    if (std::size_t(target.texcoord) >= inst.texcoords.size() || inst.texcoords[std::size_t(target.texcoord)].empty()) {
+      ++out.instances_without_uv;
+      continue;
+    }
+    for (std::size_t t = 0; t < inst.triangles.size(); ++t) {
+      const UvTriangle uv = uv_triangle(inst, target.texcoord, t, width, height);
+      const double area2 = cross(uv.b - uv.a, uv.c - uv.a);
+      const double scale = std::max({glm::length(uv.b - uv.a), glm::length(uv.c - uv.a), glm::length(uv.c - uv.b)});
+      if (!std::isfinite(area2) || !(std::abs(area2) > 1e-12 * scale * scale)) {
+        ++out.degenerate_uv;
+        continue;
+      }
+      const UvTriangle tri = area2 > 0 ? uv : UvTriangle{uv.a, uv.c, uv.b};  // positive orientation
+      const double x0 = std::min({tri.a.x, tri.b.x, tri.c.x}), x1 = std::max({tri.a.x, tri.b.x, tri.c.x});
+      const double y0 = std::min({tri.a.y, tri.b.y, tri.c.y}), y1 = std::max({tri.a.y, tri.b.y, tri.c.y});
+      const double i0 = std::ceil(x0 - reach), i1 = std::floor(x1 + reach);
+      const double j0 = std::ceil(y0 - reach), j1 = std::floor(y1 + reach);
+      if ((i1 - i0 + 1) * (j1 - j0 + 1) > max_cells) {
+        ++out.degenerate_uv;  // counted with the unusable ones: it spans more than 16 copies
+        continue;
+      }
+      ++out.triangles;
+      if (x0 < -0.5 || y0 < -0.5 || x1 > width - 0.5 || y1 > height - 0.5) ++out.wrapped;
+      for (double j = j0; j <= j1; ++j) {
+        for (double i = i0; i <= i1; ++i) {
+          const dvec2 centre(i, j);
+          const auto texel = std::uint32_t(wrap((long long)j, height, target.wrap_t) * width +
+                                            wrap((long long)i, width, target.wrap_s));
+          if (inside(tri, centre)) {
+            out.points.push_back({texel, std::uint32_t(k), std::uint32_t(t), float(i), float(j)});
+            if (out.points.size() > kMaxSurfacePoints) {
+              return Error{"", "the UV layout maps more than " + std::to_string(kMaxSurfacePoints) +
+                                   " surface points into the texture (hundreds of stacked copies?)"};
+            }
+            continue;
+          }
+          const glm::dvec3 w = nearest_weights(tri, centre);
+          const dvec2 q = w.x * tri.a + w.y * tri.b + w.z * tri.c;
+          const double distance = glm::length(q - centre);
+          if (distance <= reach) {
+            touches.push_back({texel, distance, {texel, std::uint32_t(k), std::uint32_t(t), float(q.x), float(q.y)}});
+            if (touches.size() > kMaxSurfacePoints) {
+              return Error{"", "the UV layout touches more than " + std::to_string(kMaxSurfacePoints) + " texels"};
+            }
+          }
+        }
+      }
+    }
+  }
+  std::stable_sort(out.points.begin(), out.points.end(),
+                   [](const SurfacePoint& a, const SurfacePoint& b) { return a.texel < b.texel; });
+  std::vector<SurfacePoint> merged;
+  merged.reserve(out.points.size());
+  for (std::size_t first = 0; first < out.points.size();) {
+    std::size_t last = first;
+    while (last < out.points.size() && out.points[last].texel == out.points[first].texel) ++last;
+    ++out.covered;
+    if (last - first > 1) ++out.overlapped;
+    first = last;
+  }
+  // Touched texels that no centre covers: the nearest triangle's nearest point (the first on a tie).
+  std::stable_sort(touches.begin(), touches.end(), [](const Touch& a, const Touch& b) {
+    return a.texel < b.texel || (a.texel == b.texel && a.distance < b.distance);
+  });
+  std::size_t c = 0;
+  for (std::size_t first = 0; first < touches.size();) {
+    const std::uint32_t texel = touches[first].texel;
+    while (c < out.points.size() && out.points[c].texel < texel) ++c;
+    if (c == out.points.size() || out.points[c].texel != texel) {
+      merged.push_back(touches[first].point);
+      ++out.touched;
+    }
+    while (first < touches.size() && touches[first].texel == texel) ++first;
+  }
+  if (!merged.empty()) {
+    out.points.insert(out.points.end(), merged.begin(), merged.end());
+    std::stable_sort(out.points.begin(), out.points.end(),
+                     [](const SurfacePoint& a, const SurfacePoint& b) { return a.texel < b.texel; });
+  }
+  return out;
+}
+
+std::size_t pad(std::vector<float>& values, const std::vector<bool>& mapped, int width, int height, int padding) {
+  if (padding <= 0) return 0;
+  const std::size_t w = std::size_t(width), h = std::size_t(height);
+  std::vector<double> d2(w * h);
+  for (std::size_t i = 0; i < w * h; ++i) d2[i] = mapped[i] ? 0.0 : kFar;
+  const std::size_t n = std::max(w, h);
+  std::vector<double> scratch(n);
+  std::vector<int> v(n);
+  std::vector<double> z(n + 1);
+  for (std::size_t x = 0; x < w; ++x) distance_1d(&d2[x], h, w, scratch, v, z);    // columns
+  for (std::size_t y = 0; y < h; ++y) distance_1d(&d2[y * w], w, 1, scratch, v, z);  // rows
+  const double limit = double(padding) * padding;
+  const std::vector<float> source = values;
+  std::size_t padded = 0;
+  for (std::size_t y = 0; y < h; ++y) {
+    for (std::size_t x = 0; x < w; ++x) {
+      const double d = d2[y * w + x];
+      if (d == 0 || d > limit) continue;
+      // Every mapped texel at exactly this squared distance: for each column offset, at most the two
+      // rows with dx² + dy² = d.
+      const auto r = long(std::floor(std::sqrt(d)));
+      double sum = 0;
+      int count = 0;
+      for (long dx = -r; dx <= r; ++dx) {
+        const double rest = d - double(dx) * double(dx);
+        const auto dy = long(std::llround(std::sqrt(std::max(0.0, rest))));
+        if (double(dy) * double(dy) != rest) continue;
+        for (long sy : {-dy, dy}) {
+          const long xx = long(x) + dx, yy = long(y) + sy;
+          if (xx >= 0 && yy >= 0 && xx < long(w) && yy < long(h) && mapped[std::size_t(yy) * w + std::size_t(xx)]) {
+            sum += source[std::size_t(yy) * w + std::size_t(xx)];
+            ++count;
+          }
+          if (dy == 0) break;
+        }
+      }
+      if (count) {
+        values[y * w + x] = float(sum / count);
+        ++padded;
+      }
+    }
+  }
+  return padded;
+}
+
+}  // namespace matbake::ao::texels

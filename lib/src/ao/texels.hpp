@@ -1,0 +1,45 @@
+#pragma once
+// The texels a texture bake traces: which surface point each texel centre maps to (coverage with a
+// tie rule, nearest points for touched texels), and the padding around them afterwards.
+#include <glm/vec2.hpp>
+
+#include <cstdint>
+#include <vector>
+
+#include "matbake/ao.hpp"
+
+namespace matbake::ao::texels {
+
+// A surface point a texel samples: triangle `triangle` of instance `instance`, at (x, y) in texel
+// space (texel (i, j) has its centre at (i, j); unwrapped, so it may lie outside [0, W) × [0, H)).
+struct SurfacePoint {
+  std::uint32_t texel;  // j × width + i, wrapped
+  std::uint32_t instance;
+  std::uint32_t triangle;
+  float x, y;
+};
+
+struct Coverage {
+  std::vector<SurfacePoint> points;  // sorted by texel; within a texel, in scene order
+  std::size_t covered = 0, touched = 0, overlapped = 0;
+  std::size_t triangles = 0, degenerate_uv = 0, wrapped = 0, instances_without_uv = 0;
+};
+
+// Errors: a layout mapping more surface points than kMaxSurfacePoints (hundreds of stacked copies).
+constexpr std::size_t kMaxSurfacePoints = std::size_t{1} << 28;
+Result<Coverage> cover(const scene::Scene& scene, const TextureTarget& target, int width, int height);
+
+// A triangle's UVs in texel space.
+struct UvTriangle {
+  glm::dvec2 a, b, c;
+};
+UvTriangle uv_triangle(const scene::Instance& inst, int texcoord, std::size_t triangle, int width, int height);
+
+// Barycentric weights (of a, b, c) of the point of the triangle nearest to p (p's own when inside).
+glm::dvec3 nearest_weights(const UvTriangle& t, const glm::dvec2& p);
+
+// Texels within `padding` of a mapped one take the value of the nearest mapped texel (Euclidean,
+// ties averaged); returns how many were padded. Texels farther away are left as they are.
+std::size_t pad(std::vector<float>& values, const std::vector<bool>& mapped, int width, int height, int padding);
+
+}  // namespace matbake::ao::texels

@@ -1,0 +1,157 @@
+#include "tracer.hpp"
+
+#include <glm/geometric.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+namespace matbake::ao {
+namespace {
+
+using scene::Vec3;
+
+// An orthonormal basis around n (Duff et al. 2017, branchless).
+void basis(const Vec3& n, Vec3& t, Vec3& b) {
+  const float sign = std::copysign(1.0f, n.z);
+  const float a = -1.0f / (sign + n.z);
+  const float c = n.x * n.y * a;
+  t = Vec3(1.0f + sign * n.x * n.x * a, sign * c, -sign * n.x);
+  b = Vec3(c, sign + n.y * n.y * a, -n.y);
+}
+
+// The file's unit normals where it has them; else (or when asked) from the faces.
+std::vector<Vec3> ray_normals(const scene::Instance& inst, std::optional<scene::NormalWeighting> recompute) {
+  const bool usable = !recompute && !inst.normals.empty() &&
+                      std::all_of(inst.normals.begin(), inst.normals.end(), [](const Vec3& n) { return glm::length(n) > 0; });
+  if (usable) return inst.normals;  // the common case: no face pass at all
+  const scene::NormalWeighting weighting = recompute.value_or(scene::NormalWeighting::area);
+  std::vector<Vec3> normals = scene::vertex_normals(inst.positions, inst.triangles, weighting, inst.normals).normals;
+  if (!recompute && !inst.normals.empty()) {
+    for (std::size_t v = 0; v < normals.size(); ++v) {
+      if (glm::length(inst.normals[v]) > 0) normals[v] = inst.normals[v];
+    }
+  }
+  return normals;
+}
+
+Mesh prepare(const scene::Instance& inst, std::optional<scene::NormalWeighting> recompute) {
+  Mesh m;
+  m.normals = ray_normals(inst, recompute);
+  std::vector<double> sum(inst.positions.size(), 0.0);
+  std::vector<int> count(inst.positions.size(), 0);
+  for (const auto& t : inst.triangles) {
+    for (int k = 0; k < 3; ++k) {
+      const std::uint32_t a = t[std::size_t(k)], b = t[std::size_t((k + 1) % 3)];
+      const double length = glm::length(inst.positions[a] - inst.positions[b]);
+      sum[a] += length, sum[b] += length;
+      ++count[a], ++count[b];
+    }
+    const Vec3 n = glm::cross(inst.positions[t[1]] - inst.positions[t[0]], inst.positions[t[2]] - inst.positions[t[0]]);
+    m.face_normals.push_back(n);
+  }
+  m.edge_length.resize(inst.positions.size());
+  for (std::size_t v = 0; v < sum.size(); ++v) m.edge_length[v] = count[v] ? float(sum[v] / count[v]) : 0.0f;
+  return m;
+}
+
+// One-sided occlusion: a hit on the back of a face (its normal along the ray) is not a hit.
+void reject_back_faces(const RTCFilterFunctionNArguments* args) {
+  const auto* faces = static_cast<const std::vector<Vec3>*>(args->geometryUserPtr);
+  for (unsigned i = 0; i < args->N; ++i) {
+    if (args->valid[i] != -1) continue;
+    const Vec3& n = (*faces)[RTCHitN_primID(args->hit, args->N, i)];
+    const Vec3 d(RTCRayN_dir_x(args->ray, args->N, i), RTCRayN_dir_y(args->ray, args->N, i),
+                 RTCRayN_dir_z(args->ray, args->N, i));
+    if (glm::dot(n, d) > 0) args->valid[i] = 0;
+  }
+}
+
+}  // namespace
+
+Result<std::unique_ptr<Tracer>> Tracer::build(const scene::Scene& scene, const Options& options) {
+  std::unique_ptr<Tracer> tracer(new Tracer);
+  tracer->options_ = options;
+  tracer->device_.reset(rtcNewDevice(nullptr));
+  if (!tracer->device_) return Error{"", "Embree could not start (rtcNewDevice failed)"};
+  RTCDevice device = tracer->device_.get();
+  tracer->scene_.reset(rtcNewScene(device));
+  RTCScene rtc = tracer->scene_.get();
+  if (options.watertight) rtcSetSceneFlags(rtc, RTC_SCENE_FLAG_ROBUST);
+  rtcSetSceneBuildQuality(rtc, RTC_BUILD_QUALITY_HIGH);
+  tracer->meshes_.reserve(scene.instances.size());  // filter functions keep pointers into it
+  for (const scene::Instance& inst : scene.instances) {
+    tracer->meshes_.push_back(prepare(inst, options.recompute_normals));
+    RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    // Embree reads vertex buffers in 16-byte loads: rtcSetNewGeometryBuffer pads for us.
+    auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                                                  3 * sizeof(float), inst.positions.size()));
+    for (std::size_t v = 0; v < inst.positions.size(); ++v) {
+      vertices[3 * v] = inst.positions[v].x, vertices[3 * v + 1] = inst.positions[v].y, vertices[3 * v + 2] = inst.positions[v].z;
+    }
+    auto* indices = static_cast<std::uint32_t*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                                         3 * sizeof(std::uint32_t), inst.triangles.size()));
+    for (std::size_t t = 0; t < inst.triangles.size(); ++t) {
+      for (int k = 0; k < 3; ++k) indices[3 * t + std::size_t(k)] = inst.triangles[t][std::size_t(k)];
+    }
+    if (!options.two_sided) {
+      rtcSetGeometryUserData(g, &tracer->meshes_.back().face_normals);
+      rtcSetGeometryIntersectFilterFunction(g, reject_back_faces);
+      rtcSetGeometryOccludedFilterFunction(g, reject_back_faces);
+    }
+    rtcCommitGeometry(g);
+    rtcAttachGeometry(rtc, g);
+    rtcReleaseGeometry(g);
+  }
+  rtcCommitScene(rtc);
+  if (rtcGetDeviceError(device) != RTC_ERROR_NONE) return Error{"", "Embree could not build the scene"};
+  tracer->radius_ = scene.radius();
+  tracer->d_max_ = options.absolute_distance > 0 ? options.absolute_distance : options.relative_distance * scene.radius();
+  tracer->tau_ = options.tau / tracer->d_max_;
+  tracer->normalization_ = 1.0 / (1.0 - std::exp(-tracer->tau_ * tracer->d_max_));
+  return tracer;
+}
+
+float Tracer::origin_offset(const Vec3& p, float scale) const {
+  const float magnitude = std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)});
+  return std::max(std::min(float(options_.bias) * scale, 1e-4f * radius_), 1e-6f * magnitude);
+}
+
+double Tracer::sum_over_rays(const Vec3& origin, const Vec3& n, std::uint64_t key, int first, int step,
+                             std::span<RTCRayHit> rays, std::uint64_t& cast) const {
+  Vec3 t, b;
+  basis(n, t, b);
+  const float far = float(d_max_);
+  unsigned count = 0;
+  for (int s = first; s < options_.samples; s += step) {
+    const Sample2 u = sample(options_.sampler, std::uint32_t(s), key);
+    // Cosine-weighted: r = √u, φ = 2π v.
+    const float r = std::sqrt(u.u), phi = 2 * std::numbers::pi_v<float> * u.v;
+    const Vec3 d = t * (r * std::cos(phi)) + b * (r * std::sin(phi)) + n * std::sqrt(std::max(0.0f, 1 - u.u));
+    RTCRayHit& rh = rays[count++];
+    rh.ray.org_x = origin.x, rh.ray.org_y = origin.y, rh.ray.org_z = origin.z;
+    rh.ray.dir_x = d.x, rh.ray.dir_y = d.y, rh.ray.dir_z = d.z;
+    rh.ray.tnear = 0, rh.ray.tfar = far, rh.ray.time = 0;
+    rh.ray.mask = ~0u, rh.ray.id = unsigned(s), rh.ray.flags = 0;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  }
+  if (count == 0) return 0;
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  double sum = 0;
+  // The rays of one point as a stream: they share an origin, and Embree packs them itself.
+  if (options_.falloff == Falloff::none) {
+    rtcOccluded1M(scene_.get(), &context, &rays[0].ray, count, sizeof(RTCRayHit));
+    for (unsigned i = 0; i < count; ++i) sum += rays[i].ray.tfar >= 0 ? 1.0 : 0.0;  // occluded: tfar = −inf
+  } else {
+    rtcIntersect1M(scene_.get(), &context, rays.data(), count, sizeof(RTCRayHit));
+    for (unsigned i = 0; i < count; ++i) {
+      const RTCRayHit& rh = rays[i];
+      sum += rh.hit.geomID == RTC_INVALID_GEOMETRY_ID ? 1.0 : std::min(1.0, (1.0 - std::exp(-tau_ * rh.ray.tfar)) * normalization_);
+    }
+  }
+  cast += count;
+  return sum;
+}
+
+}  // namespace matbake::ao

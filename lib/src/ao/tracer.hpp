@@ -1,0 +1,64 @@
+#pragma once
+// The estimator shared by the per-vertex and the texture bake: a scene in Embree, each vertex's ray
+// normal and bias scale, and the mean of μ over cosine-weighted rays from one point.
+#include <embree3/rtcore.h>
+
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "matbake/ao.hpp"
+
+namespace matbake::ao {
+
+struct Mesh {
+  std::vector<scene::Vec3> normals;       // per vertex, unit
+  std::vector<float> edge_length;         // per vertex: mean length of its edges (the bias scale)
+  std::vector<scene::Vec3> face_normals;  // per triangle, not normalized (|n| = twice the area)
+};
+
+struct DeviceDeleter {
+  void operator()(RTCDevice d) const { rtcReleaseDevice(d); }
+};
+struct SceneDeleter {
+  void operator()(RTCScene s) const { rtcReleaseScene(s); }
+};
+
+class Tracer {
+ public:
+  // Every instance occludes, whatever options.targets says. Errors: Embree failing to start or build.
+  static Result<std::unique_ptr<Tracer>> build(const scene::Scene& scene, const Options& options);
+
+  const Mesh& mesh(std::size_t instance) const { return meshes_[instance]; }
+  double max_distance() const { return d_max_; }
+
+  // The ray-origin offset along the normal at p, for a surface whose local length scale is `scale`
+  // (a vertex's mean edge length, a texel's world size): bias × scale, capped at 1e-4 of the scene
+  // radius (a huge triangle must not lift the origin through nearby geometry) and at least 1e-6 of
+  // p's coordinates' magnitude (float precision there: below it a ray can hit the surface it leaves).
+  // Not of the scene's size: a 1e-4 mesh in a 1e4 scene would have its rays start outside it.
+  float origin_offset(const scene::Vec3& p, float scale) const;
+
+  // Σ μ over rays first, first + step, ... (below options.samples) of the sequence keyed by `key`,
+  // cast from `origin` around the unit normal `n`; `rays` is scratch of at least options.samples.
+  // Returns the sum and adds the ray count to `cast`.
+  double sum_over_rays(const scene::Vec3& origin, const scene::Vec3& n, std::uint64_t key, int first, int step,
+                       std::span<RTCRayHit> rays, std::uint64_t& cast) const;
+
+ private:
+  Tracer() = default;
+  std::unique_ptr<RTCDeviceTy, DeviceDeleter> device_;
+  std::unique_ptr<RTCSceneTy, SceneDeleter> scene_;
+  std::vector<Mesh> meshes_;
+  Options options_;
+  float radius_ = 0;
+  double d_max_ = 0, tau_ = 0, normalization_ = 1;
+};
+
+// The per-sample key of a point: seed, instance (or texture) and element mixed so that neighbours'
+// sequences are decorrelated by the scramble.
+inline std::uint64_t sample_key(std::uint64_t seed, std::uint64_t group, std::uint64_t element) {
+  return seed * 0x100000001b3ull ^ (group << 40) ^ element;
+}
+
+}  // namespace matbake::ao
