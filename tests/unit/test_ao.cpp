@@ -11,6 +11,7 @@
 #include <numbers>
 
 #include "matbake/ao.hpp"
+#include "support/ao_scenes.hpp"
 
 namespace matbake::ao {
 namespace {
@@ -18,29 +19,8 @@ namespace {
 using scene::Instance;
 using scene::Vec3;
 
-// A square of half-size `half` in the plane through `center` spanned by u and v, facing u × v, as a
-// fan of 4 triangles around its centre vertex (vertex 0).
-Instance square(const Vec3& center, const Vec3& u, const Vec3& v, float half) {
-  Instance inst;
-  inst.positions = {center, center + half * (-u - v), center + half * (u - v), center + half * (u + v),
-                    center + half * (-u + v)};
-  inst.triangles = {{0, 1, 2}, {0, 2, 3}, {0, 3, 4}, {0, 4, 1}};
-  return inst;
-}
-
-scene::Scene scene_of(std::vector<Instance> instances) {
-  scene::Scene s;
-  s.instances = std::move(instances);
-  bool first = true;
-  for (const Instance& inst : s.instances) {
-    for (const Vec3& p : inst.positions) {
-      s.bounds_min = first ? p : glm::min(s.bounds_min, p);
-      s.bounds_max = first ? p : glm::max(s.bounds_max, p);
-      first = false;
-    }
-  }
-  return s;
-}
+using test::scene_of;
+using test::square;
 
 const Vec3 kX(1, 0, 0), kY(0, 1, 0), kZ(0, 0, 1);
 constexpr float kHalf = 1000;

@@ -19,6 +19,8 @@ namespace {
 using scene::Vec3;
 using Clock = std::chrono::steady_clock;
 
+constexpr std::uint64_t kTextureGroup = 1u << 20;  // sample_key groups of textures: beyond any instance index
+
 double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
 
 // The mean of the estimator over the K = texel_samples positions of one surface point's texel
@@ -125,7 +127,10 @@ Result<TextureBakes> bake_textures(const scene::Scene& scene, const Options& opt
         double sum = 0;
         for (std::size_t i = runs[r]; i < runs[r + 1]; ++i) {
           // Each surface of a texel its own stream: overlapping copies are independent estimates.
-          const std::uint64_t key = sample_key(options.seed, index, points[i].texel) ^ (std::uint64_t(i - runs[r]) << 32);
+          // Keyed apart from the per-vertex bake's streams (instance k, vertex v): texel j × W + i of
+          // a texture laid over a grid would otherwise repeat vertex j × W + i's rays exactly.
+          const std::uint64_t key = sample_key(options.seed, kTextureGroup + index, points[i].texel) ^
+                                    (std::uint64_t(i - runs[r]) << 32);
           sum += point_occlusion(tracer, scene, points[i], target, texture, options.samples, key, scratch, cast);
         }
         out.values[points[runs[r]].texel] = float(sum / double(runs[r + 1] - runs[r]));
