@@ -4,11 +4,11 @@
 
 namespace matbake::cli {
 
-void add_ao_options(CLI::App& cmd, AoSettings& s, const std::string& prefix) {
+void add_ao_options(CLI::App& cmd, AoSettings& s, const std::string& prefix, bool textures) {
   ao::Options& o = s.request.options;
   const std::string p = "--" + prefix;
   const std::string group = prefix.empty() ? "Options" : "Ambient occlusion";
-  cmd.add_option(p + "samples", o.samples, "Rays per vertex")->capture_default_str()->group(group);
+  cmd.add_option(p + "samples", o.samples, textures ? "Rays per vertex, or per texel with --texture" : "Rays per vertex")->capture_default_str()->group(group);
   cmd.add_option(p + "relative-distance", o.relative_distance, "d_max as a fraction of the scene radius")
       ->capture_default_str()->group(group);
   cmd.add_option(p + "max-distance", o.absolute_distance, "d_max in scene units (instead of the relative distance)")
@@ -42,6 +42,26 @@ void add_ao_options(CLI::App& cmd, AoSettings& s, const std::string& prefix) {
   cmd.add_option(p + "existing-colors", s.existing_colors,
                  "With COLOR_0, a primitive's own COLOR_0: multiply (kept, times AO; alpha kept) or replace")
       ->capture_default_str()->group(group);
+  if (!textures) return;
+  const std::string texture_group = "Texture bake (occlusionTexture)";
+  ao::TextureRequest& t = s.texture_request;
+  cmd.add_option(p + "texture", s.texture,
+                 "Bake one occlusion texture of this size (1024, or WxH) per material the scene reaches, over its UVs,\n"
+                 "instead of per-vertex values")
+      ->group(texture_group);
+  cmd.add_option(p + "texcoord", t.texcoord, "UV set (default: the material's occlusionTexture texCoord, else 0)")
+      ->group(texture_group);
+  cmd.add_option(p + "bits", t.bits, "Linear PNG bits: 8 or 16")->capture_default_str()->group(texture_group);
+  cmd.add_option(p + "padding", t.size.padding,
+                 "Texels around the UV islands that take the nearest island texel's value (default: 16 at 1024, scaled)")
+      ->group(texture_group);
+  cmd.add_option(p + "texel-samples", t.size.texel_samples,
+                 "Surface points per texel, stratified over its footprint (anti-aliasing); the rays are shared among them")
+      ->capture_default_str()->group(texture_group);
+  cmd.add_option(p + "existing-occlusion", s.existing_occlusion,
+                 "A material's own occlusion texture: multiply (times the bake) or replace")
+      ->capture_default_str()->group(texture_group);
+  cmd.add_option(p + "dump-texture", t.dump, "Also write each texture as float EXR into this folder")->group(texture_group);
 }
 
 Result<ao::Request> ao_request(const AoSettings& s, const std::string& prefix) {
@@ -53,6 +73,17 @@ Result<ao::Request> ao_request(const AoSettings& s, const std::string& prefix) {
   }
   r.into = *into;
   if (Status st = ao::check(r.options); !st) return st.error();
+  if (!s.texture.empty()) {
+    const auto size = ao::texture_size_from_text(s.texture);
+    if (!size) return Error{"", "--" + prefix + "texture '" + s.texture + "': use a size such as 1024 or 2048x1024", true};
+    if (s.existing_occlusion != "multiply" && s.existing_occlusion != "replace") {
+      return Error{"", "--" + prefix + "existing-occlusion '" + s.existing_occlusion + "': use multiply or replace", true};
+    }
+    r.texture = s.texture_request;
+    r.texture->size.width = size->first, r.texture->size.height = size->second;
+    r.texture->multiply_existing = s.existing_occlusion == "multiply";
+    if (Status st = ao::check(*r.texture, r.options); !st) return st.error();
+  }
   return r;
 }
 

@@ -10,14 +10,15 @@ namespace matbake::cli {
 CLI::App* setup_bake_ao(CLI::App& app, BakeAoSettings& s) {
   CLI::App* cmd = app.add_subcommand(
       "bake-ao",
-      "Bake per-vertex ambient obscurance (ch. 12, eq. 12.72) of a glTF scene's triangles with Embree: cosine-\n"
-      "weighted scrambled-Sobol rays over each vertex's hemisphere, against all scene geometry. Writes the\n"
-      "scene again with the values as COLOR_0 or _AO (-o), and/or the raw values (--dump).");
+      "Bake ambient obscurance (ch. 12, eq. 12.72) of a glTF scene's triangles with Embree: cosine-weighted\n"
+      "scrambled-Sobol rays over each vertex's (or texel's) hemisphere, against all scene geometry. Writes the\n"
+      "scene again with per-vertex values as COLOR_0 or _AO (-o), and/or the raw values (--dump); or, with\n"
+      "--texture SIZE, one occlusion texture per material (its occlusionTexture, a linear PNG).");
   cmd->add_option("scene", s.scene, "Input .gltf or .glb")->required();
   cmd->add_option("-o,--output", s.output,
                   "Output .gltf (+ .bin beside it) or .glb; everything but the baked attribute is kept as written");
   cmd->add_option("--dump", s.dump, "Raw values: .csv (node,mesh,primitive,vertex,x,y,z,ao) or .bin (float32)");
-  add_ao_options(*cmd, s.ao, "");
+  add_ao_options(*cmd, s.ao, "", true);
   return cmd;
 }
 
@@ -26,17 +27,48 @@ int run_bake_ao(const BakeAoSettings& s, const GlobalOptions& global) {
   if (!request) return report_error(request.error());
   auto report = exporter::bake_ao_file(s.scene, {*request, s.output, s.dump});
   if (!report) return report_error(report.error());
+  nlohmann::json textures = nlohmann::json::array();
+  for (const exporter::TextureReport& t : report->textures) {
+    textures.push_back({{"material", t.material}, {"name", t.name}, {"file", t.file}, {"width", t.width},
+                        {"height", t.height}, {"texcoord", t.texcoord}, {"covered", t.covered}, {"touched", t.touched},
+                        {"overlapped", t.overlapped}, {"padded", t.padded}, {"triangles", t.triangles},
+                        {"degenerate_uv", t.degenerate_uv}, {"wrapped", t.wrapped}, {"too_large", t.too_large},
+                        {"instances_without_uv", t.instances_without_uv}, {"existing", t.existing}, {"mean_ao", t.mean}});
+  }
   if (global.json) {
     std::cout << nlohmann::json{{"command", "bake-ao"}, {"scene", s.scene}, {"output", s.output}, {"dump", s.dump},
                                 {"instances", report->instances}, {"vertices", report->vertices},
                                 {"rays", report->rays}, {"seconds", report->seconds},
                                 {"setup_seconds", report->setup_seconds}, {"ray_seconds", report->ray_seconds},
                                 {"max_distance", report->max_distance}, {"mean_ao", report->mean},
-                                {"notes", report->notes}}
+                                {"texels", report->texels}, {"texel_seconds", report->texel_seconds},
+                                {"textures", textures}, {"notes", report->notes}}
                      .dump(2)
               << "\n";
   } else if (!global.quiet) {
     for (const std::string& note : report->notes) std::cout << "note: " << note << "\n";
+    for (const exporter::TextureReport& t : report->textures) {
+      const double mapped = double(t.covered + t.touched);
+      std::printf("material %d '%s': %s, %dx%d over TEXCOORD_%d, %zu texels mapped (%zu on seams), %.1f%% of them overlapped, "
+                  "%zu padded, mean %.4f%s\n",
+                  t.material, t.name.c_str(), t.file.c_str(), t.width, t.height, t.texcoord, t.covered + t.touched, t.touched,
+                  mapped > 0 ? 100.0 * double(t.overlapped) / mapped : 0.0, t.padded, t.mean,
+                  t.existing.empty() ? "" : (", its own occlusion texture " + t.existing).c_str());
+      if (t.wrapped) std::printf("  %zu triangles reach outside [0, 1]: wrapped by the sampler's mode\n", t.wrapped);
+      if (t.degenerate_uv) std::printf("  %zu triangles with no UV area skipped\n", t.degenerate_uv);
+      if (t.too_large) std::printf("  %zu triangles spanning more than 64 copies of the texture skipped\n", t.too_large);
+      if (t.instances_without_uv) {
+        std::printf("  %zu placed primitives lack TEXCOORD_%d: skipped (per-vertex AO can still be baked)\n",
+                    t.instances_without_uv, t.texcoord);
+      }
+    }
+    if (!report->textures.empty()) {
+      std::printf("%s: %zu textures, %llu texels, %.3g rays in %.2f s (%.1f M rays/s; UV setup %.2f s), d_max %.4g, mean %.4f\n",
+                  s.output.c_str(), report->textures.size(), (unsigned long long)report->texels, double(report->rays),
+                  report->seconds, double(report->rays) / report->seconds / 1e6, report->texel_seconds,
+                  report->max_distance, report->mean);
+      return kOk;
+    }
     std::printf("%s: %zu instances, %zu vertices, %.3g rays in %.2f s (%.1f M rays/s), d_max %.4g, mean %.4f\n",
                 (s.output.empty() ? s.dump : s.output).c_str(), report->instances, report->vertices,
                 double(report->rays), report->seconds, double(report->rays) / report->seconds / 1e6,

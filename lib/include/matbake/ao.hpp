@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <optional>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "matbake/enum_names.hpp"
@@ -85,12 +86,6 @@ std::string_view into_attribute_name(Into into);
 std::string_view into_existing_colors_name(Into into);  // "multiply" for Into::attribute too
 std::optional<Into> into_from_names(std::string_view attribute, std::string_view existing_colors);
 
-// A bake for a written glTF: the estimator's options and where the values go.
-struct Request {
-  Options options;
-  Into into = Into::color_multiply;
-};
-
 // --- Texture-space bake -------------------------------------------------------------------------------
 // Occlusion over a mesh's UVs, as Blender's, xNormal's or Substance's bakers make it: one texture per
 // target, each texel the estimator above at the surface point that its centre maps to.
@@ -126,6 +121,8 @@ struct TextureOptions {
 constexpr int kDefaultPadding = 16;
 constexpr int kMaxTextureSide = 16384;
 int padding_for(const TextureOptions& options);  // the padding used
+// "1024" (square) or "2048x1024" (width × height); nothing when it is neither (sides are checked by check()).
+std::optional<std::pair<int, int>> texture_size_from_text(std::string_view text);
 Status check(const TextureOptions& options, const Options& estimator);
 
 struct TextureBake {
@@ -140,8 +137,10 @@ struct TextureBake {
   std::size_t triangles = 0;            // rasterized
   std::size_t degenerate_uv = 0;        // zero area in UV (or not finite): skipped
   std::size_t wrapped = 0;              // reaching outside [0, 1]: sampled with the wrap mode
+  std::size_t too_large = 0;            // spanning more than 64 copies of the texture: skipped
   std::size_t instances_without_uv = 0; // instances of the target lacking its UV set
   std::uint64_t rays = 0;
+  double mean = 0;  // over covered and touched texels
 };
 
 struct TextureBakes {
@@ -157,6 +156,23 @@ struct TextureBakes {
 // instance occludes; the targets say what is baked).
 Result<TextureBakes> bake_textures(const scene::Scene& scene, const Options& options,
                                    const std::vector<TextureTarget>& targets, const TextureOptions& texture);
+
+// Texture bakes for a written glTF: one occlusion texture per material the default scene reaches.
+struct TextureRequest {
+  TextureOptions size;          // width, height, padding, texel samples
+  int texcoord = -1;            // the UV set; -1: the material's occlusionTexture texCoord, else 0
+  int bits = 8;                 // linear PNG, 8 or 16 bits
+  bool multiply_existing = true;  // an occlusion texture the material has: multiplied, or replaced
+  std::filesystem::path dump;   // a folder for each texture as float EXR as well; empty: none
+};
+Status check(const TextureRequest& request, const Options& estimator);
+
+// A bake for a written glTF: the estimator's options and where the values go.
+struct Request {
+  Options options;
+  Into into = Into::color_multiply;          // per-vertex values
+  std::optional<TextureRequest> texture;     // set: occlusion textures instead of per-vertex values
+};
 
 // Sample i of the per-vertex sequence, in [0, 1)².
 struct Sample2 {

@@ -130,9 +130,9 @@ Result<Coverage> cover(const scene::Scene& scene, const TextureTarget& target, i
   };
   std::vector<Touch> touches;
   const double reach = std::sqrt(0.5);  // half a texel diagonal
-  // A triangle's bounding box may cover the texture a few times over (wrapping UVs); beyond this it
-  // is a broken layout, and would cost unbounded time.
-  const double max_cells = 16.0 * double(width) * double(height) + 1024;
+  // A triangle's bounding box may cover the texture several times over (a tiled floor); beyond
+  // kMaxCopies it would cost unbounded time for a texture no viewer could show.
+  const double max_cells = double(kMaxCopies) * double(width) * double(height) + 1024;
   for (std::size_t k : target.instances) {
     const scene::Instance& inst = scene.instances[k];
     if (std::size_t(target.texcoord) >= inst.texcoords.size() || inst.texcoords[std::size_t(target.texcoord)].empty()) {
@@ -153,9 +153,12 @@ Result<Coverage> cover(const scene::Scene& scene, const TextureTarget& target, i
       const double i0 = std::ceil(x0 - reach), i1 = std::floor(x1 + reach);
       const double j0 = std::ceil(y0 - reach), j1 = std::floor(y1 + reach);
       if ((i1 - i0 + 1) * (j1 - j0 + 1) > max_cells) {
-        ++out.degenerate_uv;  // counted with the unusable ones: it spans more than 16 copies
+        ++out.too_large;
         continue;
       }
+      // Each edge's outward distance bound: a centre farther than `reach` outside any edge is
+      // neither covered nor touched, and skips the nearest-point search.
+      const double edge_length[3] = {glm::length(tri.b - tri.a), glm::length(tri.c - tri.b), glm::length(tri.a - tri.c)};
       ++out.triangles;
       if (x0 < -0.5 || y0 < -0.5 || x1 > width - 0.5 || y1 > height - 0.5) ++out.wrapped;
       for (double j = j0; j <= j1; ++j) {
@@ -163,6 +166,10 @@ Result<Coverage> cover(const scene::Scene& scene, const TextureTarget& target, i
           const dvec2 centre(i, j);
           const auto texel = std::uint32_t(wrap((long long)j, height, target.wrap_t) * width +
                                             wrap((long long)i, width, target.wrap_s));
+          if (edge(tri.a, tri.b, centre) < -reach * edge_length[0] || edge(tri.b, tri.c, centre) < -reach * edge_length[1] ||
+              edge(tri.c, tri.a, centre) < -reach * edge_length[2]) {
+            continue;
+          }
           if (inside(tri, centre)) {
             out.points.push_back({texel, std::uint32_t(k), std::uint32_t(t), float(i), float(j)});
             if (out.points.size() > kMaxSurfacePoints) {
@@ -184,36 +191,36 @@ Result<Coverage> cover(const scene::Scene& scene, const TextureTarget& target, i
       }
     }
   }
-  std::stable_sort(out.points.begin(), out.points.end(),
-                   [](const SurfacePoint& a, const SurfacePoint& b) { return a.texel < b.texel; });
-  std::vector<SurfacePoint> merged;
-  merged.reserve(out.points.size());
-  for (std::size_t first = 0; first < out.points.size();) {
-    std::size_t last = first;
-    while (last < out.points.size() && out.points[last].texel == out.points[first].texel) ++last;
-    ++out.covered;
-    if (last - first > 1) ++out.overlapped;
-    first = last;
-  }
-  // Touched texels that no centre covers: the nearest triangle's nearest point (the first on a tie).
+  // Touched texels: the nearest triangle's nearest point (the first on a tie).
   std::stable_sort(touches.begin(), touches.end(), [](const Touch& a, const Touch& b) {
     return a.texel < b.texel || (a.texel == b.texel && a.distance < b.distance);
   });
-  std::size_t c = 0;
-  for (std::size_t first = 0; first < touches.size();) {
-    const std::uint32_t texel = touches[first].texel;
-    while (c < out.points.size() && out.points[c].texel < texel) ++c;
-    if (c == out.points.size() || out.points[c].texel != texel) {
-      merged.push_back(touches[first].point);
+  // Per texel: how many centres cover it; touched texels that none covers get their nearest point.
+  std::vector<std::uint32_t> count(std::size_t(width) * std::size_t(height) + 1, 0);
+  for (const SurfacePoint& p : out.points) ++count[p.texel];
+  for (std::size_t first = 0; first < touches.size(); ++first) {
+    if (first > 0 && touches[first].texel == touches[first - 1].texel) continue;
+    if (count[touches[first].texel] == 0) {
+      out.points.push_back(touches[first].point);
+      ++count[touches[first].texel];
       ++out.touched;
     }
-    while (first < touches.size() && touches[first].texel == texel) ++first;
   }
-  if (!merged.empty()) {
-    out.points.insert(out.points.end(), merged.begin(), merged.end());
-    std::stable_sort(out.points.begin(), out.points.end(),
-                     [](const SurfacePoint& a, const SurfacePoint& b) { return a.texel < b.texel; });
+  for (std::uint32_t c : count) {
+    out.covered += c > 0;
+    out.overlapped += c > 1;
   }
+  out.covered -= out.touched;
+  // Counting sort by texel: stable (scene order within a texel) and linear in the points.
+  std::uint32_t offset = 0;
+  for (std::uint32_t& c : count) {
+    const std::uint32_t n = c;
+    c = offset;
+    offset += n;
+  }
+  std::vector<SurfacePoint> sorted(out.points.size());
+  for (const SurfacePoint& p : out.points) sorted[count[p.texel]++] = p;
+  out.points = std::move(sorted);
   return out;
 }
 

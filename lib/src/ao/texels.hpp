@@ -22,8 +22,9 @@ struct SurfacePoint {
 struct Coverage {
   std::vector<SurfacePoint> points;  // sorted by texel; within a texel, in scene order
   std::size_t covered = 0, touched = 0, overlapped = 0;
-  std::size_t triangles = 0, degenerate_uv = 0, wrapped = 0, instances_without_uv = 0;
+  std::size_t triangles = 0, degenerate_uv = 0, wrapped = 0, too_large = 0, instances_without_uv = 0;
 };
+constexpr int kMaxCopies = 64;  // of the texture a triangle's UVs may span (wrapping)
 
 // Errors: a layout mapping more surface points than kMaxSurfacePoints (hundreds of stacked copies).
 constexpr std::size_t kMaxSurfacePoints = std::size_t{1} << 28;

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <charconv>
 #include <chrono>
 #include <cmath>
 
@@ -66,6 +67,20 @@ int padding_for(const TextureOptions& options) {
   return std::max(1, int(std::lround(double(kDefaultPadding) * side / 1024.0)));
 }
 
+std::optional<std::pair<int, int>> texture_size_from_text(std::string_view text) {
+  const auto number = [](std::string_view digits) -> std::optional<int> {
+    int value = 0;
+    const auto [end, error] = std::from_chars(digits.data(), digits.data() + digits.size(), value);
+    if (error != std::errc() || end != digits.data() + digits.size() || digits.empty()) return std::nullopt;
+    return value;
+  };
+  const std::size_t x = text.find_first_of("xX");
+  const auto width = number(text.substr(0, x));
+  const auto height = x == std::string_view::npos ? width : number(text.substr(x + 1));
+  if (!width || !height) return std::nullopt;
+  return std::pair{*width, *height};
+}
+
 Status check(const TextureOptions& texture, const Options& estimator) {
   if (texture.width < 1 || texture.height < 1 || texture.width > kMaxTextureSide || texture.height > kMaxTextureSide) {
     return Error{"", "AO texture sides must be 1 to " + std::to_string(kMaxTextureSide) + " texels", true};
@@ -75,6 +90,13 @@ Status check(const TextureOptions& texture, const Options& estimator) {
   if (texture.texel_samples < 1 || texture.texel_samples > estimator.samples) {
     return Error{"", "AO texel samples must be 1 to the sample count (" + std::to_string(estimator.samples) + ")", true};
   }
+  return success();
+}
+
+Status check(const TextureRequest& request, const Options& estimator) {
+  if (Status s = check(request.size, estimator); !s) return s;
+  if (request.texcoord < -1) return Error{"", "AO texcoord must be a UV set number (0 or more)", true};
+  if (request.bits != 8 && request.bits != 16) return Error{"", "AO texture bits must be 8 or 16", true};
   return success();
 }
 
@@ -116,6 +138,7 @@ Result<TextureBakes> bake_textures(const scene::Scene& scene, const Options& opt
     out.values.assign(texel_count, 1.0f);
     out.covered = coverage->covered, out.touched = coverage->touched, out.overlapped = coverage->overlapped;
     out.triangles = coverage->triangles, out.degenerate_uv = coverage->degenerate_uv, out.wrapped = coverage->wrapped;
+    out.too_large = coverage->too_large;
     out.instances_without_uv = coverage->instances_without_uv;
 
     const auto ray_start = Clock::now();
@@ -138,6 +161,9 @@ Result<TextureBakes> bake_textures(const scene::Scene& scene, const Options& opt
       rays += cast;
     });
     out.rays = rays;
+    double sum = 0;
+    for (std::size_t r = 0; r + 1 < runs.size(); ++r) sum += out.values[points[runs[r]].texel];
+    out.mean = runs.size() > 1 ? sum / double(runs.size() - 1) : 0.0;
     result.rays += out.rays;
     result.ray_seconds += seconds_since(ray_start);
 

@@ -27,25 +27,6 @@ constexpr const char* kSpecular = "KHR_materials_specular";
 constexpr const char* kIor = "KHR_materials_ior";
 constexpr double kF0Tolerance = 0.001;  // below an 8-bit sRGB step at F0 0.04 (0.0014)
 
-// A channel of a decoded image read as RGBA: grey spreads to RGB, a missing alpha is 1.
-float rgba(const image::Image& im, std::size_t pixel, int c) {
-  const std::size_t base = pixel * std::size_t(im.channels);
-  if (c == 3) return im.channels == 4 ? im.pixels[base + 3] : im.channels == 2 ? im.pixels[base + 1] : 1.0f;
-  return im.channels >= 3 ? im.pixels[base + std::size_t(c)] : im.pixels[base];
-}
-
-image::Image blank(int width, int height, int channels) {
-  image::Image im;
-  im.width = width, im.height = height, im.channels = channels;
-  image::reserve_pixels(im.pixels, im.sample_count());
-  im.pixels.assign(im.sample_count(), 0.0f);
-  return im;
-}
-
-image::Image at_size(const image::Image& im, int width, int height) {
-  return im.width == width && im.height == height ? im : image::resize_image(im, width, height);
-}
-
 // A factor of `object` (as many numbers as `fallback` has; `fallback` when absent).
 Result<std::vector<double>> numbers(const Json& object, const char* key, std::vector<double> fallback,
                                     const std::string& file, const std::string& where) {

@@ -3,6 +3,7 @@
 #include <chrono>
 
 #include "../gltf/vertex_occlusion.hpp"
+#include "occlusion_texture.hpp"
 #include "../scene/from_document.hpp"
 #include "matbake/export.hpp"
 #include "matbake/output_check.hpp"
@@ -22,9 +23,19 @@ std::vector<gltf::PlacedValues> placed_values(const scene::Scene& scene, const a
 
 // An output onto a file the scene is read from, or two outputs onto one file, is refused before
 // any work.
-Status check_outputs(const gltf::Document& doc, const BakeAoOptions& options) {
-  const NamedOutput outputs[] = {{options.output, "glTF output"}, {options.dump, "dump"}};
+Status check_outputs(const gltf::Document& doc, const BakeAoOptions& options, const std::vector<fs::path>& textures) {
+  std::vector<NamedOutput> outputs = {{options.output, "glTF output"}, {options.dump, "dump"}};
+  for (const fs::path& t : textures) outputs.push_back({t, "texture dump"});
   return check_outputs(outputs, gltf::source_files(doc.file, doc.json));
+}
+
+double mean_of(const std::vector<std::vector<float>>& values, std::size_t& count) {
+  double sum = 0;
+  for (const auto& v : values) {
+    count += v.size();
+    for (float w : v) sum += w;
+  }
+  return count ? sum / double(count) : 0.0;
 }
 
 }  // namespace
@@ -47,41 +58,76 @@ Result<BakeAoReport> bake_ao_file(const fs::path& input, const BakeAoOptions& op
       return Error{options.dump.string(), "the dump is .csv or .bin", true};
     }
     if (Status s = ao::check(options.ao.options); !s) return s.error();
+    const std::optional<ao::TextureRequest>& texture = options.ao.texture;
+    if (texture) {
+      if (Status s = ao::check(*texture, options.ao.options); !s) return s.error();
+      if (!options.dump.empty()) return Error{options.dump.string(), "--dump holds per-vertex values; with --texture use --dump-texture", true};
+      if (options.output.empty()) return Error{"", "a texture bake writes a glTF (-o)", true};
+    }
     // Read once: the scene to bake and the document the values go into.
     auto doc = gltf::read_document(input);
     if (!doc) return doc.error();
-    if (Status s = check_outputs(*doc, options); !s) return s.error();
-    auto scene = scene::scene_from_document(*doc);
+    auto scene = scene::scene_from_document(*doc, {.texcoords = bool(texture)});
     if (!scene) return scene.error();
+    const std::string stem = options.output.stem().string();
+    OcclusionTargets targets;
+    std::vector<fs::path> dumped;
+    if (texture) {
+      auto found = occlusion_targets(*doc, *scene, *texture);
+      if (!found) return found.error();
+      targets = std::move(*found);
+      for (int m : targets.materials) {
+        if (!texture->dump.empty()) dumped.push_back(dumped_texture(texture->dump, stem, m));
+      }
+    }
+    if (Status s = check_outputs(*doc, options, dumped); !s) return s.error();
 
-    const auto start = std::chrono::steady_clock::now();
-    auto baked = ao::bake(*scene, options.ao.options);
-    if (!baked) return baked.error();
     BakeAoReport report;
-    report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    if (!options.dump.empty()) {
-      if (Status s = ao::write_dump(options.dump, *scene, *baked); !s) return s.error();
-      report.written.push_back(options.dump.string());
+    report.notes = scene->notes;
+    report.instances = scene->instances.size();
+    const auto start = std::chrono::steady_clock::now();
+    if (texture) {
+      ao::TextureBakes timing;
+      auto textures = bake_occlusion_textures(*doc, *scene, options.ao, targets, stem, timing);
+      if (!textures) return textures.error();
+      report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      report.textures = std::move(*textures);
+      report.notes.insert(report.notes.end(), targets.notes.begin(), targets.notes.end());
+      report.rays = timing.rays;
+      report.setup_seconds = timing.setup_seconds;
+      report.texel_seconds = timing.texel_seconds;
+      report.ray_seconds = timing.ray_seconds;
+      report.max_distance = timing.max_distance;
+      double sum = 0;
+      for (const TextureReport& t : report.textures) {
+        report.texels += t.covered + t.touched;
+        sum += t.mean * double(t.covered + t.touched);
+      }
+      report.mean = report.texels ? sum / double(report.texels) : 0.0;
+      for (const fs::path& p : dumped) report.written.push_back(p.string());
+    } else {
+      auto baked = ao::bake(*scene, options.ao.options);
+      if (!baked) return baked.error();
+      report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      if (!options.dump.empty()) {
+        if (Status s = ao::write_dump(options.dump, *scene, *baked); !s) return s.error();
+        report.written.push_back(options.dump.string());
+      }
+      if (!options.output.empty()) {
+        const std::vector<gltf::PlacedValues> placed = placed_values(*scene, *baked);
+        gltf::add_vertex_occlusion(*doc, placed, options.ao.into);
+      }
+      report.mean = mean_of(baked->values, report.vertices);
+      report.rays = baked->rays;
+      report.setup_seconds = baked->setup_seconds;
+      report.ray_seconds = baked->ray_seconds;
+      report.max_distance = baked->max_distance;
     }
     if (!options.output.empty()) {
-      const std::vector<gltf::PlacedValues> placed = placed_values(*scene, *baked);
-      gltf::add_vertex_occlusion(*doc, placed, options.ao.into);
       auto written = gltf::write_document(*doc, options.output);
       if (!written) return written.error();
       for (const fs::path& p : *written) report.written.push_back(p.string());
     }
-    double sum = 0;
-    for (const auto& values : baked->values) {
-      report.vertices += values.size();
-      for (float w : values) sum += w;
-    }
-    report.instances = scene->instances.size();
-    report.rays = baked->rays;
-    report.setup_seconds = baked->setup_seconds;
-    report.ray_seconds = baked->ray_seconds;
-    report.max_distance = baked->max_distance;
-    report.mean = report.vertices ? sum / double(report.vertices) : 0.0;
-    report.notes = scene->notes;
     return report;
   });
 }

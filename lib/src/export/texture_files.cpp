@@ -17,6 +17,25 @@ std::span<const unsigned char> as_bytes(const std::string& s) {
 
 }  // namespace
 
+// A channel of a decoded image read as RGBA: grey spreads to RGB, a missing alpha is 1.
+float rgba(const image::Image& im, std::size_t pixel, int c) {
+  const std::size_t base = pixel * std::size_t(im.channels);
+  if (c == 3) return im.channels == 4 ? im.pixels[base + 3] : im.channels == 2 ? im.pixels[base + 1] : 1.0f;
+  return im.channels >= 3 ? im.pixels[base + std::size_t(c)] : im.pixels[base];
+}
+
+image::Image blank(int width, int height, int channels) {
+  image::Image im;
+  im.width = width, im.height = height, im.channels = channels;
+  image::reserve_pixels(im.pixels, im.sample_count());
+  im.pixels.assign(im.sample_count(), 0.0f);
+  return im;
+}
+
+image::Image at_size(const image::Image& im, int width, int height) {
+  return im.width == width && im.height == height ? im : image::resize_image(im, width, height);
+}
+
 Result<const image::Image*> ImageCache::texture(int texture, color::Transfer colour) {
   const gltf::Json& json = doc_.json;
   if (texture < 0 || !json.contains("textures") || std::size_t(texture) >= json["textures"].size()) {

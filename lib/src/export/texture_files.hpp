@@ -10,6 +10,13 @@
 
 namespace matbake::exporter {
 
+// A channel of a decoded image read as RGBA: grey spreads to RGB, a missing alpha is 1.
+float rgba(const image::Image& im, std::size_t pixel, int c);
+// width × height × channels zeros.
+image::Image blank(int width, int height, int channels);
+// `im` resampled to width × height (itself when it has that size).
+image::Image at_size(const image::Image& im, int width, int height);
+
 class ImageCache {
  public:
   explicit ImageCache(const gltf::Document& doc) : doc_(doc) {}

@@ -1,0 +1,165 @@
+#include "occlusion_texture.hpp"
+
+#include <map>
+#include <set>
+
+#include "texture_files.hpp"
+
+namespace matbake::exporter {
+namespace fs = std::filesystem;
+namespace {
+
+using gltf::Json;
+
+ao::Wrap wrap_of(const Json& sampler, const char* key) {
+  const int mode = gltf::integer_in<int>(sampler, key, 10497, 10497);
+  return mode == 33071 ? ao::Wrap::clamp_to_edge : mode == 33648 ? ao::Wrap::mirrored_repeat : ao::Wrap::repeat;
+}
+
+// The material's occlusionTexture, when it has a valid one.
+const Json* occlusion_of(const Json& material, const Json& json) {
+  if (!material.contains("occlusionTexture") || !material["occlusionTexture"].is_object()) return nullptr;
+  const Json& info = material["occlusionTexture"];
+  const auto index = gltf::size_in(info, "index", SIZE_MAX);
+  return index < gltf::array_in(json, "textures").size() ? &info : nullptr;
+}
+
+const Json* sampler_of(const Json& json, std::size_t texture) {
+  const Json& t = gltf::array_in(json, "textures")[texture];
+  const auto sampler = gltf::size_in(t, "sampler", SIZE_MAX);
+  const Json& samplers = gltf::array_in(json, "samplers");
+  return sampler < samplers.size() ? &samplers[sampler] : nullptr;
+}
+
+}  // namespace
+
+Result<OcclusionTargets> occlusion_targets(const gltf::Document& doc, const scene::Scene& scene,
+                                           const ao::TextureRequest& request) {
+  OcclusionTargets out;
+  const Json& materials = gltf::array_in(doc.json, "materials");
+  std::map<int, std::vector<std::size_t>> by_material;
+  std::size_t without = 0;
+  for (std::size_t k = 0; k < scene.instances.size(); ++k) {
+    const int m = scene.instances[k].material;
+    if (m == -1) {
+      ++without;
+      continue;
+    }
+    if (m < 0 || std::size_t(m) >= materials.size()) {
+      return Error{doc.file, "mesh " + std::to_string(scene.instances[k].mesh) + " primitive " +
+                                 std::to_string(scene.instances[k].primitive) + " refers to a material that does not exist"};
+    }
+    by_material[m].push_back(k);
+  }
+  if (without) {
+    out.notes.push_back(std::to_string(without) + " placed primitives have no material, so no occlusion texture" +
+                        " (per-vertex AO can still be baked)");
+  }
+  for (const auto& [m, instances] : by_material) {
+    const Json& material = materials[std::size_t(m)];
+    const Json* existing = occlusion_of(material, doc.json);
+    ao::TextureTarget target;
+    target.instances = instances;
+    target.texcoord = request.texcoord >= 0 ? request.texcoord
+                      : existing        ? gltf::integer_in<int>(*existing, "texCoord", 0, 0)
+                                        : 0;
+    if (existing) {
+      if (const Json* sampler = sampler_of(doc.json, gltf::size_in(*existing, "index", 0))) {
+        target.wrap_s = wrap_of(*sampler, "wrapS");
+        target.wrap_t = wrap_of(*sampler, "wrapT");
+      }
+    }
+    // One texture cannot hold two placements of the same surface.
+    std::map<std::pair<int, int>, std::set<int>> nodes;  // (mesh, primitive) → placing nodes
+    for (std::size_t k : instances) nodes[{scene.instances[k].mesh, scene.instances[k].primitive}].insert(scene.instances[k].node);
+    for (const auto& [primitive, placing] : nodes) {
+      if (placing.size() < 2) continue;
+      out.notes.push_back("material " + std::to_string(m) + ": mesh " + std::to_string(primitive.first) + " primitive " +
+                          std::to_string(primitive.second) + " is placed by " + std::to_string(placing.size()) +
+                          " nodes; its texels hold the mean of the placements");
+    }
+    out.materials.push_back(m);
+    out.targets.push_back(std::move(target));
+  }
+  if (out.targets.empty()) return Error{doc.file, "no placed primitive has a material to hold an occlusion texture"};
+  return out;
+}
+
+fs::path dumped_texture(const fs::path& folder, const std::string& stem, int material) {
+  return folder / (stem + "_occlusion_" + std::to_string(material) + ".exr");
+}
+
+Result<std::vector<TextureReport>> bake_occlusion_textures(gltf::Document& doc, const scene::Scene& scene,
+                                                           const ao::Request& request, const OcclusionTargets& targets,
+                                                           const std::string& stem, ao::TextureBakes& timing) {
+  const ao::TextureRequest& texture = *request.texture;
+  auto baked = ao::bake_textures(scene, request.options, targets.targets, texture.size);
+  if (!baked) return baked.error();
+  ImageCache cache(doc);
+  std::vector<TextureReport> reports;
+  for (std::size_t t = 0; t < targets.targets.size(); ++t) {
+    const int m = targets.materials[t];
+    ao::TextureBake& bake = baked->textures[t];
+    Json& material = doc.json["materials"][std::size_t(m)];
+    TextureReport report;
+    report.material = m;
+    report.name = material.value("name", "");
+    report.width = bake.width, report.height = bake.height, report.texcoord = targets.targets[t].texcoord;
+    report.covered = bake.covered, report.touched = bake.touched, report.overlapped = bake.overlapped;
+    report.padded = bake.padded, report.triangles = bake.triangles, report.degenerate_uv = bake.degenerate_uv;
+    report.wrapped = bake.wrapped, report.too_large = bake.too_large, report.instances_without_uv = bake.instances_without_uv;
+    report.mean = bake.mean;
+
+    image::Image img = blank(bake.width, bake.height, 1);
+    img.channel_names = {"Y"};
+    img.pixels = std::move(bake.values);
+    const Json* existing = occlusion_of(material, doc.json);
+    int sampler_from = -1;
+    if (existing) {
+      const int old = gltf::integer_in<int>(*existing, "index", -1, -1);
+      sampler_from = old;
+      const int old_texcoord = gltf::integer_in<int>(*existing, "texCoord", 0, 0);
+      if (texture.multiply_existing && old_texcoord == report.texcoord) {
+        auto decoded = cache.texture(old, color::Transfer::linear);
+        if (!decoded) return decoded.error();
+        const image::Image own = at_size(**decoded, bake.width, bake.height);
+        for (std::size_t p = 0; p < img.pixels.size(); ++p) img.pixels[p] *= rgba(own, p, 0);
+        report.existing = "multiplied";
+      } else {
+        report.existing = "replaced";
+      }
+    }
+    if (!texture.dump.empty()) {
+      image::WriteOptions exr;
+      exr.type = image::SampleType::f32;
+      if (Status s = image::write_image(img, dumped_texture(texture.dump, stem, m), exr); !s) return s.error();
+    }
+    image::WriteOptions png;
+    png.type = texture.bits == 16 ? image::SampleType::u16 : image::SampleType::u8;
+    auto bytes = image::encode_image(img, "occlusion.png", png);
+    if (!bytes) return bytes.error();
+    report.file = stem + "_occlusion_" + std::to_string(m) + ".png";
+    doc.new_files[report.file] = std::move(*bytes);
+    doc.json["images"].push_back({{"uri", report.file}, {"mimeType", "image/png"}});
+    Json new_texture = {{"source", doc.json["images"].size() - 1}};
+    if (sampler_from >= 0 && doc.json["textures"][std::size_t(sampler_from)].contains("sampler")) {
+      new_texture["sampler"] = doc.json["textures"][std::size_t(sampler_from)]["sampler"];
+    }
+    doc.json["textures"].push_back(std::move(new_texture));
+    // A transform (KHR_texture_transform) of the old texture does not apply to UVs baked as they are.
+    Json info = {{"index", doc.json["textures"].size() - 1}};
+    if (report.texcoord != 0) info["texCoord"] = report.texcoord;
+    if (existing && existing->contains("strength")) info["strength"] = (*existing)["strength"];
+    material["occlusionTexture"] = std::move(info);
+
+    reports.push_back(std::move(report));
+  }
+  timing.rays = baked->rays;
+  timing.max_distance = baked->max_distance;
+  timing.setup_seconds = baked->setup_seconds;
+  timing.texel_seconds = baked->texel_seconds;
+  timing.ray_seconds = baked->ray_seconds;
+  return reports;
+}
+
+}  // namespace matbake::exporter

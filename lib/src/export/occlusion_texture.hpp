@@ -1,0 +1,34 @@
+#pragma once
+// Texture-space AO written into a glTF document: for each material the default scene reaches, an
+// occlusion texture over its primitives' UVs (ao::bake_textures), as a new linear PNG that becomes
+// the material's occlusionTexture (the file's own one multiplied in, or replaced).
+#include <string>
+#include <vector>
+
+#include "../gltf/document.hpp"
+#include "matbake/ao.hpp"
+#include "matbake/export.hpp"
+
+namespace matbake::exporter {
+
+// The materials the scene's instances use, each a texture target (UV set and wrap modes from the
+// request and the material's occlusionTexture), and what cannot be baked (instances without a
+// material; a mesh placed by several nodes sharing a material, averaged) as notes.
+struct OcclusionTargets {
+  std::vector<int> materials;
+  std::vector<ao::TextureTarget> targets;
+  std::vector<std::string> notes;
+};
+Result<OcclusionTargets> occlusion_targets(const gltf::Document& doc, const scene::Scene& scene,
+                                           const ao::TextureRequest& request);
+
+// Where bake_ao_file's --dump-texture puts material `material`'s float EXR.
+std::filesystem::path dumped_texture(const std::filesystem::path& folder, const std::string& stem, int material);
+
+// Bakes and writes the textures into `doc` (new files `<stem>_occlusion_<material>.png`); the dump
+// folder, when asked, gets each as float EXR.
+Result<std::vector<TextureReport>> bake_occlusion_textures(gltf::Document& doc, const scene::Scene& scene,
+                                                           const ao::Request& request, const OcclusionTargets& targets,
+                                                           const std::string& stem, ao::TextureBakes& timing);
+
+}  // namespace matbake::exporter
