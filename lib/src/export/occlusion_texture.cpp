@@ -31,6 +31,24 @@ const Json* sampler_of(const Json& json, std::size_t texture) {
   return sampler < samplers.size() ? &samplers[sampler] : nullptr;
 }
 
+// A primitive of the document using material `m` without TEXCOORD_<texcoord> ("mesh 2 primitive 0"),
+// or "": an occlusion texture on the material would ask it for UVs it does not have.
+std::string primitive_without_uvs(const Json& json, int m, int texcoord) {
+  const Json& meshes = gltf::array_in(json, "meshes");
+  const std::string name = "TEXCOORD_" + std::to_string(texcoord);
+  for (std::size_t mesh = 0; mesh < meshes.size(); ++mesh) {
+    const Json& primitives = gltf::array_in(meshes[mesh], "primitives");
+    for (std::size_t p = 0; p < primitives.size(); ++p) {
+      if (gltf::integer_in<int>(primitives[p], "material", -1, -1) != m) continue;
+      const Json& attributes = primitives[p].contains("attributes") ? primitives[p]["attributes"] : Json::object();
+      if (!attributes.is_object() || !attributes.contains(name)) {
+        return "mesh " + std::to_string(mesh) + " primitive " + std::to_string(p);
+      }
+    }
+  }
+  return "";
+}
+
 }  // namespace
 
 Result<OcclusionTargets> occlusion_targets(const gltf::Document& doc, const scene::Scene& scene,
@@ -63,6 +81,11 @@ Result<OcclusionTargets> occlusion_targets(const gltf::Document& doc, const scen
     target.texcoord = request.texcoord >= 0 ? request.texcoord
                       : existing        ? gltf::integer_in<int>(*existing, "texCoord", 0, 0)
                                         : 0;
+    if (const std::string lacking = primitive_without_uvs(doc.json, m, target.texcoord); !lacking.empty()) {
+      out.notes.push_back("material " + std::to_string(m) + " is used by " + lacking + ", which has no TEXCOORD_" +
+                          std::to_string(target.texcoord) + ": no occlusion texture (per-vertex AO can still be baked)");
+      continue;
+    }
     if (existing) {
       if (const Json* sampler = sampler_of(doc.json, gltf::size_in(*existing, "index", 0))) {
         target.wrap_s = wrap_of(*sampler, "wrapS");
@@ -81,7 +104,9 @@ Result<OcclusionTargets> occlusion_targets(const gltf::Document& doc, const scen
     out.materials.push_back(m);
     out.targets.push_back(std::move(target));
   }
-  if (out.targets.empty()) return Error{doc.file, "no placed primitive has a material to hold an occlusion texture"};
+  if (out.targets.empty()) {
+    return Error{doc.file, "no material the scene reaches can hold an occlusion texture (each needs a UV set on all its primitives)"};
+  }
   return out;
 }
 
