@@ -6,6 +6,8 @@
 #include <fstream>
 #include <sstream>
 
+#include "lib/src/gltf/document.hpp"
+#include "matbake/image.hpp"
 #include "support/expect_error.hpp"
 #include "support/files.hpp"
 #include "support/gltf_files.hpp"
@@ -108,6 +110,133 @@ TEST(CliBakeAo, BadScenesAndUsage) {
   }
   EXPECT_EQ(read_bytes(dir / "good.gltf"), before);
   EXPECT_EQ(list_folder(dir.path()), (std::vector<std::string>{"broken.gltf", "escape.gltf", "good.gltf"}));
+}
+
+// A UV-mapped floor (half-size 1, material 0) under a ceiling 1 above it (half-size 1000, material 1,
+// no UVs). With `own_occlusion`, material 0 has an occlusion texture of its own: a 4×4 PNG of 0.5.
+void write_floor_scene(const fs::path& path, bool own_occlusion) {
+  GltfBuilder b;
+  const float h = 1000;
+  const int floor = b.add_mesh(b.add_vec3({0, 0, 0, -1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0}),
+                               b.add_indices({0, 1, 2, 0, 2, 3, 0, 3, 4, 0, 4, 1}));
+  b.doc["meshes"][floor]["primitives"][0]["attributes"]["TEXCOORD_0"] =
+      b.add_floats({0.5f, 0.5f, 0, 0, 1, 0, 1, 1, 0, 1}, "VEC2", 2);
+  b.doc["meshes"][floor]["primitives"][0]["material"] = 0;
+  const int ceiling = b.add_mesh(b.add_vec3({-h, -h, 1, -h, h, 1, h, h, 1, h, -h, 1}), b.add_indices({0, 1, 2, 0, 2, 3}));
+  b.doc["meshes"][ceiling]["primitives"][0]["material"] = 1;
+  b.doc["materials"] = {{{"name", "floor"}}, {{"name", "ceiling"}}};
+  if (own_occlusion) {
+    image::Image own;
+    own.width = own.height = 4, own.channels = 1, own.channel_names = {"Y"};
+    own.pixels.assign(16, 0.5f);
+    image::WriteOptions png;
+    png.type = image::SampleType::u8;
+    ASSERT_TRUE(image::write_image(own, path.parent_path() / "own.png", png));
+    b.doc["images"] = {{{"uri", "own.png"}}};
+    b.doc["textures"] = {{{"source", 0}}};
+    b.doc["materials"][0]["occlusionTexture"] = {{"index", 0}, {"strength", 0.9}};
+  }
+  b.write(path, {b.add_node({{"mesh", floor}}), b.add_node({{"mesh", ceiling}})});
+}
+
+// The texture's texels, as a viewer reads the material's occlusion texture.
+std::vector<float> occlusion_texels(const fs::path& file, int material = 0) {
+  const auto doc = gltf::read_document(file);
+  EXPECT_TRUE(doc) << doc.error().to_string();
+  if (!doc) return {};
+  const auto& info = doc->json["materials"][material]["occlusionTexture"];
+  const auto bytes = gltf::image_bytes(*doc, doc->json["textures"][info["index"].get<std::size_t>()]["source"].get<std::size_t>());
+  EXPECT_TRUE(bytes);
+  const auto img = image::decode_image({reinterpret_cast<const unsigned char*>(bytes->data()), bytes->size()},
+                                       "occlusion.png", color::Transfer::linear);
+  EXPECT_TRUE(img) << img.error().to_string();
+  return img ? img->pixels : std::vector<float>{};
+}
+
+// The floor's texels are (h/D)² (binary AO of range D under an endless ceiling) in a 16-bit PNG,
+// both containers are validator-clean, material 1 (no UVs) is left alone with a note, and the
+// float EXR dump holds the same values.
+TEST(CliBakeAo, TextureOfAFloorUnderACeiling) {
+  TempDir dir;
+  write_floor_scene(dir / "floor.gltf", false);
+  const std::string input = read_bytes(dir / "floor.gltf");
+  const int n = 1024;
+  for (const char* ext : {".gltf", ".glb"}) {
+    const fs::path out = dir / "out" / (std::string("floor") + ext);
+    fs::create_directories(dir / "out" / "exr");
+    const auto r = matbake({"--json", "bake-ao", (dir / "floor.gltf").string(), "-o", out.string(), "--texture", "8x4",
+                            "--bits", "16", "--samples", std::to_string(n), "--falloff", "none", "--max-distance", "2",
+                            "--dump-texture", (dir / "out" / "exr").string()});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const auto report = nlohmann::json::parse(r.out);
+    ASSERT_EQ(report["textures"].size(), 1u);
+    EXPECT_EQ(report["textures"][0]["covered"], 32);
+    EXPECT_EQ(report["texels"], 32);
+    EXPECT_EQ(report["rays"], 32 * n);
+    ASSERT_EQ(report["notes"].size(), 1u);
+    EXPECT_NE(report["notes"][0].get<std::string>().find("has no TEXCOORD_0"), std::string::npos) << report["notes"];
+    const std::vector<float> texels = occlusion_texels(out);
+    ASSERT_EQ(texels.size(), 32u);
+    for (float v : texels) EXPECT_NEAR(v, 0.25, 3 * std::sqrt(0.25 * 0.75 / n) + 0.5 / 65535);
+    const auto exr = image::read_image(dir / "out" / "exr" / "floor_occlusion_0.exr", color::Transfer::linear);
+    ASSERT_TRUE(exr) << exr.error().to_string();
+    for (std::size_t i = 0; i < texels.size(); ++i) EXPECT_NEAR(exr->pixels[i], texels[i], 0.5 / 65535);
+    MATBAKE_VALIDATE_OR_SKIP(validated, out);
+    EXPECT_EQ(validated->errors, 0) << validated->summary;
+    EXPECT_EQ(validated->warnings, 0) << validated->summary;
+  }
+  EXPECT_EQ(read_bytes(dir / "floor.gltf"), input);
+}
+
+// A material's own occlusion texture (0.5 everywhere) is multiplied in by default, or replaced;
+// either way its strength stays, and the file's texture is left in place.
+TEST(CliBakeAo, TextureMultipliesOrReplacesTheMaterialsOwn) {
+  TempDir dir;
+  write_floor_scene(dir / "floor.gltf", true);
+  const int n = 1024;
+  for (const char* existing : {"multiply", "replace"}) {
+    const fs::path out = dir / (std::string(existing) + ".glb");
+    const auto r = matbake({"-q", "bake-ao", (dir / "floor.gltf").string(), "-o", out.string(), "--texture", "4",
+                            "--samples", std::to_string(n), "--falloff", "none", "--max-distance", "2",
+                            "--existing-occlusion", existing});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const double scale = std::string(existing) == "multiply" ? 0.5 : 1.0;
+    for (float v : occlusion_texels(out)) EXPECT_NEAR(v, 0.25 * scale, scale * 3 * std::sqrt(0.25 * 0.75 / n) + 0.5 / 255);
+    const auto doc = gltf::read_document(out);
+    ASSERT_TRUE(doc);
+    EXPECT_EQ(doc->json["materials"][0]["occlusionTexture"]["strength"], 0.9);
+    EXPECT_EQ(doc->json["images"].size(), 2u);
+    MATBAKE_VALIDATE_OR_SKIP(validated, out);
+    EXPECT_EQ(validated->errors, 0) << validated->summary;
+  }
+}
+
+TEST(CliBakeAo, TextureUsageAndScenesWithNothingToHoldIt) {
+  TempDir dir;
+  write_floor_scene(dir / "floor.gltf", false);
+  write_wall_scene(dir / "wall.gltf");  // no materials
+  const std::string floor = (dir / "floor.gltf").string(), out = (dir / "out.glb").string();
+  using Case = std::pair<std::vector<std::string>, std::string>;
+  for (const auto& [args, problem] :
+       {Case{{"--texture", "big"}, "--texture 'big': use a size such as 1024 or 2048x1024"},
+        Case{{"--texture", "0"}, "AO texture sides must be 1 to 16384 texels"},
+        Case{{"--texture", "64x99999"}, "AO texture sides must be 1 to 16384 texels"},
+        Case{{"--texture", "64", "--bits", "12"}, "AO texture bits must be 8 or 16"},
+        Case{{"--texture", "64", "--texel-samples", "100", "--samples", "64"}, "AO texel samples must be 1 to the sample count (64)"},
+        Case{{"--texture", "64", "--existing-occlusion", "add"}, "--existing-occlusion 'add': use multiply or replace"},
+        Case{{"--texture", "64", "--dump", (dir / "v.csv").string()},
+             (dir / "v.csv").string() + ": --dump holds per-vertex values; with --texture use --dump-texture"}}) {
+    std::vector<std::string> command = {"bake-ao", floor, "-o", out};
+    command.insert(command.end(), args.begin(), args.end());
+    const auto r = matbake(command);
+    EXPECT_EQ(r.exit_code, 2) << problem;
+    expect_one_error_line(r, "", problem);
+  }
+  const auto r = matbake({"bake-ao", (dir / "wall.gltf").string(), "-o", out, "--texture", "64"});
+  EXPECT_EQ(r.exit_code, 1);
+  expect_one_error_line(r, (dir / "wall.gltf").string(),
+                        "no material the scene reaches can hold an occlusion texture (each needs a UV set on all its primitives)");
+  EXPECT_EQ(list_folder(dir.path()), (std::vector<std::string>{"floor.gltf", "wall.gltf"}));
 }
 
 }  // namespace

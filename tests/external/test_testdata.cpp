@@ -12,6 +12,7 @@
 
 #include "lib/src/gltf/document.hpp"
 #include "matbake/convert.hpp"
+#include "matbake/image.hpp"
 #include "matbake/materials.hpp"
 #include "matbake/scene.hpp"
 #include "support/files.hpp"
@@ -290,6 +291,60 @@ TEST(KhronosModels, BakedAoScenesStayValidatorClean) {
     }
   }
   EXPECT_GE(checked, 40);
+}
+
+// bake-ao --texture on every sample model, as .gltf and .glb: each material the scene reaches whose
+// primitives all have TEXCOORD_0 gets a new occlusion texture (a PNG of the asked size, its values
+// in [0, 1]); the output has no validator error and no warning its input did not have. A model with
+// no such material is refused in one line, and then really has none.
+TEST(KhronosModels, TextureBakedScenesStayValidatorClean) {
+  REQUIRE_TESTDATA("gltf");
+#ifdef MATBAKE_SANITIZED
+  GTEST_SKIP() << "a sweep over every sample model: run in the release build";
+#endif
+  test::TempDir dir;
+  int baked = 0;
+  for (const fs::path& file : khronos_models()) {
+    MATBAKE_VALIDATE_OR_SKIP(in_report, file);
+    const std::set<std::string> in_codes = codes_of(*in_report);
+    const auto in = gltf::read_document(file);
+    ASSERT_TRUE(in);
+    for (const char* ext : {".gltf", ".glb"}) {
+      const fs::path out = dir / (file.stem().string() + "_" + file.parent_path().filename().string() + "_tex" + ext);
+      const auto r = test::matbake({"--json", "bake-ao", file.string(), "-o", out.string(), "--texture", "32x16",
+                                    "--samples", "4"});
+      if (r.exit_code == 1) {
+        EXPECT_NE(r.err.find("no material the scene reaches can hold an occlusion texture"), std::string::npos) << r.err;
+        const scene::Scene s = *scene::load_scene(file, {.texcoords = true});
+        for (const auto& inst : s.instances) EXPECT_TRUE(inst.material < 0 || inst.texcoords.empty()) << file;
+        EXPECT_FALSE(fs::exists(out));
+        continue;
+      }
+      ASSERT_EQ(r.exit_code, 0) << file << ": " << r.err;
+      MATBAKE_VALIDATE_OR_SKIP(out_report, out);
+      expect_clean_as_its_input(*out_report, in_codes);
+      const auto report = nlohmann::json::parse(r.out);
+      ASSERT_FALSE(report["textures"].empty()) << file;
+      const auto doc = gltf::read_document(out);
+      ASSERT_TRUE(doc);
+      for (const auto& t : report["textures"]) {
+        const auto& material = doc->json["materials"][t["material"].get<std::size_t>()];
+        const std::size_t texture = material["occlusionTexture"]["index"].get<std::size_t>();
+        const std::size_t source = doc->json["textures"][texture]["source"].get<std::size_t>();
+        EXPECT_GE(source, in->json["images"].size()) << out << ": a new image";
+        const auto bytes = gltf::image_bytes(*doc, source);
+        ASSERT_TRUE(bytes);
+        const auto img = image::decode_image({reinterpret_cast<const unsigned char*>(bytes->data()), bytes->size()},
+                                             "occlusion.png", color::Transfer::linear);
+        ASSERT_TRUE(img) << img.error().to_string();
+        EXPECT_EQ(img->width, 32);
+        EXPECT_EQ(img->height, 16);
+        for (float v : img->pixels) ASSERT_TRUE(v >= 0 && v <= 1) << out;
+      }
+      ++baked;
+    }
+  }
+  EXPECT_GE(baked, 24);
 }
 
 // export writes every sample model again: validator-clean with no warning its input did not have,
