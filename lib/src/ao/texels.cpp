@@ -123,94 +123,101 @@ glm::dvec3 nearest_weights(const UvTriangle& t, const dvec2& p) {
 
 Result<Coverage> cover(const scene::Scene& scene, const TextureTarget& target, int width, int height) {
   Coverage out;
-  struct Touch {
-    std::uint32_t texel;
-    double distance;
-    SurfacePoint point;
-  };
-  std::vector<Touch> touches;
   const double reach = std::sqrt(0.5);  // half a texel diagonal
   // A triangle's bounding box may cover the texture several times over (a tiled floor); beyond
   // kMaxCopies it would cost unbounded time for a texture no viewer could show.
   const double max_cells = double(kMaxCopies) * double(width) * double(height) + 1024;
-  for (std::size_t k : target.instances) {
-    const scene::Instance& inst = scene.instances[k];
-    if (std::size_t(target.texcoord) >= inst.texcoords.size() || inst.texcoords[std::size_t(target.texcoord)].empty()) {
-      ++out.instances_without_uv;
-      continue;
-    }
-    for (std::size_t t = 0; t < inst.triangles.size(); ++t) {
-      const UvTriangle uv = uv_triangle(inst, target.texcoord, t, width, height);
-      const double area2 = cross(uv.b - uv.a, uv.c - uv.a);
-      const double scale = std::max({glm::length(uv.b - uv.a), glm::length(uv.c - uv.a), glm::length(uv.c - uv.b)});
-      if (!std::isfinite(area2) || !(std::abs(area2) > 1e-12 * scale * scale)) {
-        ++out.degenerate_uv;
+  const auto texel_at = [&](double i, double j) {
+    return std::uint32_t(wrap((long long)j, height, target.wrap_t) * width + wrap((long long)i, width, target.wrap_s));
+  };
+  // Every usable triangle, positively oriented in texel space, with its cells within `margin`
+  // (first pass: 0, the centres inside; second: the reach of a touch). The first pass counts.
+  const auto for_each_triangle = [&](bool count, double margin, auto&& visit) -> Status {
+    for (std::size_t k : target.instances) {
+      const scene::Instance& inst = scene.instances[k];
+      if (std::size_t(target.texcoord) >= inst.texcoords.size() || inst.texcoords[std::size_t(target.texcoord)].empty()) {
+        out.instances_without_uv += count;
         continue;
       }
-      const UvTriangle tri = area2 > 0 ? uv : UvTriangle{uv.a, uv.c, uv.b};  // positive orientation
-      const double x0 = std::min({tri.a.x, tri.b.x, tri.c.x}), x1 = std::max({tri.a.x, tri.b.x, tri.c.x});
-      const double y0 = std::min({tri.a.y, tri.b.y, tri.c.y}), y1 = std::max({tri.a.y, tri.b.y, tri.c.y});
-      const double i0 = std::ceil(x0 - reach), i1 = std::floor(x1 + reach);
-      const double j0 = std::ceil(y0 - reach), j1 = std::floor(y1 + reach);
-      if ((i1 - i0 + 1) * (j1 - j0 + 1) > max_cells) {
-        ++out.too_large;
-        continue;
-      }
-      // Each edge's outward distance bound: a centre farther than `reach` outside any edge is
-      // neither covered nor touched, and skips the nearest-point search.
-      const double edge_length[3] = {glm::length(tri.b - tri.a), glm::length(tri.c - tri.b), glm::length(tri.a - tri.c)};
-      ++out.triangles;
-      if (x0 < -0.5 || y0 < -0.5 || x1 > width - 0.5 || y1 > height - 0.5) ++out.wrapped;
-      for (double j = j0; j <= j1; ++j) {
-        for (double i = i0; i <= i1; ++i) {
-          const dvec2 centre(i, j);
-          const auto texel = std::uint32_t(wrap((long long)j, height, target.wrap_t) * width +
-                                            wrap((long long)i, width, target.wrap_s));
-          if (edge(tri.a, tri.b, centre) < -reach * edge_length[0] || edge(tri.b, tri.c, centre) < -reach * edge_length[1] ||
-              edge(tri.c, tri.a, centre) < -reach * edge_length[2]) {
-            continue;
-          }
-          if (inside(tri, centre)) {
-            out.points.push_back({texel, std::uint32_t(k), std::uint32_t(t), float(i), float(j)});
-            if (out.points.size() > kMaxSurfacePoints) {
-              return Error{"", "the UV layout maps more than " + std::to_string(kMaxSurfacePoints) +
-                                   " surface points into the texture (hundreds of stacked copies?)"};
-            }
-            continue;
-          }
-          const glm::dvec3 w = nearest_weights(tri, centre);
-          const dvec2 q = w.x * tri.a + w.y * tri.b + w.z * tri.c;
-          const double distance = glm::length(q - centre);
-          if (distance <= reach) {
-            touches.push_back({texel, distance, {texel, std::uint32_t(k), std::uint32_t(t), float(q.x), float(q.y)}});
-            if (touches.size() > kMaxSurfacePoints) {
-              return Error{"", "the UV layout touches more than " + std::to_string(kMaxSurfacePoints) + " texels"};
-            }
+      for (std::size_t t = 0; t < inst.triangles.size(); ++t) {
+        const UvTriangle uv = uv_triangle(inst, target.texcoord, t, width, height);
+        const double area2 = cross(uv.b - uv.a, uv.c - uv.a);
+        const double scale = std::max({glm::length(uv.b - uv.a), glm::length(uv.c - uv.a), glm::length(uv.c - uv.b)});
+        if (!std::isfinite(area2) || !(std::abs(area2) > 1e-12 * scale * scale)) {
+          out.degenerate_uv += count;
+          continue;
+        }
+        const UvTriangle tri = area2 > 0 ? uv : UvTriangle{uv.a, uv.c, uv.b};
+        const double x0 = std::min({tri.a.x, tri.b.x, tri.c.x}), x1 = std::max({tri.a.x, tri.b.x, tri.c.x});
+        const double y0 = std::min({tri.a.y, tri.b.y, tri.c.y}), y1 = std::max({tri.a.y, tri.b.y, tri.c.y});
+        const double i0 = std::ceil(x0 - reach), i1 = std::floor(x1 + reach);
+        const double j0 = std::ceil(y0 - reach), j1 = std::floor(y1 + reach);
+        if ((i1 - i0 + 1) * (j1 - j0 + 1) > max_cells) {
+          out.too_large += count;
+          continue;
+        }
+        if (count) {
+          ++out.triangles;
+          if (x0 < -0.5 || y0 < -0.5 || x1 > width - 0.5 || y1 > height - 0.5) ++out.wrapped;
+        }
+        const double c0 = std::ceil(x0 - margin), c1 = std::floor(x1 + margin);
+        for (double j = std::ceil(y0 - margin); j <= std::floor(y1 + margin); ++j) {
+          for (double i = c0; i <= c1; ++i) {
+            if (Status s = visit(k, t, tri, i, j); !s) return s;
           }
         }
       }
     }
-  }
-  // Touched texels: the nearest triangle's nearest point (the first on a tie).
-  std::stable_sort(touches.begin(), touches.end(), [](const Touch& a, const Touch& b) {
-    return a.texel < b.texel || (a.texel == b.texel && a.distance < b.distance);
-  });
-  // Per texel: how many centres cover it; touched texels that none covers get their nearest point.
-  std::vector<std::uint32_t> count(std::size_t(width) * std::size_t(height) + 1, 0);
-  for (const SurfacePoint& p : out.points) ++count[p.texel];
-  for (std::size_t first = 0; first < touches.size(); ++first) {
-    if (first > 0 && touches[first].texel == touches[first - 1].texel) continue;
-    if (count[touches[first].texel] == 0) {
-      out.points.push_back(touches[first].point);
-      ++count[touches[first].texel];
-      ++out.touched;
+    return success();
+  };
+  // Centres inside a triangle (the tie rule takes each shared edge's once).
+  Status s = for_each_triangle(true, 0.0, [&](std::size_t k, std::size_t t, const UvTriangle& tri, double i, double j) -> Status {
+    if (!inside(tri, dvec2(i, j))) return success();
+    out.points.push_back({texel_at(i, j), std::uint32_t(k), std::uint32_t(t), float(i), float(j)});
+    if (out.points.size() > kMaxSurfacePoints) {
+      return Error{"", "the UV layout maps more than " + std::to_string(kMaxSurfacePoints) +
+                           " surface points into the texture (hundreds of stacked copies?)"};
     }
-  }
+    return success();
+  });
+  if (!s) return s.error();
+  std::vector<std::uint32_t> count(std::size_t(width) * std::size_t(height), 0);
+  for (const SurfacePoint& p : out.points) ++count[p.texel];
   for (std::uint32_t c : count) {
     out.covered += c > 0;
     out.overlapped += c > 1;
   }
-  out.covered -= out.touched;
+  // Texels no centre covers, within reach of a triangle: its nearest point (the nearest triangle's;
+  // on a tie, the first in scene order).
+  struct Touch {
+    double distance;
+    SurfacePoint point;
+  };
+  std::vector<Touch> touches;
+  s = for_each_triangle(false, reach, [&](std::size_t k, std::size_t t, const UvTriangle& tri, double i, double j) -> Status {
+    const std::uint32_t texel = texel_at(i, j);
+    if (count[texel]) return success();
+    const dvec2 centre(i, j);
+    const glm::dvec3 w = nearest_weights(tri, centre);
+    const dvec2 q = w.x * tri.a + w.y * tri.b + w.z * tri.c;
+    const double distance = glm::length(q - centre);
+    if (distance > reach) return success();
+    touches.push_back({distance, {texel, std::uint32_t(k), std::uint32_t(t), float(q.x), float(q.y)}});
+    if (touches.size() > kMaxSurfacePoints) {
+      return Error{"", "the UV layout touches more than " + std::to_string(kMaxSurfacePoints) + " texels"};
+    }
+    return success();
+  });
+  if (!s) return s.error();
+  std::stable_sort(touches.begin(), touches.end(), [](const Touch& a, const Touch& b) {
+    return a.point.texel < b.point.texel || (a.point.texel == b.point.texel && a.distance < b.distance);
+  });
+  for (std::size_t first = 0; first < touches.size(); ++first) {
+    if (first > 0 && touches[first].point.texel == touches[first - 1].point.texel) continue;
+    out.points.push_back(touches[first].point);
+    ++count[touches[first].point.texel];
+    ++out.touched;
+  }
   // Counting sort by texel: stable (scene order within a texel) and linear in the points.
   std::uint32_t offset = 0;
   for (std::uint32_t& c : count) {

@@ -1,0 +1,130 @@
+// Texture-space AO against per-vertex AO at the same ray budget: the generated terrain of bench_ao
+// (100 tiles, 62,500 vertices, 115,200 triangles) laid out as a 10 × 10 atlas over one 256²
+// texture (65,536 texels, each covered once), binary falloff, d_max 0.25 × the scene radius.
+// For 16, 64, 256 and 1024 samples: time, texels (or vertices) per second and rays per second on
+// 2 cores and on one, the share of the time spent on texel set-up (UV rasterization, padding), and
+// the RMSE against a 4096-sample bake of the same texels (or vertices).
+//   build/bench/bench_ao_texture            the whole table (about 4 minutes)
+//   build/bench/bench_ao_texture --quick    64 samples only
+#include <tbb/global_control.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <string_view>
+#include <vector>
+
+#include "matbake/ao.hpp"
+
+using namespace matbake;
+
+namespace {
+
+constexpr int kTiles = 10, kGrid = 24;
+
+scene::Scene terrain() {
+  scene::Scene s;
+  for (int ty = 0; ty < kTiles; ++ty) {
+    for (int tx = 0; tx < kTiles; ++tx) {
+      scene::Instance tile;
+      tile.texcoords.emplace_back();
+      for (int j = 0; j <= kGrid; ++j) {
+        for (int i = 0; i <= kGrid; ++i) {
+          const float x = float(tx) + float(i) / kGrid, y = float(ty) + float(j) / kGrid;
+          const float z = 0.15f * std::sin(7 * x) * std::cos(5 * y) + 0.05f * std::sin(23 * x + 11 * y);
+          tile.positions.push_back({x, y, z});
+          tile.texcoords[0].push_back({x / kTiles, y / kTiles});  // shared edges are equal floats
+        }
+      }
+      for (int j = 0; j < kGrid; ++j) {
+        for (int i = 0; i < kGrid; ++i) {
+          const auto at = [](int a, int b) { return std::uint32_t(b * (kGrid + 1) + a); };
+          tile.triangles.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
+          tile.triangles.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
+        }
+      }
+      s.instances.push_back(std::move(tile));
+    }
+  }
+  s.bounds_min = {0, 0, -0.2f};
+  s.bounds_max = {float(kTiles), float(kTiles), 0.2f};
+  return s;
+}
+
+double seconds_of(const std::function<void()>& f) {
+  const auto t0 = std::chrono::steady_clock::now();
+  f();
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+double rmse(const std::vector<float>& a, const std::vector<float>& b) {
+  double sum = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) sum += std::pow(double(a[i]) - double(b[i]), 2);
+  return std::sqrt(sum / double(a.size()));
+}
+
+std::vector<float> flat(const std::vector<std::vector<float>>& values) {
+  std::vector<float> out;
+  for (const auto& v : values) out.insert(out.end(), v.begin(), v.end());
+  return out;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const bool quick = argc > 1 && std::string_view(argv[1]) == "--quick";
+  const scene::Scene s = terrain();
+  ao::Options options;
+  options.falloff = ao::Falloff::none;
+  options.two_sided = true;  // as bench_ao: a terrain shows no back faces
+  ao::TextureOptions texture;
+  texture.width = texture.height = 256;
+  texture.padding = 0;
+  ao::TextureTarget atlas;
+  for (std::size_t k = 0; k < s.instances.size(); ++k) atlas.instances.push_back(k);
+
+  ao::Options reference_options = options;
+  reference_options.samples = 4096;
+  const std::vector<float> vertex_reference = flat(ao::bake(s, reference_options)->values);
+  const ao::TextureBakes texel_reference = *ao::bake_textures(s, reference_options, {atlas}, texture);
+  std::printf("binary falloff, %zu vertices, %zu texels (each covered %s), d_max %.3f\n\n", vertex_reference.size(),
+              texel_reference.textures[0].covered, texel_reference.textures[0].overlapped ? "more than once" : "once",
+              texel_reference.max_distance);
+  std::printf("| bake | samples | time, 2 cores | k points/s | M rays/s, 2 cores | M rays/s, 1 core | speed-up | set-up | RMSE vs 4096 |\n"
+              "|---|---|---|---|---|---|---|---|---|\n");
+  const std::vector<int> samples = quick ? std::vector<int>{64} : std::vector<int>{16, 64, 256, 1024};
+  for (int n : samples) {
+    ao::Options o = options;
+    o.samples = n;
+    {
+      ao::Bake all;
+      const double t2 = seconds_of([&] { all = *ao::bake(s, o); });
+      double t1 = 0;
+      {
+        tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
+        t1 = seconds_of([&] { (void)ao::bake(s, o); });
+      }
+      const double points = double(vertex_reference.size());
+      std::printf("| per vertex | %d | %.3f s | %.0f | %.1f | %.1f | %.2f× | %.0f%% | %.5f |\n", n, t2, points / t2 / 1e3,
+                  double(all.rays) / t2 / 1e6, double(all.rays) / t1 / 1e6, t1 / t2, 100 * all.setup_seconds / t2,
+                  rmse(flat(all.values), vertex_reference));
+    }
+    {
+      ao::TextureBakes all;
+      const double t2 = seconds_of([&] { all = *ao::bake_textures(s, o, {atlas}, texture); });
+      double t1 = 0;
+      {
+        tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
+        t1 = seconds_of([&] { (void)ao::bake_textures(s, o, {atlas}, texture); });
+      }
+      const double points = double(all.textures[0].covered + all.textures[0].touched);
+      std::printf("| texture 256² | %d | %.3f s | %.0f | %.1f | %.1f | %.2f× | %.0f%% + %.0f%% | %.5f |\n", n, t2,
+                  points / t2 / 1e3, double(all.rays) / t2 / 1e6, double(all.rays) / t1 / 1e6, t1 / t2,
+                  100 * all.setup_seconds / t2, 100 * all.texel_seconds / t2,
+                  rmse(all.textures[0].values, texel_reference.textures[0].values));
+    }
+  }
+  std::printf("\nset-up: Embree's BVH and the normals (both bakes) + texel set-up (texture only), as a share of the time on 2 cores\n");
+  return 0;
+}
