@@ -2,6 +2,8 @@
 
 #include "option_names.hpp"
 
+#include <cstdio>
+
 namespace matbake::cli {
 
 void add_ao_options(CLI::App& cmd, AoSettings& s, const std::string& prefix, bool textures) {
@@ -85,6 +87,24 @@ Result<ao::Request> ao_request(const AoSettings& s, const std::string& prefix) {
     if (Status st = ao::check(*r.texture, r.options); !st) return st.error();
   }
   return r;
+}
+
+void print_texture_reports(const std::vector<exporter::TextureReport>& textures) {
+  for (const exporter::TextureReport& t : textures) {
+    const double mapped = double(t.covered + t.touched);
+    std::printf("material %d '%s': %s, %dx%d over TEXCOORD_%d, %zu texels mapped (%zu on seams), %.1f%% of them overlapped, "
+                "%zu padded, mean %.4f%s\n",
+                t.material, t.name.c_str(), t.file.c_str(), t.width, t.height, t.texcoord, t.covered + t.touched, t.touched,
+                mapped > 0 ? 100.0 * double(t.overlapped) / mapped : 0.0, t.padded, t.mean,
+                t.existing.empty() ? "" : (", its own occlusion texture " + t.existing).c_str());
+    if (t.wrapped) std::printf("  %zu triangles reach outside [0, 1]: wrapped by the sampler's mode\n", t.wrapped);
+    if (t.degenerate_uv) std::printf("  %zu triangles with no UV area skipped\n", t.degenerate_uv);
+    if (t.too_large) std::printf("  %zu triangles spanning more than 64 copies of the texture skipped\n", t.too_large);
+    if (t.instances_without_uv) {
+      std::printf("  %zu placed primitives lack TEXCOORD_%d: skipped (per-vertex AO can still be baked)\n",
+                  t.instances_without_uv, t.texcoord);
+    }
+  }
 }
 
 }  // namespace matbake::cli

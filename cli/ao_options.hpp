@@ -6,6 +6,7 @@
 #include <string>
 
 #include "matbake/ao.hpp"
+#include "matbake/export.hpp"
 
 namespace matbake::cli {
 
@@ -23,5 +24,7 @@ struct AoSettings {
 void add_ao_options(CLI::App& cmd, AoSettings& s, const std::string& prefix, bool textures = false);
 // The request, checked; errors name the option as given on the command line.
 Result<ao::Request> ao_request(const AoSettings& s, const std::string& prefix);
+// One line per baked texture (and one per problem it counted), as bake-ao and export print them.
+void print_texture_reports(const std::vector<exporter::TextureReport>& textures);
 
 }  // namespace matbake::cli

@@ -4,6 +4,7 @@
 
 #include "commands.hpp"
 #include "matbake/export.hpp"
+#include "matbake/report_json.hpp"
 
 namespace matbake::cli {
 
@@ -28,13 +29,7 @@ int run_bake_ao(const BakeAoSettings& s, const GlobalOptions& global) {
   auto report = exporter::bake_ao_file(s.scene, {*request, s.output, s.dump});
   if (!report) return report_error(report.error());
   nlohmann::json textures = nlohmann::json::array();
-  for (const exporter::TextureReport& t : report->textures) {
-    textures.push_back({{"material", t.material}, {"name", t.name}, {"file", t.file}, {"width", t.width},
-                        {"height", t.height}, {"texcoord", t.texcoord}, {"covered", t.covered}, {"touched", t.touched},
-                        {"overlapped", t.overlapped}, {"padded", t.padded}, {"triangles", t.triangles},
-                        {"degenerate_uv", t.degenerate_uv}, {"wrapped", t.wrapped}, {"too_large", t.too_large},
-                        {"instances_without_uv", t.instances_without_uv}, {"existing", t.existing}, {"mean_ao", t.mean}});
-  }
+  for (const exporter::TextureReport& t : report->textures) textures.push_back(to_json(t));
   if (global.json) {
     std::cout << nlohmann::json{{"command", "bake-ao"}, {"scene", s.scene}, {"output", s.output}, {"dump", s.dump},
                                 {"instances", report->instances}, {"vertices", report->vertices},
@@ -47,21 +42,7 @@ int run_bake_ao(const BakeAoSettings& s, const GlobalOptions& global) {
               << "\n";
   } else if (!global.quiet) {
     for (const std::string& note : report->notes) std::cout << "note: " << note << "\n";
-    for (const exporter::TextureReport& t : report->textures) {
-      const double mapped = double(t.covered + t.touched);
-      std::printf("material %d '%s': %s, %dx%d over TEXCOORD_%d, %zu texels mapped (%zu on seams), %.1f%% of them overlapped, "
-                  "%zu padded, mean %.4f%s\n",
-                  t.material, t.name.c_str(), t.file.c_str(), t.width, t.height, t.texcoord, t.covered + t.touched, t.touched,
-                  mapped > 0 ? 100.0 * double(t.overlapped) / mapped : 0.0, t.padded, t.mean,
-                  t.existing.empty() ? "" : (", its own occlusion texture " + t.existing).c_str());
-      if (t.wrapped) std::printf("  %zu triangles reach outside [0, 1]: wrapped by the sampler's mode\n", t.wrapped);
-      if (t.degenerate_uv) std::printf("  %zu triangles with no UV area skipped\n", t.degenerate_uv);
-      if (t.too_large) std::printf("  %zu triangles spanning more than 64 copies of the texture skipped\n", t.too_large);
-      if (t.instances_without_uv) {
-        std::printf("  %zu placed primitives lack TEXCOORD_%d: skipped (per-vertex AO can still be baked)\n",
-                    t.instances_without_uv, t.texcoord);
-      }
-    }
+    print_texture_reports(report->textures);
     if (!report->textures.empty()) {
       std::printf("%s: %zu textures, %llu texels, %.3g rays in %.2f s (%.1f M rays/s; UV setup %.2f s), d_max %.4g, mean %.4f\n",
                   s.output.c_str(), report->textures.size(), (unsigned long long)report->texels, double(report->rays),

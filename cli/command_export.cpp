@@ -48,7 +48,8 @@ CLI::App* setup_export(CLI::App& app, ExportSettings& s) {
       "export",
       "Write a glTF scene again as glTF 2.0 metal-rough: materials given as Schüler pairs (--material) or in\n"
       "KHR_materials_pbrSpecularGlossiness converted (error reported; KHR_materials_specular where a dielectric's\n"
-      "F0 is not 0.04), occlusion packed into ORM, per-vertex AO baked in (--ao-samples), and only what the\n"
+      "F0 is not 0.04), occlusion packed into ORM, AO baked in (per vertex with --ao-samples, or into each\n"
+      "material's ORM red channel with --ao-texture SIZE), and only what the\n"
       "default scene reaches written.\n"
       "Example: matbake export scene.gltf -o out/scene.glb --material Brick=brick_a.png,brick_b.png --ao-samples 64");
   cmd->add_option("scene", s.scene, "Input .gltf or .glb")->required();
@@ -63,7 +64,7 @@ CLI::App* setup_export(CLI::App& app, ExportSettings& s) {
                   "none (core glTF's 0.04)");
   cmd->add_flag_callback("--no-orm", [&s] { s.options.pack_orm = false; },
                          "Keep occlusion and metallic-roughness textures apart");
-  add_ao_options(*cmd, s.ao, "ao-");
+  add_ao_options(*cmd, s.ao, "ao-", true);
   // AO is baked when --ao-samples is given (0 keeps it off, as before).
   cmd->get_option("--ao-samples")
       ->each([&s](const std::string& v) { s.bake_ao = v != "0"; })
@@ -78,7 +79,7 @@ int run_export(const ExportSettings& s, const GlobalOptions& global) {
   if (!s.bake_ao) ao.request.options.samples = ao::Options{}.samples;  // --ao-samples 0: no AO
   auto request = ao_request(ao, "ao-");
   if (!request) return report_error(request.error());
-  if (s.bake_ao) options.ao = *request;
+  if (s.bake_ao || request->texture) options.ao = *request;  // --ao-texture bakes, whatever --ao-samples says
   for (const std::string& text : s.materials) {
     auto m = parse_material(text, s.transfer);
     if (!m) return report_error(m.error());
@@ -116,6 +117,8 @@ int run_export(const ExportSettings& s, const GlobalOptions& global) {
       std::printf("\n");
     }
     for (const std::string& skipped : report->skipped) std::cout << "left out: " << skipped << "\n";
+    for (const std::string& note : report->ao_notes) std::cout << "note: " << note << "\n";
+    print_texture_reports(report->ao_textures);
   }
   return kOk;
 }

@@ -9,6 +9,7 @@
 #include <random>
 
 #include "lib/src/gltf/document.hpp"
+#include "matbake/image.hpp"
 #include "support/files.hpp"
 #include "support/gltf_files.hpp"
 #include "support/run.hpp"
@@ -225,6 +226,14 @@ TEST_F(Parity, ExportAndAoGiveTheManifestsScene) {
       {"ao_normals", "ao = { samples = 8, recompute_normals = \"angle\" }",
        {"--ao-samples", "8", "--ao-recompute-normals", "angle"}, ""},
       {"ao_fast", "ao = { samples = 8, fast_traversal = true }", {"--ao-samples", "8", "--ao-fast-traversal"}, ""},
+      {"ao_texture", "ao = { samples = 8, texture = 16 }", {"--ao-samples", "8", "--ao-texture", "16"}, ""},
+      {"ao_texture_options",
+       "ao = { samples = 8, texture = \"16x8\", padding = 2, texel_samples = 2, bits = 16, texcoord = 0, "
+       "existing_occlusion = \"replace\" }",
+       {"--ao-samples", "8", "--ao-texture", "16x8", "--ao-padding", "2", "--ao-texel-samples", "2", "--ao-bits", "16",
+        "--ao-texcoord", "0", "--ao-existing-occlusion", "replace"},
+       ""},
+      {"ao_texture_only", "ao = { texture = 4 }", {"--ao-texture", "4"}, ""},
   };
   std::string manifest;
   for (const Case& c : cases) {
@@ -264,6 +273,61 @@ TEST_F(Parity, BakeAoExportAndBuildBakeTheSameValues) {
   for (float v : baked) mean += v;
   mean /= double(baked.size());
   EXPECT_GT(mean, 0.7);  // one-sided: the floor's underside does not darken the objects on it
+}
+
+// A texture bake in export goes into the red channel of the material's ORM texture, at that
+// texture's size, its green and blue kept: painted_metal's ORM (8×8, from the pair) holds bake-ao's
+// 8×8 texture in red, and the same green and blue as an export without AO; the other materials
+// (no metallic-roughness texture in the file) get bake-ao's own occlusion textures.
+TEST_F(Parity, ExportedTextureAoIsTheOrmRedChannel) {
+  for (const char* f : {"showroom.gltf", "showroom.bin"}) fs::copy_file(kExamples / f, dir / f);
+  const std::string material = "painted_metal=" + (dir / "pair_a.png").string() + "," + (dir / "pair_b.png").string();
+  run_command({"bake-ao", (dir / "showroom.gltf").string(), "-o", (dir / "cli" / "baked.gltf").string(), "--texture", "8",
+               "--samples", "16"});
+  run_command({"export", (dir / "showroom.gltf").string(), "-o", (dir / "cli" / "plain.gltf").string(), "--material", material});
+  run_command({"export", (dir / "showroom.gltf").string(), "-o", (dir / "cli" / "ao.gltf").string(), "--material", material,
+               "--ao-texture", "8", "--ao-samples", "16"});
+  const auto texels = [&](const char* file, int m, const char* slot) {
+    auto doc = gltf::read_document(dir / "cli" / file);
+    EXPECT_TRUE(doc);
+    const json& material_json = doc->json["materials"][m];
+    const json& info = std::string(slot) == "occlusion" ? material_json["occlusionTexture"]
+                                                        : material_json["pbrMetallicRoughness"]["metallicRoughnessTexture"];
+    const auto bytes = gltf::image_bytes(*doc, doc->json["textures"][info["index"].get<std::size_t>()]["source"].get<std::size_t>());
+    EXPECT_TRUE(bytes);
+    const auto img = image::decode_image({reinterpret_cast<const unsigned char*>(bytes->data()), bytes->size()}, "t.png",
+                                         color::Transfer::linear);
+    EXPECT_TRUE(img);
+    return *img;
+  };
+  const image::Image baked = texels("baked.gltf", 0, "occlusion"), plain = texels("plain.gltf", 0, "mr");
+  const image::Image orm = texels("ao.gltf", 0, "occlusion"), mr = texels("ao.gltf", 0, "mr");
+  ASSERT_EQ(orm.width, 8);
+  ASSERT_EQ(orm.channels, 3);
+  EXPECT_EQ(mr.pixels, orm.pixels);  // one texture
+  for (std::size_t p = 0; p < 64; ++p) {
+    EXPECT_EQ(orm.pixels[p * 3], baked.pixels[p]) << p;
+    EXPECT_EQ(orm.pixels[p * 3 + 1], plain.pixels[p * std::size_t(plain.channels) + 1]) << p;
+    EXPECT_EQ(orm.pixels[p * 3 + 2], plain.pixels[p * std::size_t(plain.channels) + 2]) << p;
+  }
+  for (int m = 1; m < 5; ++m) EXPECT_EQ(texels("ao.gltf", m, "occlusion").pixels, texels("baked.gltf", m, "occlusion").pixels) << m;
+}
+
+// The manifest's texture keys are checked as the command line's options are.
+TEST_F(Parity, ManifestTextureKeysAreChecked) {
+  for (const char* f : {"showroom.gltf", "showroom.bin"}) fs::copy_file(kExamples / f, dir / f);
+  for (const auto& [ao, problem] :
+       {std::pair{"ao = { texture = 0 }", "ao.texture: a size such as 1024 or \"2048x1024\""},
+        std::pair{"ao = { texture = \"big\" }", "ao.texture: a size such as 1024 or \"2048x1024\""},
+        std::pair{"ao = { texture = 64, bits = 12 }", "AO texture bits must be 8 or 16"},
+        std::pair{"ao = { texture = 64, existing_occlusion = \"add\" }", "ao.existing_occlusion: \"multiply\" or \"replace\""},
+        std::pair{"ao = { padding = 4 }", "ao.padding applies to texture bakes: set texture = SIZE as well"}}) {
+    write_bytes(dir / "assets.toml", std::string("[scenes.s]\ninput = \"showroom.gltf\"\noutput = \"s.glb\"\n") + ao + "\n");
+    const RunResult r = matbake({"build", (dir / "assets.toml").string()});
+    EXPECT_NE(r.exit_code, 0) << ao;
+    EXPECT_NE(r.err.find(problem), std::string::npos) << ao << ": " << r.err;
+    EXPECT_FALSE(fs::exists(dir / "out" / "s.glb"));
+  }
 }
 
 }  // namespace

@@ -6,7 +6,8 @@
 //   whose F0 is not 0.04 gets KHR_materials_specular. Alpha comes from the mask: OPAQUE, MASK (only
 //   0 and 1) or BLEND.
 // - Occlusion and metallic-roughness textures of one material are packed into one ORM texture.
-// - Per-vertex AO is baked in when asked (COLOR_0 or _AO).
+// - AO is baked in when asked: per vertex (COLOR_0 or _AO), or as textures over the UVs, each into
+//   the red channel of the material's ORM texture.
 // - Only what the default scene reaches is written; the report lists what was left out. A texture
 //   shared by several materials is decoded and converted once. Same inputs, same bytes.
 #include <filesystem>
@@ -45,7 +46,8 @@ struct Options {
   DielectricF0 dielectric_f0 = DielectricF0::specular;
   workflow::RoughnessMapping mapping = workflow::kDefaultRoughnessMapping;
   bool pack_orm = true;           // occlusion + metallic-roughness into one texture
-  std::optional<ao::Request> ao;  // bake per-vertex AO when set
+  std::optional<ao::Request> ao;  // bake AO when set: per vertex, or with ao->texture into each
+                                  // material's ORM texture (red), or its own occlusion texture
 };
 
 struct MaterialReport {
@@ -58,6 +60,18 @@ struct MaterialReport {
   std::optional<double> ior;                    // KHR_materials_ior, when written
 };
 
+// One material's baked occlusion texture.
+struct TextureReport {
+  int material = -1;
+  std::string name;   // the material's
+  std::string file;   // the new image's URI (beside a .gltf, or embedded in a .glb)
+  int width = 0, height = 0, texcoord = 0;
+  std::size_t covered = 0, touched = 0, overlapped = 0, padded = 0;  // texels (ao::TextureBake)
+  std::size_t triangles = 0, degenerate_uv = 0, wrapped = 0, too_large = 0, instances_without_uv = 0;
+  std::string existing;  // what happened to the material's own occlusion texture: "", "multiplied", "replaced"
+  double mean = 0;       // of the bake (before any multiplication), over covered and touched texels
+};
+
 struct Report {
   std::vector<MaterialReport> materials;  // every written material, in output order
   std::vector<std::string> skipped;       // what the scene does not reach: "material 2 'Unused'"
@@ -65,6 +79,8 @@ struct Report {
   std::size_t images_decoded = 0;
   std::size_t textures_made = 0;
   std::uint64_t ao_rays = 0;
+  std::vector<TextureReport> ao_textures;  // with ao.texture: each material's baked occlusion
+  std::vector<std::string> ao_notes;       // what the texture bake skipped or averaged
 };
 
 Result<Report> export_scene(const std::filesystem::path& input, const std::filesystem::path& output,
@@ -81,18 +97,6 @@ struct BakeAoOptions {
   std::filesystem::path output;  // .gltf or .glb; empty: none
   std::filesystem::path dump;    // .csv or .bin; empty: none (per-vertex only)
 };
-// One material's baked occlusion texture.
-struct TextureReport {
-  int material = -1;
-  std::string name;   // the material's
-  std::string file;   // the new image's URI (beside a .gltf, or embedded in a .glb)
-  int width = 0, height = 0, texcoord = 0;
-  std::size_t covered = 0, touched = 0, overlapped = 0, padded = 0;  // texels (ao::TextureBake)
-  std::size_t triangles = 0, degenerate_uv = 0, wrapped = 0, too_large = 0, instances_without_uv = 0;
-  std::string existing;  // what happened to the material's own occlusion texture: "", "multiplied", "replaced"
-  double mean = 0;       // of the bake (before any multiplication), over covered and touched texels
-};
-
 struct BakeAoReport {
   std::size_t instances = 0;
   std::size_t vertices = 0;  // baked

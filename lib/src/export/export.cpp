@@ -9,6 +9,8 @@
 #include "../gltf/prune.hpp"
 #include "../scene/from_document.hpp"
 #include "occlusion.hpp"
+#include "occlusion_texture.hpp"
+#include "matbake/output_check.hpp"
 #include "texture_files.hpp"
 
 namespace matbake::exporter {
@@ -355,17 +357,31 @@ Result<Report> export_scene(const fs::path& input, const fs::path& output, const
     if (ext != ".gltf" && ext != ".glb") return Error{output.string(), "the output is .gltf or .glb", true};
     auto doc = gltf::read_document(input);
     if (!doc) return doc.error();
-    // The flattened scene only when AO is baked: a plain export works on the document alone.
-    std::optional<scene::Scene> scene;
-    if (options.ao) {
-      auto flattened = scene::scene_from_document(*doc);
-      if (!flattened) return flattened.error();
-      scene = std::move(*flattened);
+    if (options.ao && options.ao->texture) {
+      if (Status s = ao::check(*options.ao->texture, options.ao->options); !s) return s.error();
     }
-
     Report report;
     report.skipped = gltf::prune_unreachable(*doc);  // from here on, everything in doc is reachable
     for (std::string& s : report.skipped) s += ": not reachable from the default scene";
+    // The flattened scene only when AO is baked: a plain export works on the document alone. Made
+    // after pruning, so that its mesh and material indices are the written file's.
+    std::optional<scene::Scene> scene;
+    std::optional<OcclusionTargets> occlusion;
+    if (options.ao) {
+      auto flattened = scene::scene_from_document(*doc, {.texcoords = options.ao->texture.has_value()});
+      if (!flattened) return flattened.error();
+      scene = std::move(*flattened);
+      if (options.ao->texture) {
+        auto targets = occlusion_targets(*doc, *scene, *options.ao->texture);
+        if (!targets) return targets.error();
+        occlusion = std::move(*targets);
+        if (const fs::path& dump = options.ao->texture->dump; !dump.empty()) {
+          std::vector<NamedOutput> dumped;
+          for (int m : occlusion->materials) dumped.push_back({dumped_texture(dump, output.stem().string(), m), "texture dump"});
+          if (Status s = check_outputs(dumped, gltf::source_files(doc->file, doc->json)); !s) return s.error();
+        }
+      }
+    }
 
     std::map<int, const MaterialMaps*> given;
     for (const MaterialMaps& m : options.materials) {
@@ -413,7 +429,15 @@ Result<Report> export_scene(const fs::path& input, const fs::path& output, const
     }
     if (Status s = check_texture_coordinates(*doc); !s) return s.error();
 
-    if (options.ao) {
+    if (occlusion) {
+      ao::TextureBakes timing;
+      auto textures = bake_occlusion_textures(*doc, *scene, *options.ao, *occlusion, output.stem().string(),
+                                              OcclusionInto::orm, timing);
+      if (!textures) return textures.error();
+      report.ao_textures = std::move(*textures);
+      report.ao_notes = occlusion->notes;
+      report.ao_rays = timing.rays;
+    } else if (options.ao) {
       auto baked = bake_into(*doc, *scene, *options.ao);
       if (!baked) return baked.error();
       report.ao_rays = baked->rays;

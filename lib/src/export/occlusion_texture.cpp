@@ -1,5 +1,6 @@
 #include "occlusion_texture.hpp"
 
+#include <algorithm>
 #include <map>
 #include <set>
 
@@ -22,6 +23,30 @@ const Json* occlusion_of(const Json& material, const Json& json) {
   const Json& info = material["occlusionTexture"];
   const auto index = gltf::size_in(info, "index", SIZE_MAX);
   return index < gltf::array_in(json, "textures").size() ? &info : nullptr;
+}
+
+// The material's metallic-roughness texture when it is mapped by `texcoord` (and untransformed):
+// the one an ORM texture can share.
+const Json* metallic_roughness_of(const Json& material, const Json& json, int texcoord) {
+  if (!material.contains("pbrMetallicRoughness") || !material["pbrMetallicRoughness"].is_object()) return nullptr;
+  const Json& pbr = material["pbrMetallicRoughness"];
+  if (!pbr.contains("metallicRoughnessTexture") || !pbr["metallicRoughnessTexture"].is_object()) return nullptr;
+  const Json& info = pbr["metallicRoughnessTexture"];
+  if (gltf::size_in(info, "index", SIZE_MAX) >= gltf::array_in(json, "textures").size()) return nullptr;
+  if (gltf::integer_in<int>(info, "texCoord", 0, -1) != texcoord || info.contains("extensions")) return nullptr;
+  return &info;
+}
+
+// A new texture over a new PNG file in `doc`, with the sampler of texture `sampler_from` (none when -1).
+int add_texture(gltf::Document& doc, std::string uri, std::string bytes, int sampler_from) {
+  doc.new_files[uri] = std::move(bytes);
+  doc.json["images"].push_back({{"uri", std::move(uri)}, {"mimeType", "image/png"}});
+  Json texture = {{"source", doc.json["images"].size() - 1}};
+  if (sampler_from >= 0 && doc.json["textures"][std::size_t(sampler_from)].contains("sampler")) {
+    texture["sampler"] = doc.json["textures"][std::size_t(sampler_from)]["sampler"];
+  }
+  doc.json["textures"].push_back(std::move(texture));
+  return int(doc.json["textures"].size()) - 1;
 }
 
 const Json* sampler_of(const Json& json, std::size_t texture) {
@@ -116,7 +141,8 @@ fs::path dumped_texture(const fs::path& folder, const std::string& stem, int mat
 
 Result<std::vector<TextureReport>> bake_occlusion_textures(gltf::Document& doc, const scene::Scene& scene,
                                                            const ao::Request& request, const OcclusionTargets& targets,
-                                                           const std::string& stem, ao::TextureBakes& timing) {
+                                                           const std::string& stem, OcclusionInto into,
+                                                           ao::TextureBakes& timing) {
   const ao::TextureRequest& texture = *request.texture;
   auto baked = ao::bake_textures(scene, request.options, targets.targets, texture.size);
   if (!baked) return baked.error();
@@ -159,24 +185,41 @@ Result<std::vector<TextureReport>> bake_occlusion_textures(gltf::Document& doc, 
       exr.type = image::SampleType::f32;
       if (Status s = image::write_image(img, dumped_texture(texture.dump, stem, m), exr); !s) return s.error();
     }
-    image::WriteOptions png;
-    png.type = texture.bits == 16 ? image::SampleType::u16 : image::SampleType::u8;
-    auto bytes = image::encode_image(img, "occlusion.png", png);
-    if (!bytes) return bytes.error();
-    report.file = stem + "_occlusion_" + std::to_string(m) + ".png";
-    doc.new_files[report.file] = std::move(*bytes);
-    doc.json["images"].push_back({{"uri", report.file}, {"mimeType", "image/png"}});
-    Json new_texture = {{"source", doc.json["images"].size() - 1}};
-    if (sampler_from >= 0 && doc.json["textures"][std::size_t(sampler_from)].contains("sampler")) {
-      new_texture["sampler"] = doc.json["textures"][std::size_t(sampler_from)]["sampler"];
+    const Json* mr = into == OcclusionInto::orm ? metallic_roughness_of(material, doc.json, report.texcoord) : nullptr;
+    int index = -1;
+    if (mr) {
+      // Red: the bake at the metallic-roughness texture's size; green and blue: that texture's.
+      const int mr_index = gltf::integer_in<int>(*mr, "index", -1, -1);
+      auto decoded = cache.texture(mr_index, color::Transfer::linear);
+      if (!decoded) return decoded.error();
+      const image::Image& source = **decoded;
+      const image::Image occlusion = at_size(img, source.width, source.height);
+      image::Image orm = blank(source.width, source.height, 3);
+      for (std::size_t p = 0; p < std::size_t(source.width) * std::size_t(source.height); ++p) {
+        orm.pixels[p * 3] = std::clamp(occlusion.pixels[p], 0.0f, 1.0f);  // the resize may ring past [0, 1]
+        orm.pixels[p * 3 + 1] = rgba(source, p, 1);
+        orm.pixels[p * 3 + 2] = rgba(source, p, 2);
+      }
+      image::WriteOptions png8;
+      png8.type = image::SampleType::u8;
+      auto bytes = image::encode_image(orm, "orm.png", png8);
+      if (!bytes) return bytes.error();
+      report.file = stem + "_orm_ao_" + std::to_string(m) + ".png";
+      index = add_texture(doc, report.file, std::move(*bytes), mr_index);
+      material["pbrMetallicRoughness"]["metallicRoughnessTexture"]["index"] = index;
+    } else {
+      image::WriteOptions png;
+      png.type = texture.bits == 16 ? image::SampleType::u16 : image::SampleType::u8;
+      auto bytes = image::encode_image(img, "occlusion.png", png);
+      if (!bytes) return bytes.error();
+      report.file = stem + "_occlusion_" + std::to_string(m) + ".png";
+      index = add_texture(doc, report.file, std::move(*bytes), sampler_from);
     }
-    doc.json["textures"].push_back(std::move(new_texture));
     // A transform (KHR_texture_transform) of the old texture does not apply to UVs baked as they are.
-    Json info = {{"index", doc.json["textures"].size() - 1}};
+    Json info = {{"index", index}};
     if (report.texcoord != 0) info["texCoord"] = report.texcoord;
     if (existing && existing->contains("strength")) info["strength"] = (*existing)["strength"];
     material["occlusionTexture"] = std::move(info);
-
     reports.push_back(std::move(report));
   }
   timing.rays = baked->rays;

@@ -25,10 +25,19 @@ Result<OcclusionTargets> occlusion_targets(const gltf::Document& doc, const scen
 // Where bake_ao_file's --dump-texture puts material `material`'s float EXR.
 std::filesystem::path dumped_texture(const std::filesystem::path& folder, const std::string& stem, int material);
 
-// Bakes and writes the textures into `doc` (new files `<stem>_occlusion_<material>.png`); the dump
-// folder, when asked, gets each as float EXR.
+// Where a material's baked occlusion goes.
+enum class OcclusionInto {
+  texture,  // its own linear PNG (8 or 16 bits), the material's occlusionTexture
+  orm,      // the red channel of a new ORM texture with the material's metallic-roughness texture
+            // (same texCoord) in green and blue, at that texture's size; where the material has
+            // none, its own texture as above
+};
+
+// Bakes and writes the textures into `doc` (new files `<stem>_occlusion_<material>.png` or
+// `<stem>_orm_ao_<material>.png`); the dump folder, when asked, gets each bake as float EXR.
 Result<std::vector<TextureReport>> bake_occlusion_textures(gltf::Document& doc, const scene::Scene& scene,
                                                            const ao::Request& request, const OcclusionTargets& targets,
-                                                           const std::string& stem, ao::TextureBakes& timing);
+                                                           const std::string& stem, OcclusionInto into,
+                                                           ao::TextureBakes& timing);
 
 }  // namespace matbake::exporter

@@ -119,7 +119,8 @@ Result<ao::Request> read_ao(const Reader& r, const toml::node& node, const std::
   if (!t) return r.at(node, where + " must be a table");
   if (Status s = r.known_keys(*t, where, {"samples", "distance", "absolute_distance", "tau", "falloff", "bias",
                                           "two_sided", "seed", "sampler", "recompute_normals", "into",
-                                          "existing_colors", "fast_traversal"});
+                                          "existing_colors", "fast_traversal", "texture", "texcoord", "padding",
+                                          "texel_samples", "bits", "existing_occlusion"});
       !s) {
     return s.error();
   }
@@ -149,6 +150,41 @@ Result<ao::Request> read_ao(const Reader& r, const toml::node& node, const std::
   if (!target) return r.at(node, where + ": into = \"COLOR_0\" (existing_colors = \"multiply\" or \"replace\") or \"_AO\"");
   request.into = *target;
   if (Status s = ao::check(o); !s) return r.at(node, where + ": " + s.error().message);
+  // texture = 1024 or "2048x1024": occlusion textures (in each material's ORM red channel).
+  if (const toml::node* size = t->get("texture")) {
+    std::optional<std::pair<int, int>> parsed;
+    if (auto text = size->value<std::string>()) parsed = ao::texture_size_from_text(*text);
+    if (auto number = size->is_integer() ? size->value<std::int64_t>() : std::nullopt) {
+      if (*number >= 1 && *number <= ao::kMaxTextureSide) parsed = std::pair{int(*number), int(*number)};
+    }
+    if (!parsed) return r.at(*size, where + ".texture: a size such as 1024 or \"2048x1024\"");
+    ao::TextureRequest texture;
+    texture.size.width = parsed->first, texture.size.height = parsed->second;
+    std::int64_t texcoord = texture.texcoord, padding = texture.size.padding, texel_samples = texture.size.texel_samples,
+                 bits = texture.bits;
+    std::string existing_occlusion = texture.multiply_existing ? "multiply" : "replace";
+    for (Status s : {r.get(*t, "texcoord", where, texcoord), r.get(*t, "padding", where, padding),
+                     r.get(*t, "texel_samples", where, texel_samples), r.get(*t, "bits", where, bits),
+                     r.get(*t, "existing_occlusion", where, existing_occlusion)}) {
+      if (!s) return s.error();
+    }
+    const auto in_int = [](std::int64_t v) { return v >= INT32_MIN && v <= INT32_MAX; };
+    if (!in_int(texcoord) || !in_int(padding) || !in_int(texel_samples) || !in_int(bits)) {
+      return r.at(node, where + ": texcoord, padding, texel_samples and bits are small integers");
+    }
+    if (existing_occlusion != "multiply" && existing_occlusion != "replace") {
+      return r.at(node, where + ".existing_occlusion: \"multiply\" or \"replace\"");
+    }
+    texture.texcoord = int(texcoord), texture.size.padding = int(padding);
+    texture.size.texel_samples = int(texel_samples), texture.bits = int(bits);
+    texture.multiply_existing = existing_occlusion == "multiply";
+    if (Status s = ao::check(texture, o); !s) return r.at(node, where + ": " + s.error().message);
+    request.texture = texture;
+  } else {
+    for (const char* key : {"texcoord", "padding", "texel_samples", "bits", "existing_occlusion"}) {
+      if (t->get(key)) return r.at(node, where + "." + key + " applies to texture bakes: set texture = SIZE as well");
+    }
+  }
   return request;
 }
 

@@ -61,6 +61,8 @@ nlohmann::json to_json(const validate::Report& r, const validate::Options& optio
 }
 
 nlohmann::json to_json(const exporter::Report& r) {
+  nlohmann::json textures = nlohmann::json::array();
+  for (const exporter::TextureReport& t : r.ao_textures) textures.push_back(to_json(t));
   nlohmann::json materials = nlohmann::json::array();
   for (const exporter::MaterialReport& m : r.materials) {
     nlohmann::json j = {{"index", m.index}, {"name", m.name}, {"action", m.action}, {"alphaMode", m.alpha_mode}};
@@ -76,7 +78,7 @@ nlohmann::json to_json(const exporter::Report& r) {
   }
   return {{"materials", materials},           {"skipped", r.skipped},
           {"written", r.written},    {"images_decoded", r.images_decoded}, {"textures_made", r.textures_made},
-          {"ao_rays", r.ao_rays}};
+          {"ao_rays", r.ao_rays},    {"ao_textures", textures}, {"ao_notes", r.ao_notes}};
 }
 
 Status write_validation_report(const validate::Report& r, const validate::Options& options,
@@ -102,7 +104,27 @@ nlohmann::json to_json(const ao::Request& r) {
                                                     : nlohmann::json(nullptr)},
           {"fast_traversal", !o.watertight},
           {"into", ao::into_attribute_name(r.into)},
-          {"existing_colors", ao::into_existing_colors_name(r.into)}};
+          {"existing_colors", ao::into_existing_colors_name(r.into)},
+          {"texture", r.texture ? to_json(*r.texture) : nlohmann::json(nullptr)}};
+}
+
+nlohmann::json to_json(const ao::TextureRequest& t) {
+  return {{"width", t.size.width},
+          {"height", t.size.height},
+          {"padding", ao::padding_for(t.size)},
+          {"texel_samples", t.size.texel_samples},
+          {"texcoord", t.texcoord},
+          {"bits", t.bits},
+          {"existing_occlusion", t.multiply_existing ? "multiply" : "replace"},
+          {"dump", t.dump.string()}};
+}
+
+nlohmann::json to_json(const exporter::TextureReport& t) {
+  return {{"material", t.material}, {"name", t.name}, {"file", t.file}, {"width", t.width}, {"height", t.height},
+          {"texcoord", t.texcoord}, {"covered", t.covered}, {"touched", t.touched}, {"overlapped", t.overlapped},
+          {"padded", t.padded}, {"triangles", t.triangles}, {"degenerate_uv", t.degenerate_uv}, {"wrapped", t.wrapped},
+          {"too_large", t.too_large}, {"instances_without_uv", t.instances_without_uv}, {"existing", t.existing},
+          {"mean_ao", t.mean}};
 }
 
 nlohmann::json to_json(const exporter::Options& o) {
