@@ -63,6 +63,9 @@ void add_ao_options(CLI::App& cmd, AoSettings& s, const std::string& prefix, boo
   cmd.add_option(p + "existing-occlusion", s.existing_occlusion,
                  "A material's own occlusion texture: multiply (times the bake) or replace")
       ->capture_default_str()->group(texture_group);
+  cmd.add_flag(p + "per-instance", t.per_instance,
+               "A mesh placed by several nodes: each placement its own material copy and texture (default: averaged)")
+      ->group(texture_group);
   cmd.add_option(p + "dump-texture", t.dump, "Also write each texture as float EXR into this folder")->group(texture_group);
 }
 
@@ -92,6 +95,7 @@ Result<ao::Request> ao_request(const AoSettings& s, const std::string& prefix) {
 void print_texture_reports(const std::vector<exporter::TextureReport>& textures) {
   for (const exporter::TextureReport& t : textures) {
     const double mapped = double(t.covered + t.touched);
+    if (t.node >= 0) std::printf("node %d, ", t.node);
     std::printf("material %d '%s': %s, %dx%d over TEXCOORD_%d, %zu texels mapped (%zu on seams), %.1f%% of them overlapped, "
                 "%zu padded, mean %.4f%s\n",
                 t.material, t.name.c_str(), t.file.c_str(), t.width, t.height, t.texcoord, t.covered + t.touched, t.touched,

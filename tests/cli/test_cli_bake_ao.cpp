@@ -211,6 +211,58 @@ TEST(CliBakeAo, TextureMultipliesOrReplacesTheMaterialsOwn) {
   }
 }
 
+// One UV-mapped quad placed twice: under the ceiling ((h/D)² = 0.25) and 10 units away, open (1).
+// By default its texture averages the placements (0.625) and says so; --per-instance gives the
+// second placement a copy of the mesh and of the material, each with its own texture.
+TEST(CliBakeAo, TexturePerInstance) {
+  TempDir dir;
+  GltfBuilder b;
+  const float h = 1000;
+  const int quad = b.add_mesh(b.add_vec3({0, 0, 0, -1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0}),
+                              b.add_indices({0, 1, 2, 0, 2, 3, 0, 3, 4, 0, 4, 1}));
+  b.doc["meshes"][quad]["primitives"][0]["attributes"]["TEXCOORD_0"] =
+      b.add_floats({0.5f, 0.5f, 0, 0, 1, 0, 1, 1, 0, 1}, "VEC2", 2);
+  b.doc["meshes"][quad]["primitives"][0]["material"] = 0;
+  const int ceiling = b.add_mesh(b.add_vec3({-h, -h, 1, -h, h, 1, h, h, 1, h, -h, 1}), b.add_indices({0, 1, 2, 0, 2, 3}));
+  b.doc["materials"] = {{{"name", "tile"}}};
+  b.write(dir / "twice.gltf", {b.add_node({{"mesh", quad}, {"name", "under"}}), b.add_node({{"mesh", ceiling}}),
+                               b.add_node({{"mesh", quad}, {"name", "open"}, {"translation", {2 * h + 10, 0, 0}}})});
+  const int n = 1024;
+  const double sigma = std::sqrt(0.25 * 0.75 / n);
+  const std::vector<std::string> common = {"--texture", "4", "--samples", std::to_string(n), "--falloff", "none",
+                                           "--max-distance", "2"};
+  std::vector<std::string> args = {"--json", "bake-ao", (dir / "twice.gltf").string(), "-o", (dir / "mean.glb").string()};
+  args.insert(args.end(), common.begin(), common.end());
+  auto r = matbake(args);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  auto report = nlohmann::json::parse(r.out);
+  ASSERT_EQ(report["textures"].size(), 1u);
+  EXPECT_EQ(report["textures"][0]["overlapped"], 16);
+  EXPECT_NE(report["notes"].dump().find("is placed by 2 nodes; its texels hold the mean of the placements"), std::string::npos);
+  for (float v : occlusion_texels(dir / "mean.glb")) EXPECT_NEAR(v, 0.625, 3 * sigma / 2 + 0.5 / 255);
+
+  args[4] = (dir / "each.glb").string();
+  args.push_back("--per-instance");
+  r = matbake(args);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  report = nlohmann::json::parse(r.out);
+  ASSERT_EQ(report["textures"].size(), 2u);
+  EXPECT_EQ(report["textures"][0]["overlapped"], 0);
+  EXPECT_EQ(report["textures"][1]["material"], 1);
+  EXPECT_EQ(report["textures"][1]["name"], "tile (open)");
+  for (float v : occlusion_texels(dir / "each.glb", 0)) EXPECT_NEAR(v, 0.25, 3 * sigma + 0.5 / 255);
+  for (float v : occlusion_texels(dir / "each.glb", 1)) EXPECT_EQ(v, 1.0f);
+  const auto doc = gltf::read_document(dir / "each.glb");
+  ASSERT_TRUE(doc);
+  EXPECT_EQ(doc->json["meshes"].size(), 3u);  // the quad, the ceiling, the quad's copy for "open"
+  EXPECT_EQ(doc->json["nodes"][2]["mesh"], 2);
+  EXPECT_EQ(doc->json["meshes"][2]["primitives"][0]["material"], 1);
+  EXPECT_EQ(doc->json["meshes"][2]["primitives"][0]["attributes"], doc->json["meshes"][0]["primitives"][0]["attributes"]);
+  MATBAKE_VALIDATE_OR_SKIP(validated, dir / "each.glb");
+  EXPECT_EQ(validated->errors, 0) << validated->summary;
+  EXPECT_EQ(validated->warnings, 0) << validated->summary;
+}
+
 TEST(CliBakeAo, TextureUsageAndScenesWithNothingToHoldIt) {
   TempDir dir;
   write_floor_scene(dir / "floor.gltf", false);

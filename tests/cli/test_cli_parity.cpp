@@ -234,6 +234,8 @@ TEST_F(Parity, ExportAndAoGiveTheManifestsScene) {
         "--ao-texcoord", "0", "--ao-existing-occlusion", "replace"},
        ""},
       {"ao_texture_only", "ao = { texture = 4 }", {"--ao-texture", "4"}, ""},
+      {"ao_per_instance", "ao = { samples = 8, texture = 8, per_instance = true }",
+       {"--ao-samples", "8", "--ao-texture", "8", "--ao-per-instance"}, ""},
   };
   std::string manifest;
   for (const Case& c : cases) {

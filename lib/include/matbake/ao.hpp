@@ -164,6 +164,9 @@ struct TextureRequest {
   int bits = 8;                 // linear PNG, 8 or 16 bits
   bool multiply_existing = true;  // an occlusion texture the material has: multiplied, or replaced
   std::filesystem::path dump;   // a folder for each texture as float EXR as well; empty: none
+  // A mesh placed by several nodes: one texture averages the placements (false), or each placement
+  // gets its own copy of the material and its own texture (true).
+  bool per_instance = false;
 };
 Status check(const TextureRequest& request, const Options& estimator);
 

@@ -62,7 +62,8 @@ struct MaterialReport {
 
 // One material's baked occlusion texture.
 struct TextureReport {
-  int material = -1;
+  int material = -1;  // as written (with per-instance bakes, a copy's index for further placements)
+  int node = -1;      // with per-instance bakes, the placing node
   std::string name;   // the material's
   std::string file;   // the new image's URI (beside a .gltf, or embedded in a .glb)
   int width = 0, height = 0, texcoord = 0;

@@ -74,13 +74,51 @@ std::string primitive_without_uvs(const Json& json, int m, int texcoord) {
   return "";
 }
 
+// --per-instance: each target's node gets its own copy of the material (the first placement of a
+// material keeps the original), and its own copy of the mesh when an earlier node placed that mesh
+// (sharing every accessor), so that each placement's primitives name their own material. Returns
+// the material each target's texture goes into.
+std::vector<int> split_placements(gltf::Document& doc, const scene::Scene& scene, const OcclusionTargets& targets) {
+  Json& json = doc.json;
+  std::vector<int> into = targets.materials;
+  std::set<int> split_nodes(targets.nodes.begin(), targets.nodes.end());
+  split_nodes.erase(-1);
+  if (split_nodes.empty()) return into;
+  std::map<int, int> owner_of_mesh, mesh_of_node;
+  for (const scene::Instance& inst : scene.instances) {  // scene order: the first placement keeps the mesh
+    if (!split_nodes.contains(inst.node) || mesh_of_node.contains(inst.node)) continue;
+    const int mesh = json["nodes"][std::size_t(inst.node)]["mesh"].get<int>();
+    if (owner_of_mesh.try_emplace(mesh, inst.node).second) {
+      mesh_of_node[inst.node] = mesh;
+      continue;
+    }
+    json["meshes"].push_back(json["meshes"][std::size_t(mesh)]);
+    mesh_of_node[inst.node] = int(json["meshes"].size()) - 1;
+    json["nodes"][std::size_t(inst.node)]["mesh"] = mesh_of_node[inst.node];
+  }
+  std::set<int> kept;
+  for (std::size_t t = 0; t < into.size(); ++t) {
+    const int m = targets.materials[t], node = targets.nodes[t];
+    if (node < 0 || kept.insert(m).second) continue;
+    Json copy = json["materials"][std::size_t(m)];
+    const std::string node_name = json["nodes"][std::size_t(node)].value("name", "node " + std::to_string(node));
+    copy["name"] = copy.value("name", "material " + std::to_string(m)) + " (" + node_name + ")";
+    json["materials"].push_back(std::move(copy));
+    into[t] = int(json["materials"].size()) - 1;
+    for (Json& primitive : json["meshes"][std::size_t(mesh_of_node.at(node))]["primitives"]) {
+      if (gltf::integer_in<int>(primitive, "material", -1, -1) == m) primitive["material"] = into[t];
+    }
+  }
+  return into;
+}
+
 }  // namespace
 
 Result<OcclusionTargets> occlusion_targets(const gltf::Document& doc, const scene::Scene& scene,
                                            const ao::TextureRequest& request) {
   OcclusionTargets out;
   const Json& materials = gltf::array_in(doc.json, "materials");
-  std::map<int, std::vector<std::size_t>> by_material;
+  std::map<std::pair<int, int>, std::vector<std::size_t>> by_material;  // (material, node or -1) → instances
   std::size_t without = 0;
   for (std::size_t k = 0; k < scene.instances.size(); ++k) {
     const int m = scene.instances[k].material;
@@ -92,13 +130,14 @@ Result<OcclusionTargets> occlusion_targets(const gltf::Document& doc, const scen
       return Error{doc.file, "mesh " + std::to_string(scene.instances[k].mesh) + " primitive " +
                                  std::to_string(scene.instances[k].primitive) + " refers to a material that does not exist"};
     }
-    by_material[m].push_back(k);
+    by_material[{m, request.per_instance ? scene.instances[k].node : -1}].push_back(k);
   }
   if (without) {
     out.notes.push_back(std::to_string(without) + " placed primitives have no material, so no occlusion texture" +
                         " (per-vertex AO can still be baked)");
   }
-  for (const auto& [m, instances] : by_material) {
+  for (const auto& [key, instances] : by_material) {
+    const int m = key.first;
     const Json& material = materials[std::size_t(m)];
     const Json* existing = occlusion_of(material, doc.json);
     ao::TextureTarget target;
@@ -117,7 +156,7 @@ Result<OcclusionTargets> occlusion_targets(const gltf::Document& doc, const scen
         target.wrap_t = wrap_of(*sampler, "wrapT");
       }
     }
-    // One texture cannot hold two placements of the same surface.
+    // One texture cannot hold two placements of the same surface (without --per-instance).
     std::map<std::pair<int, int>, std::set<int>> nodes;  // (mesh, primitive) → placing nodes
     for (std::size_t k : instances) nodes[{scene.instances[k].mesh, scene.instances[k].primitive}].insert(scene.instances[k].node);
     for (const auto& [primitive, placing] : nodes) {
@@ -127,6 +166,7 @@ Result<OcclusionTargets> occlusion_targets(const gltf::Document& doc, const scen
                           " nodes; its texels hold the mean of the placements");
     }
     out.materials.push_back(m);
+    out.nodes.push_back(key.second);
     out.targets.push_back(std::move(target));
   }
   if (out.targets.empty()) {
@@ -146,14 +186,16 @@ Result<std::vector<TextureReport>> bake_occlusion_textures(gltf::Document& doc, 
   const ao::TextureRequest& texture = *request.texture;
   auto baked = ao::bake_textures(scene, request.options, targets.targets, texture.size);
   if (!baked) return baked.error();
+  const std::vector<int> materials = split_placements(doc, scene, targets);
   ImageCache cache(doc);
   std::vector<TextureReport> reports;
   for (std::size_t t = 0; t < targets.targets.size(); ++t) {
-    const int m = targets.materials[t];
+    const int m = materials[t];
     ao::TextureBake& bake = baked->textures[t];
     Json& material = doc.json["materials"][std::size_t(m)];
     TextureReport report;
     report.material = m;
+    report.node = targets.nodes[t];
     report.name = material.value("name", "");
     report.width = bake.width, report.height = bake.height, report.texcoord = targets.targets[t].texcoord;
     report.covered = bake.covered, report.touched = bake.touched, report.overlapped = bake.overlapped;

@@ -16,6 +16,7 @@ namespace matbake::exporter {
 // material; a mesh placed by several nodes sharing a material, averaged) as notes.
 struct OcclusionTargets {
   std::vector<int> materials;
+  std::vector<int> nodes;  // with per_instance, the node placing the target's instances; else -1
   std::vector<ao::TextureTarget> targets;
   std::vector<std::string> notes;
 };
@@ -33,7 +34,8 @@ enum class OcclusionInto {
             // none, its own texture as above
 };
 
-// Bakes and writes the textures into `doc` (new files `<stem>_occlusion_<material>.png` or
+// Bakes and writes the textures into `doc` (with per_instance, into a copy of the material for each
+// further placement, see occlusion_texture.cpp) (new files `<stem>_occlusion_<material>.png` or
 // `<stem>_orm_ao_<material>.png`); the dump folder, when asked, gets each bake as float EXR.
 Result<std::vector<TextureReport>> bake_occlusion_textures(gltf::Document& doc, const scene::Scene& scene,
                                                            const ao::Request& request, const OcclusionTargets& targets,

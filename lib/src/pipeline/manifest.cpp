@@ -120,7 +120,7 @@ Result<ao::Request> read_ao(const Reader& r, const toml::node& node, const std::
   if (Status s = r.known_keys(*t, where, {"samples", "distance", "absolute_distance", "tau", "falloff", "bias",
                                           "two_sided", "seed", "sampler", "recompute_normals", "into",
                                           "existing_colors", "fast_traversal", "texture", "texcoord", "padding",
-                                          "texel_samples", "bits", "existing_occlusion"});
+                                          "texel_samples", "bits", "existing_occlusion", "per_instance"});
       !s) {
     return s.error();
   }
@@ -165,7 +165,8 @@ Result<ao::Request> read_ao(const Reader& r, const toml::node& node, const std::
     std::string existing_occlusion = texture.multiply_existing ? "multiply" : "replace";
     for (Status s : {r.get(*t, "texcoord", where, texcoord), r.get(*t, "padding", where, padding),
                      r.get(*t, "texel_samples", where, texel_samples), r.get(*t, "bits", where, bits),
-                     r.get(*t, "existing_occlusion", where, existing_occlusion)}) {
+                     r.get(*t, "existing_occlusion", where, existing_occlusion),
+                     r.get(*t, "per_instance", where, texture.per_instance)}) {
       if (!s) return s.error();
     }
     const auto in_int = [](std::int64_t v) { return v >= INT32_MIN && v <= INT32_MAX; };
@@ -181,7 +182,7 @@ Result<ao::Request> read_ao(const Reader& r, const toml::node& node, const std::
     if (Status s = ao::check(texture, o); !s) return r.at(node, where + ": " + s.error().message);
     request.texture = texture;
   } else {
-    for (const char* key : {"texcoord", "padding", "texel_samples", "bits", "existing_occlusion"}) {
+    for (const char* key : {"texcoord", "padding", "texel_samples", "bits", "existing_occlusion", "per_instance"}) {
       if (t->get(key)) return r.at(node, where + "." + key + " applies to texture bakes: set texture = SIZE as well");
     }
   }

@@ -116,11 +116,12 @@ nlohmann::json to_json(const ao::TextureRequest& t) {
           {"texcoord", t.texcoord},
           {"bits", t.bits},
           {"existing_occlusion", t.multiply_existing ? "multiply" : "replace"},
-          {"dump", t.dump.string()}};
+          {"dump", t.dump.string()},
+          {"per_instance", t.per_instance}};
 }
 
 nlohmann::json to_json(const exporter::TextureReport& t) {
-  return {{"material", t.material}, {"name", t.name}, {"file", t.file}, {"width", t.width}, {"height", t.height},
+  return {{"material", t.material}, {"node", t.node}, {"name", t.name}, {"file", t.file}, {"width", t.width}, {"height", t.height},
           {"texcoord", t.texcoord}, {"covered", t.covered}, {"touched", t.touched}, {"overlapped", t.overlapped},
           {"padded", t.padded}, {"triangles", t.triangles}, {"degenerate_uv", t.degenerate_uv}, {"wrapped", t.wrapped},
           {"too_large", t.too_large}, {"instances_without_uv", t.instances_without_uv}, {"existing", t.existing},
