@@ -2,13 +2,19 @@
 # README command 1: installs what is missing, builds matbake, and builds the bundled example
 # (examples/showroom.toml: five materials and a scene with instances) into examples/out/:
 # packed glTF textures and validation reports per material, showroom.glb with the materials and
-# per-vertex AO, then checks showroom.glb with the Khronos glTF-Validator and renders a preview of
-# the materials. Safe to re-run: a second run builds nothing and says so.
+# AO baked into their ORM textures, and the occlusion textures alone (examples/out/ao/); then checks
+# showroom.glb with the Khronos glTF-Validator and renders a preview of the materials. Safe to
+# re-run: a second build builds nothing and says so (the textures alone are baked again, ~5 s).
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 bash "$root/scripts/build.sh" "$root/build"
 matbake=$root/build/cli/matbake
 "$matbake" build "$root/examples/showroom.toml"
+# The occlusion textures alone (the build puts them in the ORM textures' red channel), as
+# docs/bake-ao.md shows crate 1's: examples/out/ao/showroom_ao_occlusion_0.png.
+mkdir -p "$root/examples/out/ao"
+"$matbake" bake-ao "$root/examples/showroom.gltf" -o "$root/examples/out/ao/showroom_ao.gltf" \
+  --texture 256 --per-instance --samples 256
 "$matbake" preview --materials "$root/examples/preview.json" --model ggx --size 96 \
   -o "$root/examples/out/materials-preview.png"
 if bash "$root/scripts/install-gltf-validator.sh"; then

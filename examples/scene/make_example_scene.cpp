@@ -24,8 +24,9 @@ struct Mesh {
   std::vector<Vertex> vertices;
   std::vector<std::uint16_t> indices;
 
-  // A quad from corner `o` along edges `u` and `v` (normal u × v), its UVs scaled by `uv_scale`.
-  void quad(const float o[3], const float u[3], const float v[3], float uv_scale = 1) {
+  // A quad from corner `o` along edges `u` and `v` (normal u × v), mapped onto the UV rectangle
+  // from (u0, v0) to (u1, v1) (texture v downwards: the quad's far edge along v at v0).
+  void quad(const float o[3], const float u[3], const float v[3], float u0 = 0, float v0 = 0, float u1 = 1, float v1 = 1) {
     const float n[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
     const float len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
     const auto base = std::uint16_t(vertices.size());
@@ -36,21 +37,28 @@ struct Mesh {
         vx.p[i] = o[i] + a * u[i] + b * v[i];
         vx.n[i] = n[i] / len;
       }
-      vx.uv[0] = a * uv_scale;
-      vx.uv[1] = (1 - b) * uv_scale;
+      vx.uv[0] = u0 + a * (u1 - u0);
+      vx.uv[1] = v0 + (1 - b) * (v1 - v0);
       vertices.push_back(vx);
     }
     for (int i : {0, 1, 2, 0, 2, 3}) indices.push_back(std::uint16_t(base + i));
   }
 };
 
-// An axis-aligned box centred on x and z, standing on y = y0.
+// Every surface of a mesh has UVs of its own (no two faces share texels), so that occlusion can be
+// baked into its textures (`ao = { texture = ... }`); a gutter of 1/32 keeps the islands apart.
+constexpr float kGutter = 1.0f / 32;
+
+// An axis-aligned box centred on x and z, standing on y = y0; its six faces in a 3 × 2 UV grid.
 Mesh box(float w, float h, float d, float y0 = 0) {
   Mesh m;
   const float x = w / 2, z = d / 2;
+  int cell = 0;
   auto face = [&](float ox, float oy, float oz, float ux, float uy, float uz, float vx, float vy, float vz) {
     const float o[3] = {ox, oy, oz}, u[3] = {ux, uy, uz}, v[3] = {vx, vy, vz};
-    m.quad(o, u, v);
+    const float column = float(cell % 3), row = float(cell / 3);
+    m.quad(o, u, v, column / 3 + kGutter, row / 2 + kGutter, (column + 1) / 3 - kGutter, (row + 1) / 2 - kGutter);
+    ++cell;
   };
   face(-x, y0, z, w, 0, 0, 0, h, 0);        // +z
   face(x, y0, -z, -w, 0, 0, 0, h, 0);       // −z
@@ -61,7 +69,8 @@ Mesh box(float w, float h, float d, float y0 = 0) {
   return m;
 }
 
-// A cylinder of `segments` flat sides standing on y = 0, with a top cap.
+// A cylinder of `segments` flat sides standing on y = 0, with a top cap: the sides one strip along
+// the top of the UV square, the cap a disc below it.
 Mesh cylinder(float r, float h, int segments) {
   Mesh m;
   for (int s = 0; s < segments; ++s) {
@@ -70,15 +79,16 @@ Mesh cylinder(float r, float h, int segments) {
     const float u[3] = {r * float(std::cos(a1) - std::cos(a0)), 0, r * float(std::sin(a1) - std::sin(a0))};
     const float v[3] = {0, h, 0};
     // Wound so that the normal (v × u here, after swapping) points outwards.
-    m.quad(o, v, u);
+    m.quad(o, v, u, kGutter, float(s + 1) / float(segments), 0.7f, float(s) / float(segments));  // seamless strip
   }
   const auto centre = std::uint16_t(m.vertices.size());
-  m.vertices.push_back({{0, h, 0}, {0, 1, 0}, {0.5f, 0.5f}});
+  constexpr float kCapU = 0.85f, kCapV = 0.5f, kCapRadius = 0.15f - kGutter;
+  m.vertices.push_back({{0, h, 0}, {0, 1, 0}, {kCapU, kCapV}});
   for (int s = 0; s <= segments; ++s) {
     const double a = 2 * std::numbers::pi * s / segments;
     m.vertices.push_back({{r * float(std::cos(a)), h, r * float(std::sin(a))},
                           {0, 1, 0},
-                          {0.5f + 0.5f * float(std::cos(a)), 0.5f + 0.5f * float(std::sin(a))}});
+                          {kCapU + kCapRadius * float(std::cos(a)), kCapV + kCapRadius * float(std::sin(a))}});
   }
   for (int s = 0; s < segments; ++s) {
     for (int i : {0, s + 2, s + 1}) m.indices.push_back(std::uint16_t(centre + i));
@@ -169,7 +179,7 @@ int main(int argc, char** argv) {
   Mesh floor;
   {
     const float o[3] = {-4, 0, 4}, u[3] = {8, 0, 0}, v[3] = {0, 0, -8};
-    floor.quad(o, u, v, 4);
+    floor.quad(o, u, v);
   }
   Mesh pane;
   {

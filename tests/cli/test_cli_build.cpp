@@ -14,6 +14,7 @@
 #include <map>
 #include <thread>
 
+#include "lib/src/gltf/document.hpp"
 #include "support/files.hpp"
 #include "support/gltf_validator.hpp"
 #include "support/run.hpp"
@@ -114,6 +115,16 @@ TEST(CliBuild, ExampleBuildsOnceAndPassesTheValidator) {
   EXPECT_EQ(gold["passed"], true);
   EXPECT_EQ(gold["classes"]["metal"], 256 * 256);
 
+  // The scene's AO is baked into the ORM textures (red), one material copy per placement: 10
+  // placements of 5 materials; each material's occlusion is its metallic-roughness texture.
+  {
+    const auto doc = gltf::read_document(dir / "out/showroom.glb");
+    ASSERT_TRUE(doc) << doc.error().to_string();
+    ASSERT_EQ(doc->json["materials"].size(), 10u);
+    for (const auto& m : doc->json["materials"]) {
+      EXPECT_EQ(m["occlusionTexture"]["index"], m["pbrMetallicRoughness"]["metallicRoughnessTexture"]["index"]) << m.dump();
+    }
+  }
   MATBAKE_VALIDATE_OR_SKIP(report, dir / "out/showroom.glb");
   EXPECT_EQ(report->errors, 0) << report->summary;
   EXPECT_EQ(report->warnings, 0) << report->summary;
