@@ -1,5 +1,5 @@
 // glTF loading: the document (JSON, buffers, accessor checks) and the flattened scene built from it,
-// as export and bake-ao read them. MATBAKE_FUZZ_EXTENSION is ".gltf" or ".glb" (two targets).
+// as export and bake-ao read them, and the texel coverage of a texture bake over its UVs. MATBAKE_FUZZ_EXTENSION is ".gltf" or ".glb" (two targets).
 #include <unistd.h>
 
 #include <cstddef>
@@ -8,6 +8,8 @@
 #include <fstream>
 #include <string>
 
+#include "lib/src/ao/texels.hpp"
+#include "lib/src/export/occlusion_texture.hpp"
 #include "lib/src/gltf/document.hpp"
 #include "lib/src/scene/from_document.hpp"
 
@@ -28,7 +30,19 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   std::ofstream(file, std::ios::binary | std::ios::trunc).write(reinterpret_cast<const char*>(data), std::streamsize(size));
   auto doc = matbake::gltf::read_document(file);
   if (!doc) return 0;
-  (void)matbake::scene::scene_from_document(*doc);
+  // With the UV sets, and each material's texel coverage at a small size (no rays: the
+  // rasterization, tie rule and wrap modes see the file's UVs).
+  auto scene = matbake::scene::scene_from_document(*doc, {.texcoords = true});
+  if (scene) {
+    auto targets = matbake::exporter::occlusion_targets(*doc, *scene, matbake::ao::TextureRequest{});
+    for (std::size_t t = 0; targets && t < targets->targets.size(); ++t) {
+      for (auto wrap : {matbake::ao::Wrap::repeat, matbake::ao::Wrap::mirrored_repeat, matbake::ao::Wrap::clamp_to_edge}) {
+        auto target = targets->targets[t];
+        target.wrap_s = target.wrap_t = wrap;
+        (void)matbake::ao::texels::cover(*scene, target, 16, 8);
+      }
+    }
+  }
   for (std::size_t i = 0; doc->json.contains("images") && doc->json["images"].is_array() && i < doc->json["images"].size(); ++i) {
     (void)matbake::gltf::image_bytes(*doc, i);
   }

@@ -58,7 +58,7 @@ double e3(double z) {
 // Odd and even sizes: the fan's diagonals run through texel centres, and at odd sizes its centre
 // vertex is one. Every centre is taken exactly once, nothing overlaps, an open plane is exactly 1.
 TEST(TextureAo, OpenPlaneCoversEveryTexelOnceAndIsExactlyOne) {
-  for (auto [w, h] : {std::pair{8, 8}, {7, 7}, {1, 1}, {7, 3}, {2, 64}}) {
+  for (auto [w, h] : {std::pair{8, 8}, {7, 7}, {1, 1}, {7, 3}, {2, 64}, {8192, 2}, {3, 8192}}) {
     const TextureBake t = bake_one(scene_of({square({0, 0, 0}, kX, kY, 1)}), binary(64, 10), size(w, h));
     EXPECT_EQ(t.covered, std::size_t(w * h)) << w << "x" << h;
     EXPECT_EQ(t.overlapped, 0u) << w << "x" << h;

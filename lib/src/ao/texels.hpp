@@ -27,7 +27,7 @@ struct Coverage {
 constexpr int kMaxCopies = 64;  // of the texture a triangle's UVs may span (wrapping)
 
 // Errors: a layout mapping more surface points than kMaxSurfacePoints (hundreds of stacked copies).
-constexpr std::size_t kMaxSurfacePoints = std::size_t{1} << 28;
+constexpr std::size_t kMaxSurfacePoints = std::size_t{1} << 27;  // 2.7 GB of points
 Result<Coverage> cover(const scene::Scene& scene, const TextureTarget& target, int width, int height);
 
 // A triangle's UVs in texel space.
