@@ -15,50 +15,14 @@
 #include <vector>
 
 #include "matbake/ao.hpp"
+#include "terrain.hpp"
 
 using namespace matbake;
-
-namespace {
-
-scene::Scene terrain() {
-  scene::Scene s;
-  constexpr int kTiles = 10, kGrid = 24;
-  for (int ty = 0; ty < kTiles; ++ty) {
-    for (int tx = 0; tx < kTiles; ++tx) {
-      scene::Instance tile;
-      for (int j = 0; j <= kGrid; ++j) {
-        for (int i = 0; i <= kGrid; ++i) {
-          const float x = float(tx) + float(i) / kGrid, y = float(ty) + float(j) / kGrid;
-          const float z = 0.15f * std::sin(7 * x) * std::cos(5 * y) + 0.05f * std::sin(23 * x + 11 * y);
-          tile.positions.push_back({x, y, z});
-        }
-      }
-      for (int j = 0; j < kGrid; ++j) {
-        for (int i = 0; i < kGrid; ++i) {
-          const auto at = [](int a, int b) { return std::uint32_t(b * (kGrid + 1) + a); };
-          tile.triangles.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
-          tile.triangles.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
-        }
-      }
-      s.instances.push_back(std::move(tile));
-    }
-  }
-  s.bounds_min = {0, 0, -0.2f};
-  s.bounds_max = {float(kTiles), float(kTiles), 0.2f};
-  return s;
-}
-
-double seconds_of(const std::function<void()>& f) {
-  const auto t0 = std::chrono::steady_clock::now();
-  f();
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
-
-}  // namespace
+using bench::seconds_of;
 
 int main(int argc, char** argv) {
   const bool quick = argc > 1 && std::string_view(argv[1]) == "--quick";
-  const scene::Scene s = terrain();
+  const scene::Scene s = bench::terrain();
   std::size_t triangles = 0;
   for (const auto& i : s.instances) triangles += i.triangles.size();
   std::vector<bool> error_tiles(s.instances.size(), false);

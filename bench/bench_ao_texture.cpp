@@ -16,47 +16,12 @@
 #include <vector>
 
 #include "matbake/ao.hpp"
+#include "terrain.hpp"
 
 using namespace matbake;
+using bench::seconds_of;
 
 namespace {
-
-constexpr int kTiles = 10, kGrid = 24;
-
-scene::Scene terrain() {
-  scene::Scene s;
-  for (int ty = 0; ty < kTiles; ++ty) {
-    for (int tx = 0; tx < kTiles; ++tx) {
-      scene::Instance tile;
-      tile.texcoords.emplace_back();
-      for (int j = 0; j <= kGrid; ++j) {
-        for (int i = 0; i <= kGrid; ++i) {
-          const float x = float(tx) + float(i) / kGrid, y = float(ty) + float(j) / kGrid;
-          const float z = 0.15f * std::sin(7 * x) * std::cos(5 * y) + 0.05f * std::sin(23 * x + 11 * y);
-          tile.positions.push_back({x, y, z});
-          tile.texcoords[0].push_back({x / kTiles, y / kTiles});  // shared edges are equal floats
-        }
-      }
-      for (int j = 0; j < kGrid; ++j) {
-        for (int i = 0; i < kGrid; ++i) {
-          const auto at = [](int a, int b) { return std::uint32_t(b * (kGrid + 1) + a); };
-          tile.triangles.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
-          tile.triangles.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
-        }
-      }
-      s.instances.push_back(std::move(tile));
-    }
-  }
-  s.bounds_min = {0, 0, -0.2f};
-  s.bounds_max = {float(kTiles), float(kTiles), 0.2f};
-  return s;
-}
-
-double seconds_of(const std::function<void()>& f) {
-  const auto t0 = std::chrono::steady_clock::now();
-  f();
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
 
 double rmse(const std::vector<float>& a, const std::vector<float>& b) {
   double sum = 0;
@@ -74,7 +39,7 @@ std::vector<float> flat(const std::vector<std::vector<float>>& values) {
 
 int main(int argc, char** argv) {
   const bool quick = argc > 1 && std::string_view(argv[1]) == "--quick";
-  const scene::Scene s = terrain();
+  const scene::Scene s = bench::terrain(true);
   ao::Options options;
   options.falloff = ao::Falloff::none;
   options.two_sided = true;  // as bench_ao: a terrain shows no back faces
