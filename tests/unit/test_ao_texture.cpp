@@ -93,22 +93,25 @@ TEST(TextureAo, FloorUnderACeilingMatchesClosedForms) {
   }
 }
 
-// A floor at the foot of a wall 2000 high and wide: each texel sees half its hemisphere.
+// A floor at the foot of a wall 2000 high and wide: each texel sees half its hemisphere; at three scales.
 TEST(TextureAo, FootOfAWallIsOneHalf) {
-  const auto s = scene_of({square({0, 0, 0}, kX, kY, 1), square({-1.001f, 0, 1000}, kY, kZ, 1000)});
-  const int n = 2048;
-  const TextureBake t = bake_one(s, binary(n, 1e5), size(8, 8));
-  for (float v : t.values) EXPECT_NEAR(v, 0.5, three_sigma(0.5, n) + 1e-3);  // the wall's top: < 1e-3
+  for (float unit : {1.0f, 1e-3f, 1e3f}) {
+    const auto s = scene_of({square({0, 0, 0}, kX, kY, unit), square(Vec3(-1.001f, 0, 1000) * unit, kY, kZ, 1000 * unit)});
+    const int n = 2048;
+    const TextureBake t = bake_one(s, binary(n, 1e5 * unit), size(8, 8));
+    for (float v : t.values) EXPECT_NEAR(v, 0.5, three_sigma(0.5, n) + 1e-3) << unit;  // the wall's top: < 1e-3
+  }
 }
 
 // The floor of a closed box, wound inwards: nothing escapes, not even from the texels on its
-// border, which sample the floor's edge where it meets the walls.
+// border, which sample the floor's edge where it meets the walls; at three scales.
 TEST(TextureAo, InsideAClosedBoxIsZero) {
-  const float a = 1;
-  const auto s = scene_of({square({0, 0, -a}, kX, kY, a), square({0, 0, a}, kY, kX, a), square({a, 0, 0}, kZ, kY, a),
-                           square({-a, 0, 0}, kY, kZ, a), square({0, a, 0}, kX, kZ, a), square({0, -a, 0}, kZ, kX, a)});
-  const TextureBake t = bake_one(s, binary(256, 100), size(16, 16));
-  for (float v : t.values) EXPECT_EQ(v, 0.0f);
+  for (float a : {1.0f, 1e-3f, 1e3f}) {
+    const auto s = scene_of({square({0, 0, -a}, kX, kY, a), square({0, 0, a}, kY, kX, a), square({a, 0, 0}, kZ, kY, a),
+                             square({-a, 0, 0}, kY, kZ, a), square({0, a, 0}, kX, kZ, a), square({0, -a, 0}, kZ, kX, a)});
+    const TextureBake t = bake_one(s, binary(256, 100 * a), size(16, 16));
+    for (float v : t.values) EXPECT_EQ(v, 0.0f) << a;
+  }
 }
 
 // Islands that share texels: a mirrored copy, and a stacked copy under a ceiling while the first is

@@ -22,15 +22,6 @@ using Clock = std::chrono::steady_clock;
 
 constexpr std::uint64_t kTextureGroup = 1u << 20;  // sample_key groups of textures: beyond any instance index
 
-// Interleaves the bits of x and y (a Z-order curve index).
-std::uint64_t morton(std::uint32_t x, std::uint32_t y) {
-  std::uint64_t key = 0;
-  for (int bit = 0; bit < 16; ++bit) {
-    key |= std::uint64_t((x >> bit) & 1u) << (2 * bit) | std::uint64_t((y >> bit) & 1u) << (2 * bit + 1);
-  }
-  return key;
-}
-
 double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
 
 // The mean of the estimator over the K = texel_samples positions of one surface point's texel
@@ -151,14 +142,23 @@ Result<TextureBakes> bake_textures(const scene::Scene& scene, const Options& opt
     out.instances_without_uv = coverage->instances_without_uv;
 
     texel_start = Clock::now();
-    // Texels in Morton order: neighbours on the texture (mostly neighbours on the surface) are traced
-    // together, so their rays walk the same part of the BVH.
-    std::vector<std::pair<std::uint64_t, std::uint32_t>> order(runs.size() - 1);
-    for (std::size_t r = 0; r + 1 < runs.size(); ++r) {
-      const std::uint32_t texel = points[runs[r]].texel;
-      order[r] = {morton(texel % std::uint32_t(texture.width), texel / std::uint32_t(texture.width)), std::uint32_t(r)};
+    // Texels in 8 × 8 tiles, row by row within a tile: neighbours on the texture (mostly neighbours on
+    // the surface) are traced together, so their rays walk the same part of the BVH. Linear time.
+    std::vector<std::uint32_t> run_of(texel_count, UINT32_MAX);
+    for (std::size_t r = 0; r + 1 < runs.size(); ++r) run_of[points[runs[r]].texel] = std::uint32_t(r);
+    std::vector<std::uint32_t> order;
+    order.reserve(runs.size() - 1);
+    constexpr int kTile = 8;
+    for (int ty = 0; ty < texture.height; ty += kTile) {
+      for (int tx = 0; tx < texture.width; tx += kTile) {
+        for (int y = ty; y < std::min(ty + kTile, texture.height); ++y) {
+          for (int x = tx; x < std::min(tx + kTile, texture.width); ++x) {
+            const std::uint32_t r = run_of[std::size_t(y) * std::size_t(texture.width) + std::size_t(x)];
+            if (r != UINT32_MAX) order.push_back(r);
+          }
+        }
+      }
     }
-    std::sort(order.begin(), order.end());
     result.texel_seconds += seconds_since(texel_start);
     const auto ray_start = Clock::now();
     std::atomic<std::uint64_t> rays{0};
@@ -166,7 +166,7 @@ Result<TextureBakes> bake_textures(const scene::Scene& scene, const Options& opt
       std::vector<RTCRayHit> scratch(std::size_t(options.samples));
       std::uint64_t cast = 0;
       for (std::size_t o = range.begin(); o != range.end(); ++o) {
-        const std::size_t r = order[o].second;
+        const std::size_t r = order[o];
         double sum = 0;
         for (std::size_t i = runs[r]; i < runs[r + 1]; ++i) {
           // Each surface of a texel its own stream: overlapping copies are independent estimates.
