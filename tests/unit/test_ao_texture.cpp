@@ -6,6 +6,7 @@
 #include <tbb/global_control.h>
 
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include "../../lib/src/ao/texels.hpp"
@@ -167,8 +168,11 @@ TEST(TextureAo, DegenerateTrianglesAndMissingUvSets) {
   inst.triangles.push_back({5, 0, 5});
   Instance no_uv = square({5, 0, 0}, kX, kY, 1);
   no_uv.texcoords.clear();
-  const TextureBake t = bake_one(scene_of({inst, no_uv}), binary(64, 10), size(16, 16), {{0, 1}});
-  EXPECT_EQ(t.degenerate_uv, 3u);  // triangles 0 and 1, and the repeated-index one
+  Instance nan_uv = square({-5, 0, 0}, kX, kY, 1);
+  nan_uv.texcoords[0][0].x = std::nanf("");  // the centre vertex: all four triangles
+  nan_uv.texcoords[0][2].y = std::numeric_limits<float>::infinity();
+  const TextureBake t = bake_one(scene_of({inst, no_uv, nan_uv}), binary(64, 10), size(16, 16), {{0, 1, 2}});
+  EXPECT_EQ(t.degenerate_uv, 3u + 4u);  // triangles 0 and 1, the repeated-index one, and the NaN/∞ ones
   EXPECT_EQ(t.instances_without_uv, 1u);
   for (float v : t.values) EXPECT_TRUE(v >= 0 && v <= 1) << v;
   Instance flat = square({0, 0, 0}, kX, kY, 1);
