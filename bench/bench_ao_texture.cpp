@@ -3,14 +3,17 @@
 // texture (65,536 texels, each covered once), binary falloff, d_max 0.25 × the scene radius.
 // For 16, 64, 256 and 1024 samples: time, texels (or vertices) per second and rays per second on
 // 2 cores and on one, the share of the time spent on texel set-up (UV rasterization, padding), and
-// the RMSE against a 4096-sample bake of the same texels (or vertices).
+// the RMSE against a 4096-sample bake of the same texels (or vertices). Times are medians of at least
+// 3 runs and a second; set-up shares are summed over the 2-core runs.
 //   build/bench/bench_ao_texture            the whole table (about 4 minutes)
 //   build/bench/bench_ao_texture --quick    64 samples only
+//   build/bench/bench_ao_texture N          N samples only
 #include <tbb/global_control.h>
 
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <functional>
 #include <string_view>
 #include <vector>
@@ -19,6 +22,7 @@
 #include "terrain.hpp"
 
 using namespace matbake;
+using bench::median_seconds;
 using bench::seconds_of;
 
 namespace {
@@ -38,7 +42,14 @@ std::vector<float> flat(const std::vector<std::vector<float>>& values) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  const bool quick = argc > 1 && std::string_view(argv[1]) == "--quick";
+  const std::string_view only = argc > 1 ? argv[1] : "";
+  std::vector<int> samples{16, 64, 256, 1024};
+  if (only == "--quick") samples = {64};
+  else if (!only.empty()) samples = {std::atoi(argv[1])};
+  if (samples[0] < 1 || samples[0] > 4096) {
+    std::fprintf(stderr, "usage: bench_ao_texture [--quick | SAMPLES (1 to 4096)]\n");
+    return 2;
+  }
   const scene::Scene s = bench::terrain(true);
   ao::Options options;
   options.falloff = ao::Falloff::none;
@@ -58,35 +69,42 @@ int main(int argc, char** argv) {
               texel_reference.max_distance);
   std::printf("| bake | samples | time, 2 cores | k points/s | M rays/s, 2 cores | M rays/s, 1 core | speed-up | set-up | RMSE vs 4096 |\n"
               "|---|---|---|---|---|---|---|---|---|\n");
-  const std::vector<int> samples = quick ? std::vector<int>{64} : std::vector<int>{16, 64, 256, 1024};
   for (int n : samples) {
     ao::Options o = options;
     o.samples = n;
     {
       ao::Bake all;
-      const double t2 = seconds_of([&] { all = *ao::bake(s, o); });
+      double setup = 0, total = 0;
+      const double t2 = median_seconds([&] {
+        const double t = seconds_of([&] { all = *ao::bake(s, o); });
+        setup += all.setup_seconds, total += t;
+      });
       double t1 = 0;
       {
         tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
-        t1 = seconds_of([&] { (void)ao::bake(s, o); });
+        t1 = median_seconds([&] { (void)ao::bake(s, o); });
       }
       const double points = double(vertex_reference.size());
       std::printf("| per vertex | %d | %.3f s | %.0f | %.1f | %.1f | %.2f× | %.0f%% | %.5f |\n", n, t2, points / t2 / 1e3,
-                  double(all.rays) / t2 / 1e6, double(all.rays) / t1 / 1e6, t1 / t2, 100 * all.setup_seconds / t2,
+                  double(all.rays) / t2 / 1e6, double(all.rays) / t1 / 1e6, t1 / t2, 100 * setup / total,
                   rmse(flat(all.values), vertex_reference));
     }
     {
       ao::TextureBakes all;
-      const double t2 = seconds_of([&] { all = *ao::bake_textures(s, o, {atlas}, texture); });
+      double setup = 0, texel_setup = 0, total = 0;
+      const double t2 = median_seconds([&] {
+        const double t = seconds_of([&] { all = *ao::bake_textures(s, o, {atlas}, texture); });
+        setup += all.setup_seconds, texel_setup += all.texel_seconds, total += t;
+      });
       double t1 = 0;
       {
         tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
-        t1 = seconds_of([&] { (void)ao::bake_textures(s, o, {atlas}, texture); });
+        t1 = median_seconds([&] { (void)ao::bake_textures(s, o, {atlas}, texture); });
       }
       const double points = double(all.textures[0].covered + all.textures[0].touched);
       std::printf("| texture 256² | %d | %.3f s | %.0f | %.1f | %.1f | %.2f× | %.0f%% + %.0f%% | %.5f |\n", n, t2,
                   points / t2 / 1e3, double(all.rays) / t2 / 1e6, double(all.rays) / t1 / 1e6, t1 / t2,
-                  100 * all.setup_seconds / t2, 100 * all.texel_seconds / t2,
+                  100 * setup / total, 100 * texel_setup / total,
                   rmse(all.textures[0].values, texel_reference.textures[0].values));
     }
   }

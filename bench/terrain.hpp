@@ -2,9 +2,11 @@
 // The generated terrain of the AO benchmarks: 10 × 10 tiles of 24 × 24 quads (62,500 vertices,
 // 115,200 triangles), a bumpy height field 10 units across. With `texcoords`, TEXCOORD_0 lays the
 // tiles out as a 10 × 10 atlas over [0, 1]² (shared tile edges are equal floats).
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <functional>
+#include <vector>
 
 #include "matbake/scene.hpp"
 
@@ -44,6 +46,19 @@ inline double seconds_of(const std::function<void()>& f) {
   const auto t0 = std::chrono::steady_clock::now();
   f();
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// The median time of f over at least 3 runs and at least a second in all (at most 25 runs): a bake
+// of a tenth of a second is otherwise at the mercy of one scheduler hiccup.
+inline double median_seconds(const std::function<void()>& f) {
+  std::vector<double> times;
+  double total = 0;
+  while (times.size() < 25 && (times.size() < 3 || total < 1.0)) {
+    times.push_back(seconds_of(f));
+    total += times.back();
+  }
+  std::nth_element(times.begin(), times.begin() + std::ptrdiff_t(times.size() / 2), times.end());
+  return times[times.size() / 2];
 }
 
 }  // namespace matbake::bench

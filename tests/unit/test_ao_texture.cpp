@@ -297,6 +297,71 @@ TEST(TextureAo, SameValuesWhateverTheThreadCountAndSeed) {
   EXPECT_NE(one.values, bake_one(s, o, t).values);
 }
 
+bool same_points(const texels::Coverage& a, const texels::Coverage& b) {
+  if (a.points.size() != b.points.size()) return false;
+  for (std::size_t i = 0; i < a.points.size(); ++i) {
+    const texels::SurfacePoint &p = a.points[i], &q = b.points[i];
+    if (p.texel != q.texel || p.instance != q.instance || p.triangle != q.triangle || p.x != q.x || p.y != q.y) return false;
+  }
+  return true;
+}
+
+// Coverage is rasterized in chunks of triangles in parallel: two height fields of 9,800 triangles
+// each (several chunks apiece), the second mirrored over the first and shifted by a third of a
+// texel (overlaps, and touched texels along every island edge), give the same points in the same
+// order on one thread and on all, sorted by texel and, within a texel, in scene order.
+TEST(TextureAo, CoverageIsTheSameOnAnyNumberOfThreads) {
+  constexpr int kN = 71;
+  Instance g = height_field(kN, 0.1f);
+  g.texcoords.emplace_back();
+  for (int j = 0; j < kN; ++j) {
+    for (int i = 0; i < kN; ++i) g.texcoords[0].push_back({0.05f + 0.8f * float(i) / kN, 0.1f + 0.7f * float(j) / kN});
+  }
+  Instance mirrored = g;
+  for (auto& uv : mirrored.texcoords[0]) uv = {0.9f - uv.x + 1.0f / 300, uv.y};
+  const auto s = scene_of({g, mirrored});
+  const TextureTarget target{{0, 1}};
+  texels::Coverage one;
+  {
+    tbb::global_control c(tbb::global_control::max_allowed_parallelism, 1);
+    one = *texels::cover(s, target, 100, 100);
+  }
+  const texels::Coverage all = *texels::cover(s, target, 100, 100);
+  EXPECT_TRUE(same_points(one, all));
+  EXPECT_EQ(one.triangles, 2u * 2 * (kN - 1) * (kN - 1));
+  EXPECT_EQ(all.covered, one.covered);
+  EXPECT_EQ(all.touched, one.touched);
+  EXPECT_GT(one.overlapped, 0u);
+  EXPECT_GT(one.touched, 0u);
+  for (std::size_t i = 1; i < one.points.size(); ++i) {
+    const texels::SurfacePoint &p = one.points[i - 1], &q = one.points[i];
+    ASSERT_TRUE(p.texel < q.texel || (p.texel == q.texel && (p.instance < q.instance ||
+                                                             (p.instance == q.instance && p.triangle < q.triangle))))
+        << i;
+  }
+}
+
+// The cap on surface points holds exactly, below and above the batches in which the parallel
+// chunks count them: 5 stacked copies of a plane over 64 × 64 texels map 20,480 centres.
+TEST(TextureAo, CoverageRefusesMoreSurfacePointsThanItsCap) {
+  std::vector<Instance> copies(5, square({0, 0, 0}, kX, kY, 1));
+  for (std::size_t k = 1; k < copies.size(); ++k) {
+    for (Vec3& p : copies[k].positions) p.z = float(k);
+  }
+  const auto s = scene_of(copies);
+  const TextureTarget target{{0, 1, 2, 3, 4}};
+  const auto exact = texels::cover(s, target, 64, 64, 20480);
+  ASSERT_TRUE(exact);
+  EXPECT_EQ(exact->points.size(), 20480u);
+  EXPECT_EQ(exact->overlapped, 4096u);
+  for (std::size_t cap : {std::size_t{20479}, std::size_t{5000}, std::size_t{10}}) {
+    const auto over = texels::cover(s, target, 64, 64, cap);
+    ASSERT_FALSE(over) << cap;
+    EXPECT_NE(over.error().to_string().find("more than " + std::to_string(cap) + " surface points"), std::string::npos)
+        << over.error().to_string();
+  }
+}
+
 // Padding: the nearest mapped texel's value, ties averaged, against a float64 brute force on a
 // random mask; nothing beyond the padding changes.
 TEST(TextureAo, PaddingTakesTheNearestMappedTexelTiesAveraged) {

@@ -2,7 +2,10 @@
 
 #include <glm/geometric.hpp>
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 
@@ -41,6 +44,7 @@ bool inside(const UvTriangle& t, const dvec2& p) {
 }
 
 long long wrap(long long i, long long size, Wrap mode) {
+  if (i >= 0 && i < size) return i;  // the common case, and the same in every mode
   switch (mode) {
     case Wrap::repeat: return ((i % size) + size) % size;
     case Wrap::mirrored_repeat: {
@@ -83,13 +87,6 @@ void distance_1d(double* f, std::size_t n, std::size_t stride, std::vector<doubl
 
 }  // namespace
 
-UvTriangle uv_triangle(const scene::Instance& inst, int texcoord, std::size_t triangle, int width, int height) {
-  const auto& uv = inst.texcoords[std::size_t(texcoord)];
-  const auto& t = inst.triangles[triangle];
-  const auto texel = [&](std::uint32_t v) { return dvec2(double(uv[v].x) * width - 0.5, double(uv[v].y) * height - 0.5); };
-  return {texel(t[0]), texel(t[1]), texel(t[2])};
-}
-
 // Ericson, Real-Time Collision Detection 5.1.5, in barycentric form.
 glm::dvec3 nearest_weights(const UvTriangle& t, const dvec2& p) {
   const dvec2 ab = t.b - t.a, ac = t.c - t.a, ap = p - t.a;
@@ -121,113 +118,194 @@ glm::dvec3 nearest_weights(const UvTriangle& t, const dvec2& p) {
   return {1 - v - w, v, w};
 }
 
-Result<Coverage> cover(const scene::Scene& scene, const TextureTarget& target, int width, int height) {
+namespace {
+
+// A run of one instance's triangles: coverage is worked out per chunk in parallel and merged in
+// chunk order, so the result (and the order of points within a texel) is the serial one for any
+// number of threads.
+constexpr std::size_t kChunkTriangles = 2048;
+struct Chunk {
+  std::uint32_t instance;
+  std::size_t first, last;
+};
+
+struct Touch {
+  double distance;
+  SurfacePoint point;
+};
+
+// What one chunk found: its centres (first pass), its touches (second), its triangles' tallies.
+struct ChunkCoverage {
+  std::vector<SurfacePoint> points;
+  std::vector<Touch> touches;
+  std::size_t triangles = 0, degenerate_uv = 0, wrapped = 0, too_large = 0;
+};
+
+// Stops every chunk once the chunks together hold more than `limit` points: each adds its count in
+// batches, so the shared total never exceeds the true one and the decision is the serial one.
+class PointBudget {
+ public:
+  explicit PointBudget(std::size_t limit) : limit_(limit) {}
+  bool add(std::size_t n) { return (total_ += n) <= limit_; }
+  bool exhausted() const { return total_.load(std::memory_order_relaxed) > limit_; }
+
+ private:
+  std::size_t limit_;
+  std::atomic<std::size_t> total_{0};
+};
+constexpr std::size_t kBudgetBatch = 4096;
+
+struct Raster {
+  const scene::Scene& scene;
+  const TextureTarget& target;
+  int width, height;
+  double max_cells;  // of a triangle's bounding box (kMaxCopies textures)
+
+  std::uint32_t texel_at(double i, double j) const {
+    return std::uint32_t(wrap((long long)j, height, target.wrap_t) * width + wrap((long long)i, width, target.wrap_s));
+  }
+
+  // The chunk's usable triangles, positively oriented in texel space, with their cells within
+  // `margin` (first pass: 0, the centres inside; second: the reach of a touch). `tally` counts them
+  // (first pass only). visit returns false to stop.
+  template <class Visit>
+  bool for_each_cell(const Chunk& chunk, double margin, ChunkCoverage* tally, Visit&& visit) const {
+    const double reach = std::sqrt(0.5);
+    const scene::Instance& inst = scene.instances[chunk.instance];
+    for (std::size_t t = chunk.first; t < chunk.last; ++t) {
+      const UvTriangle uv = uv_triangle(inst, target.texcoord, t, width, height);
+      const double area2 = cross(uv.b - uv.a, uv.c - uv.a);
+      const double longest2 = std::max({glm::dot(uv.b - uv.a, uv.b - uv.a), glm::dot(uv.c - uv.a, uv.c - uv.a),
+                                        glm::dot(uv.c - uv.b, uv.c - uv.b)});
+      if (!std::isfinite(area2) || !(std::abs(area2) > 1e-12 * longest2)) {
+        if (tally) ++tally->degenerate_uv;
+        continue;
+      }
+      const UvTriangle tri = area2 > 0 ? uv : UvTriangle{uv.a, uv.c, uv.b};
+      const double x0 = std::min({tri.a.x, tri.b.x, tri.c.x}), x1 = std::max({tri.a.x, tri.b.x, tri.c.x});
+      const double y0 = std::min({tri.a.y, tri.b.y, tri.c.y}), y1 = std::max({tri.a.y, tri.b.y, tri.c.y});
+      const double i0 = std::ceil(x0 - reach), i1 = std::floor(x1 + reach);
+      const double j0 = std::ceil(y0 - reach), j1 = std::floor(y1 + reach);
+      if ((i1 - i0 + 1) * (j1 - j0 + 1) > max_cells) {
+        if (tally) ++tally->too_large;
+        continue;
+      }
+      if (tally) {
+        ++tally->triangles;
+        if (x0 < -0.5 || y0 < -0.5 || x1 > width - 0.5 || y1 > height - 0.5) ++tally->wrapped;
+      }
+      const double c0 = std::ceil(x0 - margin), c1 = std::floor(x1 + margin);
+      for (double j = std::ceil(y0 - margin); j <= std::floor(y1 + margin); ++j) {
+        for (double i = c0; i <= c1; ++i) {
+          if (!visit(t, tri, i, j)) return false;
+        }
+      }
+    }
+    return true;
+  }
+};
+
+}  // namespace
+
+Result<Coverage> cover(const scene::Scene& scene, const TextureTarget& target, int width, int height,
+                       std::size_t max_points) {
   Coverage out;
   const double reach = std::sqrt(0.5);  // half a texel diagonal
   // A triangle's bounding box may cover the texture several times over (a tiled floor); beyond
   // kMaxCopies it would cost unbounded time for a texture no viewer could show.
-  const double max_cells = double(kMaxCopies) * double(width) * double(height) + 1024;
-  const auto texel_at = [&](double i, double j) {
-    return std::uint32_t(wrap((long long)j, height, target.wrap_t) * width + wrap((long long)i, width, target.wrap_s));
-  };
-  // Every usable triangle, positively oriented in texel space, with its cells within `margin`
-  // (first pass: 0, the centres inside; second: the reach of a touch). The first pass counts.
-  const auto for_each_triangle = [&](bool count, double margin, auto&& visit) -> Status {
-    for (std::size_t k : target.instances) {
-      const scene::Instance& inst = scene.instances[k];
-      if (std::size_t(target.texcoord) >= inst.texcoords.size() || inst.texcoords[std::size_t(target.texcoord)].empty()) {
-        out.instances_without_uv += count;
-        continue;
-      }
-      for (std::size_t t = 0; t < inst.triangles.size(); ++t) {
-        const UvTriangle uv = uv_triangle(inst, target.texcoord, t, width, height);
-        const double area2 = cross(uv.b - uv.a, uv.c - uv.a);
-        const double scale = std::max({glm::length(uv.b - uv.a), glm::length(uv.c - uv.a), glm::length(uv.c - uv.b)});
-        if (!std::isfinite(area2) || !(std::abs(area2) > 1e-12 * scale * scale)) {
-          out.degenerate_uv += count;
-          continue;
-        }
-        const UvTriangle tri = area2 > 0 ? uv : UvTriangle{uv.a, uv.c, uv.b};
-        const double x0 = std::min({tri.a.x, tri.b.x, tri.c.x}), x1 = std::max({tri.a.x, tri.b.x, tri.c.x});
-        const double y0 = std::min({tri.a.y, tri.b.y, tri.c.y}), y1 = std::max({tri.a.y, tri.b.y, tri.c.y});
-        const double i0 = std::ceil(x0 - reach), i1 = std::floor(x1 + reach);
-        const double j0 = std::ceil(y0 - reach), j1 = std::floor(y1 + reach);
-        if ((i1 - i0 + 1) * (j1 - j0 + 1) > max_cells) {
-          out.too_large += count;
-          continue;
-        }
-        if (count) {
-          ++out.triangles;
-          if (x0 < -0.5 || y0 < -0.5 || x1 > width - 0.5 || y1 > height - 0.5) ++out.wrapped;
-        }
-        const double c0 = std::ceil(x0 - margin), c1 = std::floor(x1 + margin);
-        for (double j = std::ceil(y0 - margin); j <= std::floor(y1 + margin); ++j) {
-          for (double i = c0; i <= c1; ++i) {
-            if (Status s = visit(k, t, tri, i, j); !s) return s;
-          }
-        }
-      }
+  const Raster raster{scene, target, width, height, double(kMaxCopies) * double(width) * double(height) + 1024};
+  std::vector<Chunk> chunks;
+  for (std::size_t k : target.instances) {
+    const scene::Instance& inst = scene.instances[k];
+    if (std::size_t(target.texcoord) >= inst.texcoords.size() || inst.texcoords[std::size_t(target.texcoord)].empty()) {
+      ++out.instances_without_uv;
+      continue;
     }
-    return success();
+    for (std::size_t first = 0; first < inst.triangles.size(); first += kChunkTriangles) {
+      chunks.push_back({std::uint32_t(k), first, std::min(first + kChunkTriangles, inst.triangles.size())});
+    }
+  }
+  std::vector<ChunkCoverage> parts(chunks.size());
+  PointBudget budget(max_points);
+  const auto each_chunk = [&](auto&& work) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks.size(), 1), [&](const tbb::blocked_range<std::size_t>& range) {
+      for (std::size_t c = range.begin(); c != range.end() && !budget.exhausted(); ++c) work(chunks[c], parts[c]);
+    });
   };
   // Centres inside a triangle (the tie rule takes each shared edge's once).
-  Status s = for_each_triangle(true, 0.0, [&](std::size_t k, std::size_t t, const UvTriangle& tri, double i, double j) -> Status {
-    if (!inside(tri, dvec2(i, j))) return success();
-    out.points.push_back({texel_at(i, j), std::uint32_t(k), std::uint32_t(t), float(i), float(j)});
-    if (out.points.size() > kMaxSurfacePoints) {
-      return Error{"", "the UV layout maps more than " + std::to_string(kMaxSurfacePoints) +
-                           " surface points into the texture (hundreds of stacked copies?)"};
-    }
-    return success();
+  each_chunk([&](const Chunk& chunk, ChunkCoverage& part) {
+    std::size_t unbudgeted = 0;
+    raster.for_each_cell(chunk, 0.0, &part, [&](std::size_t t, const UvTriangle& tri, double i, double j) {
+      if (!inside(tri, dvec2(i, j))) return true;
+      part.points.push_back({raster.texel_at(i, j), chunk.instance, std::uint32_t(t), float(i), float(j)});
+      if (++unbudgeted < kBudgetBatch) return true;
+      unbudgeted = 0;
+      return budget.add(kBudgetBatch);
+    });
   });
-  if (!s) return s.error();
+  std::size_t centres = 0;
+  for (const ChunkCoverage& part : parts) centres += part.points.size();
+  if (budget.exhausted() || centres > max_points) {
+    return Error{"", "the UV layout maps more than " + std::to_string(max_points) +
+                         " surface points into the texture (hundreds of stacked copies?)"};
+  }
   std::vector<std::uint32_t> count(std::size_t(width) * std::size_t(height), 0);
-  for (const SurfacePoint& p : out.points) ++count[p.texel];
+  for (const ChunkCoverage& part : parts) {
+    for (const SurfacePoint& p : part.points) ++count[p.texel];
+    out.triangles += part.triangles, out.degenerate_uv += part.degenerate_uv;
+    out.wrapped += part.wrapped, out.too_large += part.too_large;
+  }
   for (std::uint32_t c : count) {
     out.covered += c > 0;
     out.overlapped += c > 1;
   }
   // Texels no centre covers, within reach of a triangle: its nearest point (the nearest triangle's;
   // on a tie, the first in scene order).
-  struct Touch {
-    double distance;
-    SurfacePoint point;
-  };
-  std::vector<Touch> touches;
-  s = for_each_triangle(false, reach, [&](std::size_t k, std::size_t t, const UvTriangle& tri, double i, double j) -> Status {
-    const std::uint32_t texel = texel_at(i, j);
-    if (count[texel]) return success();
-    const dvec2 centre(i, j);
-    const glm::dvec3 w = nearest_weights(tri, centre);
-    const dvec2 q = w.x * tri.a + w.y * tri.b + w.z * tri.c;
-    const double distance = glm::length(q - centre);
-    if (distance > reach) return success();
-    touches.push_back({distance, {texel, std::uint32_t(k), std::uint32_t(t), float(q.x), float(q.y)}});
-    if (touches.size() > kMaxSurfacePoints) {
-      return Error{"", "the UV layout touches more than " + std::to_string(kMaxSurfacePoints) + " texels"};
-    }
-    return success();
+  each_chunk([&](const Chunk& chunk, ChunkCoverage& part) {
+    std::size_t unbudgeted = 0;
+    raster.for_each_cell(chunk, reach, nullptr, [&](std::size_t t, const UvTriangle& tri, double i, double j) {
+      const std::uint32_t texel = raster.texel_at(i, j);
+      if (count[texel]) return true;
+      const dvec2 centre(i, j);
+      const glm::dvec3 w = nearest_weights(tri, centre);
+      const dvec2 q = w.x * tri.a + w.y * tri.b + w.z * tri.c;
+      const double distance = glm::length(q - centre);
+      if (distance > reach) return true;
+      part.touches.push_back({distance, {texel, chunk.instance, std::uint32_t(t), float(q.x), float(q.y)}});
+      if (++unbudgeted < kBudgetBatch) return true;
+      unbudgeted = 0;
+      return budget.add(kBudgetBatch);
+    });
   });
-  if (!s) return s.error();
+  std::vector<Touch> touches;
+  for (ChunkCoverage& part : parts) touches.insert(touches.end(), part.touches.begin(), part.touches.end());
+  if (budget.exhausted() || centres + touches.size() > max_points) {
+    return Error{"", "the UV layout maps and touches more than " + std::to_string(max_points) + " surface points"};
+  }
   std::stable_sort(touches.begin(), touches.end(), [](const Touch& a, const Touch& b) {
     return a.point.texel < b.point.texel || (a.point.texel == b.point.texel && a.distance < b.distance);
   });
   for (std::size_t first = 0; first < touches.size(); ++first) {
     if (first > 0 && touches[first].point.texel == touches[first - 1].point.texel) continue;
-    out.points.push_back(touches[first].point);
     ++count[touches[first].point.texel];
     ++out.touched;
   }
-  // Counting sort by texel: stable (scene order within a texel) and linear in the points.
+  // Counting sort by texel: stable (scene order within a texel; a touched texel has one point) and
+  // linear in the points.
   std::uint32_t offset = 0;
   for (std::uint32_t& c : count) {
     const std::uint32_t n = c;
     c = offset;
     offset += n;
   }
-  std::vector<SurfacePoint> sorted(out.points.size());
-  for (const SurfacePoint& p : out.points) sorted[count[p.texel]++] = p;
-  out.points = std::move(sorted);
+  out.points.resize(offset);
+  for (const ChunkCoverage& part : parts) {
+    for (const SurfacePoint& p : part.points) out.points[count[p.texel]++] = p;
+  }
+  for (std::size_t first = 0; first < touches.size(); ++first) {
+    if (first > 0 && touches[first].point.texel == touches[first - 1].point.texel) continue;
+    out.points[count[touches[first].point.texel]++] = touches[first].point;
+  }
   return out;
 }
 

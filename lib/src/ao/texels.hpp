@@ -26,15 +26,24 @@ struct Coverage {
 };
 constexpr int kMaxCopies = 64;  // of the texture a triangle's UVs may span (wrapping)
 
-// Errors: a layout mapping more surface points than kMaxSurfacePoints (hundreds of stacked copies).
+// Triangles are rasterized in parallel; the result is the same for any number of threads.
+// Errors: a layout mapping more than max_points surface points (hundreds of stacked copies).
 constexpr std::size_t kMaxSurfacePoints = std::size_t{1} << 27;  // 2.7 GB of points
-Result<Coverage> cover(const scene::Scene& scene, const TextureTarget& target, int width, int height);
+Result<Coverage> cover(const scene::Scene& scene, const TextureTarget& target, int width, int height,
+                       std::size_t max_points = kMaxSurfacePoints);
 
 // A triangle's UVs in texel space.
 struct UvTriangle {
   glm::dvec2 a, b, c;
 };
-UvTriangle uv_triangle(const scene::Instance& inst, int texcoord, std::size_t triangle, int width, int height);
+inline UvTriangle uv_triangle(const scene::Instance& inst, int texcoord, std::size_t triangle, int width, int height) {
+  const auto& uv = inst.texcoords[std::size_t(texcoord)];
+  const auto& t = inst.triangles[triangle];
+  const auto texel = [&](std::uint32_t v) {
+    return glm::dvec2(double(uv[v].x) * width - 0.5, double(uv[v].y) * height - 0.5);
+  };
+  return {texel(t[0]), texel(t[1]), texel(t[2])};
+}
 
 // Barycentric weights (of a, b, c) of the point of the triangle nearest to p (p's own when inside).
 glm::dvec3 nearest_weights(const UvTriangle& t, const glm::dvec2& p);

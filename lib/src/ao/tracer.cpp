@@ -1,6 +1,7 @@
 #include "tracer.hpp"
 
 #include <glm/geometric.hpp>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
@@ -79,9 +80,14 @@ Result<std::unique_ptr<Tracer>> Tracer::build(const scene::Scene& scene, const O
   RTCScene rtc = tracer->scene_.get();
   if (options.watertight) rtcSetSceneFlags(rtc, RTC_SCENE_FLAG_ROBUST);
   rtcSetSceneBuildQuality(rtc, RTC_BUILD_QUALITY_HIGH);
-  tracer->meshes_.reserve(scene.instances.size());  // filter functions keep pointers into it
-  for (const scene::Instance& inst : scene.instances) {
-    tracer->meshes_.push_back(prepare(inst, options.recompute_normals));
+  // Normals and edge lengths per instance, in parallel (the serial part of a short bake otherwise).
+  // Sized once: the filter functions keep pointers into it.
+  tracer->meshes_.resize(scene.instances.size());
+  tbb::parallel_for(std::size_t{0}, scene.instances.size(), [&](std::size_t k) {
+    tracer->meshes_[k] = prepare(scene.instances[k], options.recompute_normals);
+  });
+  for (std::size_t k = 0; k < scene.instances.size(); ++k) {
+    const scene::Instance& inst = scene.instances[k];
     RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
     // Embree reads vertex buffers in 16-byte loads: rtcSetNewGeometryBuffer pads for us.
     auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
@@ -92,10 +98,10 @@ Result<std::unique_ptr<Tracer>> Tracer::build(const scene::Scene& scene, const O
     auto* indices = static_cast<std::uint32_t*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
                                                                          3 * sizeof(std::uint32_t), inst.triangles.size()));
     for (std::size_t t = 0; t < inst.triangles.size(); ++t) {
-      for (int k = 0; k < 3; ++k) indices[3 * t + std::size_t(k)] = inst.triangles[t][std::size_t(k)];
+      for (std::size_t corner = 0; corner < 3; ++corner) indices[3 * t + corner] = inst.triangles[t][corner];
     }
     if (!options.two_sided) {
-      rtcSetGeometryUserData(g, &tracer->meshes_.back().face_normals);
+      rtcSetGeometryUserData(g, &tracer->meshes_[k].face_normals);
       rtcSetGeometryIntersectFilterFunction(g, reject_back_faces);
       rtcSetGeometryOccludedFilterFunction(g, reject_back_faces);
     }
