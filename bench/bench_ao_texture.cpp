@@ -4,8 +4,8 @@
 // For 16, 64, 256 and 1024 samples: time, texels (or vertices) per second and rays per second on
 // 2 cores and on one, the share of the time spent on texel set-up (UV rasterization, padding), and
 // the RMSE against a 4096-sample bake of the same texels (or vertices). Times are medians of at least
-// 3 runs and a second; set-up shares are summed over the 2-core runs.
-//   build/bench/bench_ao_texture            the whole table (about 4 minutes)
+// 3 runs and a second, the two bakes run in turn; set-up shares are summed over the 2-core runs.
+//   build/bench/bench_ao_texture            the whole table (about 2 minutes)
 //   build/bench/bench_ao_texture --quick    64 samples only
 //   build/bench/bench_ao_texture N          N samples only
 #include <tbb/global_control.h>
@@ -72,41 +72,32 @@ int main(int argc, char** argv) {
   for (int n : samples) {
     ao::Options o = options;
     o.samples = n;
+    ao::Bake vertex;
+    ao::TextureBakes textured;
+    double vertex_setup = 0, vertex_total = 0, setup = 0, texel_setup = 0, total = 0;
+    const auto bake_vertices = [&] {
+      const double t = seconds_of([&] { vertex = *ao::bake(s, o); });
+      vertex_setup += vertex.setup_seconds, vertex_total += t;
+    };
+    const auto bake_texture = [&] {
+      const double t = seconds_of([&] { textured = *ao::bake_textures(s, o, {atlas}, texture); });
+      setup += textured.setup_seconds, texel_setup += textured.texel_seconds, total += t;
+    };
+    const std::vector<double> two = median_seconds({bake_vertices, bake_texture});
+    std::vector<double> one;
     {
-      ao::Bake all;
-      double setup = 0, total = 0;
-      const double t2 = median_seconds([&] {
-        const double t = seconds_of([&] { all = *ao::bake(s, o); });
-        setup += all.setup_seconds, total += t;
-      });
-      double t1 = 0;
-      {
-        tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
-        t1 = median_seconds([&] { (void)ao::bake(s, o); });
-      }
-      const double points = double(vertex_reference.size());
-      std::printf("| per vertex | %d | %.3f s | %.0f | %.1f | %.1f | %.2f× | %.0f%% | %.5f |\n", n, t2, points / t2 / 1e3,
-                  double(all.rays) / t2 / 1e6, double(all.rays) / t1 / 1e6, t1 / t2, 100 * setup / total,
-                  rmse(flat(all.values), vertex_reference));
+      tbb::global_control single(tbb::global_control::max_allowed_parallelism, 1);
+      one = median_seconds({[&] { (void)ao::bake(s, o); }, [&] { (void)ao::bake_textures(s, o, {atlas}, texture); }});
     }
-    {
-      ao::TextureBakes all;
-      double setup = 0, texel_setup = 0, total = 0;
-      const double t2 = median_seconds([&] {
-        const double t = seconds_of([&] { all = *ao::bake_textures(s, o, {atlas}, texture); });
-        setup += all.setup_seconds, texel_setup += all.texel_seconds, total += t;
-      });
-      double t1 = 0;
-      {
-        tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
-        t1 = median_seconds([&] { (void)ao::bake_textures(s, o, {atlas}, texture); });
-      }
-      const double points = double(all.textures[0].covered + all.textures[0].touched);
-      std::printf("| texture 256² | %d | %.3f s | %.0f | %.1f | %.1f | %.2f× | %.0f%% + %.0f%% | %.5f |\n", n, t2,
-                  points / t2 / 1e3, double(all.rays) / t2 / 1e6, double(all.rays) / t1 / 1e6, t1 / t2,
-                  100 * setup / total, 100 * texel_setup / total,
-                  rmse(all.textures[0].values, texel_reference.textures[0].values));
-    }
+    std::printf("| per vertex | %d | %.3f s | %.0f | %.1f | %.1f | %.2f× | %.0f%% | %.5f |\n", n, two[0],
+                double(vertex_reference.size()) / two[0] / 1e3, double(vertex.rays) / two[0] / 1e6,
+                double(vertex.rays) / one[0] / 1e6, one[0] / two[0], 100 * vertex_setup / vertex_total,
+                rmse(flat(vertex.values), vertex_reference));
+    const double texels = double(textured.textures[0].covered + textured.textures[0].touched);
+    std::printf("| texture 256² | %d | %.3f s | %.0f | %.1f | %.1f | %.2f× | %.0f%% + %.0f%% | %.5f |\n", n, two[1],
+                texels / two[1] / 1e3, double(textured.rays) / two[1] / 1e6, double(textured.rays) / one[1] / 1e6,
+                one[1] / two[1], 100 * setup / total, 100 * texel_setup / total,
+                rmse(textured.textures[0].values, texel_reference.textures[0].values));
   }
   std::printf("\nset-up: Embree's BVH and the normals (both bakes) + texel set-up (texture only), as a share of the time on 2 cores\n");
   return 0;

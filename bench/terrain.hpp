@@ -48,17 +48,24 @@ inline double seconds_of(const std::function<void()>& f) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-// The median time of f over at least 3 runs and at least a second in all (at most 25 runs): a bake
-// of a tenth of a second is otherwise at the mercy of one scheduler hiccup.
-inline double median_seconds(const std::function<void()>& f) {
-  std::vector<double> times;
+// The median time of each of `bakes`, run in turn round after round (at least 3 rounds and a second
+// in all, at most 25): a bake of a tenth of a second is otherwise at the mercy of one scheduler
+// hiccup, and a drift of the machine's speed falls on all of them alike.
+inline std::vector<double> median_seconds(const std::vector<std::function<void()>>& bakes) {
+  std::vector<std::vector<double>> times(bakes.size());
   double total = 0;
-  while (times.size() < 25 && (times.size() < 3 || total < 1.0)) {
-    times.push_back(seconds_of(f));
-    total += times.back();
+  for (std::size_t round = 0; round < 25 && (round < 3 || total < 1.0); ++round) {
+    for (std::size_t b = 0; b < bakes.size(); ++b) {
+      times[b].push_back(seconds_of(bakes[b]));
+      total += times[b].back();
+    }
   }
-  std::nth_element(times.begin(), times.begin() + std::ptrdiff_t(times.size() / 2), times.end());
-  return times[times.size() / 2];
+  std::vector<double> medians;
+  for (std::vector<double>& t : times) {
+    std::nth_element(t.begin(), t.begin() + std::ptrdiff_t(t.size() / 2), t.end());
+    medians.push_back(t[t.size() / 2]);
+  }
+  return medians;
 }
 
 }  // namespace matbake::bench

@@ -203,13 +203,18 @@ Instance height_field(int n, float spacing) {
   return g;
 }
 
+// An n × n height field's grid laid over the texture: vertex (i, j) at first + (i, j) × step.
+void add_grid_uvs(Instance& g, int n, glm::vec2 first, glm::vec2 step) {
+  g.texcoords.emplace_back();
+  for (int j = 0; j < n; ++j) {
+    for (int i = 0; i < n; ++i) g.texcoords.back().push_back(first + step * glm::vec2(float(i), float(j)));
+  }
+}
+
 TEST(TextureAo, TexelsAtVerticesAgreeWithThePerVertexBake) {
   constexpr int kN = 16;
   Instance g = height_field(kN, 0.5f);
-  g.texcoords.emplace_back();
-  for (int j = 0; j < kN; ++j) {
-    for (int i = 0; i < kN; ++i) g.texcoords[0].push_back({(float(i) + 0.5f) / kN, (float(j) + 0.5f) / kN});
-  }
+  add_grid_uvs(g, kN, glm::vec2(0.5f / kN), glm::vec2(1.0f / kN));
   const auto s = scene_of({g});
   const int n = 1024;
   const Options o = binary(n, 3);
@@ -313,10 +318,7 @@ bool same_points(const texels::Coverage& a, const texels::Coverage& b) {
 TEST(TextureAo, CoverageIsTheSameOnAnyNumberOfThreads) {
   constexpr int kN = 71;
   Instance g = height_field(kN, 0.1f);
-  g.texcoords.emplace_back();
-  for (int j = 0; j < kN; ++j) {
-    for (int i = 0; i < kN; ++i) g.texcoords[0].push_back({0.05f + 0.8f * float(i) / kN, 0.1f + 0.7f * float(j) / kN});
-  }
+  add_grid_uvs(g, kN, {0.05f, 0.1f}, {0.8f / kN, 0.7f / kN});
   Instance mirrored = g;
   for (auto& uv : mirrored.texcoords[0]) uv = {0.9f - uv.x + 1.0f / 300, uv.y};
   const auto s = scene_of({g, mirrored});
