@@ -245,10 +245,13 @@ Result<Coverage> cover(const scene::Scene& scene, const TextureTarget& target, i
   });
   std::size_t centres = 0;
   for (const ChunkCoverage& part : parts) centres += part.points.size();
-  if (budget.exhausted() || centres > max_points) {
-    return Error{"", "the UV layout maps more than " + std::to_string(max_points) +
-                         " surface points into the texture (hundreds of stacked copies?)"};
-  }
+  const auto too_many = [&](const std::string& what) {
+    return Error{"", "its UV layout " + what + " more than " + std::to_string(max_points) + " surface points into the " +
+                         std::to_string(width) + "x" + std::to_string(height) +
+                         " texture (placements or UV copies stacked on the same texels): give each placement its own "
+                         "texture, or bake a smaller one"};
+  };
+  if (budget.exhausted() || centres > max_points) return too_many("maps");
   std::vector<std::uint32_t> count(std::size_t(width) * std::size_t(height), 0);
   for (const ChunkCoverage& part : parts) {
     for (const SurfacePoint& p : part.points) ++count[p.texel];
@@ -279,9 +282,7 @@ Result<Coverage> cover(const scene::Scene& scene, const TextureTarget& target, i
   });
   std::vector<Touch> touches;
   for (ChunkCoverage& part : parts) touches.insert(touches.end(), part.touches.begin(), part.touches.end());
-  if (budget.exhausted() || centres + touches.size() > max_points) {
-    return Error{"", "the UV layout maps and touches more than " + std::to_string(max_points) + " surface points"};
-  }
+  if (budget.exhausted() || centres + touches.size() > max_points) return too_many("maps and touches");
   std::stable_sort(touches.begin(), touches.end(), [](const Touch& a, const Touch& b) {
     return a.point.texel < b.point.texel || (a.point.texel == b.point.texel && a.distance < b.distance);
   });
@@ -299,8 +300,9 @@ Result<Coverage> cover(const scene::Scene& scene, const TextureTarget& target, i
     offset += n;
   }
   out.points.resize(offset);
-  for (const ChunkCoverage& part : parts) {
+  for (ChunkCoverage& part : parts) {
     for (const SurfacePoint& p : part.points) out.points[count[p.texel]++] = p;
+    std::vector<SurfacePoint>().swap(part.points);  // the peak: all points once, and one chunk's
   }
   for (std::size_t first = 0; first < touches.size(); ++first) {
     if (first > 0 && touches[first].point.texel == touches[first - 1].point.texel) continue;

@@ -124,7 +124,10 @@ Result<TextureBakes> bake_textures(const scene::Scene& scene, const Options& opt
     const TextureTarget& target = targets[index];
     auto texel_start = Clock::now();
     auto coverage = texels::cover(scene, target, texture.width, texture.height);
-    if (!coverage) return coverage.error();
+    if (!coverage) {
+      const std::string name = target.name.empty() ? "texture " + std::to_string(index) : target.name;
+      return Error{"", name + ": " + coverage.error().message};
+    }
     const std::vector<texels::SurfacePoint>& points = coverage->points;
     std::vector<std::size_t> runs;  // where each mapped texel's points begin, and the end
     for (std::size_t i = 0; i < points.size(); ++i) {

@@ -305,7 +305,7 @@ Result<int> material_index(const gltf::Document& doc, const std::string& name) {
   const std::size_t count = doc.json.contains("materials") ? doc.json["materials"].size() : 0;
   std::string names;
   for (std::size_t i = 0; i < count; ++i) {
-    const std::string n = doc.json["materials"][i].value("name", "");
+    const std::string n = gltf::name_in(doc.json["materials"][i], "");
     if (n == name || std::to_string(i) == name) return int(i);
     names += (names.empty() ? "" : ", ") + (n.empty() ? std::to_string(i) : n);
   }
@@ -400,7 +400,7 @@ Result<Report> export_scene(const fs::path& input, const fs::path& output, const
       Json& material = doc->json["materials"][i];
       MaterialReport out;
       out.index = int(i);
-      out.name = material.value("name", "");
+      out.name = gltf::name_in(material, "");
       out.action = "kept";
       Status done = success();
       if (const auto maps = given.find(int(i)); maps != given.end()) {

@@ -101,8 +101,8 @@ std::vector<int> split_placements(gltf::Document& doc, const scene::Scene& scene
     const int m = targets.materials[t], node = targets.nodes[t];
     if (node < 0 || kept.insert(m).second) continue;
     Json copy = json["materials"][std::size_t(m)];
-    const std::string node_name = json["nodes"][std::size_t(node)].value("name", "node " + std::to_string(node));
-    copy["name"] = copy.value("name", "material " + std::to_string(m)) + " (" + node_name + ")";
+    const std::string node_name = gltf::name_in(json["nodes"][std::size_t(node)], "node " + std::to_string(node));
+    copy["name"] = gltf::name_in(copy, "material " + std::to_string(m)) + " (" + node_name + ")";
     json["materials"].push_back(std::move(copy));
     into[t] = int(json["materials"].size()) - 1;
     for (Json& primitive : json["meshes"][std::size_t(mesh_of_node.at(node))]["primitives"]) {
@@ -142,6 +142,7 @@ Result<OcclusionTargets> occlusion_targets(const gltf::Document& doc, const scen
     const Json* existing = occlusion_of(material, doc.json);
     ao::TextureTarget target;
     target.instances = instances;
+    target.name = "material " + std::to_string(m) + " '" + gltf::name_in(material, "") + "'";
     target.texcoord = request.texcoord >= 0 ? request.texcoord
                       : existing        ? gltf::integer_in<int>(*existing, "texCoord", 0, 0)
                                         : 0;
@@ -185,7 +186,7 @@ Result<std::vector<TextureReport>> bake_occlusion_textures(gltf::Document& doc, 
                                                            ao::TextureBakes& timing) {
   const ao::TextureRequest& texture = *request.texture;
   auto baked = ao::bake_textures(scene, request.options, targets.targets, texture.size);
-  if (!baked) return baked.error();
+  if (!baked) return Error{doc.file, baked.error().message};
   const std::vector<int> materials = split_placements(doc, scene, targets);
   ImageCache cache(doc);
   std::vector<TextureReport> reports;
@@ -196,7 +197,7 @@ Result<std::vector<TextureReport>> bake_occlusion_textures(gltf::Document& doc, 
     TextureReport report;
     report.material = m;
     report.node = targets.nodes[t];
-    report.name = material.value("name", "");
+    report.name = gltf::name_in(material, "");
     report.width = bake.width, report.height = bake.height, report.texcoord = targets.targets[t].texcoord;
     report.covered = bake.covered, report.touched = bake.touched, report.overlapped = bake.overlapped;
     report.padded = bake.padded, report.triangles = bake.triangles, report.degenerate_uv = bake.degenerate_uv;

@@ -91,6 +91,14 @@ T integer_in(const Json& object, const char* key, T fallback, T invalid) {
   return invalid;
 }
 
+// object's "name" when it is a string, else `fallback` (names are for messages and reports: one of
+// another type is no reason to stop).
+inline std::string name_in(const Json& object, std::string fallback) {
+  if (!object.is_object()) return fallback;
+  const auto it = object.find("name");
+  return it != object.end() && it->is_string() ? it->get<std::string>() : fallback;
+}
+
 // A size, offset or index: SIZE_MAX (which every bounds check refuses) when not a valid integer.
 inline std::size_t size_in(const Json& object, const char* key, std::size_t fallback) {
   return integer_in<std::size_t>(object, key, fallback, SIZE_MAX);

@@ -34,7 +34,7 @@ std::vector<int> keep_marked(Json& json, const Marks& marks, const char* what, s
       remap[i] = int(kept.size());
       kept.push_back(std::move(item));
     } else {
-      const std::string name = item.is_object() ? item.value("name", "") : "";
+      const std::string name = name_in(item, "");
       removed.push_back(std::string(what) + " " + std::to_string(i) + (name.empty() ? "" : " '" + name + "'"));
     }
   }
