@@ -343,6 +343,59 @@ TEST(TextureAo, CoverageIsTheSameOnAnyNumberOfThreads) {
   }
 }
 
+// Coverage against a brute force over every texel and every triangle, in float64 with a tolerance
+// (texel centres within 1e-9 of an edge, or of the touch reach, are left out: the tie rule decides
+// those, tested above): a jittered grid of large triangles (rows rasterized by their crossings) and
+// one of small ones (scanned cell by cell), each also mirrored, in a non-square texture.
+TEST(TextureAo, CoverageMatchesABruteForce) {
+  const int width = 61, height = 47;
+  const double reach = std::sqrt(0.5);
+  std::mt19937 random(7);
+  for (const auto& [n, mirrored] : {std::pair{4, false}, {4, true}, {13, false}, {13, true}, {29, false}}) {
+    Instance g = height_field(n, 0.3f);
+    std::uniform_real_distribution<float> jitter(-0.3f / float(n), 0.3f / float(n));
+    add_grid_uvs(g, n, {0.08f, 0.11f}, {0.84f / float(n - 1), 0.8f / float(n - 1)});
+    for (glm::vec2& uv : g.texcoords[0]) {
+      uv += glm::vec2(jitter(random), jitter(random));
+      if (mirrored) uv.x = 1 - uv.x;
+    }
+    const auto s = scene_of({g});
+    const auto coverage = texels::cover(s, TextureTarget{{0}}, width, height);
+    ASSERT_TRUE(coverage);
+    std::vector<int> points(std::size_t(width * height), 0);
+    for (const texels::SurfacePoint& p : coverage->points) ++points[p.texel];
+    std::size_t compared = 0;
+    for (int j = 0; j < height; ++j) {
+      for (int i = 0; i < width; ++i) {
+        const glm::dvec2 centre(i, j);
+        int inside = 0;
+        double nearest = 1e300;
+        bool ambiguous = false;
+        for (std::size_t t = 0; t < g.triangles.size(); ++t) {
+          const texels::UvTriangle tri = texels::uv_triangle(g, 0, t, width, height);
+          const auto side = [&](const glm::dvec2& a, const glm::dvec2& b) {
+            const glm::dvec2 d = b - a, q = centre - a;
+            return (d.x * q.y - d.y * q.x) / glm::length(d);  // signed distance, left positive
+          };
+          const glm::dvec2 ab = tri.b - tri.a, ac = tri.c - tri.a;
+          const double sign = ab.x * ac.y - ab.y * ac.x > 0 ? 1 : -1;
+          const double e = std::min({sign * side(tri.a, tri.b), sign * side(tri.b, tri.c), sign * side(tri.c, tri.a)});
+          ambiguous |= std::abs(e) < 1e-9;
+          inside += e > 0;
+          const glm::dvec3 w = texels::nearest_weights(tri, centre);
+          nearest = std::min(nearest, glm::length(w.x * tri.a + w.y * tri.b + w.z * tri.c - centre));
+        }
+        ambiguous |= std::abs(nearest - reach) < 1e-9;
+        if (ambiguous) continue;
+        ++compared;
+        const int expected = inside > 0 ? inside : nearest <= reach ? 1 : 0;
+        ASSERT_EQ(points[std::size_t(j * width + i)], expected) << n << (mirrored ? " mirrored" : "") << ": texel " << i << ", " << j;
+      }
+    }
+    EXPECT_GT(compared, std::size_t(width * height) * 9 / 10);
+  }
+}
+
 // The cap on surface points holds exactly, below and above the batches in which the parallel
 // chunks count them: 5 stacked copies of a plane over 64 × 64 texels map 20,480 centres.
 TEST(TextureAo, CoverageRefusesMoreSurfacePointsThanItsCap) {

@@ -155,6 +155,35 @@ class PointBudget {
 };
 constexpr std::size_t kBudgetBatch = 4096;
 
+// The cross-section of a positively oriented triangle with the line y: [lo, hi] (empty when
+// lo > hi), from its edges' half-planes. on_edge: a horizontal edge lies on the line.
+struct Span {
+  double lo, hi;
+  bool on_edge;
+};
+Span span_at(const UvTriangle& tri, double y) {
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  Span span{-kInf, kInf, false};
+  for (const auto& [a, b] : {std::pair{tri.a, tri.b}, std::pair{tri.b, tri.c}, std::pair{tri.c, tri.a}}) {
+    const dvec2 d = b - a;
+    if (d.y == 0) {  // inside where d.x (y − a.y) ≥ 0
+      const double e = d.x * (y - a.y);
+      if (e < 0) return {kInf, -kInf, false};
+      span.on_edge |= e == 0;
+      continue;
+    }
+    const double x = a.x + d.x * (y - a.y) / d.y;  // inside on the left of a → b
+    if (d.y > 0) span.hi = std::min(span.hi, x);
+    else span.lo = std::max(span.lo, x);
+  }
+  return span;
+}
+
+// Which cells of a triangle for_each_cell visits: those whose centre is inside (with the tie
+// rule), or those outside it that may lie within half a texel diagonal of it (a superset).
+enum class Cells { inside, near };
+constexpr double kNarrow = 8;  // texels: narrower triangles are scanned over their bounding box
+
 struct Raster {
   const scene::Scene& scene;
   const TextureTarget& target;
@@ -165,11 +194,13 @@ struct Raster {
     return std::uint32_t(wrap((long long)j, height, target.wrap_t) * width + wrap((long long)i, width, target.wrap_s));
   }
 
-  // The chunk's usable triangles, positively oriented in texel space, with their cells within
-  // `margin` (first pass: 0, the centres inside; second: the reach of a touch). `tally` counts them
-  // (first pass only). visit returns false to stop.
+  // The chunk's usable triangles, positively oriented in texel space, and their `cells`, row by
+  // row. A row's cells a texel or more inside its cross-section are inside however the crossings
+  // round: only the few near its ends are tested, so a triangle costs its perimeter, not its
+  // bounding box. `tally` counts the triangles (first pass only). visit returns false to stop.
   template <class Visit>
-  bool for_each_cell(const Chunk& chunk, double margin, ChunkCoverage* tally, Visit&& visit) const {
+  bool for_each_cell(const Chunk& chunk, Cells cells, ChunkCoverage* tally, Visit&& visit) const {
+    constexpr double kInf = std::numeric_limits<double>::infinity();
     const double reach = std::sqrt(0.5);
     const scene::Instance& inst = scene.instances[chunk.instance];
     for (std::size_t t = chunk.first; t < chunk.last; ++t) {
@@ -194,9 +225,48 @@ struct Raster {
         ++tally->triangles;
         if (x0 < -0.5 || y0 < -0.5 || x1 > width - 0.5 || y1 > height - 0.5) ++tally->wrapped;
       }
-      const double c0 = std::ceil(x0 - margin), c1 = std::floor(x1 + margin);
-      for (double j = std::ceil(y0 - margin); j <= std::floor(y1 + margin); ++j) {
-        for (double i = c0; i <= c1; ++i) {
+      if (x1 - x0 < kNarrow) {  // a few cells a row: their tests cost less than the crossings
+        const double margin = cells == Cells::inside ? 0.0 : reach;
+        for (double j = std::ceil(y0 - margin); j <= y1 + margin; ++j) {
+          for (double i = std::ceil(x0 - margin); i <= x1 + margin; ++i) {
+            if (cells == Cells::inside && !inside(tri, dvec2(i, j))) continue;
+            if (!visit(t, tri, i, j)) return false;
+          }
+        }
+        continue;
+      }
+      if (cells == Cells::inside) {
+        for (double j = std::ceil(y0); j <= y1; ++j) {
+          const Span row = span_at(tri, j);
+          const double first = std::max(std::ceil(x0), std::ceil(row.lo - 1)), last = std::min(x1, row.hi + 1);
+          for (double i = first; i <= last; ++i) {
+            const bool sure = !row.on_edge && i >= row.lo + 1 && i <= row.hi - 1;
+            if ((sure || inside(tri, dvec2(i, j))) && !visit(t, tri, i, j)) return false;
+          }
+        }
+        continue;
+      }
+      for (double j = j0; j <= j1; ++j) {
+        // The cross-section of the band of rows within reach (at its two sides, and the vertices
+        // in it), widened by the reach and half a texel against rounding; the row's sure inside
+        // (covered by the first pass) skipped.
+        const double band = reach + 0.01;
+        double lo = kInf, hi = -kInf;
+        for (double y : {j - band, j + band}) {
+          const Span side = span_at(tri, y);
+          if (side.lo <= side.hi) lo = std::min(lo, side.lo), hi = std::max(hi, side.hi);
+        }
+        for (const dvec2& v : {tri.a, tri.b, tri.c}) {
+          if (std::abs(v.y - j) <= band) lo = std::min(lo, v.x), hi = std::max(hi, v.x);
+        }
+        const Span row = span_at(tri, j);
+        const double sure_first = row.on_edge ? kInf : std::ceil(row.lo + 1), sure_last = std::floor(row.hi - 1);
+        const double first = std::max(i0, std::ceil(lo - reach - 0.5)), last = std::min(i1, hi + reach + 0.5);
+        for (double i = first; i <= last; ++i) {
+          if (i >= sure_first && i <= sure_last) {
+            i = sure_last;
+            continue;
+          }
           if (!visit(t, tri, i, j)) return false;
         }
       }
@@ -235,8 +305,7 @@ Result<Coverage> cover(const scene::Scene& scene, const TextureTarget& target, i
   // Centres inside a triangle (the tie rule takes each shared edge's once).
   each_chunk([&](const Chunk& chunk, ChunkCoverage& part) {
     std::size_t unbudgeted = 0;
-    raster.for_each_cell(chunk, 0.0, &part, [&](std::size_t t, const UvTriangle& tri, double i, double j) {
-      if (!inside(tri, dvec2(i, j))) return true;
+    raster.for_each_cell(chunk, Cells::inside, &part, [&](std::size_t t, const UvTriangle&, double i, double j) {
       part.points.push_back({raster.texel_at(i, j), chunk.instance, std::uint32_t(t), float(i), float(j)});
       if (++unbudgeted < kBudgetBatch) return true;
       unbudgeted = 0;
@@ -266,7 +335,7 @@ Result<Coverage> cover(const scene::Scene& scene, const TextureTarget& target, i
   // on a tie, the first in scene order).
   each_chunk([&](const Chunk& chunk, ChunkCoverage& part) {
     std::size_t unbudgeted = 0;
-    raster.for_each_cell(chunk, reach, nullptr, [&](std::size_t t, const UvTriangle& tri, double i, double j) {
+    raster.for_each_cell(chunk, Cells::near, nullptr, [&](std::size_t t, const UvTriangle& tri, double i, double j) {
       const std::uint32_t texel = raster.texel_at(i, j);
       if (count[texel]) return true;
       const dvec2 centre(i, j);
@@ -316,43 +385,54 @@ std::size_t pad(std::vector<float>& values, const std::vector<bool>& mapped, int
   const std::size_t w = std::size_t(width), h = std::size_t(height);
   std::vector<double> d2(w * h);
   for (std::size_t i = 0; i < w * h; ++i) d2[i] = mapped[i] ? 0.0 : kFar;
-  const std::size_t n = std::max(w, h);
-  std::vector<double> scratch(n);
-  std::vector<int> v(n);
-  std::vector<double> z(n + 1);
-  for (std::size_t x = 0; x < w; ++x) distance_1d(&d2[x], h, w, scratch, v, z);    // columns
-  for (std::size_t y = 0; y < h; ++y) distance_1d(&d2[y * w], w, 1, scratch, v, z);  // rows
+  // Columns, then rows, each line on its own (in parallel, each range with its own scratch).
+  const auto lines = [&](std::size_t count, std::size_t length, std::size_t start_step, std::size_t stride) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 16), [&](const tbb::blocked_range<std::size_t>& range) {
+      std::vector<double> scratch(length);
+      std::vector<int> v(length);
+      std::vector<double> z(length + 1);
+      for (std::size_t line = range.begin(); line != range.end(); ++line) {
+        distance_1d(&d2[line * start_step], length, stride, scratch, v, z);
+      }
+    });
+  };
+  lines(w, h, 1, w);
+  lines(h, w, w, 1);
   const double limit = double(padding) * padding;
   const std::vector<float> source = values;
-  std::size_t padded = 0;
-  for (std::size_t y = 0; y < h; ++y) {
-    for (std::size_t x = 0; x < w; ++x) {
-      const double d = d2[y * w + x];
-      if (d == 0 || d > limit) continue;
-      // Every mapped texel at exactly this squared distance: for each column offset, at most the two
-      // rows with dx² + dy² = d.
-      const auto r = long(std::floor(std::sqrt(d)));
-      double sum = 0;
-      int count = 0;
-      for (long dx = -r; dx <= r; ++dx) {
-        const double rest = d - double(dx) * double(dx);
-        const auto dy = long(std::llround(std::sqrt(std::max(0.0, rest))));
-        if (double(dy) * double(dy) != rest) continue;
-        for (long sy : {-dy, dy}) {
-          const long xx = long(x) + dx, yy = long(y) + sy;
-          if (xx >= 0 && yy >= 0 && xx < long(w) && yy < long(h) && mapped[std::size_t(yy) * w + std::size_t(xx)]) {
-            sum += source[std::size_t(yy) * w + std::size_t(xx)];
-            ++count;
+  std::atomic<std::size_t> padded{0};
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, h, 16), [&](const tbb::blocked_range<std::size_t>& rows) {
+    std::size_t padded_here = 0;
+    for (std::size_t y = rows.begin(); y != rows.end(); ++y) {
+      for (std::size_t x = 0; x < w; ++x) {
+        const double d = d2[y * w + x];
+        if (d == 0 || d > limit) continue;
+        // Every mapped texel at exactly this squared distance: for each column offset, at most the two
+        // rows with dx² + dy² = d.
+        const auto r = long(std::floor(std::sqrt(d)));
+        double sum = 0;
+        int count = 0;
+        for (long dx = -r; dx <= r; ++dx) {
+          const double rest = d - double(dx) * double(dx);
+          const auto dy = long(std::llround(std::sqrt(std::max(0.0, rest))));
+          if (double(dy) * double(dy) != rest) continue;
+          for (long sy : {-dy, dy}) {
+            const long xx = long(x) + dx, yy = long(y) + sy;
+            if (xx >= 0 && yy >= 0 && xx < long(w) && yy < long(h) && mapped[std::size_t(yy) * w + std::size_t(xx)]) {
+              sum += source[std::size_t(yy) * w + std::size_t(xx)];
+              ++count;
+            }
+            if (dy == 0) break;
           }
-          if (dy == 0) break;
+        }
+        if (count) {
+          values[y * w + x] = float(sum / count);
+          ++padded_here;
         }
       }
-      if (count) {
-        values[y * w + x] = float(sum / count);
-        ++padded;
-      }
     }
-  }
+    padded += padded_here;
+  });
   return padded;
 }
 
