@@ -4,7 +4,7 @@
 // For 16, 64, 256 and 1024 samples: time, texels (or vertices) per second and rays per second on
 // 2 cores and on one, the share of the time spent on texel set-up (UV rasterization, padding), and
 // the RMSE against a 4096-sample bake of the same texels (or vertices). Times are medians of at least
-// 3 runs and a second, the two bakes run in turn; set-up shares are summed over the 2-core runs.
+// 3 runs and 3 seconds, the two bakes run in turn; set-up shares are summed over the 2-core runs.
 //   build/bench/bench_ao_texture            the whole table (about 2 minutes)
 //   build/bench/bench_ao_texture --quick    64 samples only
 //   build/bench/bench_ao_texture N          N samples only

@@ -48,13 +48,13 @@ inline double seconds_of(const std::function<void()>& f) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-// The median time of each of `bakes`, run in turn round after round (at least 3 rounds and a second
+// The median time of each of `bakes`, run in turn round after round (at least 3 rounds and 3 seconds
 // in all, at most 25): a bake of a tenth of a second is otherwise at the mercy of one scheduler
 // hiccup, and a drift of the machine's speed falls on all of them alike.
 inline std::vector<double> median_seconds(const std::vector<std::function<void()>>& bakes) {
   std::vector<std::vector<double>> times(bakes.size());
   double total = 0;
-  for (std::size_t round = 0; round < 25 && (round < 3 || total < 1.0); ++round) {
+  for (std::size_t round = 0; round < 25 && (round < 3 || total < 3.0); ++round) {
     for (std::size_t b = 0; b < bakes.size(); ++b) {
       times[b].push_back(seconds_of(bakes[b]));
       total += times[b].back();
