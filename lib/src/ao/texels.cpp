@@ -350,7 +350,10 @@ Result<Coverage> cover(const scene::Scene& scene, const TextureTarget& target, i
     });
   });
   std::vector<Touch> touches;
-  for (ChunkCoverage& part : parts) touches.insert(touches.end(), part.touches.begin(), part.touches.end());
+  for (ChunkCoverage& part : parts) {
+    touches.insert(touches.end(), part.touches.begin(), part.touches.end());
+    std::vector<Touch>().swap(part.touches);
+  }
   if (budget.exhausted() || centres + touches.size() > max_points) return too_many("maps and touches");
   std::stable_sort(touches.begin(), touches.end(), [](const Touch& a, const Touch& b) {
     return a.point.texel < b.point.texel || (a.point.texel == b.point.texel && a.distance < b.distance);
