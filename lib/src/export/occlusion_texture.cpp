@@ -186,7 +186,11 @@ Result<std::vector<TextureReport>> bake_occlusion_textures(gltf::Document& doc, 
                                                            ao::TextureBakes& timing) {
   const ao::TextureRequest& texture = *request.texture;
   auto baked = ao::bake_textures(scene, request.options, targets.targets, texture.size);
-  if (!baked) return Error{doc.file, baked.error().message};
+  if (!baked) {
+    Error error = baked.error();  // about the scene: named after its file (a usage error stays one)
+    if (error.path.empty() && !error.usage) error.path = doc.file;
+    return error;
+  }
   const std::vector<int> materials = split_placements(doc, scene, targets);
   ImageCache cache(doc);
   std::vector<TextureReport> reports;
