@@ -176,6 +176,13 @@ int run_build(const BuildSettings& s, const GlobalOptions& global) {
         if (r.outcome == pipeline::Outcome::out_of_date) std::printf("would build %s: %s\n", r.job->name.c_str(), r.reason.c_str());
       }
     }
+  }
+  if (s.dry_run) {  // a run reports each failure as it happens (progress above)
+    for (const pipeline::JobReport& r : report->jobs) {
+      if (r.outcome == pipeline::Outcome::failed) std::cerr << "matbake: error: " << job_error(r) << "\n";
+    }
+  }
+  if (!global.json && !global.quiet) {
     for (const pipeline::JobReport& r : report->jobs) {
       for (const std::string& w : r.warnings) std::cerr << "matbake: warning: " << r.job->name << ": " << w << "\n";
     }

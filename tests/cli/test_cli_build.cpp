@@ -239,9 +239,14 @@ layout = "gltf-orm"
   }
   ASSERT_EQ(lines.size(), 4u) << r.err;
   std::sort(lines.begin(), lines.begin() + 3);
-  EXPECT_EQ(lines[0].rfind("matbake: error: " + (dir / "corrupt.png").string() + ": ", 0), 0u) << lines[0];
-  EXPECT_NE(lines[0].find("(material:corrupt)"), std::string::npos);
-  EXPECT_EQ(lines[1].rfind("matbake: error: " + (dir / "missing.png").string() + ": ", 0), 0u) << lines[1];
+  // Each names the manifest's line and column of the value at fault, then the file.
+  const std::string manifest = (dir / "m.toml").string();
+  EXPECT_EQ(lines[1].rfind("matbake: error: " + manifest + ":9:18: materials.corrupt: " + (dir / "corrupt.png").string() + ": ", 0),
+            0u)
+      << lines[1];
+  EXPECT_NE(lines[1].find("(material:corrupt)"), std::string::npos);
+  EXPECT_EQ(lines[0], "matbake: error: " + manifest + ":6:18: materials.missing.sources.kd: " + (dir / "missing.png").string() +
+                          ": no such file (material:missing)");
   EXPECT_EQ(lines[2].rfind("matbake: error: " + (dir / "out/materials/below_real.validation.json").string() +
                                ": validation: 1 of 1 texels flagged (100%; max_violations 0%) (material:below_real)",
                            0),
@@ -255,9 +260,10 @@ layout = "gltf-orm"
             (std::vector<std::string>{"below_real.validation.json", "below_real_base_color.png", "below_real_orm.png",
                                       "good.validation.json", "good_base_color.png", "good_orm.png"}));
   // Failed jobs run again next time; the finished one does not.
-  const json dry = run_json({"build", (dir / "m.toml").string(), "-n"});
+  const json dry = run_json({"build", (dir / "m.toml").string(), "-n"}, 1);  // exit 1: a job would fail
   EXPECT_EQ(outcome_of(dry, "material:good"), "up_to_date");
-  EXPECT_EQ(outcome_of(dry, "material:missing"), "out_of_date: no earlier build");
+  // A source that is not there fails in a dry run too, saying so, rather than "would build".
+  EXPECT_EQ(outcome_of(dry, "material:missing"), "failed: no earlier build");
   EXPECT_EQ(outcome_of(dry, "material:below_real"), "out_of_date: no earlier build");
 
   // A rule that allows the flagged texels turns the failure into a warning.
@@ -268,6 +274,75 @@ layout = "gltf-orm"
   EXPECT_EQ(allowed.exit_code, 0) << allowed.err;
   EXPECT_NE(allowed.err.find("matbake: warning: material:below_real: validation: 1 of 1 texels flagged"), std::string::npos)
       << allowed.err;
+}
+
+// A layout file is named with or without its ".json", relative to the manifest whatever the current
+// folder, and is an input of exactly the jobs that use it. References that do not resolve are errors
+// at their line and column, in a dry run and a real one alike: no material silently left out.
+TEST(CliBuild, LayoutAndMaterialReferencesResolveFromTheManifest) {
+  TempDir dir;
+  fs::create_directories(dir / "project/layouts");
+  std::string layout = read_bytes(fs::path(MATBAKE_SOURCE_DIR) / "presets/layouts/gltf-orm.json");
+  write_bytes(dir / "project/layouts/mine.json", layout);
+  const std::string constants = "sources = { kd = 0.5, ks = 0.04, gloss = 0.5 }\nvalidate = { enabled = false }\n";
+  const auto manifest_with = [&](const std::string& a_layout, const std::string& extra) {
+    write_bytes(dir / "project/m.toml", "[materials.a]\n" + constants + "layout = \"" + a_layout + "\"\n" +
+                                            "[materials.b]\n" + constants + "layout = \"layouts/mine.json\"\n" +
+                                            "[materials.c]\n" + constants + "layout = \"gltf-orm\"\n" + extra);
+  };
+  manifest_with("layouts/mine", "");
+  const std::string manifest = (dir / "project/m.toml").string();
+  const json first = run_json({"build", manifest});
+  EXPECT_EQ(first["built"], 3) << first.dump();
+  for (const char* job : {"material:a", "material:b"}) {
+    bool has_layout = false;
+    for (const json& j : first["jobs"]) {
+      if (j["name"] == job) has_layout = j["inputs"] == json::array({(dir / "project/layouts/mine.json").string()});
+    }
+    EXPECT_TRUE(has_layout) << job << " " << first.dump();
+  }
+  EXPECT_EQ(read_bytes(dir / "project/out/materials/a_orm.png"), read_bytes(dir / "project/out/materials/c_orm.png"));
+
+  // Editing the layout file rebuilds the two materials that use it, not the preset's.
+  const std::string occlusion = "{\"source\": \"occlusion\", \"default\": 1}";
+  layout.replace(layout.find(occlusion), occlusion.size(), "{\"source\": \"occlusion\", \"default\": 0.5}");
+  write_bytes(dir / "project/layouts/mine.json", layout);
+  const json dry = run_json({"build", manifest, "-n"});
+  EXPECT_EQ(outcome_of(dry, "material:a"), "out_of_date: input changed: " + (dir / "project/layouts/mine.json").string());
+  EXPECT_EQ(outcome_of(dry, "material:b"), "out_of_date: input changed: " + (dir / "project/layouts/mine.json").string());
+  EXPECT_EQ(outcome_of(dry, "material:c"), "up_to_date");
+  EXPECT_EQ(run_json({"build", manifest})["built"], 2);
+  EXPECT_EQ(read_raw(dir / "project/out/materials/a_orm.png").samples[0], 128);  // occlusion 0.5 now
+  EXPECT_EQ(read_raw(dir / "project/out/materials/c_orm.png").samples[0], 255);
+
+  // Typos: one error line at the value's line and column, from -n and from a real run, nothing written.
+  const std::string at = manifest + ":4:10: materials.a.layout: layout ";
+  const std::pair<std::string, std::string> typos[] = {
+      {"gltf-ormm", at + "'gltf-ormm': no preset of that name (presets: gltf-metal-rough, gltf-orm, schuler, unity-hdrp, "
+                         "unity-urp, unreal-orm; did you mean gltf-orm?) and no layout file " +
+                         (dir / "project/gltf-ormm.json").string()},
+      {"layouts/typo.json", at + "'layouts/typo.json': no preset of that name (presets: gltf-metal-rough, gltf-orm, "
+                                 "schuler, unity-hdrp, unity-urp, unreal-orm) and no layout file " +
+                                 (dir / "project/layouts/typo.json").string()},
+  };
+  for (const auto& [typo, says] : typos) {
+    manifest_with(typo, "");
+    for (const char* dry_run : {"-n", "--force"}) {
+      const RunResult r = matbake({"build", manifest, dry_run});
+      EXPECT_EQ(r.exit_code, 1) << r.err;
+      EXPECT_EQ(r.err, "matbake: error: " + says + "\n");
+    }
+  }
+  manifest_with("layouts/mine", "[materials.d]\nsources = { kd = 0.5, ks = 0.04, gloss = 0.5 }\nreference = \"gould\"\n");
+  for (const char* dry_run : {"-n", "--force"}) {
+    const RunResult r = matbake({"build", manifest, dry_run});
+    EXPECT_EQ(r.exit_code, 1) << r.err;
+    EXPECT_NE(r.err.find("matbake: error: " + manifest + ":15:13: materials.d.reference: unknown material 'gould'; near: gold"
+                         " (material:d)\n"),
+              std::string::npos)
+        << r.err;
+  }
+  EXPECT_FALSE(fs::exists(dir / "project/out/materials/d.validation.json"));
 }
 
 TEST(CliBuild, BadManifestsAreOneLineAndWriteNothing) {

@@ -251,7 +251,10 @@ TEST(Hostile, SourcesMustBeRegularFiles) {
     const RunResult r = matbake({"build", (dir / "m.toml").string()});
     EXPECT_EQ(r.exit_code, 1) << r.err;
     const std::string path = source[0] == '/' ? source : (dir / source).string();
-    EXPECT_NE(r.err.find("matbake: error: " + path + ": is not a regular file"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("matbake: error: " + (dir / "m.toml").string() + ":3:18: materials.a.sources.kd: " + path +
+                         ": is not a regular file (material:a)"),
+              std::string::npos)
+        << r.err;
   }
   const RunResult direct = matbake({"validate", "--ks", "/dev/zero"});
   EXPECT_EQ(direct.exit_code, 1);

@@ -128,7 +128,7 @@ TEST(CliPack, BadInputsAndUsage) {
       {{"--kd", "1.5", "--ks", "0.04", "--gloss", "0.5"}, 2, "", "--kd '1.5': values are in [0, 1]"},
       {{"--kd", "0.5", "--ks", "0.04"}, 2, "", "layout schuler needs gloss"},
       {{"--kd", "0.5,0.5", "--ks", "0.04", "--gloss", "0.5"}, 2, "", "kd: 1 or 3 values expected, got 2"},
-      {{"--layout", "nope", "--kd", "0.5"}, 2, "nope", "no such layout file, and not a preset"},
+      {{"--layout", "nope", "--kd", "0.5"}, 2, "", "layout 'nope': no preset of that name (presets: gltf-metal-rough, "},
       {{"--layout", (dir / "typed.json").string(), "--kd", "0.5"}, 1, (dir / "typed.json").string(),
        "[json.exception.type_error.302] type must be string, but is number"},
   };

@@ -269,6 +269,9 @@ TEST(ImageIo, OutOfBoundsOffsetsInsideFilesAreErrorsNotCrashes) {
 // ICCProfile:dscm from this file's profile (as oiiotool shows); the profile's bytes stay.
 TEST(ImageIo, OiioIccDecoderIsReplacedByTheGuard) {
   const auto png = std::filesystem::path(MATBAKE_TESTDATA_DIR) / "gltf/BoxTextured/glTF-pbrSpecularGlossiness/CesiumLogoFlat.png";
+  if (!std::filesystem::is_regular_file(png)) {
+    GTEST_SKIP() << png.string() << " is absent (it comes with the project's shared folder, not with a clone)";
+  }
   auto in = OIIO::ImageInput::open(png.string());
   ASSERT_TRUE(in) << OIIO::geterror();
   ASSERT_NE(in->spec().find_attribute("ICCProfile"), nullptr);

@@ -62,13 +62,17 @@ TEST(BuildManifest, EveryKeyReachesItsField) {
   EXPECT_EQ(brick.sources[1].file, fs::path("/project/t/brick.png"));
   EXPECT_EQ(brick.sources[2].constant, std::vector<double>{0.04});
   EXPECT_EQ(brick.transfer, color::Transfer::gamma22);  // the manifest's default
-  EXPECT_EQ(brick.layout, "schuler");
+  ASSERT_TRUE(brick.layout);
+  EXPECT_EQ(brick.layout->reference, "schuler");
+  EXPECT_EQ(brick.layout->layout.name, "schuler");
+  EXPECT_TRUE(brick.layout->file.empty());  // a preset
   EXPECT_EQ(brick.format, "tif");
   EXPECT_EQ(brick.bits, image::SampleType::u16);
   EXPECT_DOUBLE_EQ(brick.validation.options.tolerance, 0.2);
   EXPECT_DOUBLE_EQ(brick.validation.options.max_violations, 0.01);
   const pipeline::MaterialSpec& gold = m->materials[1];
-  EXPECT_EQ(gold.packed_layout, "gltf-orm");
+  ASSERT_TRUE(gold.packed);
+  EXPECT_EQ(gold.packed->reference, "gltf-orm");
   EXPECT_EQ(gold.packed_files, (std::vector<fs::path>{"/project/a.png", "/project/b.png"}));
   EXPECT_EQ(gold.transfer, color::Transfer::srgb);
   EXPECT_EQ(gold.decode, color::Transfer::linear);

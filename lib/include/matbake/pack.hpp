@@ -43,7 +43,15 @@ struct Layout {
 
 // The presets compiled into the library (from presets/layouts/), by name.
 std::vector<std::string> builtin_layout_names();
-// A preset name, or else a path to a layout JSON file.
+// A layout reference, as the command line and the manifest take it: a preset's name, or else a
+// layout file `folder`/reference, with ".json" added when it has no extension ("layouts/mine" and
+// "layouts/mine.json" are one file). `file` is empty for a preset.
+struct ResolvedLayout {
+  Layout layout;
+  std::filesystem::path file;
+};
+Result<ResolvedLayout> resolve_layout(const std::string& reference, const std::filesystem::path& folder);
+// resolve_layout from the current folder.
 Result<Layout> find_layout(const std::string& name_or_path);
 Result<Layout> parse_layout(std::string_view json_text, const std::string& origin);
 

@@ -34,17 +34,34 @@ struct ValidationRules {
   bool heatmap = false;       // also write <name>_validation.png
 };
 
+// Where each value of a manifest entry was written ("assets.toml:12:5"), by its key within the
+// entry ("layout", "sources.kd", "packed.files", "reference"; "" for the entry itself), so that an
+// error found while planning or running a job names the line at fault.
+struct Origins {
+  std::map<std::string, std::string> by_key;
+  const std::string& of(const std::string& key) const;  // the key's, else the entry's
+};
+
+// A layout the manifest names, resolved when the manifest is read (pack::resolve_layout, relative to
+// the manifest's folder).
+struct LayoutChoice {
+  std::string reference;        // as written: a preset's name or a file
+  pack::Layout layout;
+  std::filesystem::path file;   // the layout file read (empty: a preset); an input of every job using it
+};
+
 struct MaterialSpec {
   std::string name;  // [A-Za-z0-9_.-], names its output files
+  Origins origins;
   // Either separate source maps (files or constants) ...
   std::vector<pack::SourceInput> sources;
   // ... or the packed textures of a layout (e.g. a Schüler pair).
-  std::string packed_layout;
+  std::optional<LayoutChoice> packed;
   std::vector<std::filesystem::path> packed_files;
   color::Transfer transfer = color::Transfer::srgb;  // how 8-bit colour sources were authored
   std::optional<color::Transfer> decode;  // how every colour file is decoded, whatever its depth
   bool resize = false;                               // sources of different sizes: resample to the largest
-  std::string layout;          // textures to write (a preset or layout file); empty: none
+  std::optional<LayoutChoice> layout;  // textures to write; unset: none
   std::string format = "png";  // png, exr, tif
   std::optional<image::SampleType> bits;  // unset: pack::default_sample_type (half for exr, else 8)
   int png_level = image::kPngLevelDefault;  // png_compression: deflate effort of PNG outputs
@@ -55,6 +72,7 @@ struct MaterialSpec {
 
 struct SceneSpec {
   std::string name;
+  Origins origins;
   std::filesystem::path input;   // .gltf or .glb
   std::filesystem::path output;  // inside the output folder
   std::map<std::string, std::string> materials;  // glTF material name → manifest material
@@ -67,6 +85,7 @@ struct Manifest {
   std::filesystem::path folder;  // relative paths in the manifest resolve here
   std::filesystem::path output;  // absolute; everything is written inside it
   std::filesystem::path table;   // material table (empty: the built-in one)
+  Origins origins;               // of the top-level keys ("table", "output", ...)
   std::vector<MaterialSpec> materials;
   std::vector<SceneSpec> scenes;
 };
@@ -85,7 +104,8 @@ struct Job {
   std::vector<std::filesystem::path> inputs;   // every file it reads
   std::map<std::string, std::size_t> materials;  // a scene: glTF material name → manifest material
   std::string options;   // what besides the inputs decides the outputs (canonical JSON)
-  std::string problem;   // found while planning: the job fails with it when run
+  std::optional<Error> problem;  // found while planning (a file or table entry that is not there):
+                                 // the job fails with it, in a dry run too
 };
 
 struct Plan {

@@ -1,5 +1,6 @@
 #include "matbake/read_file.hpp"
 #include "matbake/materials.hpp"
+#include "matbake/near_names.hpp"
 
 #include <toml++/toml.h>
 
@@ -25,21 +26,6 @@ Result<Vec3> read_rgb(const toml::table& entry, std::string_view key, const std:
     v[int(i)] = *x;
   }
   return v;
-}
-
-std::size_t edit_distance(std::string_view a, std::string_view b) {
-  std::vector<std::size_t> row(b.size() + 1);
-  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
-  for (std::size_t i = 1; i <= a.size(); ++i) {
-    std::size_t diagonal = row[0];
-    row[0] = i;
-    for (std::size_t j = 1; j <= b.size(); ++j) {
-      const std::size_t up = row[j];
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
-      diagonal = up;
-    }
-  }
-  return row[b.size()];
 }
 
 }  // namespace
@@ -158,16 +144,9 @@ const Material* find(const std::vector<Material>& table, std::string_view name) 
 }
 
 std::vector<std::string> near_names(const std::vector<Material>& table, std::string_view name) {
-  std::vector<std::pair<std::size_t, std::string>> scored;
-  for (const Material& m : table) {
-    const std::size_t d = edit_distance(name, m.name);
-    const bool prefix = m.name.starts_with(name) || name.starts_with(m.name);
-    if (d <= std::max<std::size_t>(2, name.size() / 3) || prefix) scored.emplace_back(prefix ? 0 : d, m.name);
-  }
-  std::stable_sort(scored.begin(), scored.end());
   std::vector<std::string> names;
-  for (auto& [d, n] : scored) names.push_back(std::move(n));
-  return names;
+  for (const Material& m : table) names.push_back(m.name);
+  return matbake::near_names(name, names);
 }
 
 Result<const Material*> lookup(const std::vector<Material>& table, std::string_view name) {

@@ -8,6 +8,8 @@
 #include <sstream>
 
 #include "builtin_layouts.hpp"
+#include "matbake/near_names.hpp"
+#include "matbake/read_file.hpp"
 
 namespace matbake::pack {
 namespace fs = std::filesystem;
@@ -146,21 +148,35 @@ Result<Layout> parse_layout(std::string_view json_text, const std::string& origi
   });
 }
 
-Result<Layout> find_layout(const std::string& name_or_path) {
+Result<ResolvedLayout> resolve_layout(const std::string& reference, const fs::path& folder) {
   for (const BuiltinLayout& b : builtin_layouts()) {
-    if (b.name == name_or_path) return parse_layout(b.json, "presets/layouts/" + std::string(b.name) + ".json");
+    if (b.name == reference) {
+      auto layout = parse_layout(b.json, "presets/layouts/" + std::string(b.name) + ".json");
+      if (!layout) return layout.error();
+      return ResolvedLayout{std::move(*layout), {}};
+    }
   }
+  fs::path file = (folder / reference).lexically_normal();
+  if (!file.has_extension()) file += ".json";
   std::error_code ec;
-  if (!fs::is_regular_file(name_or_path, ec)) {
+  if (reference.empty() || !fs::is_regular_file(file, ec)) {
+    const std::vector<std::string> presets = builtin_layout_names();
     std::string names;
-    for (const std::string& n : builtin_layout_names()) names += (names.empty() ? "" : ", ") + n;
-    return Error{name_or_path, "no such layout file, and not a preset (" + names + ")", true};
+    for (const std::string& n : presets) names += (names.empty() ? "" : ", ") + n;
+    return Error{"", "layout '" + reference + "': no preset of that name (presets: " + names +
+                         did_you_mean(reference, presets) + ") and no layout file " + file.string(), true};
   }
-  std::ifstream in(name_or_path);
-  std::stringstream text;
-  text << in.rdbuf();
-  if (!in) return Error{name_or_path, "cannot read"};
-  return parse_layout(text.str(), name_or_path);
+  std::string text;
+  if (!read_whole_file(file, text)) return Error{file.string(), "cannot read the layout file"};
+  auto layout = parse_layout(text, file.string());
+  if (!layout) return layout.error();
+  return ResolvedLayout{std::move(*layout), file};
+}
+
+Result<Layout> find_layout(const std::string& name_or_path) {
+  auto resolved = resolve_layout(name_or_path, {});
+  if (!resolved) return resolved.error();
+  return std::move(resolved->layout);
 }
 
 Result<color::Transfer> decode_transfer(const fs::path& path, color::Transfer authored) {

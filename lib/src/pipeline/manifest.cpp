@@ -7,6 +7,7 @@
 #include <set>
 #include <sstream>
 
+#include "matbake/near_names.hpp"
 #include "matbake/read_file.hpp"
 #include "matbake/pipeline.hpp"
 
@@ -19,9 +20,21 @@ struct Reader {
   std::string file;
 
   Error at(const toml::source_region& where, const std::string& message) const {
-    return Error{file + ":" + std::to_string(where.begin.line) + ":" + std::to_string(where.begin.column), message};
+    return Error{origin(where), message};
   }
   Error at(const toml::node& node, const std::string& message) const { return at(node.source(), message); }
+  std::string origin(const toml::source_region& where) const {
+    return file + ":" + std::to_string(where.begin.line) + ":" + std::to_string(where.begin.column);
+  }
+
+  // Every value's origin in an entry's table, nested tables' values as "outer.inner".
+  void record(const toml::table& table, const std::string& prefix, Origins& origins) const {
+    for (const auto& [key, value] : table) {
+      const std::string name = prefix + std::string(key.str());
+      origins.by_key[name] = origin(value.source());
+      if (const toml::table* inner = value.as_table()) record(*inner, name + ".", origins);
+    }
+  }
 
   Status known_keys(const toml::table& table, const std::string& where, std::initializer_list<std::string_view> keys) const {
     for (const auto& [key, value] : table) {
@@ -189,6 +202,19 @@ Result<ao::Request> read_ao(const Reader& r, const toml::node& node, const std::
   return request;
 }
 
+// layout = "gltf-orm" (a preset) or "layouts/mine" / "layouts/mine.json" (a file beside the manifest).
+Result<std::optional<LayoutChoice>> read_layout(const Reader& r, const toml::table& t, std::string_view key,
+                                                const std::string& where, const fs::path& folder) {
+  const toml::node* node = t.get(key);
+  if (!node) return std::optional<LayoutChoice>();
+  auto text = node->value<std::string>();
+  if (!text) return r.at(*node, where + "." + std::string(key) + ": a preset's name or a layout file expected");
+  if (text->empty()) return std::optional<LayoutChoice>();
+  auto resolved = pack::resolve_layout(*text, folder);
+  if (!resolved) return r.at(*node, where + "." + std::string(key) + ": " + resolved.error().to_string());
+  return std::optional<LayoutChoice>(LayoutChoice{*text, std::move(resolved->layout), std::move(resolved->file)});
+}
+
 Result<MaterialSpec> read_material(const Reader& r, const std::string& name, const toml::node& node,
                                    const Manifest& m, color::Transfer transfer, const ValidationRules& rules,
                                    int png_level) {
@@ -205,6 +231,8 @@ Result<MaterialSpec> read_material(const Reader& r, const std::string& name, con
   }
   MaterialSpec spec;
   spec.name = name;
+  spec.origins.by_key[""] = r.origin(node.source());
+  r.record(*t, "", spec.origins);
   spec.transfer = transfer;
   spec.validation = rules;
   spec.png_level = png_level;
@@ -212,12 +240,15 @@ Result<MaterialSpec> read_material(const Reader& r, const std::string& name, con
   std::string bits;
   for (Status s : {r.get_name(*t, "transfer", where, color::kTransferNames, spec.transfer),
                    r.get_name(*t, "decode", where, color::kTransferNames, spec.decode),
-                   r.get(*t, "resize", where, spec.resize), r.get(*t, "layout", where, spec.layout),
+                   r.get(*t, "resize", where, spec.resize),
                    r.get(*t, "format", where, spec.format), r.get(*t, "bits", where, bits),
                    r.get_name(*t, "mapping", where, workflow::kRoughnessMappingNames, spec.mapping),
                    r.get(*t, "reference", where, spec.reference)}) {
     if (!s) return s.error();
   }
+  auto layout = read_layout(r, *t, "layout", where, m.folder);
+  if (!layout) return layout.error();
+  spec.layout = std::move(*layout);
   if (spec.format != "png" && spec.format != "exr" && spec.format != "tif") {
     return r.at(*t->get("format"), where + ".format '" + spec.format + "': use png, exr or tif");
   }
@@ -266,9 +297,11 @@ Result<MaterialSpec> read_material(const Reader& r, const std::string& name, con
     const toml::table* p = packed->as_table();
     if (!p) return r.at(*packed, where + ".packed must be a table");
     if (Status s = r.known_keys(*p, where + ".packed", {"layout", "files"}); !s) return s.error();
-    if (Status s = r.get(*p, "layout", where + ".packed", spec.packed_layout); !s) return s.error();
+    auto packed_layout = read_layout(r, *p, "layout", where + ".packed", m.folder);
+    if (!packed_layout) return packed_layout.error();
+    spec.packed = std::move(*packed_layout);
     const toml::array* files = p->get_as<toml::array>("files");
-    if (spec.packed_layout.empty() || !files || files->empty()) {
+    if (!spec.packed || !files || files->empty()) {
       return r.at(*packed, where + ".packed needs layout = \"...\" and files = [\"...\", ...]");
     }
     for (const toml::node& f : *files) {
@@ -292,6 +325,8 @@ Result<SceneSpec> read_scene(const Reader& r, const std::string& name, const tom
   }
   SceneSpec spec;
   spec.name = name;
+  spec.origins.by_key[""] = r.origin(node.source());
+  r.record(*t, "", spec.origins);
   std::string input, output = name + ".glb";
   for (Status s : {r.get(*t, "input", where, input), r.get(*t, "output", where, output),
                    r.get(*t, "match_names", where, spec.match_names),
@@ -327,6 +362,13 @@ Result<SceneSpec> read_scene(const Reader& r, const std::string& name, const tom
 
 }  // namespace
 
+const std::string& Origins::of(const std::string& key) const {
+  static const std::string none;
+  if (const auto found = by_key.find(key); found != by_key.end()) return found->second;
+  const auto entry = by_key.find("");
+  return entry != by_key.end() ? entry->second : none;
+}
+
 Result<Manifest> parse_manifest(std::string_view toml_text, const fs::path& file) {
   return guarded(file.string(), [&]() -> Result<Manifest> {
     Manifest m;
@@ -344,6 +386,10 @@ Result<Manifest> parse_manifest(std::string_view toml_text, const fs::path& file
     }
     if (Status s = r.known_keys(doc, "the manifest", {"output", "table", "transfer", "png_compression", "validate", "materials", "scenes"}); !s) {
       return s.error();
+    }
+    m.origins.by_key[""] = file.string();
+    for (const auto& [key, value] : doc) {
+      if (!value.is_table()) m.origins.by_key[std::string(key.str())] = r.origin(value.source());
     }
     std::string output = "out", table;
     if (Status s = r.get(doc, "output", "manifest", output); !s) return s.error();
@@ -381,8 +427,10 @@ Result<Manifest> parse_manifest(std::string_view toml_text, const fs::path& file
     for (const SceneSpec& s : m.scenes) {
       for (const auto& [gltf_name, material] : s.materials) {
         if (!names.count(material)) {
-          return Error{file.string(), "scenes." + s.name + ".materials: '" + gltf_name + "' = '" + material +
-                                          "', but there is no [materials." + material + "]"};
+          std::vector<std::string> known(names.begin(), names.end());
+          return Error{s.origins.of("materials." + gltf_name), "scenes." + s.name + ".materials: '" + gltf_name + "' = '" +
+                                                                    material + "', but there is no [materials." + material +
+                                                                    "]" + did_you_mean(material, known)};
         }
       }
     }

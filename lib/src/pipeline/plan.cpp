@@ -5,6 +5,8 @@
 
 #include "../gltf/document.hpp"
 #include "state.hpp"
+#include "matbake/materials.hpp"
+#include "matbake/near_names.hpp"
 #include "matbake/output_check.hpp"
 #include "matbake/pipeline.hpp"
 #include "matbake/report_json.hpp"
@@ -28,11 +30,11 @@ nlohmann::json material_options(const MaterialSpec& m, const Manifest& manifest)
   std::vector<std::string> packed;
   for (const fs::path& f : m.packed_files) packed.push_back(normalized(f).string());
   return {{"sources", sources},
-          {"packed", {{"layout", m.packed_layout}, {"files", packed}}},
+          {"packed", {{"layout", m.packed ? m.packed->reference : ""}, {"files", packed}}},
           {"transfer", color::transfer_name(m.transfer)},
           {"decode", m.decode ? color::transfer_name(*m.decode) : ""},
           {"resize", m.resize},
-          {"layout", m.layout},
+          {"layout", m.layout ? m.layout->reference : ""},
           {"format", m.format},
           {"bits", m.bits ? image::sample_type_name(*m.bits) : "default"},
           {"png_level", m.png_level},
@@ -53,13 +55,40 @@ std::vector<fs::path> material_inputs(const MaterialSpec& m, const Manifest& man
     if (!s.file.empty()) inputs.push_back(normalized(s.file));
   }
   for (const fs::path& f : m.packed_files) inputs.push_back(normalized(f));
-  // A layout file (not a preset) and the material table are read too.
-  if (!m.layout.empty() && fs::path(m.layout).has_extension()) inputs.push_back(normalized(manifest.folder / m.layout));
-  if (!m.packed_layout.empty() && fs::path(m.packed_layout).has_extension()) {
-    inputs.push_back(normalized(manifest.folder / m.packed_layout));
+  // Layout files (not presets) and the material table are read too.
+  for (const std::optional<LayoutChoice>& layout : {m.layout, m.packed}) {
+    if (layout && !layout->file.empty()) inputs.push_back(normalized(layout->file));
   }
   if (!manifest.table.empty() && m.validation.enabled) inputs.push_back(normalized(manifest.table));
   return inputs;
+}
+
+// What makes a material's jobs fail before they start: a source file that is not there, or a
+// reference the material table does not have. Errors name the manifest's line and column.
+std::optional<std::string> file_problem(const fs::path& file) {
+  std::error_code ec;
+  if (fs::is_regular_file(file, ec)) return std::nullopt;
+  return Error{file.string(), fs::exists(file, ec) ? "is not a regular file" : "no such file"}.to_string();
+}
+
+std::optional<Error> material_problem(const MaterialSpec& m, const Result<std::vector<materials::Material>>& table,
+                                      const Origins& manifest_origins) {
+  for (const pack::SourceInput& s : m.sources) {
+    if (auto problem = s.file.empty() ? std::nullopt : file_problem(s.file)) {
+      return Error{m.origins.of("sources." + s.name), "materials." + m.name + ".sources." + s.name + ": " + *problem};
+    }
+  }
+  for (const fs::path& f : m.packed_files) {
+    if (auto problem = file_problem(f)) {
+      return Error{m.origins.of("packed.files"), "materials." + m.name + ".packed.files: " + *problem};
+    }
+  }
+  if (m.reference.empty() || !m.validation.enabled) return std::nullopt;
+  if (!table) return Error{manifest_origins.of("table"), "table: " + table.error().to_string()};
+  if (auto found = materials::lookup(*table, m.reference); !found) {
+    return Error{m.origins.of("reference"), "materials." + m.name + ".reference: " + found.error().message};
+  }
+  return std::nullopt;
 }
 
 void add_unique(std::vector<fs::path>& to, const std::vector<fs::path>& from) {
@@ -106,6 +135,13 @@ Result<Plan> make_plan(const Manifest& manifest) {
       return std::nullopt;
     };
 
+    const bool references = std::any_of(manifest.materials.begin(), manifest.materials.end(),
+                                        [](const MaterialSpec& m) { return !m.reference.empty(); });
+    const auto table = references ? materials::table_or_builtin(manifest.table)
+                                  : Result<std::vector<materials::Material>>(std::vector<materials::Material>{});
+    std::vector<std::optional<Error>> problems;
+    for (const MaterialSpec& m : manifest.materials) problems.push_back(material_problem(m, table, manifest.origins));
+
     std::vector<Job> scenes;
     for (std::size_t i = 0; i < manifest.scenes.size(); ++i) {
       const SceneSpec& s = manifest.scenes[i];
@@ -120,7 +156,7 @@ Result<Plan> make_plan(const Manifest& manifest) {
       std::map<std::string, std::string> assigned = s.materials;
       auto json = gltf::read_json(s.input);
       if (!json) {
-        job.problem = json.error().to_string();
+        job.problem = Error{s.origins.of("input"), "scenes." + s.name + ".input: " + json.error().to_string()};
         job.inputs.push_back(normalized(s.input));
       } else {
         job.inputs = gltf::source_files(s.input, *json);
@@ -132,8 +168,10 @@ Result<Plan> make_plan(const Manifest& manifest) {
         }
         for (const auto& [gltf_name, material] : s.materials) {
           if (!names.count(gltf_name)) {
-            job.problem = s.input.string() + ": scenes." + s.name + ".materials names '" + gltf_name +
-                          "', but the glTF has no material of that name";
+            job.problem = Error{s.origins.of("materials." + gltf_name),
+                                "scenes." + s.name + ".materials names '" + gltf_name + "', but " + s.input.string() +
+                                    " has no material of that name" +
+                                    did_you_mean(gltf_name, std::vector<std::string>(names.begin(), names.end()))};
           }
         }
         if (s.match_names) {
@@ -148,6 +186,7 @@ Result<Plan> make_plan(const Manifest& manifest) {
         used[m] = true;
         job.materials[gltf_name] = m;
         add_unique(job.inputs, material_inputs(manifest.materials[m], manifest));
+        if (!job.problem) job.problem = problems[m];
         materials[gltf_name] = material_options(manifest.materials[m], manifest);
       }
       job.options = nlohmann::json{{"input", normalized(s.input).string()},
@@ -166,22 +205,17 @@ Result<Plan> make_plan(const Manifest& manifest) {
       job.name = "material:" + m.name;
       job.inputs = material_inputs(m, manifest);
       job.options = material_options(m, manifest).dump();
-      if (!m.layout.empty()) {
-        auto layout = pack::find_layout(m.layout.find('/') != std::string::npos || fs::path(m.layout).has_extension()
-                                            ? (manifest.folder / m.layout).string()
-                                            : m.layout);
-        if (!layout) {
-          job.problem = "materials." + m.name + ".layout: " + layout.error().to_string();
-        } else {
-          auto paths = pack::output_paths(*layout, {(materials_folder / (m.name + "_{texture}." + m.format)).string()});
-          if (paths) job.outputs = *paths;
-        }
+      job.problem = problems[i];
+      if (m.layout) {
+        auto paths = pack::output_paths(m.layout->layout, {(materials_folder / (m.name + "_{texture}." + m.format)).string()});
+        if (!paths) return Error{m.origins.of("layout"), "materials." + m.name + ".layout: " + paths.error().to_string()};
+        job.outputs = *paths;
       }
       if (m.validation.enabled) {
         job.outputs.push_back(materials_folder / (m.name + ".validation.json"));
         if (m.validation.heatmap) job.outputs.push_back(materials_folder / (m.name + "_validation.png"));
       }
-      if (m.layout.empty() && !used[i] && !m.validation.enabled) {
+      if (!m.layout && !used[i] && !m.validation.enabled) {
         plan.warnings.push_back("materials." + m.name +
                                 ": no layout, no validation and no scene uses it, so nothing is built from it");
         continue;

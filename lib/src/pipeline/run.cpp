@@ -94,23 +94,32 @@ std::vector<fs::path> decoded_files(const Job& job, const Manifest& manifest) {
   return {files.begin(), files.end()};
 }
 
-std::string layout_reference(const std::string& layout, const Manifest& manifest) {
-  return fs::path(layout).has_extension() ? (manifest.folder / layout).string() : layout;
+// An error loading a material's maps, placed at the manifest value it comes from: the source whose
+// file it names, else the material's table.
+Error at_source(const MaterialSpec& m, const Error& e) {
+  std::string key;
+  for (const pack::SourceInput& s : m.sources) {
+    if (!s.file.empty() && s.file.string() == e.path) key = "sources." + s.name;
+  }
+  for (const fs::path& f : m.packed_files) {
+    if (f.string() == e.path) key = "packed.files";
+  }
+  return Error{m.origins.of(key), "materials." + m.name + ": " + e.to_string()};
 }
 
-Result<material::Maps> load_material(const MaterialSpec& m, const Manifest& manifest, DecodeCache& cache) {
+Result<material::Maps> load_material(const MaterialSpec& m, DecodeCache& cache) {
   const pack::ImageReader read = [&cache](const fs::path& f, color::Transfer t) { return cache.read(f, t); };
-  if (!m.packed_layout.empty()) {
-    auto layout = pack::find_layout(layout_reference(m.packed_layout, manifest));
-    if (!layout) return layout.error();
-    return pack::read_packed(*layout, m.packed_files, m.decode, m.transfer, read);
-  }
-  pack::LoadOptions options;
-  options.authored = m.transfer;
-  options.input = m.decode;
-  options.resize = m.resize;
-  options.read = read;
-  return pack::load_sources(m.sources, options);
+  auto maps = [&]() -> Result<material::Maps> {
+    if (m.packed) return pack::read_packed(m.packed->layout, m.packed_files, m.decode, m.transfer, read);
+    pack::LoadOptions options;
+    options.authored = m.transfer;
+    options.input = m.decode;
+    options.resize = m.resize;
+    options.read = read;
+    return pack::load_sources(m.sources, options);
+  }();
+  if (!maps) return at_source(m, maps.error());
+  return maps;
 }
 
 struct JobContext {
@@ -135,12 +144,12 @@ Status validate_material(const MaterialSpec& m, const material::Maps& maps, cons
   if (!m.reference.empty()) {
     if (!ctx.table) return *ctx.table_error;
     auto material = materials::lookup(*ctx.table, m.reference);
-    if (!material) return Error{ctx.manifest.file.string(), "materials." + m.name + ".reference: " + material.error().message};
+    if (!material) return Error{m.origins.of("reference"), "materials." + m.name + ".reference: " + material.error().message};
     options.material = *material;
   }
   auto result = validate::validate_maps(maps, options);
   if (!result) {
-    return Error{ctx.manifest.file.string(), "materials." + m.name + ": " + result.error().message +
+    return Error{m.origins.of(""), "materials." + m.name + ": " + result.error().message +
                                                  "; set validate = { enabled = false } to skip it"};
   }
   const bool passed = validate::passed(*result, options);
@@ -167,18 +176,19 @@ Status validate_material(const MaterialSpec& m, const material::Maps& maps, cons
 Status run_material(const Job& job, const JobContext& ctx, JobReport& report) {
   return guarded(ctx.manifest.materials[job.spec].name, [&]() -> Status {
     const MaterialSpec& m = ctx.manifest.materials[job.spec];
-    auto maps = load_material(m, ctx.manifest, ctx.cache);
+    auto maps = load_material(m, ctx.cache);
     if (!maps) return maps.error();
     report.details["size"] = {maps->width, maps->height};
     if (Status s = ensure_folder(ctx.manifest.output / "materials"); !s) return s;
-    if (!m.layout.empty()) {
-      auto layout = pack::find_layout(layout_reference(m.layout, ctx.manifest));
-      if (!layout) return layout.error();
+    if (m.layout) {
+      const pack::Layout* layout = &m.layout->layout;
       // Validation reads the maps as loaded: the workflow gets a copy only when it converts them
       // (else it hands them back, and validation reads them there).
       const bool converts = workflow::layout_direction(*maps, *layout).has_value();
       auto in_workflow = workflow::in_layout_workflow(converts ? material::Maps(*maps) : std::move(*maps), *layout, m.mapping);
-      if (!in_workflow) return in_workflow.error();
+      if (!in_workflow) {
+        return Error{m.origins.of("layout"), "materials." + m.name + ".layout: " + in_workflow.error().to_string()};
+      }
       if (!converts) *maps = std::move(in_workflow->maps);
       if (const auto& d = in_workflow->direction) {
         report.details["conversion"] = {{"direction", workflow::direction_name(*d)},
@@ -202,7 +212,7 @@ Result<std::vector<fs::path>> run_scene(const Job& job, const JobContext& ctx, J
     exporter::Options options = s.options;
     for (const auto& [gltf_name, m] : job.materials) {
       const MaterialSpec& spec = ctx.manifest.materials[m];
-      auto maps = load_material(spec, ctx.manifest, ctx.cache);
+      auto maps = load_material(spec, ctx.cache);
       if (!maps) return maps.error();
       options.materials.push_back({gltf_name, std::move(*maps), spec.mapping});
     }
@@ -220,8 +230,8 @@ void run_job(const Job& job, const JobContext& ctx, const fs::path& state_folder
   remove_stamp(job, state_folder);  // from here until it succeeds, the job is not up to date
   std::vector<fs::path> written = job.outputs;
   Status status = success();
-  if (!job.problem.empty()) {
-    status = Error{"", job.problem};
+  if (job.problem) {
+    status = *job.problem;
   } else if (job.kind == JobKind::material) {
     status = run_material(job, ctx, report);
   } else if (auto files = run_scene(job, ctx, report); files) {
@@ -252,7 +262,10 @@ Result<Report> run(const Manifest& manifest, const Plan& plan, const RunOptions&
     JobReport r;
     r.job = &job;
     r.reason = options.force ? "forced" : out_of_date_reason(job, plan.state_folder, !options.dry_run);
-    if (!r.reason.empty()) {
+    if (job.problem && options.dry_run) {  // it would fail: said now, not after a "would build"
+      r.outcome = Outcome::failed;
+      r.error = job.problem;
+    } else if (job.problem || !r.reason.empty()) {
       r.outcome = Outcome::out_of_date;
       to_run.push_back(report.jobs.size());
     }
