@@ -1,8 +1,8 @@
 #pragma once
-// The AO options of `bake-ao` and `export --ao-*`: every field of ao::Request, its defaults the
-// library's.
+// The AO options of `bake-ao` and `export --ao-*`: ao::request_params() as flags.
 #include <CLI/CLI.hpp>
 
+#include <set>
 #include <string>
 
 #include "matbake/ao.hpp"
@@ -12,17 +12,12 @@ namespace matbake::cli {
 
 struct AoSettings {
   ao::Request request;
-  std::string into{ao::into_attribute_name(request.into)};
-  std::string existing_colors{ao::into_existing_colors_name(request.into)};
-  // Texture bakes (bake-ao only, for now): on when `texture` (a size) is given.
-  std::string texture;
-  ao::TextureRequest texture_request;
-  std::string existing_occlusion{texture_request.multiply_existing ? "multiply" : "replace"};
+  std::set<std::string> given;  // the parameters set on the command line
+  std::string dump_texture;     // a folder for each texture as float EXR too (an output, so no manifest key)
 };
-// `prefix` goes before every option name ("" for bake-ao, "ao-" for export); `textures` adds the
-// texture bake's options.
-void add_ao_options(CLI::App& cmd, AoSettings& s, const std::string& prefix, bool textures = false);
-// The request, checked; errors name the option as given on the command line.
+// `prefix` goes before every option name ("" for bake-ao, "ao-" for export).
+void add_ao_options(CLI::App& cmd, AoSettings& s, const std::string& prefix);
+// The request, checked across its options; errors name the option as given on the command line.
 Result<ao::Request> ao_request(const AoSettings& s, const std::string& prefix);
 // One line per baked texture (and one per problem it counted), as bake-ao and export print them.
 void print_texture_reports(const std::vector<exporter::TextureReport>& textures);

@@ -19,7 +19,7 @@ CLI::App* setup_bake_ao(CLI::App& app, BakeAoSettings& s) {
   cmd->add_option("-o,--output", s.output,
                   "Output .gltf (+ .bin beside it) or .glb; everything but the baked attribute is kept as written");
   cmd->add_option("--dump", s.dump, "Raw values: .csv (node,mesh,primitive,vertex,x,y,z,ao) or .bin (float32)");
-  add_ao_options(*cmd, s.ao, "", true);
+  add_ao_options(*cmd, s.ao, "");
   return cmd;
 }
 

@@ -49,7 +49,7 @@ CLI::App* setup_export(CLI::App& app, ExportSettings& s) {
       "Write a glTF scene again as glTF 2.0 metal-rough: materials given as Schüler pairs (--material) or in\n"
       "KHR_materials_pbrSpecularGlossiness converted (error reported; KHR_materials_specular where a dielectric's\n"
       "F0 is not 0.04), occlusion packed into ORM, AO baked in (per vertex with --ao-samples, or into each\n"
-      "material's ORM red channel with --ao-texture SIZE), and only what the\n"
+      "material's ORM red channel with --ao-texture SIZE; any --ao-* option turns AO on), and only what the\n"
       "default scene reaches written.\n"
       "Example: matbake export scene.gltf -o out/scene.glb --material Brick=brick_a.png,brick_b.png --ao-samples 64");
   cmd->add_option("scene", s.scene, "Input .gltf or .glb")->required();
@@ -64,22 +64,16 @@ CLI::App* setup_export(CLI::App& app, ExportSettings& s) {
                   "none (core glTF's 0.04)");
   cmd->add_flag_callback("--no-orm", [&s] { s.options.pack_orm = false; },
                          "Keep occlusion and metallic-roughness textures apart");
-  add_ao_options(*cmd, s.ao, "ao-", true);
-  // AO is baked when --ao-samples is given (0 keeps it off, as before).
-  cmd->get_option("--ao-samples")
-      ->each([&s](const std::string& v) { s.bake_ao = v != "0"; })
-      ->description("Bake per-vertex AO with this many rays per vertex (no AO unless given; 0: none)");
+  add_ao_options(*cmd, s.ao, "ao-");  // AO is baked when any of them is given, as a manifest's ao = { ... }
   cmd->add_option("--report", s.report, "Also write the report as JSON to this file");
   return cmd;
 }
 
 int run_export(const ExportSettings& s, const GlobalOptions& global) {
   exporter::Options options = s.options;
-  AoSettings ao = s.ao;  // checked even when no AO is baked: a misspelt option is still an error
-  if (!s.bake_ao) ao.request.options.samples = ao::Options{}.samples;  // --ao-samples 0: no AO
-  auto request = ao_request(ao, "ao-");
+  auto request = ao_request(s.ao, "ao-");
   if (!request) return report_error(request.error());
-  if (s.bake_ao || request->texture) options.ao = *request;  // --ao-texture bakes, whatever --ao-samples says
+  if (!s.ao.given.empty()) options.ao = *request;
   for (const std::string& text : s.materials) {
     auto m = parse_material(text, s.transfer);
     if (!m) return report_error(m.error());

@@ -119,8 +119,7 @@ struct ExportSettings {
   std::vector<std::string> materials;  // NAME=[LAYOUT:]FILE,FILE...
   color::Transfer transfer = pack::LoadOptions{}.authored;  // of 8-bit colour in those files
   exporter::Options options;
-  bool bake_ao = false;                // --ao-samples given (and not 0)
-  AoSettings ao;
+  AoSettings ao;                       // AO is baked when any of its options is given
   std::string report;
 };
 CLI::App* setup_export(CLI::App& app, ExportSettings& settings);

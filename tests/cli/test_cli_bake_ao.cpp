@@ -103,7 +103,7 @@ TEST(CliBakeAo, BadScenesAndUsage) {
        {Case{{"bake-ao", good}, "bake-ao writes a glTF, a dump or both"},
         Case{{"bake-ao", good, "-o", good}, good + ": is an input; matbake never overwrites its inputs"},
         Case{{"bake-ao", good, "-o", (dir / "out.obj").string()}, (dir / "out.obj").string() + ": the output is .gltf or .glb"},
-        Case{{"bake-ao", good, "-o", (dir / "x.glb").string(), "--into", "COLOR_1"}, "--into 'COLOR_1' --existing-colors 'multiply': use COLOR_0 (with multiply or replace) or _AO"}}) {
+        Case{{"bake-ao", good, "-o", (dir / "x.glb").string(), "--into", "COLOR_1"}, "--into: 'COLOR_1': use COLOR_0 or _AO"}}) {
     const auto r = matbake(args);
     EXPECT_EQ(r.exit_code, 2) << problem;
     expect_one_error_line(r, "", problem);
@@ -281,12 +281,12 @@ TEST(CliBakeAo, TextureUsageAndScenesWithNothingToHoldIt) {
   const std::string floor = (dir / "floor.gltf").string(), out = (dir / "out.glb").string();
   using Case = std::pair<std::vector<std::string>, std::string>;
   for (const auto& [args, problem] :
-       {Case{{"--texture", "big"}, "--texture 'big': use a size such as 1024 or 2048x1024"},
-        Case{{"--texture", "0"}, "AO texture sides must be 1 to 16384 texels"},
+       {Case{{"--texture", "big"}, "--texture: 'big': a size such as 1024 or 2048x1024"},
+        Case{{"--texture", "0"}, "--texture: '0': a size such as 1024 or 2048x1024"},
         Case{{"--texture", "64x99999"}, "AO texture sides must be 1 to 16384 texels"},
-        Case{{"--texture", "64", "--bits", "12"}, "AO texture bits must be 8 or 16"},
+        Case{{"--texture", "64", "--bits", "12"}, "--bits: '12': 8 or 16"},
         Case{{"--texture", "64", "--texel-samples", "100", "--samples", "64"}, "AO texel samples must be 1 to the sample count (64)"},
-        Case{{"--texture", "64", "--existing-occlusion", "add"}, "--existing-occlusion 'add': use multiply or replace"},
+        Case{{"--texture", "64", "--existing-occlusion", "add"}, "--existing-occlusion: 'add': use multiply or replace"},
         Case{{"--texture", "64", "--dump", (dir / "v.csv").string()},
              (dir / "v.csv").string() + ": --dump holds per-vertex values; with --texture use --dump-texture"}}) {
     std::vector<std::string> command = {"bake-ao", floor, "-o", out};

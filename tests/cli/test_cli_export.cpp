@@ -10,6 +10,7 @@
 #include <fstream>
 
 #include "lib/src/gltf/document.hpp"
+#include "matbake/ao.hpp"
 #include "matbake/color.hpp"
 #include "matbake/workflow.hpp"
 #include "support/expect_error.hpp"
@@ -294,15 +295,23 @@ TEST(CliExport, NoTemporaryFolderOutsideTheOutput) {
   EXPECT_EQ(list_folder(dir / "out"), std::vector<std::string>{"scene.glb"});
 }
 
-// --ao-samples 0 keeps AO off, as it did before AO took bake-ao's options.
-TEST(CliExport, ZeroAoSamplesBakeNothing) {
+// AO is baked when any --ao-* option is given (as a manifest's ao table turns it on), and with none
+// of them not at all; --ao-samples 0, once "no AO", is refused naming its range.
+TEST(CliExport, AnyAoOptionBakesAndNoneBakesNothing) {
   TempDir dir;
   quad_scene(json::array({{{"name", "M"}}, {{"name", "N"}}})).write(dir / "in.gltf", {0});
-  const json report = export_json({(dir / "in.gltf").string(), "-o", (dir / "out.glb").string(), "--ao-samples", "0"});
-  ASSERT_FALSE(report.is_null());
-  EXPECT_EQ(report["ao_rays"], 0);
-  const gltf::Document out = read_output(dir / "out.glb");
-  EXPECT_FALSE(out.json["meshes"][0]["primitives"][0]["attributes"].contains("COLOR_0"));
+  const json plain = export_json({(dir / "in.gltf").string(), "-o", (dir / "plain.glb").string()});
+  ASSERT_FALSE(plain.is_null());
+  EXPECT_EQ(plain["ao_rays"], 0);
+  EXPECT_FALSE(read_output(dir / "plain.glb").json["meshes"][0]["primitives"][0]["attributes"].contains("COLOR_0"));
+  const json baked = export_json({(dir / "in.gltf").string(), "-o", (dir / "baked.glb").string(), "--ao-tau", "2"});
+  ASSERT_FALSE(baked.is_null());
+  EXPECT_EQ(baked["ao_rays"], 4 * ao::Options{}.samples);  // the quad's 4 vertices at the default count
+  EXPECT_TRUE(read_output(dir / "baked.glb").json["meshes"][0]["primitives"][0]["attributes"].contains("COLOR_0"));
+  const RunResult zero = matbake({"export", (dir / "in.gltf").string(), "-o", (dir / "zero.glb").string(), "--ao-samples", "0"});
+  EXPECT_EQ(zero.exit_code, 2);
+  expect_one_error_line(zero, "", "--ao-samples: '0': 1 to 1048576");
+  EXPECT_FALSE(fs::exists(dir / "zero.glb"));
 }
 
 // 100 000 nested nodes (a hostile or generated file): export and its AO walk them without

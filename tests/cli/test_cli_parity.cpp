@@ -9,9 +9,11 @@
 #include <random>
 
 #include "lib/src/gltf/document.hpp"
+#include "matbake/ao_params.hpp"
 #include "matbake/image.hpp"
 #include "support/files.hpp"
 #include "support/gltf_files.hpp"
+#include "support/param_values.hpp"
 #include "support/run.hpp"
 #include "support/temp_dir.hpp"
 
@@ -206,37 +208,34 @@ TEST_F(Parity, ExportAndAoGiveTheManifestsScene) {
     std::vector<std::string> command;
     std::string mapping;  // of the material (the command's --mapping)
   };
-  const std::vector<Case> cases = {
+  std::vector<Case> cases = {
       {"defaults", "", {}, ""},
       {"dielectric_ior", "dielectric_f0 = \"ior\"", {"--dielectric-f0", "ior"}, ""},
       {"no_orm", "orm = false", {"--no-orm"}, ""},
       {"walter", "", {"--mapping", "walter"}, "walter"},
       {"ao_defaults", "ao = { samples = 8 }", {"--ao-samples", "8"}, ""},
-      {"ao_attribute", "ao = { samples = 8, into = \"_AO\" }", {"--ao-samples", "8", "--ao-into", "_AO"}, ""},
-      {"ao_replace", "ao = { samples = 8, existing_colors = \"replace\" }",
-       {"--ao-samples", "8", "--ao-existing-colors", "replace"}, ""},
-      {"ao_distance", "ao = { samples = 8, distance = 0.1 }", {"--ao-samples", "8", "--ao-relative-distance", "0.1"}, ""},
-      {"ao_absolute", "ao = { samples = 8, absolute_distance = 0.5 }", {"--ao-samples", "8", "--ao-max-distance", "0.5"}, ""},
-      {"ao_tau", "ao = { samples = 8, tau = 2 }", {"--ao-samples", "8", "--ao-tau", "2"}, ""},
-      {"ao_binary", "ao = { samples = 8, falloff = \"none\" }", {"--ao-samples", "8", "--ao-falloff", "none"}, ""},
-      {"ao_bias", "ao = { samples = 8, bias = 1e-3 }", {"--ao-samples", "8", "--ao-bias", "1e-3"}, ""},
-      {"ao_two_sided", "ao = { samples = 8, two_sided = true }", {"--ao-samples", "8", "--ao-two-sided"}, ""},
-      {"ao_seed", "ao = { samples = 8, seed = 3 }", {"--ao-samples", "8", "--ao-seed", "3"}, ""},
-      {"ao_random", "ao = { samples = 8, sampler = \"random\" }", {"--ao-samples", "8", "--ao-sampler", "random"}, ""},
-      {"ao_normals", "ao = { samples = 8, recompute_normals = \"angle\" }",
-       {"--ao-samples", "8", "--ao-recompute-normals", "angle"}, ""},
-      {"ao_fast", "ao = { samples = 8, fast_traversal = true }", {"--ao-samples", "8", "--ao-fast-traversal"}, ""},
-      {"ao_texture", "ao = { samples = 8, texture = 16 }", {"--ao-samples", "8", "--ao-texture", "16"}, ""},
+      {"ao_texture_only", "ao = { texture = 4 }", {"--ao-texture", "4"}, ""},
       {"ao_texture_options",
        "ao = { samples = 8, texture = \"16x8\", padding = 2, texel_samples = 2, bits = 16, texcoord = 0, "
        "existing_occlusion = \"replace\" }",
        {"--ao-samples", "8", "--ao-texture", "16x8", "--ao-padding", "2", "--ao-texel-samples", "2", "--ao-bits", "16",
         "--ao-texcoord", "0", "--ao-existing-occlusion", "replace"},
        ""},
-      {"ao_texture_only", "ao = { texture = 4 }", {"--ao-texture", "4"}, ""},
-      {"ao_per_instance", "ao = { samples = 8, texture = 8, per_instance = true }",
-       {"--ao-samples", "8", "--ao-texture", "8", "--ao-per-instance"}, ""},
   };
+  // Each AO parameter once, at its description's example (with the texture it needs), both ways.
+  for (const params::Param<ao::Request>& p : ao::request_params().params) {
+    const bool samples = p.spec.name == "samples";  // the others at 8 samples, to stay quick
+    Case c{"ao_" + p.spec.name, "ao = { " + std::string(samples ? "" : "samples = 8, ") + p.spec.name + " = " + toml_literal(p.spec),
+           samples ? std::vector<std::string>{} : std::vector<std::string>{"--ao-samples", "8"}, ""};
+    c.command.push_back(params::flag_name(p.spec, "ao-"));
+    if (p.spec.kind != params::Kind::flag) c.command.push_back(p.spec.example);
+    if (!p.spec.needs.empty()) {
+      c.manifest += ", " + p.spec.needs + " = 8";
+      c.command.insert(c.command.end(), {"--ao-" + p.spec.needs, "8"});
+    }
+    c.manifest += " }";
+    cases.push_back(std::move(c));
+  }
   std::string manifest;
   for (const Case& c : cases) {
     manifest += "\n[materials.pair_" + c.name + "]\npacked = { layout = \"schuler\", files = [\"pair_a.png\", \"pair_b.png\"] }\n" +
@@ -319,11 +318,15 @@ TEST_F(Parity, ExportedTextureAoIsTheOrmRedChannel) {
 TEST_F(Parity, ManifestTextureKeysAreChecked) {
   for (const char* f : {"showroom.gltf", "showroom.bin"}) fs::copy_file(kExamples / f, dir / f);
   for (const auto& [ao, problem] :
-       {std::pair{"ao = { texture = 0 }", "ao.texture: a size such as 1024 or \"2048x1024\""},
-        std::pair{"ao = { texture = \"big\" }", "ao.texture: a size such as 1024 or \"2048x1024\""},
-        std::pair{"ao = { texture = 64, bits = 12 }", "AO texture bits must be 8 or 16"},
-        std::pair{"ao = { texture = 64, existing_occlusion = \"add\" }", "ao.existing_occlusion: \"multiply\" or \"replace\""},
-        std::pair{"ao = { padding = 4 }", "ao.padding applies to texture bakes: set texture = SIZE as well"}}) {
+       {std::pair{"ao = { texture = 0 }", "assets.toml:4:18: scenes.s.ao.texture: a size such as 1024 or 2048x1024"},
+        std::pair{"ao = { texture = \"big\" }", "assets.toml:4:18: scenes.s.ao.texture: a size such as 1024 or 2048x1024"},
+        std::pair{"ao = { texture = 64, bits = 12 }", "assets.toml:4:29: scenes.s.ao.bits: 8 or 16"},
+        std::pair{"ao = { texture = 64, existing_occlusion = \"add\" }",
+                  "assets.toml:4:43: scenes.s.ao.existing_occlusion: use multiply or replace"},
+        std::pair{"ao = { padding = 4 }", "assets.toml:4:18: scenes.s.ao.padding: applies only with scenes.s.ao.texture as well"},
+        std::pair{"ao = { samplez = 4 }", "assets.toml:4:8: unknown key 'samplez' in scenes.s.ao; did you mean samples or sampler?"},
+        std::pair{"ao = { samples = 4.5 }", "assets.toml:4:18: scenes.s.ao.samples: an integer expected"},
+        std::pair{"ao = { tau = 0 }", "assets.toml:4:14: scenes.s.ao.tau: above 0"}}) {
     write_bytes(dir / "assets.toml", std::string("[scenes.s]\ninput = \"showroom.gltf\"\noutput = \"s.glb\"\n") + ao + "\n");
     const RunResult r = matbake({"build", (dir / "assets.toml").string()});
     EXPECT_NE(r.exit_code, 0) << ao;

@@ -86,6 +86,7 @@ struct Manifest {
   std::filesystem::path output;  // absolute; everything is written inside it
   std::filesystem::path table;   // material table (empty: the built-in one)
   Origins origins;               // of the top-level keys ("table", "output", ...)
+  std::vector<std::string> notes;  // older key names read, each with its line (printed as warnings)
   std::vector<MaterialSpec> materials;
   std::vector<SceneSpec> scenes;
 };

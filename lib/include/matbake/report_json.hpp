@@ -24,7 +24,6 @@ Status write_validation_report(const validate::Report& r, const validate::Option
 nlohmann::json to_json(const exporter::Report& r);
 // Options by the names the manifest uses (a build's stamp records them; material maps not included).
 nlohmann::json to_json(const ao::Request& r);
-nlohmann::json to_json(const ao::TextureRequest& t);
 // One material's baked occlusion texture, as bake-ao and export report it.
 nlohmann::json to_json(const exporter::TextureReport& t);
 nlohmann::json to_json(const exporter::Options& o);

@@ -7,6 +7,7 @@
 #include <set>
 #include <sstream>
 
+#include "matbake/ao_params.hpp"
 #include "matbake/near_names.hpp"
 #include "matbake/read_file.hpp"
 #include "matbake/pipeline.hpp"
@@ -126,80 +127,50 @@ Status read_png_compression(const Reader& r, const toml::table& t, const std::st
   return success();
 }
 
-// `ao = { ... }` of a scene: every field of ao::Request, by the names the command line uses.
-Result<ao::Request> read_ao(const Reader& r, const toml::node& node, const std::string& where) {
-  const toml::table* t = node.as_table();
-  if (!t) return r.at(node, where + " must be a table");
-  if (Status s = r.known_keys(*t, where, {"samples", "distance", "absolute_distance", "tau", "falloff", "bias",
-                                          "two_sided", "seed", "sampler", "recompute_normals", "into",
-                                          "existing_colors", "fast_traversal", "texture", "texcoord", "padding",
-                                          "texel_samples", "bits", "existing_occlusion", "per_instance"});
-      !s) {
-    return s.error();
+// A TOML value as a parameter takes it (params::accept then checks its kind).
+Result<params::Value> toml_value(const toml::node& node) {
+  if (auto b = node.value_exact<bool>()) return params::Value(*b);
+  // Integers only from integer nodes: toml++ 3.3 converts a float by a cast that is undefined
+  // beyond the integer's range (found by fuzzing: samples = 2e52).
+  if (node.is_integer()) return params::Value(*node.value<std::int64_t>());
+  if (auto d = node.value_exact<double>()) return params::Value(*d);
+  if (auto text = node.value_exact<std::string>()) return params::Value(*text);
+  return Error{"", "a number, a string or true/false expected"};
+}
+
+// The keys of `t` that a parameter group describes (`where` names the table: "scenes.s.ao"): each
+// value checked and stored by its parameter, an older key read with a note, an unknown key an
+// error that suggests the nearest names; then the group's rules across its parameters.
+template <class T>
+Status read_params(const Reader& r, const toml::table& t, const std::string& where, const params::Group<T>& group,
+                   T& target, std::vector<std::string>& notes) {
+  std::set<std::string> given;
+  for (const auto& [key, node] : t) {
+    const std::string name(key.str());
+    const params::Param<T>* p = group.find_key(name);
+    if (!p) {
+      std::vector<std::string> known;
+      for (const params::Spec* spec : group.specs()) known.push_back(spec->name);
+      const std::string near = did_you_mean(name, known);
+      std::string list;
+      for (const std::string& k : known) list += (list.empty() ? "" : ", ") + k;
+      return r.at(key.source(), "unknown key '" + name + "' in " + where + (near.empty() ? " (known: " + list + ")" : near));
+    }
+    if (name != p->spec.name) {
+      notes.push_back(r.origin(key.source()) + ": " + where + "." + name + " is now called " + p->spec.name +
+                      " (the old name still works)");
+    }
+    auto value = toml_value(node);
+    std::optional<std::string> problem = value ? params::apply(*p, target, *value) : value.error().message;
+    if (problem) return r.at(node, where + "." + name + ": " + *problem);
+    given.insert(p->spec.name);
   }
-  ao::Request request;
-  ao::Options& o = request.options;
-  std::int64_t samples = o.samples, seed = std::int64_t(o.seed);
-  bool fast = !o.watertight;
-  std::string into{ao::into_attribute_name(request.into)}, existing{ao::into_existing_colors_name(request.into)};
-  scene::NormalWeighting weighting = scene::NormalWeighting::area;
-  for (Status s : {r.get(*t, "samples", where, samples), r.get(*t, "distance", where, o.relative_distance),
-                   r.get(*t, "absolute_distance", where, o.absolute_distance), r.get(*t, "tau", where, o.tau),
-                   r.get_name(*t, "falloff", where, ao::kFalloffNames, o.falloff), r.get(*t, "bias", where, o.bias),
-                   r.get(*t, "two_sided", where, o.two_sided), r.get(*t, "seed", where, seed),
-                   r.get_name(*t, "sampler", where, ao::kSamplerNames, o.sampler),
-                   r.get_name(*t, "recompute_normals", where, scene::kNormalWeightingNames, weighting),
-                   r.get(*t, "into", where, into), r.get(*t, "existing_colors", where, existing),
-                   r.get(*t, "fast_traversal", where, fast)}) {
-    if (!s) return s.error();
-  }
-  if (samples < 1 || samples > ao::kMaxSamples) return r.at(node, where + ".samples: 1 to " + std::to_string(ao::kMaxSamples));
-  if (seed < 0) return r.at(node, where + ".seed: not negative");
-  o.samples = int(samples);
-  o.seed = std::uint64_t(seed);
-  o.watertight = !fast;
-  if (t->get("recompute_normals")) o.recompute_normals = weighting;
-  const auto target = ao::into_from_names(into, existing);
-  if (!target) return r.at(node, where + ": into = \"COLOR_0\" (existing_colors = \"multiply\" or \"replace\") or \"_AO\"");
-  request.into = *target;
-  if (Status s = ao::check(o); !s) return r.at(node, where + ": " + s.error().message);
-  // texture = 1024 or "2048x1024": occlusion textures (in each material's ORM red channel).
-  if (const toml::node* size = t->get("texture")) {
-    std::optional<std::pair<int, int>> parsed;
-    if (auto text = size->value<std::string>()) parsed = ao::texture_size_from_text(*text);
-    if (auto number = size->is_integer() ? size->value<std::int64_t>() : std::nullopt) {
-      if (*number >= 1 && *number <= ao::kMaxTextureSide) parsed = std::pair{int(*number), int(*number)};
-    }
-    if (!parsed) return r.at(*size, where + ".texture: a size such as 1024 or \"2048x1024\"");
-    ao::TextureRequest texture;
-    texture.size.width = parsed->first, texture.size.height = parsed->second;
-    std::int64_t texcoord = texture.texcoord, padding = texture.size.padding, texel_samples = texture.size.texel_samples,
-                 bits = texture.bits;
-    std::string existing_occlusion = texture.multiply_existing ? "multiply" : "replace";
-    for (Status s : {r.get(*t, "texcoord", where, texcoord), r.get(*t, "padding", where, padding),
-                     r.get(*t, "texel_samples", where, texel_samples), r.get(*t, "bits", where, bits),
-                     r.get(*t, "existing_occlusion", where, existing_occlusion),
-                     r.get(*t, "per_instance", where, texture.per_instance)}) {
-      if (!s) return s.error();
-    }
-    const auto in_int = [](std::int64_t v) { return v >= INT32_MIN && v <= INT32_MAX; };
-    if (!in_int(texcoord) || !in_int(padding) || !in_int(texel_samples) || !in_int(bits)) {
-      return r.at(node, where + ": texcoord, padding, texel_samples and bits are small integers");
-    }
-    if (existing_occlusion != "multiply" && existing_occlusion != "replace") {
-      return r.at(node, where + ".existing_occlusion: \"multiply\" or \"replace\"");
-    }
-    texture.texcoord = int(texcoord), texture.size.padding = int(padding);
-    texture.size.texel_samples = int(texel_samples), texture.bits = int(bits);
-    texture.multiply_existing = existing_occlusion == "multiply";
-    if (Status s = ao::check(texture, o); !s) return r.at(node, where + ": " + s.error().message);
-    request.texture = texture;
-  } else {
-    for (const char* key : {"texcoord", "padding", "texel_samples", "bits", "existing_occlusion", "per_instance"}) {
-      if (t->get(key)) return r.at(node, where + "." + key + " applies to texture bakes: set texture = SIZE as well");
-    }
-  }
-  return request;
+  Status s = params::finish(group, target, given, [&](const std::string& name) { return where + "." + name; });
+  if (s) return s;
+  const std::string key = s.error().path.substr(std::min(s.error().path.size(), where.size() + 1));
+  const toml::node* at = key.empty() ? nullptr : t.get(key);
+  return r.at(at ? *at : static_cast<const toml::node&>(t),
+              (s.error().path.empty() ? where : s.error().path) + ": " + s.error().message);
 }
 
 // layout = "gltf-orm" (a preset) or "layouts/mine" / "layouts/mine.json" (a file beside the manifest).
@@ -313,7 +284,8 @@ Result<MaterialSpec> read_material(const Reader& r, const std::string& name, con
   return spec;
 }
 
-Result<SceneSpec> read_scene(const Reader& r, const std::string& name, const toml::node& node, const Manifest& m) {
+Result<SceneSpec> read_scene(const Reader& r, const std::string& name, const toml::node& node, const Manifest& m,
+                             std::vector<std::string>& notes) {
   const std::string where = "scenes." + name;
   const toml::table* t = node.as_table();
   if (!t) return r.at(node, where + " must be a table");
@@ -353,9 +325,12 @@ Result<SceneSpec> read_scene(const Reader& r, const std::string& name, const tom
     }
   }
   if (const toml::node* a = t->get("ao")) {
-    auto request = read_ao(r, *a, where + ".ao");
-    if (!request) return request.error();
-    spec.options.ao = *request;
+    if (!a->is_table()) return r.at(*a, where + ".ao must be a table: ao = { samples = 64, ... }");
+    ao::Request request;
+    if (Status s = read_params(r, *a->as_table(), where + ".ao", ao::request_params(), request, notes); !s) {
+      return s.error();
+    }
+    spec.options.ao = request;
   }
   return spec;
 }
@@ -416,7 +391,7 @@ Result<Manifest> parse_manifest(std::string_view toml_text, const fs::path& file
     if (const toml::node* scenes = doc.get("scenes")) {
       if (!scenes->is_table()) return r.at(*scenes, "scenes must be a table of tables: [scenes.NAME]");
       for (const auto& [key, value] : *scenes->as_table()) {
-        auto spec = read_scene(r, std::string(key.str()), value, m);
+        auto spec = read_scene(r, std::string(key.str()), value, m, m.notes);
         if (!spec) return spec.error();
         m.scenes.push_back(std::move(*spec));
       }

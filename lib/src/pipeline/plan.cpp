@@ -125,6 +125,7 @@ std::size_t Report::count(Outcome o) const {
 Result<Plan> make_plan(const Manifest& manifest) {
   return guarded(manifest.file.string(), [&]() -> Result<Plan> {
     Plan plan;
+    plan.warnings = manifest.notes;
     plan.state_folder = manifest.output / ".matbake";
     const fs::path materials_folder = manifest.output / "materials";
     std::vector<bool> used(manifest.materials.size(), false);

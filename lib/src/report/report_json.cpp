@@ -1,5 +1,6 @@
 #include "matbake/report_json.hpp"
 
+#include "matbake/ao_params.hpp"
 #include "matbake/atomic_file.hpp"
 
 namespace matbake {
@@ -89,36 +90,7 @@ Status write_validation_report(const validate::Report& r, const validate::Option
   return write_file_atomically(json, v.dump(2) + "\n");
 }
 
-nlohmann::json to_json(const ao::Request& r) {
-  const ao::Options& o = r.options;
-  return {{"samples", o.samples},
-          {"distance", o.relative_distance},
-          {"absolute_distance", o.absolute_distance},
-          {"tau", o.tau},
-          {"falloff", ao::falloff_name(o.falloff)},
-          {"bias", o.bias},
-          {"two_sided", o.two_sided},
-          {"seed", o.seed},
-          {"sampler", ao::sampler_name(o.sampler)},
-          {"recompute_normals", o.recompute_normals ? nlohmann::json(scene::normal_weighting_name(*o.recompute_normals))
-                                                    : nlohmann::json(nullptr)},
-          {"fast_traversal", !o.watertight},
-          {"into", ao::into_attribute_name(r.into)},
-          {"existing_colors", ao::into_existing_colors_name(r.into)},
-          {"texture", r.texture ? to_json(*r.texture) : nlohmann::json(nullptr)}};
-}
-
-nlohmann::json to_json(const ao::TextureRequest& t) {
-  return {{"width", t.size.width},
-          {"height", t.size.height},
-          {"padding", ao::padding_for(t.size)},
-          {"texel_samples", t.size.texel_samples},
-          {"texcoord", t.texcoord},
-          {"bits", t.bits},
-          {"existing_occlusion", t.multiply_existing ? "multiply" : "replace"},
-          {"dump", t.dump.string()},
-          {"per_instance", t.per_instance}};
-}
+nlohmann::json to_json(const ao::Request& r) { return params::to_json(ao::request_params(), r); }
 
 nlohmann::json to_json(const exporter::TextureReport& t) {
   return {{"material", t.material}, {"node", t.node}, {"name", t.name}, {"file", t.file}, {"width", t.width}, {"height", t.height},

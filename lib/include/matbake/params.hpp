@@ -1,0 +1,191 @@
+#pragma once
+// One description per request: each parameter's name, type, range or names, help and an example,
+// with the field it fills. The command line's flags (cli/params_cli.hpp), the manifest's keys
+// (pipeline/manifest.cpp), the --json echo and build stamps (to_json) and the docs' tables
+// (markdown_table, checked by a test) are all made from it, so a parameter is spelt, decoded,
+// checked and documented once. Defaults are the request struct's own (T{}).
+// pbrt-v4's ParameterDictionary (typed look-ups, origins in errors, unknown names reported) and
+// KTX-Software's self-checking option groups were the models.
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <set>
+#include <string>
+#include <string_view>
+#include <variant>
+#include <vector>
+
+#include "matbake/enum_names.hpp"
+#include "matbake/result.hpp"
+
+namespace matbake::params {
+
+// A value as a door gives it: the command line's text is turned into one by from_text, a
+// manifest's TOML value by its type.
+using Value = std::variant<bool, std::int64_t, double, std::string>;
+
+enum class Kind {
+  flag,             // true or false; on the command line a flag without a value
+  integer,          // within [min, max]
+  number,           // within [min, max] (an integer is taken as a number)
+  text,             // any string; the parameter's set() judges it
+  choice,           // one of `choices`
+  integer_or_text,  // an integer or a name (a PNG level or "small"; a size 1024 or "2048x1024")
+};
+
+// What both doors and the docs need to know of a parameter, whatever it fills.
+struct Spec {
+  std::string name;                  // the manifest's key; the flag is --name with '-' for '_'
+  Kind kind = Kind::text;
+  std::string help;                  // one line, no trailing period
+  std::vector<std::string> choices;  // choice: the accepted names
+  double min = 0, max = 0;           // integer, number: the range (none when both are 0; max may be ∞)
+  bool above_min = false;            // the range excludes min (a distance above 0)
+  std::string example;               // a value other than the default, as a flag takes it
+  std::vector<std::string> aliases;  // older manifest keys, still read, with a note
+  std::string needs;                 // the parameter this one applies with (texcoord: texture)
+};
+
+// "--ao-relative-distance" for "relative_distance" with prefix "ao-".
+std::string flag_name(const Spec& spec, std::string_view prefix);
+// The command line's text as a value of the spec's kind, or a problem ("an integer expected").
+Result<Value> from_text(const Spec& spec, std::string_view text);
+// A value as the spec takes it: its kind and range checked, an integer made a number where a
+// number is wanted. The problem says what is accepted ("1 to 1048576", "use sobol or random").
+Result<Value> accept(const Spec& spec, Value value);
+// "integer 1 to 1048576", "sobol, random", "true/false": the docs' type column.
+std::string type_text(const Spec& spec);
+// A default as help and docs show it: 0.25, 1e-05, sobol; "" for null (unset).
+std::string value_text(const nlohmann::json& value);
+
+template <class T>
+struct Param {
+  Spec spec;
+  // Stores an accepted value in the request; a problem it alone can see ("2048x": not a size), or nothing.
+  std::function<std::optional<std::string>(T&, const Value&)> set;
+  std::function<nlohmann::json(const T&)> get;  // as --json, stamps and the docs' defaults show it
+};
+
+template <class T>
+struct Group {
+  std::vector<Param<T>> params;
+  // Rules across parameters, once all are set (ao::check's ranges of one against another).
+  std::function<Status(const T&)> check = [](const T&) { return success(); };
+
+  const Param<T>* find(std::string_view name) const {
+    for (const Param<T>& p : params) {
+      if (p.spec.name == name) return &p;
+    }
+    return nullptr;
+  }
+  // The parameter a manifest key names, by its name or an older alias.
+  const Param<T>* find_key(std::string_view key) const {
+    for (const Param<T>& p : params) {
+      if (p.spec.name == key || std::find(p.spec.aliases.begin(), p.spec.aliases.end(), key) != p.spec.aliases.end()) {
+        return &p;
+      }
+    }
+    return nullptr;
+  }
+  std::vector<const Spec*> specs() const {
+    std::vector<const Spec*> out;
+    for (const Param<T>& p : params) out.push_back(&p.spec);
+    return out;
+  }
+};
+
+// Checks the value and stores it: nothing, or the problem (without the parameter's name).
+template <class T>
+std::optional<std::string> apply(const Param<T>& p, T& target, const Value& value) {
+  auto accepted = accept(p.spec, value);
+  if (!accepted) return accepted.error().message;
+  return p.set(target, *accepted);
+}
+
+// After every given parameter is set: one that applies only with another that was not given, then
+// the group's own rules. `where` names a parameter as its door does (a flag, a file:line:column).
+template <class T>
+Status finish(const Group<T>& group, const T& target, const std::set<std::string>& given,
+              const std::function<std::string(const std::string&)>& where) {
+  for (const Param<T>& p : group.params) {
+    if (!p.spec.needs.empty() && given.count(p.spec.name) && !given.count(p.spec.needs)) {
+      return Error{where(p.spec.name), "applies only with " + where(p.spec.needs) + " as well", true};
+    }
+  }
+  return group.check(target);
+}
+
+// Every parameter's value, by name (sorted, so a reordered manifest stamps the same).
+template <class T>
+nlohmann::json to_json(const Group<T>& group, const T& target) {
+  nlohmann::json j = nlohmann::json::object();
+  for (const Param<T>& p : group.params) j[p.spec.name] = p.get(target);
+  return j;
+}
+
+// The docs' reference table: flag (with `flag_prefix`), manifest key, type, default, help.
+std::string markdown_table(const std::vector<const Spec*>& specs, const nlohmann::json& defaults,
+                           std::string_view flag_prefix);
+template <class T>
+std::string markdown_table(const Group<T>& group, std::string_view flag_prefix) {
+  return markdown_table(group.specs(), to_json(group, T{}), flag_prefix);
+}
+
+// --- Parameters of the common kinds, over a field: `field(target)` gives a reference to it -----------
+
+template <class T, class Field>
+Param<T> flag(Spec spec, Field field) {
+  spec.kind = Kind::flag;
+  return {std::move(spec), [field](T& t, const Value& v) -> std::optional<std::string> {
+            field(t) = std::get<bool>(v);
+            return std::nullopt;
+          },
+          [field](const T& t) { return nlohmann::json(bool(field(t))); }};
+}
+
+template <class T, class Field>
+Param<T> integer(Spec spec, Field field) {
+  spec.kind = Kind::integer;
+  return {std::move(spec), [field](T& t, const Value& v) -> std::optional<std::string> {
+            using F = std::remove_reference_t<decltype(field(t))>;
+            field(t) = static_cast<F>(std::get<std::int64_t>(v));
+            return std::nullopt;
+          },
+          [field](const T& t) { return nlohmann::json(field(t)); }};
+}
+
+template <class T, class Field>
+Param<T> number(Spec spec, Field field) {
+  spec.kind = Kind::number;
+  return {std::move(spec), [field](T& t, const Value& v) -> std::optional<std::string> {
+            field(t) = std::get<double>(v);
+            return std::nullopt;
+          },
+          [field](const T& t) { return nlohmann::json(field(t)); }};
+}
+
+// An enum (or an optional one: unset shows as null) named by a module's NameTable.
+template <class T, class Field, class E, std::size_t N>
+Param<T> choice(Spec spec, Field field, const NameTable<E, N>& names) {
+  spec.kind = Kind::choice;
+  spec.choices.clear();
+  for (const auto& [value, name] : names) spec.choices.emplace_back(name);
+  return {std::move(spec), [field, &names](T& t, const Value& v) -> std::optional<std::string> {
+            field(t) = *value_in(names, std::get<std::string>(v));
+            return std::nullopt;
+          },
+          [field, &names](const T& t) -> nlohmann::json {
+            const auto& value = field(t);
+            if constexpr (requires { value.has_value(); }) {
+              if (!value) return nullptr;
+              return std::string(name_in(names, *value));
+            } else {
+              return std::string(name_in(names, value));
+            }
+          }};
+}
+
+}  // namespace matbake::params

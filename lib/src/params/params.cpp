@@ -1,0 +1,151 @@
+#include "matbake/params.hpp"
+
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+
+
+namespace matbake::params {
+namespace {
+
+std::string number_text(double x) {
+  char text[32];
+  if (x == std::trunc(x) && std::abs(x) < 1e16) {
+    std::snprintf(text, sizeof text, "%.0f", x);
+  } else {
+    std::snprintf(text, sizeof text, "%.6g", x);
+  }
+  return text;
+}
+
+bool has_range(const Spec& spec) { return !(spec.min == 0 && spec.max == 0); }
+
+std::string range_text(const Spec& spec) {
+  if (!has_range(spec)) return "";
+  if (std::isinf(spec.max)) return (spec.above_min ? "above " : "at least ") + number_text(spec.min);
+  return number_text(spec.min) + " to " + number_text(spec.max);
+}
+
+bool in_range(const Spec& spec, double x) {
+  if (!has_range(spec)) return true;
+  return (spec.above_min ? x > spec.min : x >= spec.min) && x <= spec.max;
+}
+
+std::string choices_text(const Spec& spec, std::string_view last_joiner) {
+  std::string out;
+  for (std::size_t i = 0; i < spec.choices.size(); ++i) {
+    out += (i == 0 ? "" : i + 1 == spec.choices.size() ? std::string(last_joiner) : ", ") + spec.choices[i];
+  }
+  return out;
+}
+
+std::optional<std::int64_t> integer_from(std::string_view text) {
+  std::int64_t v = 0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+  if (ec != std::errc() || end != text.data() + text.size()) return std::nullopt;
+  return v;
+}
+
+}  // namespace
+
+std::string flag_name(const Spec& spec, std::string_view prefix) {
+  std::string name = "--" + std::string(prefix) + spec.name;
+  std::replace(name.begin(), name.end(), '_', '-');
+  return name;
+}
+
+Result<Value> from_text(const Spec& spec, std::string_view text) {
+  switch (spec.kind) {
+    case Kind::flag:
+      if (text == "true" || text.empty()) return Value(true);
+      if (text == "false") return Value(false);
+      return Error{"", "true or false expected", true};
+    case Kind::integer:
+      if (auto v = integer_from(text)) return Value(*v);
+      return Error{"", "an integer expected", true};
+    case Kind::number: {
+      const std::string s(text);
+      char* end = nullptr;
+      const double v = std::strtod(s.c_str(), &end);
+      if (s.empty() || end != s.c_str() + s.size()) return Error{"", "a number expected", true};
+      return Value(v);
+    }
+    case Kind::integer_or_text:
+      if (auto v = integer_from(text)) return Value(*v);
+      return Value(std::string(text));
+    case Kind::text:
+    case Kind::choice: return Value(std::string(text));
+  }
+  return Error{"", "unknown kind", true};
+}
+
+Result<Value> accept(const Spec& spec, Value value) {
+  const auto out_of_range = [&](double x) { return !in_range(spec, x); };
+  switch (spec.kind) {
+    case Kind::flag:
+      if (std::holds_alternative<bool>(value)) return value;
+      return Error{"", "true or false expected", true};
+    case Kind::integer:
+      if (!std::holds_alternative<std::int64_t>(value)) return Error{"", "an integer expected", true};
+      if (out_of_range(double(std::get<std::int64_t>(value)))) return Error{"", range_text(spec), true};
+      return value;
+    case Kind::number: {
+      if (const auto* i = std::get_if<std::int64_t>(&value)) value = double(*i);
+      if (!std::holds_alternative<double>(value)) return Error{"", "a number expected", true};
+      const double x = std::get<double>(value);
+      if (!std::isfinite(x) || out_of_range(x)) {
+        return Error{"", has_range(spec) ? range_text(spec) : std::string("a finite number expected"), true};
+      }
+      return value;
+    }
+    case Kind::text:
+      if (std::holds_alternative<std::string>(value)) return value;
+      return Error{"", "a string expected", true};
+    case Kind::choice: {
+      const std::string* name = std::get_if<std::string>(&value);
+      if (!name || std::find(spec.choices.begin(), spec.choices.end(), *name) == spec.choices.end()) {
+        return Error{"", "use " + choices_text(spec, " or "), true};
+      }
+      return value;
+    }
+    case Kind::integer_or_text:
+      if (std::holds_alternative<std::int64_t>(value) || std::holds_alternative<std::string>(value)) return value;
+      return Error{"", "an integer or a string expected", true};
+  }
+  return Error{"", "unknown kind", true};
+}
+
+std::string type_text(const Spec& spec) {
+  switch (spec.kind) {
+    case Kind::flag: return "true/false";
+    case Kind::integer: return has_range(spec) ? "integer, " + range_text(spec) : "integer";
+    case Kind::number: return has_range(spec) ? "number, " + range_text(spec) : "number";
+    case Kind::text: return "text";
+    case Kind::choice: return choices_text(spec, ", ");
+    case Kind::integer_or_text: return "integer or text";
+  }
+  return "";
+}
+
+std::string value_text(const nlohmann::json& value) {
+  if (value.is_null()) return "";
+  if (value.is_string()) return value.get<std::string>();
+  if (value.is_number()) return number_text(value.get<double>());
+  return value.dump();
+}
+
+std::string markdown_table(const std::vector<const Spec*>& specs, const nlohmann::json& defaults,
+                           std::string_view flag_prefix) {
+  std::string out = "| flag | manifest key | type | default | what it does |\n|---|---|---|---|---|\n";
+  for (const Spec* s : specs) {
+    const nlohmann::json& d = defaults.at(s->name);
+    const std::string shown = d.is_null() ? "unset" : value_text(d);
+    out += "| `" + flag_name(*s, flag_prefix) + "` | `" + s->name + "` | " + type_text(*s) + " | " + shown + " | " +
+           s->help + (s->needs.empty() ? "" : " (with `" + s->needs + "`)") +
+           (s->aliases.empty() ? "" : "; older key: `" + s->aliases.front() + "`") + " |\n";
+  }
+  return out;
+}
+
+}  // namespace matbake::params

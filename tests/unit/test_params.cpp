@@ -1,0 +1,158 @@
+// Parameter descriptions (matbake/params.hpp): values decoded and checked by kind and range, and
+// every AO parameter walked: reachable from the command line and the manifest with the same effect,
+// round-tripped through the stamp's JSON, and documented in docs/build.md's table.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+
+#include "cli/ao_options.hpp"
+#include "matbake/ao_params.hpp"
+#include "matbake/params.hpp"
+#include "matbake/pipeline.hpp"
+#include "support/files.hpp"
+#include "support/param_values.hpp"
+
+namespace matbake::params {
+namespace {
+
+namespace fs = std::filesystem;
+
+template <class T>
+std::string problem(const Result<T>& r) {
+  return r ? "" : r.error().message;
+}
+
+TEST(Params, ValuesAreCheckedByKindAndRange) {
+  const Spec count{.name = "samples", .kind = Kind::integer, .min = 1, .max = 64};
+  EXPECT_EQ(std::get<std::int64_t>(*accept(count, *from_text(count, "64"))), 64);
+  EXPECT_EQ(problem(accept(count, *from_text(count, "65"))), "1 to 64");
+  EXPECT_EQ(problem(accept(count, *from_text(count, "0"))), "1 to 64");
+  EXPECT_EQ(problem(from_text(count, "4.5")), "an integer expected");
+  EXPECT_EQ(problem(from_text(count, "")), "an integer expected");
+  EXPECT_EQ(problem(accept(count, Value(4.0))), "an integer expected");  // a TOML float is no integer
+  EXPECT_EQ(problem(accept(count, Value(std::string("4")))), "an integer expected");
+
+  const Spec distance{.name = "tau", .kind = Kind::number, .min = 0, .max = HUGE_VAL, .above_min = true};
+  EXPECT_EQ(std::get<double>(*accept(distance, Value(std::int64_t(2)))), 2.0);  // an integer is a number
+  EXPECT_EQ(problem(accept(distance, Value(0.0))), "above 0");
+  EXPECT_EQ(problem(accept(distance, Value(std::nan("")))), "above 0");
+  EXPECT_EQ(problem(accept(distance, Value(HUGE_VAL))), "above 0");
+  EXPECT_EQ(problem(from_text(distance, "1e-3x")), "a number expected");
+  EXPECT_DOUBLE_EQ(std::get<double>(*accept(distance, *from_text(distance, "1e-300"))), 1e-300);
+  const Spec bias{.name = "bias", .kind = Kind::number, .min = 0, .max = HUGE_VAL};
+  EXPECT_EQ(problem(accept(bias, Value(0.0))), "");
+  EXPECT_EQ(problem(accept(bias, Value(-1e-9))), "at least 0");
+
+  const Spec pick{.name = "sampler", .kind = Kind::choice, .choices = {"sobol", "random", "halton"}};
+  EXPECT_EQ(problem(accept(pick, Value(std::string("Sobol")))), "use sobol, random or halton");
+  EXPECT_EQ(problem(accept(pick, Value(true))), "use sobol, random or halton");
+  const Spec on{.name = "two_sided", .kind = Kind::flag};
+  EXPECT_EQ(problem(accept(on, Value(std::int64_t(1)))), "true or false expected");
+  const Spec size{.name = "texture", .kind = Kind::integer_or_text};
+  EXPECT_TRUE(std::holds_alternative<std::int64_t>(*from_text(size, "1024")));
+  EXPECT_TRUE(std::holds_alternative<std::string>(*from_text(size, "2048x1024")));
+
+  EXPECT_EQ(flag_name(Spec{.name = "relative_distance"}, "ao-"), "--ao-relative-distance");
+  EXPECT_EQ(type_text(count), "integer, 1 to 64");
+  EXPECT_EQ(type_text(distance), "number, above 0");
+  EXPECT_EQ(value_text(nlohmann::json(1e-5)), "1e-05");
+  EXPECT_EQ(value_text(nlohmann::json(0.25)), "0.25");
+  EXPECT_EQ(value_text(nlohmann::json(64)), "64");
+}
+
+// A stamp's value back as the door would give it (null: unset, not given).
+std::optional<Value> from_json(const nlohmann::json& j) {
+  if (j.is_boolean()) return Value(j.get<bool>());
+  if (j.is_number_integer()) return Value(j.get<std::int64_t>());
+  if (j.is_number()) return Value(j.get<double>());
+  if (j.is_string()) return Value(j.get<std::string>());
+  return std::nullopt;
+}
+
+Result<ao::Request> from_command_line(std::vector<std::string> args) {
+  CLI::App app;
+  cli::AoSettings settings;
+  cli::add_ao_options(app, settings, "ao-");
+  std::reverse(args.begin(), args.end());  // CLI11 takes them last first
+  app.parse(args);
+  return cli::ao_request(settings, "ao-");
+}
+
+Result<ao::Request> from_manifest(const std::string& ao_table) {
+  auto m = pipeline::parse_manifest("[scenes.s]\ninput = \"s.gltf\"\nao = { " + ao_table + " }\n", "/p/assets.toml");
+  if (!m) return m.error();
+  return *m->scenes.at(0).options.ao;
+}
+
+TEST(AoParams, EveryParameterReachesTheRequestFromBothDoorsAndRoundTripsThroughTheStamp) {
+  const Group<ao::Request>& group = ao::request_params();
+  const nlohmann::json defaults = to_json(group, ao::Request{});
+  ASSERT_EQ(group.params.size(), 20u);  // a new parameter is walked here too
+  for (const Param<ao::Request>& p : group.params) {
+    SCOPED_TRACE(p.spec.name);
+    // Its example, and the texture it needs, through each door.
+    std::vector<std::string> args = {flag_name(p.spec, "ao-")};
+    if (p.spec.kind != Kind::flag) args.push_back(p.spec.example);
+    std::string table = p.spec.name + " = " + test::toml_literal(p.spec);
+    if (!p.spec.needs.empty()) {
+      args.insert(args.end(), {"--ao-" + p.spec.needs, "16"});
+      table += ", " + p.spec.needs + " = 16";
+    }
+    auto cli = from_command_line(args);
+    auto manifest = from_manifest(table);
+    ASSERT_TRUE(cli) << cli.error().to_string();
+    ASSERT_TRUE(manifest) << manifest.error().to_string();
+    const nlohmann::json stamped = to_json(group, *cli);
+    EXPECT_EQ(stamped, to_json(group, *manifest));
+    EXPECT_NE(stamped.at(p.spec.name), defaults.at(p.spec.name)) << "the example must differ from the default";
+
+    // The stamp's values, given again where they are not the defaults, make the same request.
+    ao::Request again;
+    for (const Param<ao::Request>& q : group.params) {
+      if (auto v = from_json(stamped.at(q.spec.name)); v && stamped.at(q.spec.name) != defaults.at(q.spec.name)) {
+        EXPECT_EQ(apply(q, again, *v), std::nullopt) << q.spec.name;
+      }
+    }
+    EXPECT_EQ(to_json(group, again), stamped);
+  }
+}
+
+TEST(AoParams, OlderManifestKeysAreReadWithANote) {
+  auto m = pipeline::parse_manifest("[scenes.s]\ninput = \"s.gltf\"\nao = { distance = 0.1, absolute_distance = 2 }\n",
+                                    "/p/assets.toml");
+  ASSERT_TRUE(m) << m.error().to_string();
+  EXPECT_DOUBLE_EQ(m->scenes[0].options.ao->options.relative_distance, 0.1);
+  EXPECT_DOUBLE_EQ(m->scenes[0].options.ao->options.absolute_distance, 2);
+  EXPECT_EQ(m->notes, (std::vector<std::string>{
+                          "/p/assets.toml:3:24: scenes.s.ao.absolute_distance is now called max_distance (the old name still works)",
+                          "/p/assets.toml:3:8: scenes.s.ao.distance is now called relative_distance (the old name still works)"}));
+}
+
+// Each docs table made from a description stands between markers; MATBAKE_WRITE_DOCS=1 writes it.
+TEST(DocsTables, MatchTheParameterDescriptions) {
+  struct Table {
+    std::string file, marker, text;
+  };
+  const Table tables[] = {
+      {"docs/build.md", "params:ao", markdown_table(ao::request_params(), "")},
+  };
+  for (const Table& t : tables) {
+    const fs::path path = fs::path(MATBAKE_SOURCE_DIR) / t.file;
+    std::string doc = test::read_bytes(path);
+    const std::size_t begin = doc.find("<!-- " + t.marker + " begin");
+    const std::size_t end = doc.find("<!-- " + t.marker + " end -->");
+    ASSERT_NE(begin, std::string::npos) << t.file;
+    ASSERT_NE(end, std::string::npos) << t.file;
+    const std::size_t body = doc.find('\n', begin) + 1;
+    if (std::getenv("MATBAKE_WRITE_DOCS")) {
+      doc.replace(body, end - body, t.text);
+      test::write_bytes(path, doc);
+      continue;
+    }
+    EXPECT_EQ(doc.substr(body, end - body), t.text) << t.file << " " << t.marker
+                                                    << ": run MATBAKE_WRITE_DOCS=1 ctest -R DocsTables to write it";
+  }
+}
+
+}  // namespace
+}  // namespace matbake::params
