@@ -9,7 +9,7 @@ namespace matbake::cli {
 
 void add_ao_options(CLI::App& cmd, AoSettings& s, const std::string& prefix) {
   const std::string group = prefix.empty() ? "Options" : "Ambient occlusion";
-  add_params(cmd, ao::request_params(), s.request, s.given, prefix, group);
+  add_params(cmd, ao::request_params(), s.request, prefix, group, &s.given);
   cmd.add_option("--" + prefix + "dump-texture", s.dump_texture,
                  "Also write each texture as float EXR into this folder (with --" + prefix + "texture)")
       ->group(group);

@@ -3,6 +3,8 @@
 #include <cstdio>
 
 #include "commands.hpp"
+#include "matbake/encoding_params.hpp"
+#include "params_cli.hpp"
 #include "matbake/export.hpp"
 #include "matbake/report_json.hpp"
 
@@ -19,6 +21,7 @@ CLI::App* setup_bake_ao(CLI::App& app, BakeAoSettings& s) {
   cmd->add_option("-o,--output", s.output,
                   "Output .gltf (+ .bin beside it) or .glb; everything but the baked attribute is kept as written");
   cmd->add_option("--dump", s.dump, "Raw values: .csv (node,mesh,primitive,vertex,x,y,z,ao) or .bin (float32)");
+  add_params(*cmd, image::encoding_params(), s.encoding, "", "Options");
   add_ao_options(*cmd, s.ao, "");
   return cmd;
 }
@@ -26,7 +29,7 @@ CLI::App* setup_bake_ao(CLI::App& app, BakeAoSettings& s) {
 int run_bake_ao(const BakeAoSettings& s, const GlobalOptions& global) {
   auto request = ao_request(s.ao, "");
   if (!request) return report_error(request.error());
-  auto report = exporter::bake_ao_file(s.scene, {*request, s.output, s.dump});
+  auto report = exporter::bake_ao_file(s.scene, {*request, s.output, s.dump, s.encoding});
   if (!report) return report_error(report.error());
   nlohmann::json textures = nlohmann::json::array();
   for (const exporter::TextureReport& t : report->textures) textures.push_back(to_json(t));

@@ -5,6 +5,8 @@
 #include <map>
 
 #include "commands.hpp"
+#include "matbake/encoding_params.hpp"
+#include "params_cli.hpp"
 #include "option_names.hpp"
 #include "silenced_stderr.hpp"
 
@@ -68,7 +70,7 @@ CLI::App* setup_convert(CLI::App& app, ConvertSettings& s) {
       ->check(CLI::IsMember({"8", "16", "half", "float"}));
   cmd->add_option("--compression", s.options.compression,
                   "EXR/TIFF: OIIO compression name, e.g. none, zip, zips, zip:1..9, piz, dwaa (default: zip for EXR)");
-  add_png_compression_option(*cmd, s.options.png_level);
+  add_params(*cmd, image::encoding_params(), s.options.encoding, "", "Options");
   return cmd;
 }
 

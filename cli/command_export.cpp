@@ -3,6 +3,8 @@
 #include <cstdio>
 
 #include "commands.hpp"
+#include "matbake/encoding_params.hpp"
+#include "params_cli.hpp"
 #include "option_names.hpp"
 #include "material_sources.hpp"
 #include "matbake/atomic_file.hpp"
@@ -64,6 +66,7 @@ CLI::App* setup_export(CLI::App& app, ExportSettings& s) {
                   "none (core glTF's 0.04)");
   cmd->add_flag_callback("--no-orm", [&s] { s.options.pack_orm = false; },
                          "Keep occlusion and metallic-roughness textures apart");
+  add_params(*cmd, image::encoding_params(), s.options.encoding, "", "Options");
   add_ao_options(*cmd, s.ao, "ao-");  // AO is baked when any of them is given, as a manifest's ao = { ... }
   cmd->add_option("--report", s.report, "Also write the report as JSON to this file");
   return cmd;

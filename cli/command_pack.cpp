@@ -3,6 +3,8 @@
 #include <filesystem>
 
 #include "commands.hpp"
+#include "matbake/encoding_params.hpp"
+#include "params_cli.hpp"
 #include "option_names.hpp"
 #include "silenced_stderr.hpp"
 
@@ -60,7 +62,7 @@ CLI::App* setup_unpack(CLI::App& app, UnpackSettings& s) {
   cmd->add_option("--bits", s.bits, "8, 16, half or float (default: 8; half for exr)");
   cmd->add_option("--transfer", s.transfer, "Curve of 8-bit colour channels, read and written: srgb or gamma2.2")
       ->capture_default_str();
-  add_png_compression_option(*cmd, s.png_level);
+  add_params(*cmd, image::encoding_params(), s.encoding, "", "Options");
   return cmd;
 }
 
@@ -73,7 +75,7 @@ int run_unpack(const UnpackSettings& s, const GlobalOptions& global) {
   if (!sources) return report_error(sources.error());
   auto transfer = parse_transfer(s.transfer, "--transfer");
   if (!transfer) return report_error(transfer.error());
-  pack::UnpackRequest request{s.out_dir, s.format, std::nullopt, *transfer, {s.inputs.begin(), s.inputs.end()}, s.png_level};
+  pack::UnpackRequest request{s.out_dir, s.format, std::nullopt, *transfer, {s.inputs.begin(), s.inputs.end()}, s.encoding};
   if (!s.bits.empty()) {
     request.type = image::sample_type_from_name(s.bits);
     if (!request.type) return report_error(Error{"", "--bits '" + s.bits + "': use 8, 16, half or float", true});

@@ -72,7 +72,7 @@ struct UnpackSettings {
   std::string format = "png";
   std::string bits;
   std::string transfer = "srgb";
-  int png_level = image::kPngLevelDefault;
+  image::Encoding encoding;
 };
 CLI::App* setup_unpack(CLI::App& app, UnpackSettings& settings);
 int run_unpack(const UnpackSettings& settings, const GlobalOptions& global);
@@ -108,6 +108,7 @@ struct BakeAoSettings {
   std::string scene;
   std::string output;
   std::string dump;
+  image::Encoding encoding;  // of the occlusion textures
   AoSettings ao;
 };
 CLI::App* setup_bake_ao(CLI::App& app, BakeAoSettings& settings);

@@ -4,6 +4,8 @@
 #include <sstream>
 
 #include "commands.hpp"
+#include "matbake/encoding_params.hpp"
+#include "params_cli.hpp"
 #include "option_names.hpp"
 #include "silenced_stderr.hpp"
 
@@ -137,7 +139,7 @@ void add_output_options(CLI::App& cmd, OutputSettings& o, const std::string& wha
       ->required();
   cmd.add_option("--bits", o.bits, "8, 16, half or float (default: 8; half for .exr). Colour is encoded with "
                                    "--transfer in 8-bit and linear otherwise");
-  add_png_compression_option(cmd, o.png_level);
+  add_params(cmd, image::encoding_params(), o.encoding, "", "Options");
 }
 
 std::vector<std::filesystem::path> input_files(const SourceSettings& inputs) {
@@ -153,7 +155,7 @@ Result<std::vector<std::string>> write_textures(const pack::Layout& layout, cons
                                                 std::vector<NamedOutput> also) {
   auto transfer = parse_transfer(inputs.transfer, "--transfer");
   if (!transfer) return transfer.error();
-  pack::WriteRequest request{o.outputs, std::nullopt, *transfer, input_files(inputs), std::move(also), o.png_level};
+  pack::WriteRequest request{o.outputs, std::nullopt, *transfer, input_files(inputs), std::move(also), o.encoding};
   if (!o.bits.empty()) {
     request.type = image::sample_type_from_name(o.bits);
     if (!request.type) return Error{"", "--bits '" + o.bits + "': use 8, 16, half or float", true};

@@ -32,7 +32,7 @@ Result<material::Maps> read_packed(const std::string& layout_name, const std::ve
 struct OutputSettings {
   std::vector<std::string> outputs;  // one per layout texture, or one with {texture}
   std::string bits;                  // 8, 16, half, float; default 8 (half for .exr)
-  int png_level = image::kPngLevelDefault;
+  image::Encoding encoding;
 };
 void add_output_options(CLI::App& cmd, OutputSettings& o, const std::string& what);
 // Writes the layout's textures; returns the paths written. An output that is one of the inputs

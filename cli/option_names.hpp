@@ -6,7 +6,6 @@
 #include <string>
 
 #include "matbake/enum_names.hpp"
-#include "matbake/image.hpp"
 
 namespace matbake::cli {
 
@@ -24,21 +23,6 @@ CLI::Option* add_name_option(CLI::App& cmd, const std::string& flag, E& value, c
           },
           description + ": " + names_in(table))
       ->default_str(std::string(name_in(table, value)));
-}
-
-// --png-compression: fast, default, small or a libdeflate level 0 to 12, into `level`.
-inline CLI::Option* add_png_compression_option(CLI::App& cmd, int& level) {
-  return cmd
-      .add_option_function<std::string>(
-          "--png-compression",
-          [&level](const std::string& text) {
-            const auto parsed = image::png_level_from_name(text);
-            if (!parsed) throw CLI::ValidationError("--png-compression", "'" + text + "': use fast, default, small or 0 to 12");
-            level = *parsed;
-          },
-          "Deflate effort of 8/16-bit PNG outputs: fast (level 1), default (6), small (12) or a level 0 to 12 "
-          "(docs/performance.md has size and time per level)")
-      ->default_str("default");
 }
 
 }  // namespace matbake::cli

@@ -15,8 +15,8 @@ namespace matbake::cli {
 inline constexpr const char* kTypeNames[] = {"", "INT", "NUMBER", "TEXT", "NAME", "VALUE"};
 
 template <class T>
-void add_params(CLI::App& cmd, const params::Group<T>& group, T& target, std::set<std::string>& given,
-                const std::string& prefix, const std::string& help_group) {
+void add_params(CLI::App& cmd, const params::Group<T>& group, T& target, const std::string& prefix,
+                const std::string& help_group, std::set<std::string>* given = nullptr) {
   const nlohmann::json defaults = params::to_json(group, T{});
   for (const params::Param<T>& p : group.params) {
     const std::string flag = params::flag_name(p.spec, prefix);
@@ -24,9 +24,9 @@ void add_params(CLI::App& cmd, const params::Group<T>& group, T& target, std::se
     if (p.spec.kind == params::Kind::choice) help += ": " + params::type_text(p.spec);
     if (!p.spec.needs.empty()) help += " (with --" + prefix + p.spec.needs + ")";
     if (p.spec.kind == params::Kind::flag) {
-      cmd.add_flag_callback(flag, [&p, &target, &given] {
+      cmd.add_flag_callback(flag, [&p, &target, given] {
            (void)params::apply(p, target, params::Value(true));
-           given.insert(p.spec.name);
+           if (given) given->insert(p.spec.name);
          }, help)
           ->group(help_group);
       continue;
@@ -34,11 +34,11 @@ void add_params(CLI::App& cmd, const params::Group<T>& group, T& target, std::se
     const nlohmann::json& d = defaults.at(p.spec.name);
     cmd.add_option_function<std::string>(
            flag,
-           [&p, &target, &given, flag](const std::string& text) {
+           [&p, &target, given, flag](const std::string& text) {
              auto value = params::from_text(p.spec, text);
              std::optional<std::string> problem = value ? params::apply(p, target, *value) : value.error().message;
              if (problem) throw CLI::ValidationError(flag, "'" + text + "': " + *problem);
-             given.insert(p.spec.name);
+             if (given) given->insert(p.spec.name);
            },
            help)
         ->type_name(kTypeNames[std::size_t(p.spec.kind)])

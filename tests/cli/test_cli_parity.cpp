@@ -314,6 +314,51 @@ TEST_F(Parity, ExportedTextureAoIsTheOrmRedChannel) {
   for (int m = 1; m < 5; ++m) EXPECT_EQ(texels("ao.gltf", m, "occlusion").pixels, texels("baked.gltf", m, "occlusion").pixels) << m;
 }
 
+// Every PNG a scene gets (export's converted and ORM textures, bake-ao's occlusion textures, a build's
+// scene) is written at the requested compression: the zlib header's FLEVEL says stored (level 0) or
+// maximum, the stored files are larger, and both decode to the same codes.
+TEST_F(Parity, ScenePngsHonourTheCompression) {
+  for (const char* f : {"showroom.gltf", "showroom.bin"}) fs::copy_file(kExamples / f, dir / f);
+  const std::string scene = (dir / "showroom.gltf").string();
+  const std::string pair = "painted_metal=" + (dir / "pair_a.png").string() + "," + (dir / "pair_b.png").string();
+  std::string manifest = "[materials.pair]\npacked = { layout = \"schuler\", files = [\"pair_a.png\", \"pair_b.png\"] }\n"
+                         "validate = { enabled = false }\n";
+  for (const char* level : {"0", "small"}) {
+    const fs::path out = dir / "cli" / level;
+    fs::create_directories(out);
+    run_command({"export", scene, "-o", (out / "exported.gltf").string(), "--material", pair, "--ao-texture", "8",
+                 "--ao-samples", "4", "--png-compression", level});
+    run_command({"bake-ao", scene, "-o", (out / "baked.gltf").string(), "--texture", "8", "--samples", "4",
+                 "--png-compression", level});
+    manifest += std::string("[scenes.s") + level + "]\ninput = \"showroom.gltf\"\noutput = \"" + level +
+                "/built.gltf\"\nmaterials = { painted_metal = \"pair\" }\nao = { samples = 4, texture = 8 }\n" +
+                "png_compression = " + (level == std::string("0") ? "0" : "\"small\"") + "\n";
+  }
+  ASSERT_EQ(build(manifest).value("failed", -1), 0);
+  const auto flevel = [](const std::string& bytes) {
+    const std::size_t idat = bytes.find("IDAT");
+    return idat == std::string::npos ? -1 : int(std::uint8_t(bytes[idat + 5]));
+  };
+  for (const auto& [stored, small] : {std::pair{dir / "cli" / "0", dir / "cli" / "small"}, std::pair{dir / "out" / "0", dir / "out" / "small"}}) {
+    std::size_t pngs = 0, stored_bytes = 0, small_bytes = 0;
+    for (const auto& e : fs::directory_iterator(stored)) {
+      if (e.path().extension() != ".png") continue;
+      SCOPED_TRACE(e.path().string());
+      ++pngs;
+      const fs::path other = small / e.path().filename();
+      const std::string a = read_bytes(e.path()), b = read_bytes(other);
+      EXPECT_EQ(flevel(a), 0x01);
+      EXPECT_EQ(flevel(b), 0xda);
+      stored_bytes += a.size(), small_bytes += b.size();
+      const RawImage x = read_raw(e.path()), y = read_raw(other);
+      EXPECT_GT(x.width, 0);
+      EXPECT_EQ(x.samples, y.samples);
+    }
+    EXPECT_GE(pngs, 5u) << stored;  // converted, ORM and occlusion textures
+    EXPECT_GT(stored_bytes, small_bytes);
+  }
+}
+
 // The manifest's texture keys are checked as the command line's options are.
 TEST_F(Parity, ManifestTextureKeysAreChecked) {
   for (const char* f : {"showroom.gltf", "showroom.bin"}) fs::copy_file(kExamples / f, dir / f);

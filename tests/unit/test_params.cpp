@@ -7,6 +7,7 @@
 
 #include "cli/ao_options.hpp"
 #include "matbake/ao_params.hpp"
+#include "matbake/encoding_params.hpp"
 #include "matbake/params.hpp"
 #include "matbake/pipeline.hpp"
 #include "support/files.hpp"
@@ -135,6 +136,7 @@ TEST(DocsTables, MatchTheParameterDescriptions) {
   };
   const Table tables[] = {
       {"docs/build.md", "params:ao", markdown_table(ao::request_params(), "")},
+      {"docs/build.md", "params:encoding", markdown_table(image::encoding_params(), "")},
   };
   for (const Table& t : tables) {
     const fs::path path = fs::path(MATBAKE_SOURCE_DIR) / t.file;

@@ -132,9 +132,11 @@ TEST(BuildManifest, ErrorsSayWhereAndWhat) {
       // A float where an integer goes: refused, never cast (toml++ casts 2e52 to int64 unchecked; fuzzing).
       {"[scenes.s]\ninput = \"a.gltf\"\nao = { samples = 2e52 }\n", "m.toml:3:", "samples: an integer expected"},
       {"", "m.toml", "nothing to build"},
-      {"png_compression = 13\n[materials.a]\nsources = { kd = 0.5 }\n", "m.toml:1:", "png_compression: \"fast\""},
+      {"png_compression = 13\n[materials.a]\nsources = { kd = 0.5 }\n", "m.toml:1:19",
+       "manifest.png_compression: fast, default, small or a level 0 to 12"},
       {"[materials.a]\nsources = { kd = 0.5 }\npng_compression = \"quick\"\n", "m.toml:3:", "materials.a.png_compression"},
-      {"[materials.a]\nsources = { kd = 0.5 }\npng_compression = 6.0\n", "m.toml:3:", "or a level 0 to 12"},
+      {"[materials.a]\nsources = { kd = 0.5 }\npng_compression = 6.0\n", "m.toml:3:19",
+       "materials.a.png_compression: an integer or a string expected"},
   };
   for (const Case& c : cases) {
     auto m = pipeline::parse_manifest(c.text, "m.toml");

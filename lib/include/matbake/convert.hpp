@@ -18,7 +18,7 @@ struct ConvertOptions {
   std::optional<image::SampleType> type;  // default: see default_sample_type()
   std::string compression;                // EXR default: zip
   std::filesystem::path ocio_config;      // empty: $OCIO, else the shipped config
-  int png_level = image::kPngLevelDefault;  // 8/16-bit PNG outputs
+  image::Encoding encoding;  // of PNG outputs
 };
 
 // How a conversion runs: either exact built-in transfers at read and write, or (when either side

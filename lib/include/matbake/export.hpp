@@ -46,6 +46,7 @@ struct Options {
   DielectricF0 dielectric_f0 = DielectricF0::specular;
   workflow::RoughnessMapping mapping = workflow::kDefaultRoughnessMapping;
   bool pack_orm = true;           // occlusion + metallic-roughness into one texture
+  image::Encoding encoding;       // of the PNGs it makes (converted, ORM and occlusion textures)
   std::optional<ao::Request> ao;  // bake AO when set: per vertex, or with ao->texture into each
                                   // material's ORM texture (red), or its own occlusion texture
 };
@@ -97,6 +98,7 @@ struct BakeAoOptions {
   ao::Request ao;
   std::filesystem::path output;  // .gltf or .glb; empty: none
   std::filesystem::path dump;    // .csv or .bin; empty: none (per-vertex only)
+  image::Encoding encoding;      // of the occlusion textures' PNGs
 };
 struct BakeAoReport {
   std::size_t instances = 0;

@@ -84,6 +84,12 @@ inline constexpr int kPngLevelSmallest = 12;
 // "fast", "default", "small" or a level "0" to "12".
 std::optional<int> png_level_from_name(std::string_view name);
 
+// How matbake encodes the images it writes, whichever command writes them (convert, pack, unpack,
+// workflow, export, bake-ao's textures, a build): its parameters are image::encoding_params().
+struct Encoding {
+  int png_level = kPngLevelDefault;  // 8/16-bit PNG deflate effort
+};
+
 struct WriteOptions {
   color::Transfer colour = color::Transfer::linear;  // applied to colour channels, never alpha
   SampleType type = SampleType::half;

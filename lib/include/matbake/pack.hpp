@@ -95,7 +95,7 @@ Result<material::Maps> unpack(const Layout& layout, std::span<const image::Image
 struct OutputOptions {
   image::SampleType type = image::SampleType::u8;
   color::Transfer transfer = color::Transfer::srgb;  // for colour channels of 8-bit output; else linear
-  int png_level = image::kPngLevelDefault;
+  image::Encoding encoding;
 };
 image::WriteOptions write_options(bool color, const OutputOptions& options);
 // Where a layout's textures go: one path per texture, in order, or one path holding "{texture}"
@@ -110,7 +110,7 @@ struct WriteRequest {
   color::Transfer transfer = color::Transfer::srgb;  // colour channels of 8-bit outputs
   std::vector<std::filesystem::path> inputs;         // files the maps were read from: never written over
   std::vector<NamedOutput> also;                     // the run's other outputs (a report): checked with the textures
-  int png_level = image::kPngLevelDefault;           // PNG outputs' deflate effort
+  image::Encoding encoding;
 };
 // Packs `sources` into the layout's textures and writes them (each atomically). An output that is
 // an input, or two outputs that are one file, are refused before anything is written.
@@ -125,7 +125,7 @@ struct UnpackRequest {
   std::optional<image::SampleType> type;    // unset: default_sample_type of the format
   color::Transfer transfer = color::Transfer::srgb;
   std::vector<std::filesystem::path> inputs;
-  int png_level = image::kPngLevelDefault;
+  image::Encoding encoding;
 };
 Result<std::vector<std::filesystem::path>> write_maps(const material::Maps& maps, const UnpackRequest& request);
 

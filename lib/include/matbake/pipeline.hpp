@@ -64,7 +64,7 @@ struct MaterialSpec {
   std::optional<LayoutChoice> layout;  // textures to write; unset: none
   std::string format = "png";  // png, exr, tif
   std::optional<image::SampleType> bits;  // unset: pack::default_sample_type (half for exr, else 8)
-  int png_level = image::kPngLevelDefault;  // png_compression: deflate effort of PNG outputs
+  image::Encoding encoding;  // png_compression
   workflow::RoughnessMapping mapping = workflow::kDefaultRoughnessMapping;
   std::string reference;  // a material table entry to validate against
   ValidationRules validation;

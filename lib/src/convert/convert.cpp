@@ -101,7 +101,7 @@ Result<ConvertReport> convert_file(const ConversionPlan& plan, const fs::path& i
     image::ReadInfo info;
     image::ImageLayout layout;
     image::WriteOptions write{plan.encode, options.type.value_or(image::SampleType::half), options.compression,
-                              colorspace_tag(plan, options), options.png_level};
+                              colorspace_tag(plan, options), options.encoding.png_level};
     image::BandTransform transform;
     transform.accept = [&](const image::ImageLayout& l) -> Status {
       if (plan.ocio && l.channels < 3) {

@@ -390,7 +390,7 @@ Result<Report> export_scene(const fs::path& input, const fs::path& output, const
       given[*index] = &m;
     }
 
-    ImageCache cache(*doc);
+    ImageCache cache(*doc, options.encoding);
     for (std::size_t i = 0; doc->json.contains("images") && i < doc->json["images"].size(); ++i) {
       if (Status s = cache.check(i); !s) return s.error();
     }
@@ -431,7 +431,7 @@ Result<Report> export_scene(const fs::path& input, const fs::path& output, const
 
     if (occlusion) {
       ao::TextureBakes timing;
-      auto textures = bake_occlusion_textures(*doc, *scene, *options.ao, *occlusion, output.stem().string(),
+      auto textures = bake_occlusion_textures(*doc, *scene, cache, *options.ao, *occlusion, output.stem().string(),
                                               OcclusionInto::orm, timing);
       if (!textures) return textures.error();
       report.ao_textures = std::move(*textures);

@@ -88,7 +88,8 @@ Result<BakeAoReport> bake_ao_file(const fs::path& input, const BakeAoOptions& op
     const auto start = std::chrono::steady_clock::now();
     if (texture) {
       ao::TextureBakes timing;
-      auto textures = bake_occlusion_textures(*doc, *scene, options.ao, targets, stem, OcclusionInto::texture, timing);
+      ImageCache cache(*doc, options.encoding);
+      auto textures = bake_occlusion_textures(*doc, *scene, cache, options.ao, targets, stem, OcclusionInto::texture, timing);
       if (!textures) return textures.error();
       report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       report.textures = std::move(*textures);

@@ -181,7 +181,8 @@ fs::path dumped_texture(const fs::path& folder, const std::string& stem, int mat
 }
 
 Result<std::vector<TextureReport>> bake_occlusion_textures(gltf::Document& doc, const scene::Scene& scene,
-                                                           const ao::Request& request, const OcclusionTargets& targets,
+                                                           ImageCache& cache, const ao::Request& request,
+                                                           const OcclusionTargets& targets,
                                                            const std::string& stem, OcclusionInto into,
                                                            ao::TextureBakes& timing) {
   const ao::TextureRequest& texture = *request.texture;
@@ -192,7 +193,6 @@ Result<std::vector<TextureReport>> bake_occlusion_textures(gltf::Document& doc, 
     return error;
   }
   const std::vector<int> materials = split_placements(doc, scene, targets);
-  ImageCache cache(doc);
   std::vector<TextureReport> reports;
   for (std::size_t t = 0; t < targets.targets.size(); ++t) {
     const int m = materials[t];
@@ -247,17 +247,14 @@ Result<std::vector<TextureReport>> bake_occlusion_textures(gltf::Document& doc, 
         orm.pixels[p * 3 + 1] = rgba(source, p, 1);
         orm.pixels[p * 3 + 2] = rgba(source, p, 2);
       }
-      image::WriteOptions png8;
-      png8.type = image::SampleType::u8;
-      auto bytes = image::encode_image(orm, "orm.png", png8);
+      auto bytes = cache.encode_png(orm, color::Transfer::linear);
       if (!bytes) return bytes.error();
       report.file = stem + "_orm_ao_" + std::to_string(m) + ".png";
       index = add_texture(doc, report.file, std::move(*bytes), mr_index);
       material["pbrMetallicRoughness"]["metallicRoughnessTexture"]["index"] = index;
     } else {
-      image::WriteOptions png;
-      png.type = texture.bits == 16 ? image::SampleType::u16 : image::SampleType::u8;
-      auto bytes = image::encode_image(img, "occlusion.png", png);
+      auto bytes = cache.encode_png(img, color::Transfer::linear,
+                                    texture.bits == 16 ? image::SampleType::u16 : image::SampleType::u8);
       if (!bytes) return bytes.error();
       report.file = stem + "_occlusion_" + std::to_string(m) + ".png";
       index = add_texture(doc, report.file, std::move(*bytes), sampler_from);

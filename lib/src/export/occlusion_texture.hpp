@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "../gltf/document.hpp"
+#include "texture_files.hpp"
 #include "matbake/ao.hpp"
 #include "matbake/export.hpp"
 
@@ -36,9 +37,11 @@ enum class OcclusionInto {
 
 // Bakes and writes the textures into `doc` (with per_instance, into a copy of the material for each
 // further placement, see occlusion_texture.cpp) (new files `<stem>_occlusion_<material>.png` or
-// `<stem>_orm_ao_<material>.png`); the dump folder, when asked, gets each bake as float EXR.
+// `<stem>_orm_ao_<material>.png`, encoded as `cache` says); the dump folder, when asked, gets each bake
+// as float EXR. `cache` is the document's: a metallic-roughness texture it decoded is not decoded again.
 Result<std::vector<TextureReport>> bake_occlusion_textures(gltf::Document& doc, const scene::Scene& scene,
-                                                           const ao::Request& request, const OcclusionTargets& targets,
+                                                           ImageCache& cache, const ao::Request& request,
+                                                           const OcclusionTargets& targets,
                                                            const std::string& stem, OcclusionInto into,
                                                            ao::TextureBakes& timing);
 

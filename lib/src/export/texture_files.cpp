@@ -69,10 +69,11 @@ Status ImageCache::check(std::size_t index) {
   return success();
 }
 
-Result<std::string> ImageCache::encode_png(const image::Image& img, color::Transfer colour) {
+Result<std::string> ImageCache::encode_png(const image::Image& img, color::Transfer colour, image::SampleType type) const {
   image::WriteOptions options;
   options.colour = colour;
-  options.type = image::SampleType::u8;
+  options.type = type;
+  options.png_level = encoding_.png_level;
   return image::encode_image(img, "made.png", options);
 }
 

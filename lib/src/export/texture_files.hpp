@@ -19,7 +19,7 @@ image::Image at_size(const image::Image& im, int width, int height);
 
 class ImageCache {
  public:
-  explicit ImageCache(const gltf::Document& doc) : doc_(doc) {}
+  ImageCache(const gltf::Document& doc, const image::Encoding& encoding) : doc_(doc), encoding_(encoding) {}
   ImageCache(const ImageCache&) = delete;
   ImageCache& operator=(const ImageCache&) = delete;
 
@@ -30,11 +30,13 @@ class ImageCache {
   // Image `index` is a PNG, JPEG or WebP whose header reads, or a KTX2 file (passed through).
   Status check(std::size_t index);
 
-  // 8-bit PNG bytes of `img` (colour channels encoded with `colour`).
-  Result<std::string> encode_png(const image::Image& img, color::Transfer colour);
+  // PNG bytes of `img` (colour channels encoded with `colour`), at the document's encoding.
+  Result<std::string> encode_png(const image::Image& img, color::Transfer colour,
+                                 image::SampleType type = image::SampleType::u8) const;
 
  private:
   const gltf::Document& doc_;
+  image::Encoding encoding_;
   std::map<std::pair<int, color::Transfer>, image::Image> images_;  // by (image index, transfer)
 };
 

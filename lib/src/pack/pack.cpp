@@ -355,7 +355,7 @@ image::WriteOptions write_options(bool color, const OutputOptions& options) {
   image::WriteOptions w;
   w.type = options.type;
   w.colour = color && options.type == image::SampleType::u8 ? options.transfer : color::Transfer::linear;
-  w.png_level = options.png_level;
+  w.png_level = options.encoding.png_level;
   return w;
 }
 
@@ -392,7 +392,7 @@ Result<std::vector<fs::path>> write_textures(const Layout& layout, const materia
     if (!images) return images.error();
     for (std::size_t t = 0; t < paths->size(); ++t) {
       const image::SampleType type = request.type.value_or(default_sample_type((*paths)[t]));
-      const image::WriteOptions options = write_options(layout.textures[t].color, {type, request.transfer, request.png_level});
+      const image::WriteOptions options = write_options(layout.textures[t].color, {type, request.transfer, request.encoding});
       if (Status s = image::write_image((*images)[t], (*paths)[t], options); !s) return s.error();
     }
     return paths;
@@ -410,7 +410,7 @@ Result<std::vector<fs::path>> write_maps(const material::Maps& maps, const Unpac
     for (const NamedOutput& out : outputs) {
       const bool colour = material::find_source(out.role)->kind == material::SourceKind::color;
       const image::SampleType type = request.type.value_or(default_sample_type(out.path));
-      if (Status s = image::write_image(maps.maps.at(out.role), out.path, write_options(colour, {type, request.transfer, request.png_level})); !s) {
+      if (Status s = image::write_image(maps.maps.at(out.role), out.path, write_options(colour, {type, request.transfer, request.encoding})); !s) {
         return s.error();
       }
       written.push_back(out.path);

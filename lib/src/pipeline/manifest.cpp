@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "matbake/ao_params.hpp"
+#include "matbake/encoding_params.hpp"
 #include "matbake/near_names.hpp"
 #include "matbake/read_file.hpp"
 #include "matbake/pipeline.hpp"
@@ -37,15 +38,15 @@ struct Reader {
     }
   }
 
-  Status known_keys(const toml::table& table, const std::string& where, std::initializer_list<std::string_view> keys) const {
+  // Every key of `table` is one of `keys`; an unknown one is an error suggesting the nearest.
+  Status known_keys(const toml::table& table, const std::string& where, const std::vector<std::string>& keys) const {
     for (const auto& [key, value] : table) {
-      bool known = false;
-      for (std::string_view k : keys) known = known || key.str() == k;
-      if (!known) {
-        std::string list;
-        for (std::string_view k : keys) list += (list.empty() ? "" : ", ") + std::string(k);
-        return at(key.source(), "unknown key '" + std::string(key.str()) + "' in " + where + " (known: " + list + ")");
-      }
+      if (std::find(keys.begin(), keys.end(), key.str()) != keys.end()) continue;
+      const std::string near = did_you_mean(key.str(), keys);
+      std::string list;
+      for (const std::string& k : keys) list += (list.empty() ? "" : ", ") + k;
+      return at(key.source(), "unknown key '" + std::string(key.str()) + "' in " + where +
+                                  (near.empty() ? " (known: " + list + ")" : near));
     }
     return success();
   }
@@ -112,21 +113,6 @@ Status read_validation(const Reader& r, const toml::table& t, const std::string&
   return success();
 }
 
-// png_compression = "fast" | "default" | "small" | a level 0 to 12 (as --png-compression takes it).
-Status read_png_compression(const Reader& r, const toml::table& t, const std::string& where, int& level) {
-  const toml::node* node = t.get("png_compression");
-  if (!node) return success();
-  std::optional<int> parsed;
-  if (auto name = node->value<std::string>()) {
-    parsed = image::png_level_from_name(*name);
-  } else if (auto number = node->is_integer() ? node->value<std::int64_t>() : std::nullopt) {
-    if (*number >= 0 && *number <= image::kPngLevelSmallest) parsed = int(*number);
-  }
-  if (!parsed) return r.at(*node, where + "png_compression: \"fast\", \"default\", \"small\" or a level 0 to 12");
-  level = *parsed;
-  return success();
-}
-
 // A TOML value as a parameter takes it (params::accept then checks its kind).
 Result<params::Value> toml_value(const toml::node& node) {
   if (auto b = node.value_exact<bool>()) return params::Value(*b);
@@ -138,24 +124,17 @@ Result<params::Value> toml_value(const toml::node& node) {
   return Error{"", "a number, a string or true/false expected"};
 }
 
-// The keys of `t` that a parameter group describes (`where` names the table: "scenes.s.ao"): each
-// value checked and stored by its parameter, an older key read with a note, an unknown key an
-// error that suggests the nearest names; then the group's rules across its parameters.
+// The keys of `t` that a parameter group describes (`where` names the table: "scenes.s.ao"), and
+// no others: each value checked and stored by its parameter, an older key read with a note; then
+// the group's rules across its parameters. Errors are at the value's line and column.
 template <class T>
-Status read_params(const Reader& r, const toml::table& t, const std::string& where, const params::Group<T>& group,
-                   T& target, std::vector<std::string>& notes) {
+Status read_params_in(const Reader& r, const toml::table& t, const std::string& where, const params::Group<T>& group,
+                      T& target, std::vector<std::string>& notes) {
   std::set<std::string> given;
   for (const auto& [key, node] : t) {
     const std::string name(key.str());
     const params::Param<T>* p = group.find_key(name);
-    if (!p) {
-      std::vector<std::string> known;
-      for (const params::Spec* spec : group.specs()) known.push_back(spec->name);
-      const std::string near = did_you_mean(name, known);
-      std::string list;
-      for (const std::string& k : known) list += (list.empty() ? "" : ", ") + k;
-      return r.at(key.source(), "unknown key '" + name + "' in " + where + (near.empty() ? " (known: " + list + ")" : near));
-    }
+    if (!p) continue;
     if (name != p->spec.name) {
       notes.push_back(r.origin(key.source()) + ": " + where + "." + name + " is now called " + p->spec.name +
                       " (the old name still works)");
@@ -173,6 +152,32 @@ Status read_params(const Reader& r, const toml::table& t, const std::string& whe
               (s.error().path.empty() ? where : s.error().path) + ": " + s.error().message);
 }
 
+// The keys a group describes, with their older names: for a table that holds other keys too.
+template <class T>
+std::vector<std::string> keys_of(const params::Group<T>& group) {
+  std::vector<std::string> keys;
+  for (const params::Spec* spec : group.specs()) {
+    keys.push_back(spec->name);
+    keys.insert(keys.end(), spec->aliases.begin(), spec->aliases.end());
+  }
+  return keys;
+}
+
+template <class T>
+std::vector<std::string> with_keys_of(const params::Group<T>& group, std::vector<std::string> keys) {
+  const std::vector<std::string> more = keys_of(group);
+  keys.insert(keys.end(), more.begin(), more.end());
+  return keys;
+}
+
+// A table that holds a group's keys and no others: an unknown key suggests the nearest names.
+template <class T>
+Status read_params(const Reader& r, const toml::table& t, const std::string& where, const params::Group<T>& group,
+                   T& target, std::vector<std::string>& notes) {
+  if (Status s = r.known_keys(t, where, keys_of(group)); !s) return s;
+  return read_params_in(r, t, where, group, target, notes);
+}
+
 // layout = "gltf-orm" (a preset) or "layouts/mine" / "layouts/mine.json" (a file beside the manifest).
 Result<std::optional<LayoutChoice>> read_layout(const Reader& r, const toml::table& t, std::string_view key,
                                                 const std::string& where, const fs::path& folder) {
@@ -188,15 +193,16 @@ Result<std::optional<LayoutChoice>> read_layout(const Reader& r, const toml::tab
 
 Result<MaterialSpec> read_material(const Reader& r, const std::string& name, const toml::node& node,
                                    const Manifest& m, color::Transfer transfer, const ValidationRules& rules,
-                                   int png_level) {
+                                   const image::Encoding& encoding, std::vector<std::string>& notes) {
   const std::string where = "materials." + name;
   const toml::table* t = node.as_table();
   if (!t) return r.at(node, where + " must be a table");
   if (!is_file_name_safe(name)) {
     return r.at(node, "material name '" + name + "': letters, digits, '_', '-' and '.' only (it names files)");
   }
-  if (Status s = r.known_keys(*t, where, {"sources", "packed", "transfer", "decode", "resize", "layout", "format", "bits",
-                                          "png_compression", "mapping", "reference", "validate"});
+  if (Status s = r.known_keys(*t, where, with_keys_of(image::encoding_params(),
+                                                      {"sources", "packed", "transfer", "decode", "resize", "layout",
+                                                       "format", "bits", "mapping", "reference", "validate"}));
       !s) {
     return s.error();
   }
@@ -206,8 +212,8 @@ Result<MaterialSpec> read_material(const Reader& r, const std::string& name, con
   r.record(*t, "", spec.origins);
   spec.transfer = transfer;
   spec.validation = rules;
-  spec.png_level = png_level;
-  if (Status s = read_png_compression(r, *t, where + ".", spec.png_level); !s) return s.error();
+  spec.encoding = encoding;
+  if (Status s = read_params_in(r, *t, where, image::encoding_params(), spec.encoding, notes); !s) return s.error();
   std::string bits;
   for (Status s : {r.get_name(*t, "transfer", where, color::kTransferNames, spec.transfer),
                    r.get_name(*t, "decode", where, color::kTransferNames, spec.decode),
@@ -285,17 +291,22 @@ Result<MaterialSpec> read_material(const Reader& r, const std::string& name, con
 }
 
 Result<SceneSpec> read_scene(const Reader& r, const std::string& name, const toml::node& node, const Manifest& m,
-                             std::vector<std::string>& notes) {
+                             const image::Encoding& encoding, std::vector<std::string>& notes) {
   const std::string where = "scenes." + name;
   const toml::table* t = node.as_table();
   if (!t) return r.at(node, where + " must be a table");
   if (!is_file_name_safe(name)) return r.at(node, "scene name '" + name + "': letters, digits, '_', '-' and '.' only");
-  if (Status s = r.known_keys(*t, where, {"input", "output", "materials", "match_names", "ao", "dielectric_f0", "orm",
-                                          "mapping"});
+  if (Status s = r.known_keys(*t, where, with_keys_of(image::encoding_params(),
+                                                      {"input", "output", "materials", "match_names", "ao",
+                                                       "dielectric_f0", "orm", "mapping"}));
       !s) {
     return s.error();
   }
   SceneSpec spec;
+  spec.options.encoding = encoding;
+  if (Status s = read_params_in(r, *t, where, image::encoding_params(), spec.options.encoding, notes); !s) {
+    return s.error();
+  }
   spec.name = name;
   spec.origins.by_key[""] = r.origin(node.source());
   r.record(*t, "", spec.origins);
@@ -359,7 +370,10 @@ Result<Manifest> parse_manifest(std::string_view toml_text, const fs::path& file
                        std::to_string(e.source().begin.column),
                    "not valid TOML: " + std::string(e.description())};
     }
-    if (Status s = r.known_keys(doc, "the manifest", {"output", "table", "transfer", "png_compression", "validate", "materials", "scenes"}); !s) {
+    if (Status s = r.known_keys(doc, "the manifest", with_keys_of(image::encoding_params(),
+                                                                  {"output", "table", "transfer", "validate", "materials",
+                                                                   "scenes"}));
+        !s) {
       return s.error();
     }
     m.origins.by_key[""] = file.string();
@@ -373,8 +387,8 @@ Result<Manifest> parse_manifest(std::string_view toml_text, const fs::path& file
     if (!table.empty()) m.table = m.folder / table;
     color::Transfer transfer = MaterialSpec{}.transfer;
     if (Status s = r.get_name(doc, "transfer", "manifest", color::kTransferNames, transfer); !s) return s.error();
-    int png_level = MaterialSpec{}.png_level;
-    if (Status s = read_png_compression(r, doc, "", png_level); !s) return s.error();
+    image::Encoding encoding;  // for every material and scene, each of which may say otherwise
+    if (Status s = read_params_in(r, doc, "manifest", image::encoding_params(), encoding, m.notes); !s) return s.error();
     ValidationRules rules;
     if (const toml::node* v = doc.get("validate")) {
       if (!v->is_table()) return r.at(*v, "validate must be a table");
@@ -383,7 +397,7 @@ Result<Manifest> parse_manifest(std::string_view toml_text, const fs::path& file
     if (const toml::node* mats = doc.get("materials")) {
       if (!mats->is_table()) return r.at(*mats, "materials must be a table of tables: [materials.NAME]");
       for (const auto& [key, value] : *mats->as_table()) {
-        auto spec = read_material(r, std::string(key.str()), value, m, transfer, rules, png_level);
+        auto spec = read_material(r, std::string(key.str()), value, m, transfer, rules, encoding, m.notes);
         if (!spec) return spec.error();
         m.materials.push_back(std::move(*spec));
       }
@@ -391,7 +405,7 @@ Result<Manifest> parse_manifest(std::string_view toml_text, const fs::path& file
     if (const toml::node* scenes = doc.get("scenes")) {
       if (!scenes->is_table()) return r.at(*scenes, "scenes must be a table of tables: [scenes.NAME]");
       for (const auto& [key, value] : *scenes->as_table()) {
-        auto spec = read_scene(r, std::string(key.str()), value, m, m.notes);
+        auto spec = read_scene(r, std::string(key.str()), value, m, encoding, m.notes);
         if (!spec) return spec.error();
         m.scenes.push_back(std::move(*spec));
       }

@@ -5,6 +5,7 @@
 
 #include "../gltf/document.hpp"
 #include "state.hpp"
+#include "matbake/encoding_params.hpp"
 #include "matbake/materials.hpp"
 #include "matbake/near_names.hpp"
 #include "matbake/output_check.hpp"
@@ -23,13 +24,14 @@ fs::path normalized(const fs::path& p) {
 
 // Everything in a material's spec that decides its outputs, for the stamp.
 nlohmann::json material_options(const MaterialSpec& m, const Manifest& manifest) {
+  nlohmann::json options = params::to_json(image::encoding_params(), m.encoding);
   nlohmann::json sources = nlohmann::json::object();
   for (const pack::SourceInput& s : m.sources) {
     sources[s.name] = s.file.empty() ? nlohmann::json(s.constant) : nlohmann::json(normalized(s.file).string());
   }
   std::vector<std::string> packed;
   for (const fs::path& f : m.packed_files) packed.push_back(normalized(f).string());
-  return {{"sources", sources},
+  options.update(nlohmann::json{{"sources", sources},
           {"packed", {{"layout", m.packed ? m.packed->reference : ""}, {"files", packed}}},
           {"transfer", color::transfer_name(m.transfer)},
           {"decode", m.decode ? color::transfer_name(*m.decode) : ""},
@@ -37,7 +39,6 @@ nlohmann::json material_options(const MaterialSpec& m, const Manifest& manifest)
           {"layout", m.layout ? m.layout->reference : ""},
           {"format", m.format},
           {"bits", m.bits ? image::sample_type_name(*m.bits) : "default"},
-          {"png_level", m.png_level},
           {"mapping", workflow::roughness_mapping_name(m.mapping)},
           {"reference", m.reference},
           {"table", manifest.table.string()},
@@ -46,7 +47,8 @@ nlohmann::json material_options(const MaterialSpec& m, const Manifest& manifest)
             {"tolerance", m.validation.options.tolerance},
             {"max_violations", m.validation.options.max_violations},
             {"worst", m.validation.options.worst_count},
-            {"heatmap", m.validation.heatmap}}}};
+            {"heatmap", m.validation.heatmap}}}});
+  return options;
 }
 
 std::vector<fs::path> material_inputs(const MaterialSpec& m, const Manifest& manifest) {

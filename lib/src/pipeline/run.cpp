@@ -198,7 +198,7 @@ Status run_material(const Job& job, const JobContext& ctx, JobReport& report) {
       }
       const std::vector<std::string> outputs(job.outputs.begin(), job.outputs.begin() + std::ptrdiff_t(layout->textures.size()));
       auto written = pack::write_textures(*layout, converts ? in_workflow->maps : *maps,
-                                          {outputs, m.bits, m.transfer, decoded_files(m), {}, m.png_level});
+                                          {outputs, m.bits, m.transfer, decoded_files(m), {}, m.encoding});
       if (!written) return written.error();
     }
     if (m.validation.enabled) return validate_material(m, *maps, ctx, job.outputs, report);

@@ -2,6 +2,7 @@
 
 #include "matbake/ao_params.hpp"
 #include "matbake/atomic_file.hpp"
+#include "matbake/encoding_params.hpp"
 
 namespace matbake {
 namespace {
@@ -101,10 +102,12 @@ nlohmann::json to_json(const exporter::TextureReport& t) {
 }
 
 nlohmann::json to_json(const exporter::Options& o) {
-  return {{"dielectric_f0", exporter::dielectric_f0_name(o.dielectric_f0)},
-          {"mapping", workflow::roughness_mapping_name(o.mapping)},
-          {"orm", o.pack_orm},
-          {"ao", o.ao ? to_json(*o.ao) : nlohmann::json(nullptr)}};
+  nlohmann::json j = params::to_json(image::encoding_params(), o.encoding);
+  j.update(nlohmann::json{{"dielectric_f0", exporter::dielectric_f0_name(o.dielectric_f0)},
+                          {"mapping", workflow::roughness_mapping_name(o.mapping)},
+                          {"orm", o.pack_orm},
+                          {"ao", o.ao ? to_json(*o.ao) : nlohmann::json(nullptr)}});
+  return j;
 }
 
 }  // namespace matbake
