@@ -41,9 +41,6 @@ Result<std::vector<fs::path>> output_paths(const ConvertSettings& s, bool target
       return Error{in, "would be written to " + outputs.back().string() + " as " + it->second + " is", true};
     }
   }
-  std::error_code ec;
-  fs::create_directories(s.out_dir, ec);
-  if (ec) return Error{s.out_dir, "cannot create the output folder: " + ec.message()};
   return outputs;
 }
 

@@ -1,11 +1,40 @@
 #include <tbb/global_control.h>
 
 #include <memory>
+#include <optional>
 
 #include "commands.hpp"
 #include "interrupt.hpp"
 #include "matbake/image.hpp"
+#include "matbake/near_names.hpp"
 #include "matbake/version.hpp"
+
+namespace {
+
+// An option the command does not have, with the nearest ones it does: "unknown option --samplez;
+// did you mean --samples or --sampler?".
+std::optional<std::string> unknown_option(const CLI::App& app, const CLI::ParseError& e) {
+  if (!dynamic_cast<const CLI::ExtrasError*>(&e)) return std::nullopt;
+  for (const CLI::App* command : app.get_subcommands()) {
+    std::vector<std::string> known;
+    for (const CLI::App* scope : {command, &app}) {
+      for (const CLI::Option* option : scope->get_options()) {
+        for (const std::string& name : option->get_lnames()) known.push_back("--" + name);
+      }
+    }
+    std::vector<std::string> args = command->remaining();
+    const std::vector<std::string> passed_up = app.remaining();  // extras a subcommand hands to its parent
+    args.insert(args.end(), passed_up.begin(), passed_up.end());
+    for (std::string arg : args) {
+      if (!arg.starts_with("--")) continue;
+      arg = arg.substr(0, arg.find('='));
+      return "unknown option " + arg + " for " + command->get_name() + matbake::did_you_mean(arg, known);
+    }
+  }
+  return std::nullopt;
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   using namespace matbake::cli;
@@ -53,6 +82,7 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
+    if (auto unknown = unknown_option(app, e)) return report_error(matbake::Error{"", *unknown + " (see matbake --help)", true});
     std::string message = e.what();
     message = message.substr(0, message.find('\n'));
     return report_error(matbake::Error{"", message + " (see matbake --help)", true});

@@ -146,10 +146,13 @@ TEST(CliConvert, BadInputsExitOneWithOneLineNamingTheFile) {
   const auto same = matbake({"convert", (dir / "good.png").string(), "-o", (dir / "good.png").string()});
   EXPECT_EQ(same.exit_code, 2);  // a usage error, as for every command
   expect_one_error_line(same, (dir / "good.png").string(), "is an input; matbake never overwrites its inputs");
-  // Output folder missing, or a file.
-  const auto no_folder = matbake({"convert", (dir / "good.png").string(), "-o", (dir / "none/x.exr").string()});
+  // An output folder that cannot be made (under a file); a missing one is made.
+  const auto no_folder = matbake({"convert", (dir / "good.png").string(), "-o", (dir / "good.png/x.exr").string()});
   EXPECT_EQ(no_folder.exit_code, 1);
-  expect_one_error_line(no_folder, (dir / "none/x.exr").string(), "output folder does not exist");
+  expect_one_error_line(no_folder, (dir / "good.png/x.exr").string(), "cannot make the output folder: ");
+  const auto new_folder = matbake({"convert", (dir / "good.png").string(), "-o", (dir / "made/x.exr").string()});
+  EXPECT_EQ(new_folder.exit_code, 0) << new_folder.err;
+  EXPECT_TRUE(fs::is_regular_file(dir / "made/x.exr"));
   EXPECT_EQ(read_bytes(dir / "good.png"), good);
 }
 

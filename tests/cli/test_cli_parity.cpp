@@ -359,6 +359,21 @@ TEST_F(Parity, ScenePngsHonourTheCompression) {
   }
 }
 
+// A misspelt name gets the nearest ones, from the command line as from the manifest.
+TEST_F(Parity, UnknownNamesSuggestTheNearest) {
+  const RunResult flag = matbake({"export", "in.gltf", "-o", "out.glb", "--ao-sample", "3"});
+  EXPECT_EQ(flag.exit_code, 2);
+  EXPECT_EQ(flag.err, "matbake: error: unknown option --ao-sample for export; did you mean --ao-samples or --ao-sampler? "
+                      "(see matbake --help)\n");
+  const RunResult far = matbake({"bake-ao", "in.gltf", "--qwertyuiop"});
+  EXPECT_EQ(far.err, "matbake: error: unknown option --qwertyuiop for bake-ao (see matbake --help)\n");
+  write_bytes(dir / "assets.toml", "png_compresion = 3\n");
+  const RunResult key = matbake({"build", (dir / "assets.toml").string()});
+  EXPECT_EQ(key.exit_code, 1);
+  EXPECT_EQ(key.err, "matbake: error: " + (dir / "assets.toml").string() +
+                         ":1:1: unknown key 'png_compresion' in the manifest; did you mean png_compression?\n");
+}
+
 // The manifest's texture keys are checked as the command line's options are.
 TEST_F(Parity, ManifestTextureKeysAreChecked) {
   for (const char* f : {"showroom.gltf", "showroom.bin"}) fs::copy_file(kExamples / f, dir / f);

@@ -309,10 +309,12 @@ TEST(ImageIo, FailedWriteLeavesTheExistingOutputAndNoTemporaryFile) {
   EXPECT_EQ(test::read_bytes(dir / "out.xyz"), "previous good output");
   EXPECT_EQ(list_folder(dir.path()), (std::vector<std::string>{"in.png", "out.xyz"}));
 
-  // A folder that does not exist: a clean error, nothing created.
-  Status missing = write_image(*image, dir / "no" / "out.exr", {});
-  ASSERT_FALSE(missing);
-  EXPECT_EQ(missing.error().message, "output folder does not exist");
+  // A folder that does not exist is made; one that cannot be (under a file) is a clean error.
+  EXPECT_TRUE(write_image(*image, dir / "new" / "sub" / "out.exr", {}));
+  EXPECT_TRUE(std::filesystem::is_regular_file(dir / "new" / "sub" / "out.exr"));
+  Status under_file = write_image(*image, dir / "in.png" / "out.exr", {});
+  ASSERT_FALSE(under_file);
+  EXPECT_EQ(under_file.error().message.rfind("cannot make the output folder: ", 0), 0u) << under_file.error().message;
 }
 
 TEST(ImageIo, WritesAreDeterministic) {

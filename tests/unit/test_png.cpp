@@ -232,8 +232,11 @@ TEST(Png, FileWritesMatchMemoryEncodesAndAreAtomic) {
   const std::string on_disk((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
   EXPECT_EQ(on_disk, encode_image(image, "x.png", options).value());
   EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir.path()), std::filesystem::directory_iterator()), 1);
-  // A folder that does not exist: an error naming the file, nothing written.
-  EXPECT_FALSE(write_image(image, dir / "missing" / "a.png", options));
+  // A folder that cannot be made (under a file): an error naming the file, nothing written.
+  const auto under_file = write_image(image, dir / "a.png" / "b.png", options);
+  ASSERT_FALSE(under_file);
+  EXPECT_EQ(under_file.error().path, (dir / "a.png" / "b.png").string());
+  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir.path()), std::filesystem::directory_iterator()), 1);
 }
 
 }  // namespace

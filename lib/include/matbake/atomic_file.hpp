@@ -11,7 +11,8 @@ namespace matbake {
 
 class AtomicFile {
  public:
-  // Fails when the target's folder does not exist or is not writable.
+  // Makes the target's folder when it is missing (every output of every command); fails when it
+  // cannot be made or is not writable.
   static Result<AtomicFile> create(const std::filesystem::path& target);
 
   AtomicFile(AtomicFile&& other) noexcept;

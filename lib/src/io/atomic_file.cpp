@@ -63,7 +63,13 @@ Result<AtomicFile> AtomicFile::create(const fs::path& target) {
   std::error_code ec;
   if (fs::is_directory(target, ec)) return Error{target.string(), "is a folder, not a file"};
   const fs::path folder = target.has_parent_path() ? target.parent_path() : fs::path(".");
-  if (!fs::is_directory(folder, ec)) return Error{target.string(), "output folder does not exist"};
+  // The one rule for every output of every command: a missing folder is made (as mkdir -p does).
+  if (!fs::is_directory(folder, ec)) {
+    fs::create_directories(folder, ec);
+    if (ec || !fs::is_directory(folder)) {
+      return Error{target.string(), "cannot make the output folder: " + (ec ? ec.message() : "not a folder")};
+    }
+  }
 
   // Hidden, unique within the process and across processes, same extension as the target.
   static std::atomic<unsigned> counter{0};

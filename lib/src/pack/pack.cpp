@@ -404,8 +404,6 @@ Result<std::vector<fs::path>> write_maps(const material::Maps& maps, const Unpac
     std::vector<NamedOutput> outputs;
     for (const auto& [name, map] : maps.maps) outputs.push_back({request.folder / (name + "." + request.format), name});
     if (Status s = check_outputs(outputs, request.inputs); !s) return s.error();
-    std::error_code ec;
-    fs::create_directories(request.folder, ec);
     std::vector<fs::path> written;
     for (const NamedOutput& out : outputs) {
       const bool colour = material::find_source(out.role)->kind == material::SourceKind::color;
