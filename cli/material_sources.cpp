@@ -22,23 +22,6 @@ std::string option_of(std::string_view source) {
 
 }  // namespace
 
-std::optional<std::vector<double>> parse_numbers(const std::string& text) {
-  std::vector<double> values;
-  std::stringstream in(text);
-  std::string part;
-  while (std::getline(in, part, ',')) {
-    try {
-      std::size_t used = 0;
-      values.push_back(std::stod(part, &used));
-      if (used != part.size()) return std::nullopt;
-    } catch (const std::exception&) {
-      return std::nullopt;
-    }
-  }
-  if (values.empty()) return std::nullopt;
-  return values;
-}
-
 Result<color::Transfer> parse_transfer(const std::string& name, const char* option) {
   auto t = color::transfer_from_name(name);
   if (!t) return Error{"", std::string(option) + " '" + name + "': use srgb, gamma2.2 or linear", true};
@@ -88,20 +71,9 @@ Result<material::Maps> gather_sources(const SourceSettings& s) {
   for (std::size_t i = 0; i < sources.size(); ++i) {
     const std::string& text = s.values[i];
     if (text.empty()) continue;
-    pack::SourceInput input{std::string(sources[i].name), {}, {}};
-    std::error_code ec;
-    auto numbers = parse_numbers(text);
-    if (numbers && !fs::exists(text, ec)) {
-      for (double v : *numbers) {
-        if (!material::is_valid_constant(v)) {
-          return Error{"", option_of(sources[i].name) + " '" + text + "': values are in [0, 1]", true};
-        }
-      }
-      input.constant = *numbers;
-    } else {
-      input.file = text;
-    }
-    inputs.push_back(std::move(input));
+    auto input = pack::source_from_text(sources[i].name, text, {});
+    if (!input) return Error{"", option_of(sources[i].name) + ": " + input.error().message, true};
+    inputs.push_back(std::move(*input));
   }
   material::Maps maps;
   {
@@ -145,7 +117,9 @@ void add_output_options(CLI::App& cmd, OutputSettings& o, const std::string& wha
 std::vector<std::filesystem::path> input_files(const SourceSettings& inputs) {
   std::vector<std::filesystem::path> files(inputs.inputs.begin(), inputs.inputs.end());
   for (const std::string& v : inputs.values) {
-    if (!v.empty() && !parse_numbers(v)) files.emplace_back(v);
+    if (auto source = v.empty() ? Result<pack::SourceInput>(Error{}) : pack::source_from_text("", v, {}); source && !source->file.empty()) {
+      files.push_back(source->file);
+    }
   }
   return files;
 }

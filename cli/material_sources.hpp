@@ -43,7 +43,5 @@ Result<std::vector<std::string>> write_textures(const pack::Layout& layout, cons
                                                 const OutputSettings& o, const SourceSettings& inputs,
                                                 std::vector<NamedOutput> also = {});
 Result<color::Transfer> parse_transfer(const std::string& name, const char* option);
-// "0.5" or "0.9,0.6,0.2": the numbers, or nothing when `text` is not a list of numbers.
-std::optional<std::vector<double>> parse_numbers(const std::string& text);
 
 }  // namespace matbake::cli

@@ -104,6 +104,22 @@ TEST(BuildManifest, EveryKeyReachesItsField) {
   EXPECT_EQ(room.options.ao->into, ao::Into::attribute);
 }
 
+// A source written as text follows the command line's rule: numbers are a constant, anything else a
+// file beside the manifest ("./0.5" for a file of that name).
+TEST(BuildManifest, SourceTextIsNumbersOrAFileAsOnTheCommandLine) {
+  auto m = pipeline::parse_manifest("[materials.a]\nsources = { gloss = \"0.5\", kd = \"0.9,0.6,0.2\", ks = \"./0.04\" }\n",
+                                    "/p/m.toml");
+  ASSERT_TRUE(m) << m.error().to_string();
+  const auto& sources = m->materials[0].sources;
+  EXPECT_EQ(sources[0].constant, std::vector<double>{0.5});
+  EXPECT_EQ(sources[1].constant, (std::vector<double>{0.9, 0.6, 0.2}));
+  EXPECT_TRUE(sources[2].constant.empty());
+  EXPECT_EQ(sources[2].file.lexically_normal(), fs::path("/p/0.04"));
+  auto bad = pipeline::parse_manifest("[materials.a]\nsources = { gloss = \"1.5\" }\n", "/p/m.toml");
+  ASSERT_FALSE(bad);
+  EXPECT_EQ(bad.error().to_string(), "/p/m.toml:2:21: materials.a.sources.gloss: '1.5': values are in [0, 1]");
+}
+
 // Each bad manifest: the error names the file with line and column and says what is wrong.
 TEST(BuildManifest, ErrorsSayWhereAndWhat) {
   struct Case {

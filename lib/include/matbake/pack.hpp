@@ -61,6 +61,11 @@ struct SourceInput {
   std::vector<double> constant; // linear values: 1 (scalar, or grey) or 3 (colour)
 };
 
+// A source as text, the one rule of both doors: one number or three ("0.5", "0.9,0.6,0.2") are a
+// constant (linear, in [0, 1]), anything else a file relative to `folder` (write "./0.5" for a file
+// of that name). Errors say what is wrong with the text, not where it came from.
+Result<SourceInput> source_from_text(std::string_view name, const std::string& text, const std::filesystem::path& folder);
+
 // Decodes a file (read_image, or a cache in front of it that decodes each file once).
 using ImageReader = std::function<Result<std::shared_ptr<const image::Image>>(const std::filesystem::path&, color::Transfer)>;
 

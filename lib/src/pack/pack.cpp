@@ -3,6 +3,8 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cmath>
+#include <cstdlib>
 #include <array>
 #include <fstream>
 #include <sstream>
@@ -171,6 +173,36 @@ Result<ResolvedLayout> resolve_layout(const std::string& reference, const fs::pa
   auto layout = parse_layout(text, file.string());
   if (!layout) return layout.error();
   return ResolvedLayout{std::move(*layout), file};
+}
+
+Result<SourceInput> source_from_text(std::string_view name, const std::string& text, const fs::path& folder) {
+  SourceInput input{std::string(name), {}, {}};
+  std::vector<double> numbers;
+  for (std::size_t start = 0; start <= text.size();) {
+    const std::size_t comma = std::min(text.find(',', start), text.size());
+    const std::string part = text.substr(start, comma - start);
+    char* end = nullptr;
+    const double v = std::strtod(part.c_str(), &end);
+    if (part.empty() || end != part.c_str() + part.size() || std::isspace(static_cast<unsigned char>(part[0]))) {
+      numbers.clear();
+      break;
+    }
+    numbers.push_back(v);
+    start = comma + 1;
+  }
+  if (numbers.empty()) {
+    if (text.empty()) return Error{"", "a file name or 1 or 3 numbers expected", true};
+    input.file = folder / text;
+    return input;
+  }
+  if (numbers.size() != 1 && numbers.size() != 3) {
+    return Error{"", "'" + text + "': 1 or 3 numbers expected, got " + std::to_string(numbers.size()), true};
+  }
+  for (double v : numbers) {
+    if (!material::is_valid_constant(v)) return Error{"", "'" + text + "': values are in [0, 1]", true};
+  }
+  input.constant = std::move(numbers);
+  return input;
 }
 
 Result<Layout> find_layout(const std::string& name_or_path) {

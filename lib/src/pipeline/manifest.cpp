@@ -252,8 +252,10 @@ Result<MaterialSpec> read_material(const Reader& r, const std::string& name, con
         return r.at(key.source(), where + ".sources: unknown source '" + source + "' (known: " + known + ")");
       }
       pack::SourceInput in{source, {}, {}};
-      if (auto file = value.value<std::string>()) {
-        in.file = m.folder / *file;
+      if (auto text = value.value<std::string>()) {  // a file, or numbers written as text (as on the command line)
+        auto parsed = pack::source_from_text(source, *text, m.folder);
+        if (!parsed) return r.at(value, where + ".sources." + source + ": " + parsed.error().message);
+        in = std::move(*parsed);
       } else if (auto number = value.value<double>()) {
         if (!material::is_valid_constant(*number)) return r.at(value, where + ".sources." + source + ": values are in [0, 1]");
         in.constant = {*number};
