@@ -4,6 +4,7 @@
 
 #include "commands.hpp"
 #include "matbake/encoding_params.hpp"
+#include "matbake/export_params.hpp"
 #include "params_cli.hpp"
 #include "option_names.hpp"
 #include "material_sources.hpp"
@@ -60,12 +61,7 @@ CLI::App* setup_export(CLI::App& app, ExportSettings& s) {
                   "NAME=A.png,B.png: material NAME (or its index) from a Schüler pair; NAME=LAYOUT:FILE,... from\n"
                   "any pack layout's textures (e.g. gltf-metal-rough:base.png,mr.png). Repeatable");
   add_name_option(*cmd, "--transfer", s.transfer, color::kTransferNames, "How 8-bit colour in --material files was authored");
-  add_name_option(*cmd, "--mapping", s.options.mapping, workflow::kRoughnessMappingNames, "Gloss -> roughness");
-  add_name_option(*cmd, "--dielectric-f0", s.options.dielectric_f0, exporter::kDielectricF0Names,
-                  "A converted dielectric whose F0 is not 0.04: KHR_materials_specular, KHR_materials_ior, or\n"
-                  "none (core glTF's 0.04)");
-  cmd->add_flag_callback("--no-orm", [&s] { s.options.pack_orm = false; },
-                         "Keep occlusion and metallic-roughness textures apart");
+  add_params(*cmd, exporter::options_params(), s.options, "", "Options");
   add_params(*cmd, image::encoding_params(), s.options.encoding, "", "Options");
   add_ao_options(*cmd, s.ao, "ao-");  // AO is baked when any of them is given, as a manifest's ao = { ... }
   cmd->add_option("--report", s.report, "Also write the report as JSON to this file");

@@ -23,9 +23,10 @@ void add_params(CLI::App& cmd, const params::Group<T>& group, T& target, const s
     std::string help = p.spec.help;
     if (p.spec.kind == params::Kind::choice) help += ": " + params::type_text(p.spec);
     if (!p.spec.needs.empty()) help += " (with --" + prefix + p.spec.needs + ")";
-    if (p.spec.kind == params::Kind::flag) {
-      cmd.add_flag_callback(flag, [&p, &target, given] {
-           (void)params::apply(p, target, params::Value(true));
+    if (p.spec.kind == params::Kind::flag) {  // on by default: --no-NAME turns it off
+      const bool on = defaults.at(p.spec.name) == true;
+      cmd.add_flag_callback(on ? "--no-" + flag.substr(2) : flag, [&p, &target, given, on] {
+           (void)params::apply(p, target, params::Value(!on));
            if (given) given->insert(p.spec.name);
          }, help)
           ->group(help_group);

@@ -6,8 +6,10 @@
 #include <cstdlib>
 
 #include "cli/ao_options.hpp"
+#include "cli/params_cli.hpp"
 #include "matbake/ao_params.hpp"
 #include "matbake/encoding_params.hpp"
+#include "matbake/export_params.hpp"
 #include "matbake/params.hpp"
 #include "matbake/pipeline.hpp"
 #include "support/files.hpp"
@@ -118,6 +120,34 @@ TEST(AoParams, EveryParameterReachesTheRequestFromBothDoorsAndRoundTripsThroughT
   }
 }
 
+// A group whose keys a manifest scene holds directly: each parameter at its example through the
+// command line's flags and the scene's key, the two requests' stamps equal and not the default's.
+template <class T, class Of>
+void walk_scene_keys(const Group<T>& group, Of of) {
+  const nlohmann::json defaults = to_json(group, T{});
+  for (const Param<T>& p : group.params) {
+    SCOPED_TRACE(p.spec.name);
+    CLI::App app;
+    T from_flags;
+    cli::add_params(app, group, from_flags, "", "Options");
+    const bool on = p.spec.kind == Kind::flag && defaults.at(p.spec.name) == true;
+    std::vector<std::string> args = {on ? "--no-" + flag_name(p.spec, "").substr(2) : flag_name(p.spec, "")};
+    if (p.spec.kind != Kind::flag) args.push_back(p.spec.example);
+    std::reverse(args.begin(), args.end());
+    app.parse(args);
+    auto m = pipeline::parse_manifest("[scenes.s]\ninput = \"s.gltf\"\n" + p.spec.name + " = " + test::toml_literal(p.spec) + "\n",
+                                      "/p/assets.toml");
+    ASSERT_TRUE(m) << m.error().to_string();
+    EXPECT_EQ(to_json(group, from_flags), to_json(group, of(m->scenes[0])));
+    EXPECT_NE(to_json(group, from_flags).at(p.spec.name), defaults.at(p.spec.name));
+  }
+}
+
+TEST(SceneParams, EveryExportAndEncodingParameterReachesTheSceneFromBothDoors) {
+  walk_scene_keys(exporter::options_params(), [](const pipeline::SceneSpec& s) { return s.options; });
+  walk_scene_keys(image::encoding_params(), [](const pipeline::SceneSpec& s) { return s.options.encoding; });
+}
+
 TEST(AoParams, OlderManifestKeysAreReadWithANote) {
   auto m = pipeline::parse_manifest("[scenes.s]\ninput = \"s.gltf\"\nao = { distance = 0.1, absolute_distance = 2 }\n",
                                     "/p/assets.toml");
@@ -137,6 +167,7 @@ TEST(DocsTables, MatchTheParameterDescriptions) {
   const Table tables[] = {
       {"docs/build.md", "params:ao", markdown_table(ao::request_params(), "")},
       {"docs/build.md", "params:encoding", markdown_table(image::encoding_params(), "")},
+      {"docs/export.md", "params:export", markdown_table(exporter::options_params(), "")},
   };
   for (const Table& t : tables) {
     const fs::path path = fs::path(MATBAKE_SOURCE_DIR) / t.file;

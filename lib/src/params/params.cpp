@@ -141,7 +141,9 @@ std::string markdown_table(const std::vector<const Spec*>& specs, const nlohmann
   for (const Spec* s : specs) {
     const nlohmann::json& d = defaults.at(s->name);
     const std::string shown = d.is_null() ? "unset" : value_text(d);
-    out += "| `" + flag_name(*s, flag_prefix) + "` | `" + s->name + "` | " + type_text(*s) + " | " + shown + " | " +
+    const bool off_flag = s->kind == Kind::flag && d.is_boolean() && d.get<bool>();
+    const std::string flag = flag_name(*s, flag_prefix);
+    out += "| `" + (off_flag ? "--no-" + flag.substr(2) : flag) + "` | `" + s->name + "` | " + type_text(*s) + " | " + shown + " | " +
            s->help + (s->needs.empty() ? "" : " (with `" + s->needs + "`)") +
            (s->aliases.empty() ? "" : "; older key: `" + s->aliases.front() + "`") + " |\n";
   }

@@ -9,6 +9,7 @@
 
 #include "matbake/ao_params.hpp"
 #include "matbake/encoding_params.hpp"
+#include "matbake/export_params.hpp"
 #include "matbake/near_names.hpp"
 #include "matbake/read_file.hpp"
 #include "matbake/pipeline.hpp"
@@ -299,8 +300,8 @@ Result<SceneSpec> read_scene(const Reader& r, const std::string& name, const tom
   if (!t) return r.at(node, where + " must be a table");
   if (!is_file_name_safe(name)) return r.at(node, "scene name '" + name + "': letters, digits, '_', '-' and '.' only");
   if (Status s = r.known_keys(*t, where, with_keys_of(image::encoding_params(),
-                                                      {"input", "output", "materials", "match_names", "ao",
-                                                       "dielectric_f0", "orm", "mapping"}));
+                                                      with_keys_of(exporter::options_params(),
+                                                                   {"input", "output", "materials", "match_names", "ao"})));
       !s) {
     return s.error();
   }
@@ -315,9 +316,7 @@ Result<SceneSpec> read_scene(const Reader& r, const std::string& name, const tom
   std::string input, output = name + ".glb";
   for (Status s : {r.get(*t, "input", where, input), r.get(*t, "output", where, output),
                    r.get(*t, "match_names", where, spec.match_names),
-                   r.get_name(*t, "dielectric_f0", where, exporter::kDielectricF0Names, spec.options.dielectric_f0),
-                   r.get(*t, "orm", where, spec.options.pack_orm),
-                   r.get_name(*t, "mapping", where, workflow::kRoughnessMappingNames, spec.options.mapping)}) {
+                   read_params_in(r, *t, where, exporter::options_params(), spec.options, notes)}) {
     if (!s) return s.error();
   }
   if (input.empty()) return r.at(node, where + ": input = \"scene.gltf\" is required");

@@ -3,6 +3,7 @@
 #include "matbake/ao_params.hpp"
 #include "matbake/atomic_file.hpp"
 #include "matbake/encoding_params.hpp"
+#include "matbake/export_params.hpp"
 
 namespace matbake {
 namespace {
@@ -102,11 +103,9 @@ nlohmann::json to_json(const exporter::TextureReport& t) {
 }
 
 nlohmann::json to_json(const exporter::Options& o) {
-  nlohmann::json j = params::to_json(image::encoding_params(), o.encoding);
-  j.update(nlohmann::json{{"dielectric_f0", exporter::dielectric_f0_name(o.dielectric_f0)},
-                          {"mapping", workflow::roughness_mapping_name(o.mapping)},
-                          {"orm", o.pack_orm},
-                          {"ao", o.ao ? to_json(*o.ao) : nlohmann::json(nullptr)}});
+  nlohmann::json j = params::to_json(exporter::options_params(), o);
+  j.update(params::to_json(image::encoding_params(), o.encoding));
+  j["ao"] = o.ao ? to_json(*o.ao) : nlohmann::json(nullptr);
   return j;
 }
 

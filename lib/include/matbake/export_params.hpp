@@ -1,0 +1,11 @@
+#pragma once
+// The parameters of exporter::Options that a person sets (its materials and AO come from their own
+// descriptions): `export`'s options and a manifest scene's keys, described once (params.hpp).
+#include "matbake/export.hpp"
+#include "matbake/params.hpp"
+
+namespace matbake::exporter {
+
+const params::Group<Options>& options_params();
+
+}  // namespace matbake::exporter

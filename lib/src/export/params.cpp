@@ -1,0 +1,36 @@
+#include "matbake/export_params.hpp"
+
+namespace matbake::exporter {
+namespace {
+
+params::Group<Options> make_group() {
+  using params::Spec;
+  params::Group<Options> g;
+  g.params = {
+      params::choice<Options>(Spec{.name = "dielectric_f0",
+                                   .help = "A converted dielectric whose F0 is not 0.04: KHR_materials_specular, "
+                                           "KHR_materials_ior, or none (core glTF's 0.04)",
+                                   .example = "ior"},
+                              [](auto& o) -> auto& { return o.dielectric_f0; }, kDielectricF0Names),
+      params::choice<Options>(Spec{.name = "mapping",
+                                   .help = "Gloss → roughness of the glTF's own spec-gloss materials (and of --material "
+                                           "pairs; a manifest material brings its own)",
+                                   .example = "walter"},
+                              [](auto& o) -> auto& { return o.mapping; }, workflow::kRoughnessMappingNames),
+      params::flag<Options>(Spec{.name = "orm",
+                                 .help = "Pack occlusion and metallic-roughness textures of a material into one ORM "
+                                         "texture (--no-orm keeps them apart)",
+                                 .example = "false"},
+                            [](auto& o) -> auto& { return o.pack_orm; }),
+  };
+  return g;
+}
+
+}  // namespace
+
+const params::Group<Options>& options_params() {
+  static const params::Group<Options> group = make_group();
+  return group;
+}
+
+}  // namespace matbake::exporter
