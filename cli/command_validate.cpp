@@ -4,6 +4,8 @@
 #include <filesystem>
 
 #include "commands.hpp"
+#include "matbake/validate_params.hpp"
+#include "params_cli.hpp"
 #include "matbake/materials.hpp"
 #include "matbake/output_check.hpp"
 #include "matbake/report_json.hpp"
@@ -92,14 +94,9 @@ CLI::App* setup_validate(CLI::App& app, ValidateSettings& s) {
   add_source_options(*cmd, s.sources);
   cmd->add_option("--material", s.material, "Also compare with a table entry (see `matbake materials`)");
   cmd->add_option("--materials-table", s.table, "Another table file in the TOML format of presets/materials.toml");
-  cmd->add_option("--tolerance", s.options.tolerance, "With --material: relative tolerance per channel")
-      ->capture_default_str();
-  cmd->add_option("--max-violations", s.options.max_violations, "Flagged share of unmasked texels allowed before exit 3")
-      ->capture_default_str()
-      ->check(CLI::Range(0.0, 1.0));
+  add_params(*cmd, validate::options_params(), s.options, "", "Options");
   cmd->add_option("--heatmap", s.heatmap, "Write a false-colour class map (.png; legend in the README)");
   cmd->add_option("--report", s.report, "Also write the report as JSON to this file (as `matbake build` writes it)");
-  cmd->add_option("--worst", s.options.worst_count, "How many of the worst texels to list")->capture_default_str();
   return cmd;
 }
 

@@ -11,6 +11,7 @@
 #include "matbake/encoding_params.hpp"
 #include "matbake/export_params.hpp"
 #include "matbake/params.hpp"
+#include "matbake/validate_params.hpp"
 #include "matbake/pipeline.hpp"
 #include "support/files.hpp"
 #include "support/param_values.hpp"
@@ -120,6 +121,24 @@ TEST(AoParams, EveryParameterReachesTheRequestFromBothDoorsAndRoundTripsThroughT
   }
 }
 
+TEST(ValidateParams, EveryParameterReachesTheMaterialsValidationFromBothDoors) {
+  const Group<validate::Options>& group = validate::options_params();
+  const nlohmann::json defaults = to_json(group, validate::Options{});
+  for (const Param<validate::Options>& p : group.params) {
+    SCOPED_TRACE(p.spec.name);
+    CLI::App app;
+    validate::Options from_flags;
+    cli::add_params(app, group, from_flags, "", "Options");
+    app.parse(std::vector<std::string>{p.spec.example, flag_name(p.spec, "")});
+    auto m = pipeline::parse_manifest("[materials.a]\nsources = { kd = 0.5 }\nvalidate = { " + p.spec.name + " = " +
+                                          test::toml_literal(p.spec) + " }\n",
+                                      "/p/assets.toml");
+    ASSERT_TRUE(m) << m.error().to_string();
+    EXPECT_EQ(to_json(group, from_flags), to_json(group, m->materials[0].validation.options));
+    EXPECT_NE(to_json(group, from_flags).at(p.spec.name), defaults.at(p.spec.name));
+  }
+}
+
 // A group whose keys a manifest scene holds directly: each parameter at its example through the
 // command line's flags and the scene's key, the two requests' stamps equal and not the default's.
 template <class T, class Of>
@@ -168,6 +187,7 @@ TEST(DocsTables, MatchTheParameterDescriptions) {
       {"docs/build.md", "params:ao", markdown_table(ao::request_params(), "")},
       {"docs/build.md", "params:encoding", markdown_table(image::encoding_params(), "")},
       {"docs/export.md", "params:export", markdown_table(exporter::options_params(), "")},
+      {"docs/validate.md", "params:validate", markdown_table(validate::options_params(), "")},
   };
   for (const Table& t : tables) {
     const fs::path path = fs::path(MATBAKE_SOURCE_DIR) / t.file;

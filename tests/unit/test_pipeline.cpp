@@ -138,7 +138,7 @@ TEST(BuildManifest, ErrorsSayWhereAndWhat) {
       {"[scenes.s]\ninput = \"a.gltf\"\noutput = \"/tmp/a.glb\"\n", "m.toml:3:", "inside the output folder"},
       {"[scenes.s]\ninput = \"a.gltf\"\nao = { samples = 0 }\n", "m.toml:3:", "samples: 1 to"},
       {"[scenes.s]\ninput = \"a.gltf\"\nmaterials = { \"X\" = \"nope\" }\n", "m.toml", "no [materials.nope]"},
-      {"[validate]\nmax_violations = 2.0\n[materials.a]\nsources = { kd = 0.5 }\n", "m.toml:1:", "max_violations in [0, 1]"},
+      {"[validate]\nmax_violations = 2.0\n[materials.a]\nsources = { kd = 0.5 }\n", "m.toml:2:18", "validate.max_violations: 0 to 1"},
       {"output = 3\n", "m.toml:1:", "output: a string expected"},
       // Constants hold texel values, as on the command line (issue "Hostile input").
       {"[materials.a]\nsources = { kd = 0.5, ks = nan }\n", "m.toml:2:28", "materials.a.sources.ks: values are in [0, 1]"},

@@ -11,6 +11,7 @@
 #include "matbake/encoding_params.hpp"
 #include "matbake/export_params.hpp"
 #include "matbake/near_names.hpp"
+#include "matbake/validate_params.hpp"
 #include "matbake/read_file.hpp"
 #include "matbake/pipeline.hpp"
 
@@ -98,21 +99,6 @@ bool is_file_name_safe(const std::string& name) {
   return true;
 }
 
-Status read_validation(const Reader& r, const toml::table& t, const std::string& where, ValidationRules& rules) {
-  if (Status s = r.known_keys(t, where, {"enabled", "tolerance", "max_violations", "heatmap", "worst"}); !s) return s;
-  validate::Options& o = rules.options;
-  std::int64_t worst = std::int64_t(o.worst_count);
-  for (Status s : {r.get(t, "enabled", where, rules.enabled), r.get(t, "tolerance", where, o.tolerance),
-                   r.get(t, "max_violations", where, o.max_violations), r.get(t, "heatmap", where, rules.heatmap),
-                   r.get(t, "worst", where, worst)}) {
-    if (!s) return s;
-  }
-  if (!(o.tolerance > 0) || !(o.max_violations >= 0 && o.max_violations <= 1) || worst < 0) {
-    return r.at(t, where + ": tolerance must be > 0, max_violations in [0, 1] and worst not negative");
-  }
-  o.worst_count = std::size_t(worst);
-  return success();
-}
 
 // A TOML value as a parameter takes it (params::accept then checks its kind).
 Result<params::Value> toml_value(const toml::node& node) {
@@ -179,6 +165,16 @@ Status read_params(const Reader& r, const toml::table& t, const std::string& whe
   return read_params_in(r, t, where, group, target, notes);
 }
 
+Status read_validation(const Reader& r, const toml::table& t, const std::string& where, ValidationRules& rules,
+                       std::vector<std::string>& notes) {
+  if (Status s = r.known_keys(t, where, with_keys_of(validate::options_params(), {"enabled", "heatmap"})); !s) return s;
+  for (Status s : {r.get(t, "enabled", where, rules.enabled), r.get(t, "heatmap", where, rules.heatmap),
+                   read_params_in(r, t, where, validate::options_params(), rules.options, notes)}) {
+    if (!s) return s;
+  }
+  return success();
+}
+
 // layout = "gltf-orm" (a preset) or "layouts/mine" / "layouts/mine.json" (a file beside the manifest).
 Result<std::optional<LayoutChoice>> read_layout(const Reader& r, const toml::table& t, std::string_view key,
                                                 const std::string& where, const fs::path& folder) {
@@ -237,7 +233,7 @@ Result<MaterialSpec> read_material(const Reader& r, const std::string& name, con
   }
   if (const toml::node* v = t->get("validate")) {
     if (!v->is_table()) return r.at(*v, where + ".validate must be a table");
-    if (Status s = read_validation(r, *v->as_table(), where + ".validate", spec.validation); !s) return s.error();
+    if (Status s = read_validation(r, *v->as_table(), where + ".validate", spec.validation, notes); !s) return s.error();
   }
 
   const toml::node* sources = t->get("sources");
@@ -393,7 +389,7 @@ Result<Manifest> parse_manifest(std::string_view toml_text, const fs::path& file
     ValidationRules rules;
     if (const toml::node* v = doc.get("validate")) {
       if (!v->is_table()) return r.at(*v, "validate must be a table");
-      if (Status s = read_validation(r, *v->as_table(), "validate", rules); !s) return s.error();
+      if (Status s = read_validation(r, *v->as_table(), "validate", rules, m.notes); !s) return s.error();
     }
     if (const toml::node* mats = doc.get("materials")) {
       if (!mats->is_table()) return r.at(*mats, "materials must be a table of tables: [materials.NAME]");

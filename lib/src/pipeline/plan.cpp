@@ -6,6 +6,7 @@
 #include "../gltf/document.hpp"
 #include "state.hpp"
 #include "matbake/encoding_params.hpp"
+#include "matbake/validate_params.hpp"
 #include "matbake/materials.hpp"
 #include "matbake/near_names.hpp"
 #include "matbake/output_check.hpp"
@@ -42,12 +43,8 @@ nlohmann::json material_options(const MaterialSpec& m, const Manifest& manifest)
           {"mapping", workflow::roughness_mapping_name(m.mapping)},
           {"reference", m.reference},
           {"table", manifest.table.string()},
-          {"validate",
-           {{"enabled", m.validation.enabled},
-            {"tolerance", m.validation.options.tolerance},
-            {"max_violations", m.validation.options.max_violations},
-            {"worst", m.validation.options.worst_count},
-            {"heatmap", m.validation.heatmap}}}});
+          {"validate", {{"enabled", m.validation.enabled}, {"heatmap", m.validation.heatmap}}}});
+  options["validate"].update(params::to_json(validate::options_params(), m.validation.options));
   return options;
 }
 

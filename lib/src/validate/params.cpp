@@ -1,0 +1,35 @@
+#include <cmath>
+
+#include "matbake/validate_params.hpp"
+
+namespace matbake::validate {
+namespace {
+
+params::Group<Options> make_group() {
+  using params::Spec;
+  params::Group<Options> g;
+  g.params = {
+      params::number<Options>(Spec{.name = "tolerance",
+                                   .help = "With a reference material: relative tolerance of F0 per channel",
+                                   .min = 0, .max = HUGE_VAL, .above_min = true, .example = "0.2"},
+                              [](auto& o) -> auto& { return o.tolerance; }),
+      params::number<Options>(Spec{.name = "max_violations",
+                                   .help = "Flagged share of unmasked texels allowed before the check fails (validate: "
+                                           "exit 3; a build: the job fails)",
+                                   .min = 0, .max = 1, .example = "0.5"},
+                              [](auto& o) -> auto& { return o.max_violations; }),
+      params::integer<Options>(Spec{.name = "worst", .help = "How many of the worst texels the report lists", .min = 0,
+                                    .max = 1e6, .example = "3"},
+                               [](auto& o) -> auto& { return o.worst_count; }),
+  };
+  return g;
+}
+
+}  // namespace
+
+const params::Group<Options>& options_params() {
+  static const params::Group<Options> group = make_group();
+  return group;
+}
+
+}  // namespace matbake::validate
