@@ -1,12 +1,10 @@
 #include "matbake/export_params.hpp"
 
 namespace matbake::exporter {
-namespace {
 
-params::Group<Options> make_group() {
+const params::Group<Options>& options_params() {
   using params::Spec;
-  params::Group<Options> g;
-  g.params = {
+  static const params::Group<Options> group{{
       params::choice<Options>(Spec{.name = "dielectric_f0",
                                    .help = "A converted dielectric whose F0 is not 0.04: KHR_materials_specular, "
                                            "KHR_materials_ior, or none (core glTF's 0.04)",
@@ -22,14 +20,7 @@ params::Group<Options> make_group() {
                                          "texture (--no-orm keeps them apart)",
                                  .example = "false"},
                             [](auto& o) -> auto& { return o.pack_orm; }),
-  };
-  return g;
-}
-
-}  // namespace
-
-const params::Group<Options>& options_params() {
-  static const params::Group<Options> group = make_group();
+  }};
   return group;
 }
 

@@ -1,11 +1,8 @@
 #include "matbake/encoding_params.hpp"
 
 namespace matbake::image {
-namespace {
-
-params::Group<Encoding> make_group() {
-  params::Group<Encoding> g;
-  g.params = {{params::Spec{.name = "png_compression",
+const params::Group<Encoding>& encoding_params() {
+  static const params::Group<Encoding> group{{{params::Spec{.name = "png_compression",
                             .kind = params::Kind::integer_or_text,
                             .help = "Deflate effort of 8/16-bit PNG outputs: fast (level 1), default (6), small (12) or "
                                     "a level 0 to 12 (docs/performance.md has size and time per level)",
@@ -21,14 +18,7 @@ params::Group<Encoding> make_group() {
                  e.png_level = *level;
                  return std::nullopt;
                },
-               [](const Encoding& e) { return nlohmann::json(e.png_level); }}};
-  return g;
-}
-
-}  // namespace
-
-const params::Group<Encoding>& encoding_params() {
-  static const params::Group<Encoding> group = make_group();
+               [](const Encoding& e) { return nlohmann::json(e.png_level); }}}};
   return group;
 }
 

@@ -3,12 +3,9 @@
 #include "matbake/validate_params.hpp"
 
 namespace matbake::validate {
-namespace {
-
-params::Group<Options> make_group() {
+const params::Group<Options>& options_params() {
   using params::Spec;
-  params::Group<Options> g;
-  g.params = {
+  static const params::Group<Options> group{{
       params::number<Options>(Spec{.name = "tolerance",
                                    .help = "With a reference material: relative tolerance of F0 per channel",
                                    .min = 0, .max = HUGE_VAL, .above_min = true, .example = "0.2"},
@@ -21,14 +18,7 @@ params::Group<Options> make_group() {
       params::integer<Options>(Spec{.name = "worst", .help = "How many of the worst texels the report lists", .min = 0,
                                     .max = 1e6, .example = "3"},
                                [](auto& o) -> auto& { return o.worst_count; }),
-  };
-  return g;
-}
-
-}  // namespace
-
-const params::Group<Options>& options_params() {
-  static const params::Group<Options> group = make_group();
+  }};
   return group;
 }
 
