@@ -6,7 +6,7 @@
 #include "matbake/encoding_params.hpp"
 #include "matbake/export_params.hpp"
 #include "params_cli.hpp"
-#include "option_names.hpp"
+#include "matbake/material_params.hpp"
 #include "material_sources.hpp"
 #include "matbake/atomic_file.hpp"
 #include "matbake/export.hpp"
@@ -18,7 +18,7 @@ namespace matbake::cli {
 namespace {
 
 // "NAME=[LAYOUT:]FILE,FILE..." → the material's name and its maps (layout schuler by default).
-Result<exporter::MaterialMaps> parse_material(const std::string& text, color::Transfer authored) {
+Result<exporter::MaterialMaps> parse_material(const std::string& text, const pack::MaterialOptions& options) {
   const std::size_t equals = text.find('=');
   if (equals == std::string::npos || equals == 0 || equals + 1 == text.size()) {
     return Error{"", "--material '" + text + "': use NAME=A.png,B.png (a Schüler pair) or NAME=LAYOUT:FILE,...", true};
@@ -38,7 +38,10 @@ Result<exporter::MaterialMaps> parse_material(const std::string& text, color::Tr
     files.push_back(rest.substr(start, comma - start));
     start = comma + 1;
   }
-  auto maps = read_packed(layout, files, std::nullopt, authored);
+  auto found = pack::find_layout(layout);
+  if (!found) return found.error();
+  SilencedStderr quiet;
+  auto maps = pack::read_packed(*found, {files.begin(), files.end()}, options);
   if (!maps) return maps.error();
   m.maps = std::move(*maps);
   return m;
@@ -60,7 +63,7 @@ CLI::App* setup_export(CLI::App& app, ExportSettings& s) {
   cmd->add_option("--material", s.materials,
                   "NAME=A.png,B.png: material NAME (or its index) from a Schüler pair; NAME=LAYOUT:FILE,... from\n"
                   "any pack layout's textures (e.g. gltf-metal-rough:base.png,mr.png). Repeatable");
-  add_name_option(*cmd, "--transfer", s.transfer, color::kTransferNames, "How 8-bit colour in --material files was authored");
+  add_params(*cmd, pack::material_params(), s.material_options, "", "Options", nullptr, {"transfer", "decode"});
   add_params(*cmd, exporter::options_params(), s.options, "", "Options");
   add_params(*cmd, image::encoding_params(), s.options.encoding, "", "Options");
   add_ao_options(*cmd, s.ao, "ao-");  // AO is baked when any of them is given, as a manifest's ao = { ... }
@@ -74,7 +77,7 @@ int run_export(const ExportSettings& s, const GlobalOptions& global) {
   if (!request) return report_error(request.error());
   if (!s.ao.given.empty()) options.ao = *request;
   for (const std::string& text : s.materials) {
-    auto m = parse_material(text, s.transfer);
+    auto m = parse_material(text, s.material_options);
     if (!m) return report_error(m.error());
     options.materials.push_back(std::move(*m));
   }

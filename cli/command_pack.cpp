@@ -5,7 +5,7 @@
 #include "commands.hpp"
 #include "matbake/encoding_params.hpp"
 #include "params_cli.hpp"
-#include "option_names.hpp"
+#include "matbake/material_params.hpp"
 #include "silenced_stderr.hpp"
 
 namespace fs = std::filesystem;
@@ -28,7 +28,7 @@ CLI::App* setup_pack(CLI::App& app, PackSettings& s) {
       "metallicRoughness / ORM, Unreal ORM, Unity HDRP mask map, Unity URP. Constants are linear.\n"
       "Example: matbake pack --kd kd.png --mask 1 --ks 0.04 --gloss gloss.png -o out/brick_{texture}.png");
   cmd->add_option("--layout", s.layout, layout_help())->capture_default_str();
-  add_source_options(*cmd, s.sources);
+  add_source_options(*cmd, s.sources, {"transfer", "decode", "resize", "size", "bits"});
   add_output_options(*cmd, s.output, "textures");
   return cmd;
 }
@@ -58,10 +58,7 @@ CLI::App* setup_unpack(CLI::App& app, UnpackSettings& s) {
   cmd->add_option("--layout", s.layout, layout_help())->capture_default_str();
   cmd->add_option("inputs", s.inputs, "The packed textures, in the layout's order")->required();
   cmd->add_option("-o,--out-dir", s.out_dir, "Folder for the source maps")->required();
-  cmd->add_option("--format", s.format, "Extension of the source maps")->capture_default_str();
-  cmd->add_option("--bits", s.bits, "8, 16, half or float (default: 8; half for exr)");
-  cmd->add_option("--transfer", s.transfer, "Curve of 8-bit colour channels, read and written: srgb or gamma2.2")
-      ->capture_default_str();
+  add_params(*cmd, pack::material_params(), s.options, "", "Options", nullptr, {"transfer", "decode", "bits", "format"});
   add_params(*cmd, image::encoding_params(), s.encoding, "", "Options");
   return cmd;
 }
@@ -70,16 +67,11 @@ int run_unpack(const UnpackSettings& s, const GlobalOptions& global) {
   SourceSettings in;
   in.from = s.layout;
   in.inputs = s.inputs;
-  in.transfer = s.transfer;
+  in.options = s.options;
   auto sources = gather_sources(in);
   if (!sources) return report_error(sources.error());
-  auto transfer = parse_transfer(s.transfer, "--transfer");
-  if (!transfer) return report_error(transfer.error());
-  pack::UnpackRequest request{s.out_dir, s.format, std::nullopt, *transfer, {s.inputs.begin(), s.inputs.end()}, s.encoding};
-  if (!s.bits.empty()) {
-    request.type = image::sample_type_from_name(s.bits);
-    if (!request.type) return report_error(Error{"", "--bits '" + s.bits + "': use 8, 16, half or float", true});
-  }
+  const pack::UnpackRequest request{s.out_dir,         s.options.format, s.options.bits, s.options.transfer,
+                                    {s.inputs.begin(), s.inputs.end()}, s.encoding};
   Result<std::vector<fs::path>> paths = Error{"", ""};
   {
     SilencedStderr quiet;  // the image libraries' own messages: our error line says it

@@ -54,7 +54,7 @@ CLI::App* setup_preview(CLI::App& app, PreviewSettings& s) {
       "textures sampled at the ball's UV; Schüler's (--kd, --ks, --gloss, --mask; defaults 0.5, 0.04, 0.5) or\n"
       "metal-rough (--base-color, --metallic, --roughness), or a packed pair (--from schuler A.png B.png).");
   cmd->add_option("-o,--output", s.output, "Output .png")->required();
-  add_source_options(*cmd, s.sources, false);
+  add_source_options(*cmd, s.sources, {"transfer", "decode", "resize"});
   cmd->add_option("--materials", s.materials, "JSON list of materials, one row each (see docs/preview.md)");
   cmd->add_option("--gloss-sweep", s.gloss_sweep, "Columns at these gloss values, e.g. 0.25,0.5,0.75,1")->delimiter(',');
   cmd->add_option("--model", s.model, "BRDF for the direct lights: " + model_names)->capture_default_str();

@@ -91,7 +91,7 @@ CLI::App* setup_validate(CLI::App& app, ValidateSettings& s) {
       "coloured dielectric specular, implausible albedo. Inputs: a Schüler pair (--from schuler A.png B.png),\n"
       "pair B alone (--ks B.png), or metal-rough maps (--from gltf-metal-rough base.png mr.png, or --base-color\n"
       "and --metallic). Exit 0 clean, 3 when the flagged share exceeds --max-violations, 1 bad input.");
-  add_source_options(*cmd, s.sources);
+  add_source_options(*cmd, s.sources, {"transfer", "decode", "resize", "size"});
   cmd->add_option("--material", s.material, "Also compare with a table entry (see `matbake materials`)");
   cmd->add_option("--materials-table", s.table, "Another table file in the TOML format of presets/materials.toml");
   add_params(*cmd, validate::options_params(), s.options, "", "Options");

@@ -5,7 +5,6 @@
 #include <fstream>
 
 #include "commands.hpp"
-#include "option_names.hpp"
 #include "matbake/report_json.hpp"
 #include "matbake/atomic_file.hpp"
 #include "matbake/workflow_maps.hpp"
@@ -48,10 +47,8 @@ CLI::App* setup_workflow(CLI::App& app, WorkflowSettings& s) {
       "(and, to metal-rough, of the Khronos spec-gloss converter on the same texels).\n"
       "Example: matbake workflow --from schuler A.png B.png --to gltf-orm -o out/brick_{texture}.png");
   cmd->add_option("--to", s.to, "Target layout: a preset or a layout JSON file")->required();
-  add_name_option(*cmd, "--mapping", s.mapping, workflow::kRoughnessMappingNames,
-                  "Gloss <-> roughness (fitted: least squares over the lobe)");
   cmd->add_option("--report", s.report, "Also write the error report as JSON to this file");
-  add_source_options(*cmd, s.sources);
+  add_source_options(*cmd, s.sources, {"transfer", "decode", "resize", "size", "bits", "mapping"});
   add_output_options(*cmd, s.output, "textures");
   return cmd;
 }
@@ -62,7 +59,7 @@ int run_workflow(const WorkflowSettings& s, const GlobalOptions& global) {
   auto sources = gather_sources(s.sources);
   if (!sources) return report_error(sources.error());
 
-  auto converted = workflow::in_layout_workflow(std::move(*sources), *layout, s.mapping);
+  auto converted = workflow::in_layout_workflow(std::move(*sources), *layout, s.sources.options.mapping);
   if (!converted) return report_error(converted.error());
   if (!converted->direction) {
     return report_error(Error{"", "nothing to convert: give Schüler sources (--kd, --ks, --gloss) for a metal-rough "
@@ -75,7 +72,7 @@ int run_workflow(const WorkflowSettings& s, const GlobalOptions& global) {
 
   const workflow::ConversionReport& report = converted->report;
   const std::string direction(workflow::direction_name(*converted->direction));
-  const std::string mapping(workflow::roughness_mapping_name(s.mapping));
+  const std::string mapping(workflow::roughness_mapping_name(s.sources.options.mapping));
   nlohmann::json doc = {{"command", "workflow"}, {"direction", direction}, {"layout", layout->name},
                         {"mapping", mapping}, {"outputs", *written}, {"texels", report.texels},
                         {"errors", to_json(report.errors)}};

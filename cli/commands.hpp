@@ -69,9 +69,7 @@ struct UnpackSettings {
   std::string layout = "schuler";
   std::vector<std::string> inputs;
   std::string out_dir;
-  std::string format = "png";
-  std::string bits;
-  std::string transfer = "srgb";
+  pack::MaterialOptions options;  // transfer, decode, bits, format
   image::Encoding encoding;
 };
 CLI::App* setup_unpack(CLI::App& app, UnpackSettings& settings);
@@ -79,7 +77,6 @@ int run_unpack(const UnpackSettings& settings, const GlobalOptions& global);
 
 struct WorkflowSettings {
   std::string to;  // target layout
-  workflow::RoughnessMapping mapping = workflow::kDefaultRoughnessMapping;
   std::string report;  // JSON file
   SourceSettings sources;
   OutputSettings output;
@@ -118,7 +115,7 @@ struct ExportSettings {
   std::string scene;
   std::string output;
   std::vector<std::string> materials;  // NAME=[LAYOUT:]FILE,FILE...
-  color::Transfer transfer = pack::LoadOptions{}.authored;  // of 8-bit colour in those files
+  pack::MaterialOptions material_options;  // transfer, decode: how those files are read
   exporter::Options options;
   AoSettings ao;                       // AO is baked when any of its options is given
   std::string report;

@@ -1,12 +1,11 @@
 #include "material_sources.hpp"
 
 #include <filesystem>
-#include <sstream>
 
 #include "commands.hpp"
 #include "matbake/encoding_params.hpp"
 #include "params_cli.hpp"
-#include "option_names.hpp"
+#include "matbake/material_params.hpp"
 #include "silenced_stderr.hpp"
 
 namespace fs = std::filesystem;
@@ -22,13 +21,7 @@ std::string option_of(std::string_view source) {
 
 }  // namespace
 
-Result<color::Transfer> parse_transfer(const std::string& name, const char* option) {
-  auto t = color::transfer_from_name(name);
-  if (!t) return Error{"", std::string(option) + " '" + name + "': use srgb, gamma2.2 or linear", true};
-  return *t;
-}
-
-void add_source_options(CLI::App& cmd, SourceSettings& s, bool constant_size) {
+void add_source_options(CLI::App& cmd, SourceSettings& s, const std::set<std::string>& params) {
   const auto sources = material::sources();
   for (std::size_t i = 0; i < sources.size(); ++i) {
     const bool colour = sources[i].kind == material::SourceKind::color;
@@ -39,33 +32,10 @@ void add_source_options(CLI::App& cmd, SourceSettings& s, bool constant_size) {
   cmd.add_option("--from", s.from, "Layout of packed input textures (the positional inputs), e.g. schuler")
       ->group("Sources");
   cmd.add_option("inputs", s.inputs, "Packed input textures, one per texture of --from")->group("Sources");
-  cmd.add_option("--transfer", s.transfer, "Curve of 8-bit colour channels, read and written: srgb or gamma2.2")
-      ->capture_default_str();
-  cmd.add_option("--input-transfer", s.input_transfer,
-                 "Curve of every colour input, overriding the rule (8-bit: --transfer; 16-bit, half, float: linear)");
-  cmd.add_flag("--resize", s.resize, "Resample sources of different sizes to the largest (in linear light)");
-  if (constant_size) cmd.add_option("--size", s.size, "WxH of the output when every source is a constant (default 1x1)");
+  add_params(cmd, pack::material_params(), s.options, "", "Options", nullptr, params);
 }
 
 Result<material::Maps> gather_sources(const SourceSettings& s) {
-  auto transfer = parse_transfer(s.transfer, "--transfer");
-  if (!transfer) return transfer.error();
-  pack::LoadOptions options;
-  options.authored = *transfer;
-  options.resize = s.resize;
-  if (!s.input_transfer.empty()) {
-    auto t = parse_transfer(s.input_transfer, "--input-transfer");
-    if (!t) return t.error();
-    options.input = *t;
-  }
-  if (!s.size.empty()) {
-    char x = 0;
-    std::stringstream in(s.size);
-    if (!(in >> options.width >> x >> options.height) || x != 'x' || options.width < 1 || options.height < 1 ||
-        !in.eof()) {
-      return Error{"", "--size '" + s.size + "': use WxH, e.g. 256x256", true};
-    }
-  }
   std::vector<pack::SourceInput> inputs;
   const auto sources = material::sources();
   for (std::size_t i = 0; i < sources.size(); ++i) {
@@ -78,7 +48,7 @@ Result<material::Maps> gather_sources(const SourceSettings& s) {
   material::Maps maps;
   {
     SilencedStderr quiet;
-    auto loaded = pack::load_sources(inputs, options);
+    auto loaded = pack::load_sources(inputs, s.options);
     if (!loaded) return loaded.error();
     maps = std::move(loaded.value());
   }
@@ -87,7 +57,13 @@ Result<material::Maps> gather_sources(const SourceSettings& s) {
     return maps;
   }
   // Packed inputs: unpack, then the per-source options take precedence.
-  auto unpacked = read_packed(s.from, s.inputs, options.input, *transfer);
+  auto layout = pack::find_layout(s.from);
+  if (!layout) return layout.error();
+  Result<material::Maps> unpacked = Error{};
+  {
+    SilencedStderr quiet;
+    unpacked = pack::read_packed(*layout, {s.inputs.begin(), s.inputs.end()}, s.options);
+  }
   if (!unpacked) return unpacked.error();
   if (!maps.maps.empty() && (maps.width != unpacked->width || maps.height != unpacked->height)) {
     return Error{s.inputs[0], "size differs from the other sources"};
@@ -96,21 +72,11 @@ Result<material::Maps> gather_sources(const SourceSettings& s) {
   return unpacked;
 }
 
-Result<material::Maps> read_packed(const std::string& layout_name, const std::vector<std::string>& files,
-                                     std::optional<color::Transfer> input, color::Transfer authored) {
-  auto layout = pack::find_layout(layout_name);
-  if (!layout) return layout.error();
-  SilencedStderr quiet;
-  return pack::read_packed(*layout, {files.begin(), files.end()}, input, authored);
-}
-
 void add_output_options(CLI::App& cmd, OutputSettings& o, const std::string& what) {
   cmd.add_option("-o,--output", o.outputs,
                  "Output " + what + ": one per texture of the layout, in order, or one path with {texture}, "
                  "e.g. out/brick_{texture}.png")
       ->required();
-  cmd.add_option("--bits", o.bits, "8, 16, half or float (default: 8; half for .exr). Colour is encoded with "
-                                   "--transfer in 8-bit and linear otherwise");
   add_params(cmd, image::encoding_params(), o.encoding, "", "Options");
 }
 
@@ -127,13 +93,8 @@ std::vector<std::filesystem::path> input_files(const SourceSettings& inputs) {
 Result<std::vector<std::string>> write_textures(const pack::Layout& layout, const material::Maps& sources,
                                                 const OutputSettings& o, const SourceSettings& inputs,
                                                 std::vector<NamedOutput> also) {
-  auto transfer = parse_transfer(inputs.transfer, "--transfer");
-  if (!transfer) return transfer.error();
-  pack::WriteRequest request{o.outputs, std::nullopt, *transfer, input_files(inputs), std::move(also), o.encoding};
-  if (!o.bits.empty()) {
-    request.type = image::sample_type_from_name(o.bits);
-    if (!request.type) return Error{"", "--bits '" + o.bits + "': use 8, 16, half or float", true};
-  }
+  const pack::WriteRequest request{o.outputs,           inputs.options.bits, inputs.options.transfer,
+                                   input_files(inputs), std::move(also),     o.encoding};
   SilencedStderr quiet;
   auto written = pack::write_textures(layout, sources, request);
   if (!written) return written.error();

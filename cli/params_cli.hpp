@@ -2,6 +2,7 @@
 // Command-line flags made from a parameter description (matbake/params.hpp): each parameter as
 // --<prefix><name>, its text decoded and checked by the description, --help showing its default
 // (the request struct's) and accepted names. `given` collects the names set, for params::finish.
+// An older name (Spec::aliases) is a hidden flag that works as the new one and says it was renamed.
 #include <CLI/CLI.hpp>
 
 #include <set>
@@ -14,11 +15,24 @@ namespace matbake::cli {
 // --help's placeholder per params::Kind.
 inline constexpr const char* kTypeNames[] = {"", "INT", "NUMBER", "TEXT", "NAME", "VALUE"};
 
+// The text of --FLAG VALUE, checked and stored: a problem is a usage error naming the flag.
+template <class T>
+void set_from_flag(const params::Param<T>& p, T& target, const std::string& flag, const std::string& text,
+                   std::set<std::string>* given) {
+  auto value = params::from_text(p.spec, text);
+  std::optional<std::string> problem = value ? params::apply(p, target, *value) : value.error().message;
+  if (problem) throw CLI::ValidationError(flag, "'" + text + "': " + *problem);
+  if (given) given->insert(p.spec.name);
+}
+
+// `only`: the names of the group's parameters the command takes (empty: all).
 template <class T>
 void add_params(CLI::App& cmd, const params::Group<T>& group, T& target, const std::string& prefix,
-                const std::string& help_group, std::set<std::string>* given = nullptr) {
+                const std::string& help_group, std::set<std::string>* given = nullptr,
+                const std::set<std::string>& only = {}) {
   const nlohmann::json defaults = params::to_json(group, T{});
   for (const params::Param<T>& p : group.params) {
+    if (!only.empty() && !only.count(p.spec.name)) continue;
     const std::string flag = params::flag_name(p.spec, prefix);
     std::string help = p.spec.help;
     if (p.spec.kind == params::Kind::choice) help += ": " + params::type_text(p.spec);
@@ -34,17 +48,18 @@ void add_params(CLI::App& cmd, const params::Group<T>& group, T& target, const s
     }
     const nlohmann::json& d = defaults.at(p.spec.name);
     cmd.add_option_function<std::string>(
-           flag,
-           [&p, &target, given, flag](const std::string& text) {
-             auto value = params::from_text(p.spec, text);
-             std::optional<std::string> problem = value ? params::apply(p, target, *value) : value.error().message;
-             if (problem) throw CLI::ValidationError(flag, "'" + text + "': " + *problem);
-             if (given) given->insert(p.spec.name);
-           },
+           flag, [&p, &target, given, flag](const std::string& text) { set_from_flag(p, target, flag, text, given); },
            help)
         ->type_name(kTypeNames[std::size_t(p.spec.kind)])
         ->default_str(params::value_text(d))
         ->group(help_group);
+    for (const std::string& alias : p.spec.aliases) {
+      const std::string old = params::flag_name(params::Spec{.name = alias}, prefix);
+      cmd.add_option_function<std::string>(old, [&p, &target, given, old, flag](const std::string& text) {
+           std::cerr << "matbake: note: " << old << " is now called " << flag << " (the old name still works)\n";
+           set_from_flag(p, target, old, text, given);
+         })->group("");
+    }
   }
 }
 

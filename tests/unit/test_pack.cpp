@@ -19,7 +19,7 @@ material::Maps all_sources() {
       {"kd", {}, {0.11, 0.12, 0.13}}, {"ks", {}, {0.21, 0.22, 0.23}}, {"mask", {}, {0.9}},
       {"gloss", {}, {0.35}},          {"base_color", {}, {0.41, 0.42, 0.43}}, {"metallic", {}, {0.7}},
       {"roughness", {}, {0.25}},      {"occlusion", {}, {0.6}},               {"detail_mask", {}, {0.4}}};
-  auto maps = load_sources(inputs, {color::Transfer::srgb, {}, false, 2, 1, {}});
+  auto maps = load_sources(inputs, {.width = 2, .height = 1});
   EXPECT_TRUE(maps) << maps.error().to_string();
   for (auto& [name, map] : maps->maps) {
     for (std::size_t i = std::size_t(map.channels); i < map.pixels.size(); ++i) map.pixels[i] *= 0.5f;
@@ -153,7 +153,7 @@ TEST(Sources, ColourFilesDecodeBy8BitRuleGreyRepeats) {
   TempDir dir;
   test::write_raw(dir / "grey.png", 1, 1, 1, "uint8", {188});
   test::write_raw(dir / "rgb16.png", 1, 1, 3, "uint16", {0, 32768, 65535});
-  auto maps = load_sources({{"kd", dir / "grey.png", {}}, {"ks", dir / "rgb16.png", {}}}, {color::Transfer::gamma22, {}, false, 0, 0, {}});
+  auto maps = load_sources({{"kd", dir / "grey.png", {}}, {"ks", dir / "rgb16.png", {}}}, {.transfer = color::Transfer::gamma22});
   ASSERT_TRUE(maps);
   const float grey = float(std::pow(188 / 255.0, 2.2));
   EXPECT_EQ(maps->find("kd")->pixels, std::vector<float>(3, grey));
@@ -170,9 +170,7 @@ TEST(Sources, DifferentSizesAreAnErrorUnlessResized) {
   EXPECT_EQ(refused.error().path, (dir / "small.png").string());
   EXPECT_EQ(refused.error().message, "2x2, but " + (dir / "big.png").string() +
                                          " is 4x4 (resizing resamples to the largest)");
-  LoadOptions resize;
-  resize.resize = true;
-  auto resized = load_sources(inputs, resize);
+  auto resized = load_sources(inputs, {.resize = true});
   ASSERT_TRUE(resized);
   for (float v : resized->find("mask")->pixels) EXPECT_NEAR(v, 0.2f, 1e-6);  // a constant stays constant
 }

@@ -10,6 +10,7 @@
 #include "matbake/ao_params.hpp"
 #include "matbake/encoding_params.hpp"
 #include "matbake/export_params.hpp"
+#include "matbake/material_params.hpp"
 #include "matbake/params.hpp"
 #include "matbake/validate_params.hpp"
 #include "matbake/pipeline.hpp"
@@ -167,6 +168,40 @@ TEST(SceneParams, EveryExportAndEncodingParameterReachesTheSceneFromBothDoors) {
   walk_scene_keys(image::encoding_params(), [](const pipeline::SceneSpec& s) { return s.options.encoding; });
 }
 
+// A material's options: each at its example through the flags, a material's key and the manifest's
+// top level (every material's default), the three stamps equal and not the default's.
+TEST(MaterialParams, EveryParameterReachesTheMaterialFromBothDoorsAndTheTopLevel) {
+  const Group<pack::MaterialOptions>& group = pack::material_params();
+  const nlohmann::json defaults = to_json(group, pack::MaterialOptions{});
+  for (const Param<pack::MaterialOptions>& p : group.params) {
+    SCOPED_TRACE(p.spec.name);
+    CLI::App app;
+    pack::MaterialOptions from_flags;
+    cli::add_params(app, group, from_flags, "", "Options");
+    std::vector<std::string> args = {flag_name(p.spec, "")};
+    if (p.spec.kind != Kind::flag) args.push_back(p.spec.example);
+    std::reverse(args.begin(), args.end());
+    app.parse(args);
+    const std::string key = p.spec.name + " = " + test::toml_literal(p.spec) + "\n";
+    auto in_material = pipeline::parse_manifest("[materials.a]\nsources = { kd = 0.5 }\n" + key, "/p/assets.toml");
+    auto at_top = pipeline::parse_manifest(key + "[materials.a]\nsources = { kd = 0.5 }\n", "/p/assets.toml");
+    ASSERT_TRUE(in_material) << in_material.error().to_string();
+    ASSERT_TRUE(at_top) << at_top.error().to_string();
+    EXPECT_EQ(to_json(group, from_flags), to_json(group, in_material->materials[0].options));
+    EXPECT_EQ(to_json(group, from_flags), to_json(group, at_top->materials[0].options));
+    EXPECT_NE(to_json(group, from_flags).at(p.spec.name), defaults.at(p.spec.name));
+  }
+}
+
+TEST(MaterialParams, AnOlderFlagWorksAsTheNewOne) {
+  CLI::App app;
+  pack::MaterialOptions options;
+  cli::add_params(app, pack::material_params(), options, "", "Options");
+  app.parse(std::vector<std::string>{"linear", "--input-transfer"});
+  EXPECT_EQ(options.decode, color::Transfer::linear);
+  EXPECT_THROW(app.parse(std::vector<std::string>{"lin", "--decode"}), CLI::ValidationError);
+}
+
 TEST(AoParams, OlderManifestKeysAreReadWithANote) {
   auto m = pipeline::parse_manifest("[scenes.s]\ninput = \"s.gltf\"\nao = { distance = 0.1, absolute_distance = 2 }\n",
                                     "/p/assets.toml");
@@ -188,6 +223,7 @@ TEST(DocsTables, MatchTheParameterDescriptions) {
       {"docs/build.md", "params:encoding", markdown_table(image::encoding_params(), "")},
       {"docs/export.md", "params:export", markdown_table(exporter::options_params(), "")},
       {"docs/validate.md", "params:validate", markdown_table(validate::options_params(), "")},
+      {"docs/build.md", "params:material", markdown_table(pack::material_params(), "")},
   };
   for (const Table& t : tables) {
     const fs::path path = fs::path(MATBAKE_SOURCE_DIR) / t.file;

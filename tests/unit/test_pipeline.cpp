@@ -61,21 +61,21 @@ TEST(BuildManifest, EveryKeyReachesItsField) {
   EXPECT_EQ(brick.sources[1].name, "kd");
   EXPECT_EQ(brick.sources[1].file, fs::path("/project/t/brick.png"));
   EXPECT_EQ(brick.sources[2].constant, std::vector<double>{0.04});
-  EXPECT_EQ(brick.transfer, color::Transfer::gamma22);  // the manifest's default
+  EXPECT_EQ(brick.options.transfer, color::Transfer::gamma22);  // the manifest's default
   ASSERT_TRUE(brick.layout);
   EXPECT_EQ(brick.layout->reference, "schuler");
   EXPECT_EQ(brick.layout->layout.name, "schuler");
   EXPECT_TRUE(brick.layout->file.empty());  // a preset
-  EXPECT_EQ(brick.format, "tif");
-  EXPECT_EQ(brick.bits, image::SampleType::u16);
+  EXPECT_EQ(brick.options.format, "tif");
+  EXPECT_EQ(brick.options.bits, image::SampleType::u16);
   EXPECT_DOUBLE_EQ(brick.validation.options.tolerance, 0.2);
   EXPECT_DOUBLE_EQ(brick.validation.options.max_violations, 0.01);
   const pipeline::MaterialSpec& gold = m->materials[1];
   ASSERT_TRUE(gold.packed);
   EXPECT_EQ(gold.packed->reference, "gltf-orm");
   EXPECT_EQ(gold.packed_files, (std::vector<fs::path>{"/project/a.png", "/project/b.png"}));
-  EXPECT_EQ(gold.transfer, color::Transfer::srgb);
-  EXPECT_EQ(gold.decode, color::Transfer::linear);
+  EXPECT_EQ(gold.options.transfer, color::Transfer::srgb);
+  EXPECT_EQ(gold.options.decode, color::Transfer::linear);
   EXPECT_EQ(gold.reference, "gold");
   EXPECT_DOUBLE_EQ(gold.validation.options.tolerance, 0.2);  // inherited, then overridden key by key
   EXPECT_DOUBLE_EQ(gold.validation.options.max_violations, 0.5);
@@ -130,7 +130,7 @@ TEST(BuildManifest, ErrorsSayWhereAndWhat) {
   const Case cases[] = {
       {"output = \"o\"\n[materials.a]\nsources = { kd = 0.5 }\nlayot = \"x\"\n", "m.toml:4:1", "unknown key 'layot' in materials.a"},
       {"[materials.a\n", "m.toml:1:", "not valid TOML"},
-      {"[materials.a]\nsources = { kd = 0.5 }\nbits = \"12\"\n", "m.toml:3:", "materials.a.bits '12'"},
+      {"[materials.a]\nsources = { kd = 0.5 }\nbits = \"12\"\n", "m.toml:3:", "materials.a.bits: use 8, 16, half or float"},
       {"[materials.a]\nsources = { albedo = \"x.png\" }\n", "m.toml:2:", "unknown source 'albedo'"},
       {"[materials.a]\nlayout = \"schuler\"\n", "m.toml:1:", "give either sources = {...} or packed = {...}"},
       {"[materials.\"../up\"]\nsources = { kd = 0.5 }\n", "m.toml:", "letters, digits"},

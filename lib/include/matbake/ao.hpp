@@ -122,8 +122,6 @@ struct TextureOptions {
 constexpr int kDefaultPadding = 16;
 constexpr int kMaxTextureSide = 16384;
 int padding_for(const TextureOptions& options);  // the padding used
-// "1024" (square) or "2048x1024" (width × height); nothing when it is neither (sides are checked by check()).
-std::optional<std::pair<int, int>> texture_size_from_text(std::string_view text);
 Status check(const TextureOptions& options, const Options& estimator);
 
 struct TextureBake {

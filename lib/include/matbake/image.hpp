@@ -12,14 +12,20 @@
 #include <vector>
 
 #include "matbake/color.hpp"
+#include "matbake/enum_names.hpp"
 #include "matbake/result.hpp"
 
 namespace matbake::image {
 
 enum class SampleType { u8, u16, half, f32 };
 
-std::optional<SampleType> sample_type_from_name(std::string_view name);  // "8", "16", "half", "float"
-std::string_view sample_type_name(SampleType type);
+inline constexpr NameTable<SampleType, 4> kSampleTypeNames{
+    {{SampleType::u8, "8"}, {SampleType::u16, "16"}, {SampleType::half, "half"}, {SampleType::f32, "float"}}};
+inline std::optional<SampleType> sample_type_from_name(std::string_view name) { return value_in(kSampleTypeNames, name); }
+inline std::string_view sample_type_name(SampleType type) { return name_in(kSampleTypeNames, type); }
+// An image size as text: "1024" (square) or "2048x1024" (also "X"); any positive or not, the caller
+// judges the range.
+std::optional<std::pair<int, int>> size_from_text(std::string_view text);
 bool is_integer(SampleType type);
 
 // The largest image matbake holds, in pixels (width × height), for every image it reads or makes:

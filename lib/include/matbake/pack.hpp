@@ -17,6 +17,7 @@
 #include "matbake/material.hpp"
 #include "matbake/output_check.hpp"
 #include "matbake/result.hpp"
+#include "matbake/workflow.hpp"
 
 namespace matbake::pack {
 
@@ -69,26 +70,26 @@ Result<SourceInput> source_from_text(std::string_view name, const std::string& t
 // Decodes a file (read_image, or a cache in front of it that decodes each file once).
 using ImageReader = std::function<Result<std::shared_ptr<const image::Image>>(const std::filesystem::path&, color::Transfer)>;
 
-struct LoadOptions {
-  color::Transfer authored = color::Transfer::srgb;  // how 8-bit colour sources were encoded
-  std::optional<color::Transfer> input;              // for every colour file, overriding the rule below
+// How a material's sources are read, converted and its textures written, whichever door asks
+// (pack, unpack, workflow, validate, preview, a manifest's material). Its parameters are described
+// once in pack::material_params() (material_params.hpp).
+struct MaterialOptions {
+  color::Transfer transfer = color::Transfer::srgb;  // 8-bit colour: how sources were authored, how outputs are encoded
+  std::optional<color::Transfer> decode;             // every colour file, overriding the rule below
   bool resize = false;  // else sources of different sizes are an error
   int width = 0;        // size when every source is a constant (0: 1×1)
   int height = 0;
-  ImageReader read;  // empty: image::read_image
+  std::optional<image::SampleType> bits;  // of written textures; unset: default_sample_type of each path
+  std::string format = "png";             // extension of outputs that no path names (a manifest's, unpack's)
+  workflow::RoughnessMapping mapping = workflow::kDefaultRoughnessMapping;  // gloss ⇄ roughness of a conversion
 };
-// Reads every file (colour files: 8-bit ones decoded with `authored`, 16-bit, half and float ones
-// as linear, which is how pack writes them, unless `input` says otherwise; a colour source from a grey
-// file is grey, from RGB(A) its RGB; a scalar source is a file's first channel), resizes to the
-// largest (by pixel count) when asked, in linear light with OIIO's default filter, and fills the
-// constants.
-Result<material::Maps> load_sources(const std::vector<SourceInput>& inputs, const LoadOptions& options);
+Result<material::Maps> load_sources(const std::vector<SourceInput>& inputs, const MaterialOptions& options,
+                                    const ImageReader& read = {});
 
 // The source maps held by `files`, the textures of `layout` in order: colour textures decoded with
-// `input` when given, else as decode_transfer() says; the others linear.
+// `options.decode` when given, else as decode_transfer() says; the others linear.
 Result<material::Maps> read_packed(const Layout& layout, const std::vector<std::filesystem::path>& files,
-                               std::optional<color::Transfer> input, color::Transfer authored,
-                               const ImageReader& read = {});
+                                   const MaterialOptions& options, const ImageReader& read = {});
 
 // The sources a layout reads, and which of them it cannot do without (no fallback).
 std::vector<std::string> layout_sources(const Layout& layout);

@@ -58,14 +58,9 @@ struct MaterialSpec {
   // ... or the packed textures of a layout (e.g. a Schüler pair).
   std::optional<LayoutChoice> packed;
   std::vector<std::filesystem::path> packed_files;
-  color::Transfer transfer = color::Transfer::srgb;  // how 8-bit colour sources were authored
-  std::optional<color::Transfer> decode;  // how every colour file is decoded, whatever its depth
-  bool resize = false;                               // sources of different sizes: resample to the largest
+  pack::MaterialOptions options;  // transfer, decode, resize, size, bits, format, mapping
   std::optional<LayoutChoice> layout;  // textures to write; unset: none
-  std::string format = "png";  // png, exr, tif
-  std::optional<image::SampleType> bits;  // unset: pack::default_sample_type (half for exr, else 8)
   image::Encoding encoding;  // png_compression
-  workflow::RoughnessMapping mapping = workflow::kDefaultRoughnessMapping;
   std::string reference;  // a material table entry to validate against
   ValidationRules validation;
 };

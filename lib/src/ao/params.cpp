@@ -2,6 +2,7 @@
 #include <cmath>
 
 #include "matbake/ao_params.hpp"
+#include "matbake/image.hpp"
 
 namespace matbake::ao {
 namespace {
@@ -31,7 +32,7 @@ Param<Request> texture_size() {
             if (const auto* side = std::get_if<std::int64_t>(&v)) {
               if (*side >= 1 && *side <= kMaxTextureSide) size = std::pair{int(*side), int(*side)};
             } else {
-              size = texture_size_from_text(std::get<std::string>(v));
+              size = image::size_from_text(std::get<std::string>(v));
             }
             if (!size) return "a size such as 1024 or 2048x1024";
             texture_of(r).size.width = size->first, texture_of(r).size.height = size->second;

@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <atomic>
-#include <charconv>
 #include <chrono>
 #include <cmath>
 
@@ -65,20 +64,6 @@ int padding_for(const TextureOptions& options) {
   if (options.padding >= 0) return options.padding;
   const int side = std::max(options.width, options.height);
   return std::max(1, int(std::lround(double(kDefaultPadding) * side / 1024.0)));
-}
-
-std::optional<std::pair<int, int>> texture_size_from_text(std::string_view text) {
-  const auto number = [](std::string_view digits) -> std::optional<int> {
-    int value = 0;
-    const auto [end, error] = std::from_chars(digits.data(), digits.data() + digits.size(), value);
-    if (error != std::errc() || end != digits.data() + digits.size() || digits.empty()) return std::nullopt;
-    return value;
-  };
-  const std::size_t x = text.find_first_of("xX");
-  const auto width = number(text.substr(0, x));
-  const auto height = x == std::string_view::npos ? width : number(text.substr(x + 1));
-  if (!width || !height) return std::nullopt;
-  return std::pair{*width, *height};
 }
 
 Status check(const TextureOptions& texture, const Options& estimator) {

@@ -478,22 +478,18 @@ Status check_image_size(const std::string& file, std::int64_t width, std::int64_
   return success();
 }
 
-std::optional<SampleType> sample_type_from_name(std::string_view name) {
-  if (name == "8") return SampleType::u8;
-  if (name == "16") return SampleType::u16;
-  if (name == "half") return SampleType::half;
-  if (name == "float") return SampleType::f32;
-  return std::nullopt;
-}
-
-std::string_view sample_type_name(SampleType type) {
-  switch (type) {
-    case SampleType::u8: return "8";
-    case SampleType::u16: return "16";
-    case SampleType::half: return "half";
-    case SampleType::f32: return "float";
-  }
-  return "?";
+std::optional<std::pair<int, int>> size_from_text(std::string_view text) {
+  const auto number = [](std::string_view digits) -> std::optional<int> {
+    int value = 0;
+    const auto [end, error] = std::from_chars(digits.data(), digits.data() + digits.size(), value);
+    if (error != std::errc() || end != digits.data() + digits.size() || digits.empty()) return std::nullopt;
+    return value;
+  };
+  const std::size_t x = text.find_first_of("xX");
+  const auto width = number(text.substr(0, x));
+  const auto height = x == std::string_view::npos ? width : number(text.substr(x + 1));
+  if (!width || !height) return std::nullopt;
+  return std::pair{*width, *height};
 }
 
 std::optional<int> png_level_from_name(std::string_view name) {

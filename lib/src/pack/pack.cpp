@@ -119,6 +119,11 @@ Result<std::shared_ptr<const image::Image>> read_shared(const std::filesystem::p
   return std::make_shared<const image::Image>(std::move(*file));
 }
 
+// How a colour file is decoded: as `decode` says, else by decode_transfer's rule.
+Result<color::Transfer> colour_decode(const fs::path& file, const MaterialOptions& options) {
+  return options.decode ? Result<color::Transfer>(*options.decode) : decode_transfer(file, options.transfer);
+}
+
 }  // namespace
 
 std::vector<std::string> builtin_layout_names() {
@@ -217,7 +222,8 @@ Result<color::Transfer> decode_transfer(const fs::path& path, color::Transfer au
   return info->stored_type == image::SampleType::u8 ? authored : color::Transfer::linear;
 }
 
-Result<material::Maps> load_sources(const std::vector<SourceInput>& inputs, const LoadOptions& options) {
+Result<material::Maps> load_sources(const std::vector<SourceInput>& inputs, const MaterialOptions& options,
+                                    const ImageReader& read) {
   return guarded("", [&]() -> Result<material::Maps> {
     material::Maps result;
     std::map<std::string, std::string> origin;  // source → file, for size errors
@@ -227,15 +233,11 @@ Result<material::Maps> load_sources(const std::vector<SourceInput>& inputs, cons
       if (input.file.empty()) continue;
       color::Transfer decode = color::Transfer::linear;
       if (source->kind == SourceKind::color) {
-        if (options.input) {
-          decode = *options.input;
-        } else {
-          auto t = decode_transfer(input.file, options.authored);
-          if (!t) return t.error();
-          decode = *t;
-        }
+        auto t = colour_decode(input.file, options);
+        if (!t) return t.error();
+        decode = *t;
       }
-      auto file = options.read ? options.read(input.file, decode) : read_shared(input.file, decode);
+      auto file = read ? read(input.file, decode) : read_shared(input.file, decode);
       if (!file) return file.error();
       result.maps[input.name] = source_from_file(**file, source->kind);
       origin[input.name] = input.file.string();
@@ -285,7 +287,7 @@ Result<material::Maps> load_sources(const std::vector<SourceInput>& inputs, cons
 }
 
 Result<material::Maps> read_packed(const Layout& layout, const std::vector<std::filesystem::path>& files,
-                               std::optional<color::Transfer> input, color::Transfer authored, const ImageReader& read) {
+                                   const MaterialOptions& options, const ImageReader& read) {
   return guarded("", [&]() -> Result<material::Maps> {
     if (files.size() != layout.textures.size()) {
       return Error{"", "layout " + layout.name + " takes " + std::to_string(layout.textures.size()) + " textures, got " +
@@ -296,7 +298,7 @@ Result<material::Maps> read_packed(const Layout& layout, const std::vector<std::
     for (std::size_t t = 0; t < files.size(); ++t) {
       color::Transfer decode = color::Transfer::linear;
       if (layout.textures[t].color) {
-        auto d = input ? Result<color::Transfer>(*input) : decode_transfer(files[t], authored);
+        auto d = colour_decode(files[t], options);
         if (!d) return d.error();
         decode = *d;
       }

@@ -10,6 +10,7 @@
 #include "matbake/ao_params.hpp"
 #include "matbake/encoding_params.hpp"
 #include "matbake/export_params.hpp"
+#include "matbake/material_params.hpp"
 #include "matbake/near_names.hpp"
 #include "matbake/validate_params.hpp"
 #include "matbake/read_file.hpp"
@@ -50,19 +51,6 @@ struct Reader {
       return at(key.source(), "unknown key '" + std::string(key.str()) + "' in " + where +
                                   (near.empty() ? " (known: " + list + ")" : near));
     }
-    return success();
-  }
-
-  // A key whose value is one of an option enum's names.
-  // `out` is the enum, or an optional one.
-  template <class E, std::size_t N, class Out>
-  Status get_name(const toml::table& table, std::string_view key, const std::string& where,
-                  const NameTable<E, N>& names, Out& out) const {
-    std::string name;
-    if (Status s = get(table, key, where, name); !s || !table.get(key)) return s;
-    const auto value = value_in(names, name);
-    if (!value) return at(*table.get(key), where + "." + std::string(key) + " '" + name + "': use " + names_in(names));
-    out = *value;
     return success();
   }
 
@@ -189,48 +177,31 @@ Result<std::optional<LayoutChoice>> read_layout(const Reader& r, const toml::tab
 }
 
 Result<MaterialSpec> read_material(const Reader& r, const std::string& name, const toml::node& node,
-                                   const Manifest& m, color::Transfer transfer, const ValidationRules& rules,
-                                   const image::Encoding& encoding, std::vector<std::string>& notes) {
+                                   const Manifest& m, const MaterialSpec& defaults, std::vector<std::string>& notes) {
   const std::string where = "materials." + name;
   const toml::table* t = node.as_table();
   if (!t) return r.at(node, where + " must be a table");
   if (!is_file_name_safe(name)) {
     return r.at(node, "material name '" + name + "': letters, digits, '_', '-' and '.' only (it names files)");
   }
-  if (Status s = r.known_keys(*t, where, with_keys_of(image::encoding_params(),
-                                                      {"sources", "packed", "transfer", "decode", "resize", "layout",
-                                                       "format", "bits", "mapping", "reference", "validate"}));
+  if (Status s = r.known_keys(*t, where, with_keys_of(pack::material_params(),
+                                                      with_keys_of(image::encoding_params(),
+                                                                   {"sources", "packed", "layout", "reference", "validate"})));
       !s) {
     return s.error();
   }
-  MaterialSpec spec;
+  MaterialSpec spec = defaults;
   spec.name = name;
   spec.origins.by_key[""] = r.origin(node.source());
   r.record(*t, "", spec.origins);
-  spec.transfer = transfer;
-  spec.validation = rules;
-  spec.encoding = encoding;
-  if (Status s = read_params_in(r, *t, where, image::encoding_params(), spec.encoding, notes); !s) return s.error();
-  std::string bits;
-  for (Status s : {r.get_name(*t, "transfer", where, color::kTransferNames, spec.transfer),
-                   r.get_name(*t, "decode", where, color::kTransferNames, spec.decode),
-                   r.get(*t, "resize", where, spec.resize),
-                   r.get(*t, "format", where, spec.format), r.get(*t, "bits", where, bits),
-                   r.get_name(*t, "mapping", where, workflow::kRoughnessMappingNames, spec.mapping),
+  for (Status s : {read_params_in(r, *t, where, image::encoding_params(), spec.encoding, notes),
+                   read_params_in(r, *t, where, pack::material_params(), spec.options, notes),
                    r.get(*t, "reference", where, spec.reference)}) {
     if (!s) return s.error();
   }
   auto layout = read_layout(r, *t, "layout", where, m.folder);
   if (!layout) return layout.error();
   spec.layout = std::move(*layout);
-  if (spec.format != "png" && spec.format != "exr" && spec.format != "tif") {
-    return r.at(*t->get("format"), where + ".format '" + spec.format + "': use png, exr or tif");
-  }
-  if (!bits.empty()) {
-    auto type = image::sample_type_from_name(bits);
-    if (!type) return r.at(*t->get("bits"), where + ".bits '" + bits + "': use 8, 16, half or float");
-    spec.bits = *type;
-  }
   if (const toml::node* v = t->get("validate")) {
     if (!v->is_table()) return r.at(*v, where + ".validate must be a table");
     if (Status s = read_validation(r, *v->as_table(), where + ".validate", spec.validation, notes); !s) return s.error();
@@ -367,9 +338,10 @@ Result<Manifest> parse_manifest(std::string_view toml_text, const fs::path& file
                        std::to_string(e.source().begin.column),
                    "not valid TOML: " + std::string(e.description())};
     }
-    if (Status s = r.known_keys(doc, "the manifest", with_keys_of(image::encoding_params(),
-                                                                  {"output", "table", "transfer", "validate", "materials",
-                                                                   "scenes"}));
+    if (Status s = r.known_keys(doc, "the manifest",
+                                with_keys_of(pack::material_params(),
+                                             with_keys_of(image::encoding_params(),
+                                                          {"output", "table", "validate", "materials", "scenes"})));
         !s) {
       return s.error();
     }
@@ -382,19 +354,21 @@ Result<Manifest> parse_manifest(std::string_view toml_text, const fs::path& file
     if (Status s = r.get(doc, "table", "manifest", table); !s) return s.error();
     m.output = (m.folder / output).lexically_normal();
     if (!table.empty()) m.table = m.folder / table;
-    color::Transfer transfer = MaterialSpec{}.transfer;
-    if (Status s = r.get_name(doc, "transfer", "manifest", color::kTransferNames, transfer); !s) return s.error();
-    image::Encoding encoding;  // for every material and scene, each of which may say otherwise
-    if (Status s = read_params_in(r, doc, "manifest", image::encoding_params(), encoding, m.notes); !s) return s.error();
-    ValidationRules rules;
+    // The top level's material options, encoding and validation are every material's defaults (the
+    // encoding every scene's too), each of which may say otherwise.
+    MaterialSpec defaults;
+    for (Status s : {read_params_in(r, doc, "manifest", pack::material_params(), defaults.options, m.notes),
+                     read_params_in(r, doc, "manifest", image::encoding_params(), defaults.encoding, m.notes)}) {
+      if (!s) return s.error();
+    }
     if (const toml::node* v = doc.get("validate")) {
       if (!v->is_table()) return r.at(*v, "validate must be a table");
-      if (Status s = read_validation(r, *v->as_table(), "validate", rules, m.notes); !s) return s.error();
+      if (Status s = read_validation(r, *v->as_table(), "validate", defaults.validation, m.notes); !s) return s.error();
     }
     if (const toml::node* mats = doc.get("materials")) {
       if (!mats->is_table()) return r.at(*mats, "materials must be a table of tables: [materials.NAME]");
       for (const auto& [key, value] : *mats->as_table()) {
-        auto spec = read_material(r, std::string(key.str()), value, m, transfer, rules, encoding, m.notes);
+        auto spec = read_material(r, std::string(key.str()), value, m, defaults, m.notes);
         if (!spec) return spec.error();
         m.materials.push_back(std::move(*spec));
       }
@@ -402,7 +376,7 @@ Result<Manifest> parse_manifest(std::string_view toml_text, const fs::path& file
     if (const toml::node* scenes = doc.get("scenes")) {
       if (!scenes->is_table()) return r.at(*scenes, "scenes must be a table of tables: [scenes.NAME]");
       for (const auto& [key, value] : *scenes->as_table()) {
-        auto spec = read_scene(r, std::string(key.str()), value, m, encoding, m.notes);
+        auto spec = read_scene(r, std::string(key.str()), value, m, defaults.encoding, m.notes);
         if (!spec) return spec.error();
         m.scenes.push_back(std::move(*spec));
       }

@@ -6,6 +6,7 @@
 #include "../gltf/document.hpp"
 #include "state.hpp"
 #include "matbake/encoding_params.hpp"
+#include "matbake/material_params.hpp"
 #include "matbake/validate_params.hpp"
 #include "matbake/materials.hpp"
 #include "matbake/near_names.hpp"
@@ -26,6 +27,7 @@ fs::path normalized(const fs::path& p) {
 // Everything in a material's spec that decides its outputs, for the stamp.
 nlohmann::json material_options(const MaterialSpec& m, const Manifest& manifest) {
   nlohmann::json options = params::to_json(image::encoding_params(), m.encoding);
+  options.update(params::to_json(pack::material_params(), m.options));
   nlohmann::json sources = nlohmann::json::object();
   for (const pack::SourceInput& s : m.sources) {
     sources[s.name] = s.file.empty() ? nlohmann::json(s.constant) : nlohmann::json(normalized(s.file).string());
@@ -34,13 +36,7 @@ nlohmann::json material_options(const MaterialSpec& m, const Manifest& manifest)
   for (const fs::path& f : m.packed_files) packed.push_back(normalized(f).string());
   options.update(nlohmann::json{{"sources", sources},
           {"packed", {{"layout", m.packed ? m.packed->reference : ""}, {"files", packed}}},
-          {"transfer", color::transfer_name(m.transfer)},
-          {"decode", m.decode ? color::transfer_name(*m.decode) : ""},
-          {"resize", m.resize},
           {"layout", m.layout ? m.layout->reference : ""},
-          {"format", m.format},
-          {"bits", m.bits ? image::sample_type_name(*m.bits) : "default"},
-          {"mapping", workflow::roughness_mapping_name(m.mapping)},
           {"reference", m.reference},
           {"table", manifest.table.string()},
           {"validate", {{"enabled", m.validation.enabled}, {"heatmap", m.validation.heatmap}}}});
@@ -207,7 +203,7 @@ Result<Plan> make_plan(const Manifest& manifest) {
       job.options = material_options(m, manifest).dump();
       job.problem = problems[i];
       if (m.layout) {
-        auto paths = pack::output_paths(m.layout->layout, {(materials_folder / (m.name + "_{texture}." + m.format)).string()});
+        auto paths = pack::output_paths(m.layout->layout, {(materials_folder / (m.name + "_{texture}." + m.options.format)).string()});
         if (!paths) return Error{m.origins.of("layout"), "materials." + m.name + ".layout: " + paths.error().to_string()};
         job.outputs = *paths;
       }

@@ -110,13 +110,8 @@ Error at_source(const MaterialSpec& m, const Error& e) {
 Result<material::Maps> load_material(const MaterialSpec& m, DecodeCache& cache) {
   const pack::ImageReader read = [&cache](const fs::path& f, color::Transfer t) { return cache.read(f, t); };
   auto maps = [&]() -> Result<material::Maps> {
-    if (m.packed) return pack::read_packed(m.packed->layout, m.packed_files, m.decode, m.transfer, read);
-    pack::LoadOptions options;
-    options.authored = m.transfer;
-    options.input = m.decode;
-    options.resize = m.resize;
-    options.read = read;
-    return pack::load_sources(m.sources, options);
+    if (m.packed) return pack::read_packed(m.packed->layout, m.packed_files, m.options, read);
+    return pack::load_sources(m.sources, m.options, read);
   }();
   if (!maps) return at_source(m, maps.error());
   return maps;
@@ -185,20 +180,20 @@ Status run_material(const Job& job, const JobContext& ctx, JobReport& report) {
       // Validation reads the maps as loaded: the workflow gets a copy only when it converts them
       // (else it hands them back, and validation reads them there).
       const bool converts = workflow::layout_direction(*maps, *layout).has_value();
-      auto in_workflow = workflow::in_layout_workflow(converts ? material::Maps(*maps) : std::move(*maps), *layout, m.mapping);
+      auto in_workflow = workflow::in_layout_workflow(converts ? material::Maps(*maps) : std::move(*maps), *layout, m.options.mapping);
       if (!in_workflow) {
         return Error{m.origins.of("layout"), "materials." + m.name + ".layout: " + in_workflow.error().to_string()};
       }
       if (!converts) *maps = std::move(in_workflow->maps);
       if (const auto& d = in_workflow->direction) {
         report.details["conversion"] = {{"direction", workflow::direction_name(*d)},
-                                        {"mapping", workflow::roughness_mapping_name(m.mapping)},
+                                        {"mapping", workflow::roughness_mapping_name(m.options.mapping)},
                                         {"texels", in_workflow->report.texels},
                                         {"errors", to_json(in_workflow->report.errors)}};
       }
       const std::vector<std::string> outputs(job.outputs.begin(), job.outputs.begin() + std::ptrdiff_t(layout->textures.size()));
       auto written = pack::write_textures(*layout, converts ? in_workflow->maps : *maps,
-                                          {outputs, m.bits, m.transfer, decoded_files(m), {}, m.encoding});
+                                          {outputs, m.options.bits, m.options.transfer, decoded_files(m), {}, m.encoding});
       if (!written) return written.error();
     }
     if (m.validation.enabled) return validate_material(m, *maps, ctx, job.outputs, report);
@@ -214,7 +209,7 @@ Result<std::vector<fs::path>> run_scene(const Job& job, const JobContext& ctx, J
       const MaterialSpec& spec = ctx.manifest.materials[m];
       auto maps = load_material(spec, ctx.cache);
       if (!maps) return maps.error();
-      options.materials.push_back({gltf_name, std::move(*maps), spec.mapping});
+      options.materials.push_back({gltf_name, std::move(*maps), spec.options.mapping});
     }
     const fs::path output = job.outputs.front();
     if (Status st = ensure_folder(output.parent_path()); !st) return st.error();
