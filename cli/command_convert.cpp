@@ -7,7 +7,7 @@
 #include "commands.hpp"
 #include "matbake/encoding_params.hpp"
 #include "params_cli.hpp"
-#include "option_names.hpp"
+#include "matbake/convert_params.hpp"
 #include "silenced_stderr.hpp"
 
 namespace fs = std::filesystem;
@@ -15,7 +15,7 @@ namespace fs = std::filesystem;
 namespace matbake::cli {
 namespace {
 
-std::string describe_channels(const ConvertReport& r) {
+std::string describe_channels(const convert::Report& r) {
   static const char* const kLayouts[] = {"", "gray", "gray+alpha", "RGB", "RGBA"};
   return kLayouts[r.channels];
 }
@@ -28,15 +28,15 @@ Result<std::vector<fs::path>> output_paths(const ConvertSettings& s, bool target
   if (!s.output.empty()) {
     if (s.inputs.size() != 1) return Error{"", "-o takes one input; use --out-dir DIR for several", true};
     const fs::path out(s.output);
-    if (!s.format.empty() && out.extension() != "." + s.format) {
-      return Error{s.output, "--format " + s.format + " disagrees with the output's extension", true};
+    if (!s.options.format.empty() && out.extension() != "." + s.options.format) {
+      return Error{s.output, "--format " + s.options.format + " disagrees with the output's extension", true};
     }
     return std::vector<fs::path>{out};
   }
   std::vector<fs::path> outputs;
   std::map<fs::path, std::string> taken;
   for (const std::string& in : s.inputs) {
-    outputs.push_back(output_path_in_folder(in, s.out_dir, s.format, target_is_linear));
+    outputs.push_back(convert::output_path_in_folder(in, s.out_dir, s.options.format, target_is_linear));
     if (auto [it, fresh] = taken.emplace(outputs.back(), in); !fresh) {
       return Error{in, "would be written to " + outputs.back().string() + " as " + it->second + " is", true};
     }
@@ -55,28 +55,16 @@ CLI::App* setup_convert(CLI::App& app, ConvertSettings& s) {
   CLI::Option* out = cmd->add_option("-o,--output", s.output, "Output file (.exr, .png, .tif), for one input");
   CLI::Option* dir = cmd->add_option("--out-dir", s.out_dir, "Output folder (created if missing): <input name>.<format> per input");
   out->excludes(dir);
-  cmd->add_option("--from", s.options.from, "Encoding of the inputs: srgb, gamma2.2, linear, or an OCIO colour space")
-      ->capture_default_str();
-  cmd->add_option("--to", s.options.to, "Encoding of the outputs: linear, srgb, gamma2.2, or an OCIO colour space")
-      ->capture_default_str();
-  cmd->add_option("--format", s.format, "Output format with --out-dir (default: exr for a linear target, else png)")
-      ->check(CLI::IsMember({"exr", "png", "tif"}));
-  cmd->add_option("--bits", s.bits,
-                  "Output samples: 8, 16 (PNG, TIFF), half, float (EXR, TIFF). Default: half for EXR; for PNG/TIFF "
-                  "16 when the target is linear, else the input's depth")
-      ->check(CLI::IsMember({"8", "16", "half", "float"}));
-  cmd->add_option("--compression", s.options.compression,
-                  "EXR/TIFF: OIIO compression name, e.g. none, zip, zips, zip:1..9, piz, dwaa (default: zip for EXR)");
+  add_params(*cmd, convert::options_params(), s.options, "", "Options");
   add_params(*cmd, image::encoding_params(), s.options.encoding, "", "Options");
   return cmd;
 }
 
 int run_convert(const ConvertSettings& settings, const GlobalOptions& global) {
-  ConvertOptions options = settings.options;
+  convert::Options options = settings.options;
   options.ocio_config = global.ocio_config;
-  if (!settings.bits.empty()) options.type = image::sample_type_from_name(settings.bits);
 
-  auto plan = plan_conversion(options);
+  auto plan = convert::plan_conversion(options);
   if (!plan) return report_error(plan.error());
   auto outputs = output_paths(settings, plan->target_is_linear);
   if (!outputs) return report_error(outputs.error());
@@ -88,7 +76,7 @@ int run_convert(const ConvertSettings& settings, const GlobalOptions& global) {
     const auto start = std::chrono::steady_clock::now();
     auto report = [&] {
       SilencedStderr quiet;
-      return convert_file(*plan, settings.inputs[i], (*outputs)[i], options);
+      return convert::convert_file(*plan, settings.inputs[i], (*outputs)[i], options);
     }();
     const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     if (!report) {
@@ -97,7 +85,7 @@ int run_convert(const ConvertSettings& settings, const GlobalOptions& global) {
       results.push_back({{"input", settings.inputs[i]}, {"error", report.error().to_string()}});
       continue;
     }
-    const ConvertReport& r = *report;
+    const convert::Report& r = *report;
     if (!global.quiet && !global.json) {
       std::cout << r.input.string() << " -> " << r.output.string() << " (" << r.width << "x" << r.height << " "
                 << describe_channels(r) << ", " << options.from << " " << image::sample_type_name(r.input_type)
@@ -116,7 +104,11 @@ int run_convert(const ConvertSettings& settings, const GlobalOptions& global) {
     std::cerr << "matbake: " << failed << " of " << settings.inputs.size() << " conversions failed\n";
   }
   if (global.json) {
-    nlohmann::json out = {{"command", "convert"}, {"from", options.from}, {"to", options.to}, {"results", results}};
+    nlohmann::json out = {{"command", "convert"},
+                          {"from", options.from},
+                          {"to", options.to},
+                          {"options", params::to_json(convert::options_params(), options)},
+                          {"results", results}};
     if (!plan->ocio_source.empty()) out["ocio_config"] = plan->ocio_source;
     std::cout << out.dump(2) << "\n";
   }

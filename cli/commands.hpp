@@ -39,9 +39,7 @@ struct ConvertSettings {
   std::vector<std::string> inputs;
   std::string output;
   std::string out_dir;
-  std::string format;
-  std::string bits;
-  ConvertOptions options;
+  convert::Options options;
 };
 CLI::App* setup_convert(CLI::App& app, ConvertSettings& settings);
 int run_convert(const ConvertSettings& settings, const GlobalOptions& global);

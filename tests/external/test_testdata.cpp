@@ -31,12 +31,12 @@ const fs::path kTestdata = MATBAKE_TESTDATA_DIR;
   if (!fs::is_directory(kTestdata / (sub))) GTEST_SKIP() << (kTestdata / (sub)).string() << \
       " is absent (it comes with the project's shared folder, not with a clone)"
 
-Result<ConvertReport> convert(const fs::path& in, const fs::path& out, std::string from = "srgb",
+Result<convert::Report> convert_one(const fs::path& in, const fs::path& out, std::string from = "srgb",
                               std::string to = "linear") {
-  ConvertOptions options;
+  convert::Options options;
   options.from = std::move(from);
   options.to = std::move(to);
-  return convert_file(*plan_conversion(options), in, out, options);
+  return convert::convert_file(*convert::plan_conversion(options), in, out, options);
 }
 
 // Every .gltf and .glb of the Khronos sample models.
@@ -67,7 +67,7 @@ std::vector<fs::path> files_in(const fs::path& folder, const std::string& ext = 
 }
 
 // A refusal is one line that names the file.
-void expect_clean_error(const Result<ConvertReport>& r, const fs::path& in) {
+void expect_clean_error(const Result<convert::Report>& r, const fs::path& in) {
   ASSERT_FALSE(r) << in;
   EXPECT_EQ(r.error().path, in.string());
   EXPECT_FALSE(r.error().message.empty());
@@ -81,7 +81,7 @@ TEST(PngSuite, ValidFilesConvertAndCorruptOnesAreRefused) {
   for (const fs::path& in : files_in(kTestdata / "images/pngsuite", ".png")) {
     // PngSuite names corrupt files x*.png.
     const bool is_corrupt = in.filename().string()[0] == 'x';
-    auto r = convert(in, dir / "out.exr");
+    auto r = convert_one(in, dir / "out.exr");
     if (is_corrupt) {
       expect_clean_error(r, in);
       ++corrupt;
@@ -100,21 +100,21 @@ TEST(PngSuite, LowBitDepthsAndPalettesDecodeToTheRightValues) {
   REQUIRE_TESTDATA("images/pngsuite");
   test::TempDir dir;
   // 1-bit gray: only black and white, so only 0 and 1 after decoding.
-  ASSERT_TRUE(convert(kTestdata / "images/pngsuite/basn0g01.png", dir / "g1.exr"));
+  ASSERT_TRUE(convert_one(kTestdata / "images/pngsuite/basn0g01.png", dir / "g1.exr"));
   for (double v : test::read_raw(dir / "g1.exr").samples) EXPECT_TRUE(v == 0.0 || v == 1.0) << v;
   // 16-bit gray keeps 16-bit precision: the codes come back through a float EXR.
-  ConvertOptions to_float;
-  to_float.type = image::SampleType::f32;
+  convert::Options to_float;
+  to_float.bits = image::SampleType::f32;
   const fs::path g16 = kTestdata / "images/pngsuite/basn0g16.png";
-  ASSERT_TRUE(convert_file(*plan_conversion(to_float), g16, dir / "g16.exr", to_float));
-  ConvertOptions back;
+  ASSERT_TRUE(convert::convert_file(*convert::plan_conversion(to_float), g16, dir / "g16.exr", to_float));
+  convert::Options back;
   back.from = "linear";
   back.to = "srgb";
-  back.type = image::SampleType::u16;
-  ASSERT_TRUE(convert_file(*plan_conversion(back), dir / "g16.exr", dir / "g16.png", back));
+  back.bits = image::SampleType::u16;
+  ASSERT_TRUE(convert::convert_file(*convert::plan_conversion(back), dir / "g16.exr", dir / "g16.png", back));
   EXPECT_EQ(test::read_raw(dir / "g16.png").samples, test::read_raw(g16).samples);
   // A palette image arrives as RGB.
-  ASSERT_TRUE(convert(kTestdata / "images/pngsuite/basn3p08.png", dir / "p8.exr"));
+  ASSERT_TRUE(convert_one(kTestdata / "images/pngsuite/basn3p08.png", dir / "p8.exr"));
   EXPECT_EQ(test::read_raw(dir / "p8.exr").channels, 3);
 }
 
@@ -122,12 +122,12 @@ TEST(LibpngImages, TaggedImagesConvertAndCrashersAreHandled) {
   REQUIRE_TESTDATA("images/libpng-testpngs");
   test::TempDir dir;
   for (const fs::path& in : files_in(kTestdata / "images/libpng-testpngs", ".png")) {
-    auto r = convert(in, dir / "out.exr");
+    auto r = convert_one(in, dir / "out.exr");
     EXPECT_TRUE(r) << r.error().to_string();
   }
   // Each crasher is either read (libpng skips a bad ancillary chunk) or refused in one line.
   for (const fs::path& in : files_in(kTestdata / "images/libpng-testpngs/crashers")) {
-    auto r = convert(in, dir / "out.exr");
+    auto r = convert_one(in, dir / "out.exr");
     if (!r) expect_clean_error(r, in);
   }
 }
@@ -146,7 +146,7 @@ TEST(OpenExrImages, NonFiniteSamplesAreCountedExactly) {
       ++index;
     }
     ASSERT_GT(nan + inf, 0u);
-    auto r = convert(in, dir / "out.exr", "linear", "srgb");
+    auto r = convert_one(in, dir / "out.exr", "linear", "srgb");
     expect_clean_error(r, in);
     const std::size_t row = std::size_t(raw.width) * raw.channels;
     EXPECT_EQ(r.error().message, "contains " + std::to_string(nan) + " NaN and " + std::to_string(inf) +
@@ -163,16 +163,16 @@ TEST(OpenExrImages, WideRangesAndDamagedFiles) {
   // Negative and large values: encoded with the mirrored sRGB curve, no clamping in float; values
   // beyond the half range are refused rather than written as Inf.
   const fs::path wide = kTestdata / "images/openexr/TestImages/WideFloatRange.exr";
-  auto half = convert(wide, dir / "wide.exr", "linear", "srgb");
+  auto half = convert_one(wide, dir / "wide.exr", "linear", "srgb");
   ASSERT_FALSE(half);
   EXPECT_EQ(half.error().path, (dir / "wide.exr").string());
   EXPECT_NE(half.error().message.find("exceed the half-float range"), std::string::npos);
   EXPECT_FALSE(fs::exists(dir / "wide.exr"));
-  ConvertOptions to_float;
+  convert::Options to_float;
   to_float.from = "linear";
   to_float.to = "srgb";
-  to_float.type = image::SampleType::f32;
-  ASSERT_TRUE(convert_file(*plan_conversion(to_float), wide, dir / "wide.exr", to_float));
+  to_float.bits = image::SampleType::f32;
+  ASSERT_TRUE(convert::convert_file(*convert::plan_conversion(to_float), wide, dir / "wide.exr", to_float));
   const auto in = test::read_raw(wide), out = test::read_raw(dir / "wide.exr");
   ASSERT_EQ(in.samples.size(), out.samples.size());
   for (std::size_t i = 0; i < in.samples.size(); i += 97) {
@@ -181,7 +181,7 @@ TEST(OpenExrImages, WideRangesAndDamagedFiles) {
   }
   for (const fs::path& damaged : files_in(kTestdata / "images/openexr/Damaged")) {
     if (damaged.extension() == ".rst") continue;
-    expect_clean_error(convert(damaged, dir / "out.exr"), damaged);
+    expect_clean_error(convert_one(damaged, dir / "out.exr"), damaged);
   }
 }
 

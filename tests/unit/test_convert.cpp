@@ -7,7 +7,7 @@
 #include "support/files.hpp"
 #include "support/temp_dir.hpp"
 
-namespace matbake {
+namespace matbake::convert {
 namespace {
 
 using image::SampleType;
@@ -15,8 +15,8 @@ using test::read_raw;
 using test::TempDir;
 using test::write_raw;
 
-ConvertOptions options(std::string from, std::string to) {
-  ConvertOptions o;
+Options options(std::string from, std::string to) {
+  Options o;
   o.from = std::move(from);
   o.to = std::move(to);
   return o;
@@ -66,8 +66,8 @@ TEST(ConvertFile, SrgbPngToLinearExrHoldsTheExactTable) {
   write_raw(dir / "ramp.png", 16, 16, 1, "uint8", codes);
   const auto o = options("srgb", "linear");
   auto plan = plan_conversion(o);
-  ConvertOptions as_float = o;
-  as_float.type = SampleType::f32;
+  Options as_float = o;
+  as_float.bits = SampleType::f32;
   auto report = convert_file(*plan, dir / "ramp.png", dir / "ramp.exr", as_float);
   ASSERT_TRUE(report) << report.error().to_string();
   EXPECT_EQ(report->input_type, SampleType::u8);
@@ -81,8 +81,8 @@ TEST(ConvertFile, OcioPathAgreesWithTheExactPathWithinItsMeasuredDifference) {
   std::vector<double> rgb;
   for (int i = 0; i < 256; ++i) rgb.insert(rgb.end(), {double(i), double(255 - i), double(i / 2)});
   write_raw(dir / "in.png", 256, 1, 3, "uint8", rgb);
-  ConvertOptions o = options("sRGB - Texture", "Linear Rec.709 (sRGB)");
-  o.type = SampleType::f32;
+  Options o = options("sRGB - Texture", "Linear Rec.709 (sRGB)");
+  o.bits = SampleType::f32;
   auto report = convert_file(*plan_conversion(o), dir / "in.png", dir / "ocio.exr", o);
   ASSERT_TRUE(report) << report.error().to_string();
   const auto out = read_raw(dir / "ocio.exr");
@@ -102,8 +102,8 @@ TEST(ConvertFile, RefusalsLeaveNothingBehind) {
   ASSERT_FALSE(same);
   EXPECT_EQ(same.error().message, "is an input; matbake never overwrites its inputs");
 
-  ConvertOptions eight_bit_exr = builtin;
-  eight_bit_exr.type = SampleType::u8;
+  Options eight_bit_exr = builtin;
+  eight_bit_exr.bits = SampleType::u8;
   auto wrong_type = convert_file(*plan, dir / "gray.png", dir / "out.exr", eight_bit_exr);
   ASSERT_FALSE(wrong_type);
   EXPECT_TRUE(wrong_type.error().usage);
@@ -121,4 +121,4 @@ TEST(ConvertFile, RefusalsLeaveNothingBehind) {
 }
 
 }  // namespace
-}  // namespace matbake
+}  // namespace matbake::convert

@@ -8,6 +8,7 @@
 #include "cli/ao_options.hpp"
 #include "cli/params_cli.hpp"
 #include "matbake/ao_params.hpp"
+#include "matbake/convert_params.hpp"
 #include "matbake/encoding_params.hpp"
 #include "matbake/export_params.hpp"
 #include "matbake/material_params.hpp"
@@ -193,6 +194,22 @@ TEST(MaterialParams, EveryParameterReachesTheMaterialFromBothDoorsAndTheTopLevel
   }
 }
 
+// `convert` has one door: each parameter's example through its flag is what --json echoes.
+TEST(ConvertParams, EveryParameterIsAFlagWhoseExampleChangesTheEcho) {
+  const Group<convert::Options>& group = convert::options_params();
+  const nlohmann::json defaults = to_json(group, convert::Options{});
+  for (const Param<convert::Options>& p : group.params) {
+    SCOPED_TRACE(p.spec.name);
+    CLI::App app;
+    convert::Options options;
+    cli::add_params(app, group, options, "", "Options");
+    app.parse(std::vector<std::string>{p.spec.example, flag_name(p.spec, "")});
+    nlohmann::json expected = defaults;
+    expected[p.spec.name] = p.spec.example;
+    EXPECT_EQ(to_json(group, options), expected);
+  }
+}
+
 TEST(MaterialParams, AnOlderFlagWorksAsTheNewOne) {
   CLI::App app;
   pack::MaterialOptions options;
@@ -224,6 +241,7 @@ TEST(DocsTables, MatchTheParameterDescriptions) {
       {"docs/export.md", "params:export", markdown_table(exporter::options_params(), "")},
       {"docs/validate.md", "params:validate", markdown_table(validate::options_params(), "")},
       {"docs/build.md", "params:material", markdown_table(pack::material_params(), "")},
+      {"docs/convert.md", "params:convert", markdown_table(convert::options_params(), "")},
   };
   for (const Table& t : tables) {
     const fs::path path = fs::path(MATBAKE_SOURCE_DIR) / t.file;

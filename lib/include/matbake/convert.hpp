@@ -10,20 +10,23 @@
 #include "matbake/ocio.hpp"
 #include "matbake/result.hpp"
 
-namespace matbake {
+namespace matbake::convert {
 
-struct ConvertOptions {
+// Its parameters (all but ocio_config, which is global) are options_params() (convert_params.hpp).
+struct Options {
   std::string from = "srgb";    // srgb | gamma2.2 | linear | an OCIO colour space
   std::string to = "linear";    // the same choices
-  std::optional<image::SampleType> type;  // default: see default_sample_type()
-  std::string compression;                // EXR default: zip
+  std::optional<image::SampleType> bits;  // default: see default_sample_type()
+  std::string format;                     // of outputs named by output_path_in_folder; empty: by the target
+  std::string compression;                // EXR/TIFF, OIIO's name; EXR default: zip
   std::filesystem::path ocio_config;      // empty: $OCIO, else the shipped config
   image::Encoding encoding;  // of PNG outputs
 };
 
+
 // How a conversion runs: either exact built-in transfers at read and write, or (when either side
 // names an OCIO colour space) raw I/O around an OCIO processor. Built once for a batch.
-struct ConversionPlan {
+struct Plan {
   color::Transfer decode = color::Transfer::linear;
   color::Transfer encode = color::Transfer::linear;
   std::optional<color::OcioProcessor> ocio;
@@ -31,9 +34,9 @@ struct ConversionPlan {
   std::string ocio_source;  // the OCIO config used, when one is
 };
 
-Result<ConversionPlan> plan_conversion(const ConvertOptions& options);
+Result<Plan> plan_conversion(const Options& options);
 
-struct ConvertReport {
+struct Report {
   std::filesystem::path input;
   std::filesystem::path output;
   int width = 0;
@@ -55,7 +58,7 @@ std::filesystem::path output_path_in_folder(const std::filesystem::path& input,
                                             const std::filesystem::path& folder,
                                             const std::string& format, bool target_is_linear);
 
-Result<ConvertReport> convert_file(const ConversionPlan& plan, const std::filesystem::path& input,
-                                   const std::filesystem::path& output, const ConvertOptions& options);
+Result<Report> convert_file(const Plan& plan, const std::filesystem::path& input,
+                                   const std::filesystem::path& output, const Options& options);
 
-}  // namespace matbake
+}  // namespace matbake::convert

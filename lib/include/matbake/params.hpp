@@ -167,6 +167,21 @@ Param<T> number(Spec spec, Field field) {
           [field](const T& t) { return nlohmann::json(field(t)); }};
 }
 
+// Text stored as given (the request judges it where it is used: an OCIO colour space); with
+// spec.choices, one of them. Empty shows as null (unset).
+template <class T, class Field>
+Param<T> text(Spec spec, Field field) {
+  spec.kind = spec.choices.empty() ? Kind::text : Kind::choice;
+  return {std::move(spec), [field](T& t, const Value& v) -> std::optional<std::string> {
+            field(t) = std::get<std::string>(v);
+            return std::nullopt;
+          },
+          [field](const T& t) -> nlohmann::json {
+            if (field(t).empty()) return nullptr;
+            return field(t);
+          }};
+}
+
 // An enum (or an optional one: unset shows as null) named by a module's NameTable.
 template <class T, class Field, class E, std::size_t N>
 Param<T> choice(Spec spec, Field field, const NameTable<E, N>& names) {

@@ -6,7 +6,7 @@
 
 namespace fs = std::filesystem;
 
-namespace matbake {
+namespace matbake::convert {
 namespace {
 
 std::string lower_extension(const fs::path& path) {
@@ -26,7 +26,7 @@ bool format_stores(const fs::path& output, image::SampleType type) {
 }
 
 // The tag OIIO writes into the file (PNG sRGB/gAMA chunks, an EXR/TIFF attribute).
-std::string colorspace_tag(const ConversionPlan& plan, const ConvertOptions& options) {
+std::string colorspace_tag(const Plan& plan, const Options& options) {
   if (plan.ocio) return options.to;
   switch (plan.encode) {
     case color::Transfer::linear: return "Linear";
@@ -38,10 +38,10 @@ std::string colorspace_tag(const ConversionPlan& plan, const ConvertOptions& opt
 
 }  // namespace
 
-Result<ConversionPlan> plan_conversion(const ConvertOptions& options) {
+Result<Plan> plan_conversion(const Options& options) {
   const auto from = color::transfer_from_name(options.from);
   const auto to = color::transfer_from_name(options.to);
-  ConversionPlan plan;
+  Plan plan;
   if (from && to) {
     plan.decode = *from;
     plan.encode = *to;
@@ -82,15 +82,15 @@ fs::path output_path_in_folder(const fs::path& input, const fs::path& folder, co
   return folder / (input.stem().string() + "." + ext);
 }
 
-Result<ConvertReport> convert_file(const ConversionPlan& plan, const fs::path& input, const fs::path& output,
-                                   const ConvertOptions& options) {
-  return guarded(input.string(), [&]() -> Result<ConvertReport> {
+Result<Report> convert_file(const Plan& plan, const fs::path& input, const fs::path& output,
+                                   const Options& options) {
+  return guarded(input.string(), [&]() -> Result<Report> {
     if (!is_supported_output_extension(output)) {
       return Error{output.string(), "unsupported output format (matbake writes .exr, .png, .tif)", true};
     }
-    if (options.type && !format_stores(output, *options.type)) {
+    if (options.bits && !format_stores(output, *options.bits)) {
       return Error{output.string(),
-                   "this format cannot store " + std::string(image::sample_type_name(*options.type)) +
+                   "this format cannot store " + std::string(image::sample_type_name(*options.bits)) +
                        " samples (EXR: half or float; PNG: 8 or 16)",
                    true};
     }
@@ -100,7 +100,7 @@ Result<ConvertReport> convert_file(const ConversionPlan& plan, const fs::path& i
     // Without --bits the output type depends on the input's, known only once the input is open.
     image::ReadInfo info;
     image::ImageLayout layout;
-    image::WriteOptions write{plan.encode, options.type.value_or(image::SampleType::half), options.compression,
+    image::WriteOptions write{plan.encode, options.bits.value_or(image::SampleType::half), options.compression,
                               colorspace_tag(plan, options), options.encoding.png_level};
     image::BandTransform transform;
     transform.accept = [&](const image::ImageLayout& l) -> Status {
@@ -113,7 +113,7 @@ Result<ConvertReport> convert_file(const ConversionPlan& plan, const fs::path& i
     if (plan.ocio) {
       transform.apply = [&](std::span<float> band, const image::ImageLayout& l) { plan.ocio->apply(band, l.channels); };
     }
-    if (!options.type) {
+    if (!options.bits) {
       // Peek at the stored type first (opening is cheap: the header only).
       auto probe = image::probe_image(input);
       if (!probe) return probe.error();
@@ -122,8 +122,8 @@ Result<ConvertReport> convert_file(const ConversionPlan& plan, const fs::path& i
     if (Status s = image::stream_image(input, plan.decode, output, write, transform, &info, &layout); !s) {
       return s.error();
     }
-    return ConvertReport{input, output, layout.width, layout.height, layout.channels, info.stored_type, write.type};
+    return Report{input, output, layout.width, layout.height, layout.channels, info.stored_type, write.type};
   });
 }
 
-}  // namespace matbake
+}  // namespace matbake::convert

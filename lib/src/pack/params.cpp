@@ -27,21 +27,6 @@ params::Param<MaterialOptions> constant_size() {
           }};
 }
 
-// A format is its extension (params::accept has checked it is one of the choices).
-params::Param<MaterialOptions> output_format() {
-  return {params::Spec{.name = "format",
-                       .kind = params::Kind::choice,
-                       .help = "Format of the textures where no output path names one (a manifest material's, "
-                               "unpack's maps)",
-                       .choices = {"png", "exr", "tif"},
-                       .example = "exr"},
-          [](MaterialOptions& o, const params::Value& v) -> std::optional<std::string> {
-            o.format = std::get<std::string>(v);
-            return std::nullopt;
-          },
-          [](const MaterialOptions& o) { return nlohmann::json(o.format); }};
-}
-
 }  // namespace
 
 const params::Group<MaterialOptions>& material_params() {
@@ -69,7 +54,12 @@ const params::Group<MaterialOptions>& material_params() {
                                                    "colour is encoded with transfer in 8-bit, linear otherwise",
                                            .example = "16"},
                                       [](auto& o) -> auto& { return o.bits; }, image::kSampleTypeNames),
-      output_format(),
+      params::text<MaterialOptions>(Spec{.name = "format",
+                                         .help = "Format of the textures where no output path names one (a "
+                                                 "manifest material's, unpack's maps)",
+                                         .choices = {"png", "exr", "tif"},
+                                         .example = "exr"},
+                                    [](auto& o) -> auto& { return o.format; }),
       params::choice<MaterialOptions>(Spec{.name = "mapping",
                                            .help = "Gloss ⇄ roughness of a workflow conversion (fitted: least "
                                                    "squares over the lobe)",
