@@ -30,7 +30,7 @@ std::string_view outcome_name(pipeline::Outcome o) {
 nlohmann::json job_json(const pipeline::JobReport& r) {
   std::vector<std::string> inputs, outputs;
   for (const fs::path& p : r.job->inputs) inputs.push_back(p.string());
-  for (const fs::path& p : r.job->outputs) outputs.push_back(p.string());
+  for (const fs::path& p : r.job->outputs.all()) outputs.push_back(p.string());
   nlohmann::json j = {{"name", r.job->name}, {"outcome", outcome_name(r.outcome)}, {"inputs", inputs},
                       {"outputs", outputs},  {"seconds", r.seconds},              {"warnings", r.warnings}};
   if (!r.reason.empty()) j["reason"] = r.reason;
@@ -140,7 +140,8 @@ int run_build(const BuildSettings& s, const GlobalOptions& global) {
   if (!s.depfile.empty() && !s.dry_run) {
     std::vector<fs::path> targets, inputs = {manifest.file};
     for (const pipeline::JobReport& r : report->jobs) {
-      targets.insert(targets.end(), r.job->outputs.begin(), r.job->outputs.end());
+      const std::vector<fs::path> files = r.job->outputs.all();
+      targets.insert(targets.end(), files.begin(), files.end());
       for (const fs::path& p : r.job->inputs) {
         if (std::find(inputs.begin(), inputs.end(), p) == inputs.end()) inputs.push_back(p);
       }

@@ -92,11 +92,21 @@ Result<Manifest> read_manifest(const std::filesystem::path& file);
 
 enum class JobKind { material, scene };
 
+// What a job writes, by role, as known before it runs (empty: not made by this job).
+struct JobOutputs {
+  std::vector<std::filesystem::path> textures;  // a material's layout textures, in the layout's order
+  std::filesystem::path validation_report;      // <name>.validation.json
+  std::filesystem::path heatmap;                // <name>_validation.png
+  std::filesystem::path scene;                  // a scene's .gltf or .glb
+  std::filesystem::path buffer;                 // a .gltf scene's .bin
+  std::vector<std::filesystem::path> all() const;  // every one, in that order
+};
+
 struct Job {
   JobKind kind = JobKind::material;
   std::size_t spec = 0;  // index into the manifest's materials or scenes
   std::string name;      // "material:wood", "scene:showroom"
-  std::vector<std::filesystem::path> outputs;  // every file it writes, as known before it runs
+  JobOutputs outputs;
   std::vector<std::filesystem::path> inputs;   // every file it reads
   std::map<std::string, std::size_t> materials;  // a scene: glTF material name → manifest material
   std::string options;   // what besides the inputs decides the outputs (canonical JSON)

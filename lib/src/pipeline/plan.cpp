@@ -113,6 +113,14 @@ std::string make_escape(const std::string& path) {
 
 }  // namespace
 
+std::vector<fs::path> JobOutputs::all() const {
+  std::vector<fs::path> files = textures;
+  for (const fs::path* f : {&validation_report, &heatmap, &scene, &buffer}) {
+    if (!f->empty()) files.push_back(*f);
+  }
+  return files;
+}
+
 std::size_t Report::count(Outcome o) const {
   return std::size_t(std::count_if(jobs.begin(), jobs.end(), [&](const JobReport& j) { return j.outcome == o; }));
 }
@@ -146,8 +154,8 @@ Result<Plan> make_plan(const Manifest& manifest) {
       job.spec = i;
       job.name = "scene:" + s.name;
       const fs::path out = manifest.output / s.output;
-      job.outputs.push_back(out);
-      if (out.extension() == ".gltf") job.outputs.push_back(out.parent_path() / (out.stem().string() + ".bin"));
+      job.outputs.scene = out;
+      if (out.extension() == ".gltf") job.outputs.buffer = out.parent_path() / (out.stem().string() + ".bin");
       // Which manifest materials the scene gets: named in the spec, or by the glTF material's name.
       std::map<std::string, std::string> assigned = s.materials;
       auto json = gltf::read_json(s.input);
@@ -205,18 +213,18 @@ Result<Plan> make_plan(const Manifest& manifest) {
       if (m.layout) {
         auto paths = pack::output_paths(m.layout->layout, {(materials_folder / (m.name + "_{texture}." + m.options.format)).string()});
         if (!paths) return Error{m.origins.of("layout"), "materials." + m.name + ".layout: " + paths.error().to_string()};
-        job.outputs = *paths;
+        job.outputs.textures = *paths;
       }
       if (m.validation.enabled) {
-        job.outputs.push_back(materials_folder / (m.name + ".validation.json"));
-        if (m.validation.heatmap) job.outputs.push_back(materials_folder / (m.name + "_validation.png"));
+        job.outputs.validation_report = materials_folder / (m.name + ".validation.json");
+        if (m.validation.heatmap) job.outputs.heatmap = materials_folder / (m.name + "_validation.png");
       }
       if (!m.layout && !used[i] && !m.validation.enabled) {
         plan.warnings.push_back("materials." + m.name +
                                 ": no layout, no validation and no scene uses it, so nothing is built from it");
         continue;
       }
-      if (job.outputs.empty()) continue;  // used by scenes only, nothing of its own to write
+      if (job.outputs.all().empty()) continue;  // used by scenes only, nothing of its own to write
       plan.jobs.push_back(std::move(job));
     }
     for (Job& s : scenes) plan.jobs.push_back(std::move(s));
@@ -238,7 +246,7 @@ Result<Plan> make_plan(const Manifest& manifest) {
       return Error{plan.state_folder.string(), "is a link out of the output folder; matbake writes only inside it"};
     }
     for (const Job& job : plan.jobs) {
-      for (const fs::path& out : job.outputs) {
+      for (const fs::path& out : job.outputs.all()) {
         if (!is_really_inside(manifest.output, out)) {
           return Error{out.string(), job.name + " would be written outside the output folder (through a link); matbake writes only inside it"};
         }
@@ -276,7 +284,7 @@ std::string ninja_text(const Manifest& manifest, const Plan& plan, const fs::pat
           "  restat = 1\n\n";
   for (const Job& job : plan.jobs) {
     text += "build";
-    for (const fs::path& out : job.outputs) text += " " + ninja_escape(out.string());
+    for (const fs::path& out : job.outputs.all()) text += " " + ninja_escape(out.string());
     text += ": matbake $manifest";
     if (!job.inputs.empty()) {
       text += " |";

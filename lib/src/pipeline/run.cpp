@@ -133,7 +133,7 @@ Status ensure_folder(const fs::path& folder) {
 
 // Validation of the material as authored; a job error when more texels are flagged than allowed.
 Status validate_material(const MaterialSpec& m, const material::Maps& maps, const JobContext& ctx,
-                         const std::vector<fs::path>& outputs, JobReport& report) {
+                         const JobOutputs& outputs, JobReport& report) {
   validate::Options options = m.validation.options;
   options.class_map = m.validation.heatmap;
   if (!m.reference.empty()) {
@@ -152,13 +152,11 @@ Status validate_material(const MaterialSpec& m, const material::Maps& maps, cons
                                   {"violations", result->violations},
                                   {"violation_fraction", result->violation_fraction()},
                                   {"passed", passed}};
-  const fs::path& json_file = *std::find_if(outputs.begin(), outputs.end(), [](const fs::path& p) {
-    return p.string().ends_with(".validation.json");
-  });
+  const fs::path& json_file = outputs.validation_report;
   report.details["validation"]["report"] = json_file.string();
   if (Status s = write_validation_report(*result, options, json_file); !s) return s;
   if (m.validation.heatmap) {
-    if (Status s = validate::write_heatmap(*result, outputs.back()); !s) return s;
+    if (Status s = validate::write_heatmap(*result, outputs.heatmap); !s) return s;
   }
   char line[160];
   std::snprintf(line, sizeof line, "validation: %zu of %zu texels flagged (%.3g%%; max_violations %.3g%%)",
@@ -191,7 +189,7 @@ Status run_material(const Job& job, const JobContext& ctx, JobReport& report) {
                                         {"texels", in_workflow->report.texels},
                                         {"errors", to_json(in_workflow->report.errors)}};
       }
-      const std::vector<std::string> outputs(job.outputs.begin(), job.outputs.begin() + std::ptrdiff_t(layout->textures.size()));
+      const std::vector<std::string> outputs(job.outputs.textures.begin(), job.outputs.textures.end());
       auto written = pack::write_textures(*layout, converts ? in_workflow->maps : *maps,
                                           {outputs, m.options.bits, m.options.transfer, decoded_files(m), {}, m.encoding});
       if (!written) return written.error();
@@ -211,7 +209,7 @@ Result<std::vector<fs::path>> run_scene(const Job& job, const JobContext& ctx, J
       if (!maps) return maps.error();
       options.materials.push_back({gltf_name, std::move(*maps), spec.options.mapping});
     }
-    const fs::path output = job.outputs.front();
+    const fs::path& output = job.outputs.scene;
     if (Status st = ensure_folder(output.parent_path()); !st) return st.error();
     auto exported = exporter::export_scene(s.input, output, options);
     if (!exported) return exported.error();
@@ -223,7 +221,7 @@ Result<std::vector<fs::path>> run_scene(const Job& job, const JobContext& ctx, J
 void run_job(const Job& job, const JobContext& ctx, const fs::path& state_folder, JobReport& report) {
   const auto start = std::chrono::steady_clock::now();
   remove_stamp(job, state_folder);  // from here until it succeeds, the job is not up to date
-  std::vector<fs::path> written = job.outputs;
+  std::vector<fs::path> written = job.outputs.all();
   Status status = success();
   if (job.problem) {
     status = *job.problem;
