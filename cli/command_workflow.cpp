@@ -45,8 +45,8 @@ CLI::App* setup_workflow(CLI::App& app, WorkflowSettings& s) {
       "Convert between Schüler's specular workflow (Kd, Ks, gloss) and the metalness workflow (base colour,\n"
       "metallic, roughness), write the target layout's textures and report the error of the conversion\n"
       "(and, to metal-rough, of the Khronos spec-gloss converter on the same texels).\n"
-      "Example: matbake workflow --from schuler A.png B.png --to gltf-orm -o out/brick_{texture}.png");
-  cmd->add_option("--to", s.to, "Target layout: a preset or a layout JSON file")->required();
+      "Example: matbake workflow --from schuler A.png B.png --layout gltf-orm -o out/brick_{texture}.png");
+  cmd->add_option("--layout,--to", s.to, "Target layout: a preset or a layout JSON file (--to: its older name)")->required();
   cmd->add_option("--report", s.report, "Also write the error report as JSON to this file");
   add_source_options(*cmd, s.sources, {"transfer", "decode", "resize", "size", "bits", "mapping"});
   add_output_options(*cmd, s.output, "textures");

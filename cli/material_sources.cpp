@@ -45,31 +45,17 @@ Result<material::Maps> gather_sources(const SourceSettings& s) {
     if (!input) return Error{"", option_of(sources[i].name) + ": " + input.error().message, true};
     inputs.push_back(std::move(*input));
   }
-  material::Maps maps;
-  {
-    SilencedStderr quiet;
-    auto loaded = pack::load_sources(inputs, s.options);
-    if (!loaded) return loaded.error();
-    maps = std::move(loaded.value());
+  if (s.from.empty() && !s.inputs.empty()) {
+    return Error{"", "input textures need --from LAYOUT to say what they hold", true};
   }
-  if (s.from.empty()) {
-    if (!s.inputs.empty()) return Error{"", "input textures need --from LAYOUT to say what they hold", true};
-    return maps;
+  std::optional<pack::Layout> packed;
+  if (!s.from.empty()) {
+    auto layout = pack::find_layout(s.from);
+    if (!layout) return layout.error();
+    packed = std::move(*layout);
   }
-  // Packed inputs: unpack, then the per-source options take precedence.
-  auto layout = pack::find_layout(s.from);
-  if (!layout) return layout.error();
-  Result<material::Maps> unpacked = Error{};
-  {
-    SilencedStderr quiet;
-    unpacked = pack::read_packed(*layout, {s.inputs.begin(), s.inputs.end()}, s.options);
-  }
-  if (!unpacked) return unpacked.error();
-  if (!maps.maps.empty() && (maps.width != unpacked->width || maps.height != unpacked->height)) {
-    return Error{s.inputs[0], "size differs from the other sources"};
-  }
-  for (auto& [name, map] : maps.maps) unpacked->maps[name] = std::move(map);
-  return unpacked;
+  SilencedStderr quiet;
+  return pack::load_material(inputs, packed ? &*packed : nullptr, {s.inputs.begin(), s.inputs.end()}, s.options);
 }
 
 void add_output_options(CLI::App& cmd, OutputSettings& o, const std::string& what) {

@@ -175,5 +175,39 @@ TEST(Sources, DifferentSizesAreAnErrorUnlessResized) {
   for (float v : resized->find("mask")->pixels) EXPECT_NEAR(v, 0.2f, 1e-6);  // a constant stays constant
 }
 
+// A packed pair with sources given beside it: each source replaces the unpacked map of its name,
+// constants at the pair's size, a file of another size resized only when asked.
+TEST(Sources, SourcesBesidePackedTexturesReplaceTheirMaps) {
+  TempDir dir;
+  // Schüler A = kd (linear 8-bit: written as linear codes) + mask, B = ks + gloss; 4x2.
+  const Layout schuler = *find_layout("schuler");
+  std::vector<double> a(4 * 2 * 4, 102), b(4 * 2 * 4, 204);
+  test::write_raw(dir / "a.png", 4, 2, 4, "uint8", a);
+  test::write_raw(dir / "b.png", 4, 2, 4, "uint8", b);
+  test::write_raw(dir / "gloss.png", 2, 1, 1, "uint8", {51, 51});
+  const std::vector<std::filesystem::path> pair = {dir / "a.png", dir / "b.png"};
+  const MaterialOptions linear{.transfer = color::Transfer::linear};
+
+  auto constant = load_material({{"gloss", {}, {0.25}}}, &schuler, pair, linear);
+  ASSERT_TRUE(constant) << constant.error().to_string();
+  EXPECT_EQ(constant->width, 4);
+  EXPECT_EQ(constant->height, 2);
+  for (float v : constant->find("gloss")->pixels) EXPECT_FLOAT_EQ(v, 0.25f);
+  for (float v : constant->find("mask")->pixels) EXPECT_FLOAT_EQ(v, 0.4f);  // 102/255, from the pair
+  EXPECT_FLOAT_EQ(constant->find("ks")->pixels[0], 0.8f);                   // 204/255
+
+  const std::vector<SourceInput> small = {{"gloss", dir / "gloss.png", {}}};
+  auto refused = load_material(small, &schuler, pair, linear);
+  ASSERT_FALSE(refused);
+  EXPECT_EQ(refused.error().path, (dir / "a.png").string());
+  EXPECT_EQ(refused.error().message, "4x2, but the sources given with it are 2x1 (resizing resamples them)");
+  MaterialOptions resize = linear;
+  resize.resize = true;
+  auto resized = load_material(small, &schuler, pair, resize);
+  ASSERT_TRUE(resized) << resized.error().to_string();
+  EXPECT_EQ(resized->find("gloss")->width, 4);
+  for (float v : resized->find("gloss")->pixels) EXPECT_NEAR(v, 0.2f, 1e-6);  // a constant image stays constant
+}
+
 }  // namespace
 }  // namespace matbake::pack

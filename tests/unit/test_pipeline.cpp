@@ -132,7 +132,7 @@ TEST(BuildManifest, ErrorsSayWhereAndWhat) {
       {"[materials.a\n", "m.toml:1:", "not valid TOML"},
       {"[materials.a]\nsources = { kd = 0.5 }\nbits = \"12\"\n", "m.toml:3:", "materials.a.bits: use 8, 16, half or float"},
       {"[materials.a]\nsources = { albedo = \"x.png\" }\n", "m.toml:2:", "unknown source 'albedo'"},
-      {"[materials.a]\nlayout = \"schuler\"\n", "m.toml:1:", "give either sources = {...} or packed = {...}"},
+      {"[materials.a]\nlayout = \"schuler\"\n", "m.toml:1:", "give sources = {...}, packed = {...} or both"},
       {"[materials.\"../up\"]\nsources = { kd = 0.5 }\n", "m.toml:", "letters, digits"},
       {"[scenes.s]\ninput = \"a.gltf\"\noutput = \"../a.glb\"\n", "m.toml:3:", "inside the output folder"},
       {"[scenes.s]\ninput = \"a.gltf\"\noutput = \"/tmp/a.glb\"\n", "m.toml:3:", "inside the output folder"},

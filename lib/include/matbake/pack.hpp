@@ -91,6 +91,14 @@ Result<material::Maps> load_sources(const std::vector<SourceInput>& inputs, cons
 Result<material::Maps> read_packed(const Layout& layout, const std::vector<std::filesystem::path>& files,
                                    const MaterialOptions& options, const ImageReader& read = {});
 
+// A material's maps as both doors give them: the textures of the `packed` layout (when not null)
+// unpacked, then each of `sources` in place of the map of its name (`--from schuler A B --gloss 0.5`,
+// or a manifest's `packed` with `sources`). Constants take the packed size; a file of another
+// size is resized to it with `options.resize`, else refused.
+Result<material::Maps> load_material(const std::vector<SourceInput>& sources, const Layout* packed,
+                                     const std::vector<std::filesystem::path>& packed_files,
+                                     const MaterialOptions& options, const ImageReader& read = {});
+
 // The sources a layout reads, and which of them it cannot do without (no fallback).
 std::vector<std::string> layout_sources(const Layout& layout);
 Result<std::vector<image::Image>> pack(const Layout& layout, const material::Maps& sources);

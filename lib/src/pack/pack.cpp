@@ -311,6 +311,29 @@ Result<material::Maps> read_packed(const Layout& layout, const std::vector<std::
   });
 }
 
+Result<material::Maps> load_material(const std::vector<SourceInput>& sources, const Layout* packed,
+                                     const std::vector<fs::path>& packed_files, const MaterialOptions& options,
+                                     const ImageReader& read) {
+  if (!packed) return load_sources(sources, options, read);
+  auto maps = read_packed(*packed, packed_files, options, read);
+  if (!maps || sources.empty()) return maps;
+  MaterialOptions sized = options;
+  sized.width = maps->width, sized.height = maps->height;
+  auto overrides = load_sources(sources, sized, read);
+  if (!overrides) return overrides.error();
+  if (overrides->width != maps->width || overrides->height != maps->height) {
+    if (!options.resize) {
+      return Error{packed_files.front().string(), std::to_string(maps->width) + "x" + std::to_string(maps->height) +
+                                                      ", but the sources given with it are " +
+                                                      std::to_string(overrides->width) + "x" +
+                                                      std::to_string(overrides->height) + " (resizing resamples them)"};
+    }
+    for (auto& [name, map] : overrides->maps) map = image::resize_image(map, maps->width, maps->height);
+  }
+  for (auto& [name, map] : overrides->maps) maps->maps[name] = std::move(map);
+  return maps;
+}
+
 std::vector<std::string> layout_sources(const Layout& layout) {
   std::vector<std::string> names;
   for (const Texture& t : layout.textures) {

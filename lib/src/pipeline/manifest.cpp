@@ -176,6 +176,62 @@ Result<std::optional<LayoutChoice>> read_layout(const Reader& r, const toml::tab
   return std::optional<LayoutChoice>(LayoutChoice{*text, std::move(resolved->layout), std::move(resolved->file)});
 }
 
+// sources = { kd = "t/paint.png", ks = 0.04, gloss = "0.6" }: files or constants.
+Status read_sources(const Reader& r, const toml::node& sources, const std::string& where, const Manifest& m,
+                    MaterialSpec& spec) {
+  if (!sources.is_table()) return r.at(sources, where + ".sources must be a table");
+  for (const auto& [key, value] : *sources.as_table()) {
+    const std::string source(key.str());
+    if (!material::find_source(source)) {
+      std::string known;
+      for (const material::Source& s : material::sources()) known += (known.empty() ? "" : ", ") + std::string(s.name);
+      return r.at(key.source(), where + ".sources: unknown source '" + source + "' (known: " + known + ")");
+    }
+    pack::SourceInput in{source, {}, {}};
+    if (auto text = value.value<std::string>()) {  // a file, or numbers written as text (as on the command line)
+      auto parsed = pack::source_from_text(source, *text, m.folder);
+      if (!parsed) return r.at(value, where + ".sources." + source + ": " + parsed.error().message);
+      in = std::move(*parsed);
+    } else if (auto number = value.value<double>()) {
+      if (!material::is_valid_constant(*number)) return r.at(value, where + ".sources." + source + ": values are in [0, 1]");
+      in.constant = {*number};
+    } else if (const toml::array* list = value.as_array()) {
+      for (const toml::node& n : *list) {
+        auto x = n.value<double>();
+        if (!x) return r.at(n, where + ".sources." + source + ": numbers expected");
+        if (!material::is_valid_constant(*x)) return r.at(n, where + ".sources." + source + ": values are in [0, 1]");
+        in.constant.push_back(*x);
+      }
+    } else {
+      return r.at(value, where + ".sources." + source + ": a file name, a number or a list of 3 numbers expected");
+    }
+    spec.sources.push_back(std::move(in));
+  }
+  if (spec.sources.empty()) return r.at(sources, where + ".sources is empty");
+  return success();
+}
+
+// packed = { layout = "schuler", files = ["t/a.png", "t/b.png"] }: a layout's textures.
+Status read_packed_entry(const Reader& r, const toml::node& packed, const std::string& where, const Manifest& m,
+                         MaterialSpec& spec) {
+  const toml::table* p = packed.as_table();
+  if (!p) return r.at(packed, where + ".packed must be a table");
+  if (Status s = r.known_keys(*p, where + ".packed", {"layout", "files"}); !s) return s.error();
+  auto packed_layout = read_layout(r, *p, "layout", where + ".packed", m.folder);
+  if (!packed_layout) return packed_layout.error();
+  spec.packed = std::move(*packed_layout);
+  const toml::array* files = p->get_as<toml::array>("files");
+  if (!spec.packed || !files || files->empty()) {
+    return r.at(packed, where + ".packed needs layout = \"...\" and files = [\"...\", ...]");
+  }
+  for (const toml::node& f : *files) {
+    auto file = f.value<std::string>();
+    if (!file) return r.at(f, where + ".packed.files: file names expected");
+    spec.packed_files.push_back(m.folder / *file);
+  }
+  return success();
+}
+
 Result<MaterialSpec> read_material(const Reader& r, const std::string& name, const toml::node& node,
                                    const Manifest& m, const MaterialSpec& defaults, std::vector<std::string>& notes) {
   const std::string where = "materials." + name;
@@ -209,54 +265,11 @@ Result<MaterialSpec> read_material(const Reader& r, const std::string& name, con
 
   const toml::node* sources = t->get("sources");
   const toml::node* packed = t->get("packed");
-  if (bool(sources) == bool(packed)) return r.at(node, where + ": give either sources = {...} or packed = {...}");
-  if (sources) {
-    if (!sources->is_table()) return r.at(*sources, where + ".sources must be a table");
-    for (const auto& [key, value] : *sources->as_table()) {
-      const std::string source(key.str());
-      if (!material::find_source(source)) {
-        std::string known;
-        for (const material::Source& s : material::sources()) known += (known.empty() ? "" : ", ") + std::string(s.name);
-        return r.at(key.source(), where + ".sources: unknown source '" + source + "' (known: " + known + ")");
-      }
-      pack::SourceInput in{source, {}, {}};
-      if (auto text = value.value<std::string>()) {  // a file, or numbers written as text (as on the command line)
-        auto parsed = pack::source_from_text(source, *text, m.folder);
-        if (!parsed) return r.at(value, where + ".sources." + source + ": " + parsed.error().message);
-        in = std::move(*parsed);
-      } else if (auto number = value.value<double>()) {
-        if (!material::is_valid_constant(*number)) return r.at(value, where + ".sources." + source + ": values are in [0, 1]");
-        in.constant = {*number};
-      } else if (const toml::array* list = value.as_array()) {
-        for (const toml::node& n : *list) {
-          auto x = n.value<double>();
-          if (!x) return r.at(n, where + ".sources." + source + ": numbers expected");
-          if (!material::is_valid_constant(*x)) return r.at(n, where + ".sources." + source + ": values are in [0, 1]");
-          in.constant.push_back(*x);
-        }
-      } else {
-        return r.at(value, where + ".sources." + source + ": a file name, a number or a list of 3 numbers expected");
-      }
-      spec.sources.push_back(std::move(in));
-    }
-    if (spec.sources.empty()) return r.at(*sources, where + ".sources is empty");
-  } else {
-    const toml::table* p = packed->as_table();
-    if (!p) return r.at(*packed, where + ".packed must be a table");
-    if (Status s = r.known_keys(*p, where + ".packed", {"layout", "files"}); !s) return s.error();
-    auto packed_layout = read_layout(r, *p, "layout", where + ".packed", m.folder);
-    if (!packed_layout) return packed_layout.error();
-    spec.packed = std::move(*packed_layout);
-    const toml::array* files = p->get_as<toml::array>("files");
-    if (!spec.packed || !files || files->empty()) {
-      return r.at(*packed, where + ".packed needs layout = \"...\" and files = [\"...\", ...]");
-    }
-    for (const toml::node& f : *files) {
-      auto file = f.value<std::string>();
-      if (!file) return r.at(f, where + ".packed.files: file names expected");
-      spec.packed_files.push_back(m.folder / *file);
-    }
+  if (!sources && !packed) {
+    return r.at(node, where + ": give sources = {...}, packed = {...} or both (the sources replace packed maps)");
   }
+  if (Status s = sources ? read_sources(r, *sources, where, m, spec) : success(); !s) return s.error();
+  if (Status s = packed ? read_packed_entry(r, *packed, where, m, spec) : success(); !s) return s.error();
   return spec;
 }
 

@@ -109,10 +109,7 @@ Error at_source(const MaterialSpec& m, const Error& e) {
 
 Result<material::Maps> load_material(const MaterialSpec& m, DecodeCache& cache) {
   const pack::ImageReader read = [&cache](const fs::path& f, color::Transfer t) { return cache.read(f, t); };
-  auto maps = [&]() -> Result<material::Maps> {
-    if (m.packed) return pack::read_packed(m.packed->layout, m.packed_files, m.options, read);
-    return pack::load_sources(m.sources, m.options, read);
-  }();
+  auto maps = pack::load_material(m.sources, m.packed ? &m.packed->layout : nullptr, m.packed_files, m.options, read);
   if (!maps) return at_source(m, maps.error());
   return maps;
 }
