@@ -17,28 +17,6 @@ namespace matbake::cli {
 namespace fs = std::filesystem;
 namespace {
 
-std::string_view outcome_name(pipeline::Outcome o) {
-  switch (o) {
-    case pipeline::Outcome::built: return "built";
-    case pipeline::Outcome::up_to_date: return "up_to_date";
-    case pipeline::Outcome::failed: return "failed";
-    case pipeline::Outcome::out_of_date: return "out_of_date";
-  }
-  return "";
-}
-
-nlohmann::json job_json(const pipeline::JobReport& r) {
-  std::vector<std::string> inputs, outputs;
-  for (const fs::path& p : r.job->inputs) inputs.push_back(p.string());
-  for (const fs::path& p : r.job->outputs.all()) outputs.push_back(p.string());
-  nlohmann::json j = {{"name", r.job->name}, {"outcome", outcome_name(r.outcome)}, {"inputs", inputs},
-                      {"outputs", outputs},  {"seconds", r.seconds},              {"warnings", r.warnings}};
-  if (!r.reason.empty()) j["reason"] = r.reason;
-  if (r.error) j["error"] = r.error->to_string();
-  if (!r.details.is_null()) j["details"] = r.details;
-  return j;
-}
-
 std::string job_error(const pipeline::JobReport& r) { return r.error->to_string() + " (" + r.job->name + ")"; }
 
 Result<pipeline::Plan> load(const std::string& manifest_file, const std::string& output_dir, pipeline::Manifest& manifest) {
@@ -137,40 +115,15 @@ int run_build(const BuildSettings& s, const GlobalOptions& global) {
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const std::size_t failed = report->count(pipeline::Outcome::failed);
 
-  if (!s.depfile.empty() && !s.dry_run) {
-    std::vector<fs::path> targets, inputs = {manifest.file};
-    for (const pipeline::JobReport& r : report->jobs) {
-      const std::vector<fs::path> files = r.job->outputs.all();
-      targets.insert(targets.end(), files.begin(), files.end());
-      for (const fs::path& p : r.job->inputs) {
-        if (std::find(inputs.begin(), inputs.end(), p) == inputs.end()) inputs.push_back(p);
-      }
+  if (!s.dry_run) {
+    if (Status st = pipeline::write_build_tool_files(manifest, *report, s.depfile, s.stamp); !st) {
+      return report_error(st.error());
     }
-    if (!s.stamp.empty()) targets = {fs::absolute(s.stamp).lexically_normal()};
-    if (Status st = write_file_atomically(s.depfile, pipeline::depfile_text(targets, inputs)); !st) return report_error(st.error());
   }
-  if (!s.stamp.empty() && !s.dry_run && failed == 0) {
-    const std::string text = "matbake build " + manifest.file.string() + ": " + std::to_string(report->jobs.size()) + " jobs\n";
-    if (Status st = write_file_atomically(s.stamp, text); !st) return report_error(st.error());
-  }
-
   if (global.json) {
-    nlohmann::json jobs = nlohmann::json::array();
-    for (const pipeline::JobReport& r : report->jobs) jobs.push_back(job_json(r));
-    std::cout << nlohmann::json{{"command", "build"},
-                                {"manifest", manifest.file.string()},
-                                {"output", manifest.output.string()},
-                                {"dry_run", s.dry_run},
-                                {"jobs", jobs},
-                                {"built", report->count(pipeline::Outcome::built)},
-                                {"up_to_date", report->count(pipeline::Outcome::up_to_date)},
-                                {"out_of_date", report->count(pipeline::Outcome::out_of_date)},
-                                {"failed", failed},
-                                {"images_decoded", report->images_decoded},
-                                {"seconds", seconds},
-                                {"warnings", plan->warnings}}
-                     .dump(2)
-              << "\n";
+    nlohmann::json doc = {{"command", "build"}, {"dry_run", s.dry_run}, {"seconds", seconds}};
+    doc.update(pipeline::json_report(manifest, *plan, *report));
+    std::cout << doc.dump(2) << "\n";
   } else if (!global.quiet) {
     if (s.dry_run) {
       for (const pipeline::JobReport& r : report->jobs) {

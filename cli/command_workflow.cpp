@@ -73,14 +73,9 @@ int run_workflow(const WorkflowSettings& s, const GlobalOptions& global) {
   const workflow::ConversionReport& report = converted->report;
   const std::string direction(workflow::direction_name(*converted->direction));
   const std::string mapping(workflow::roughness_mapping_name(s.sources.options.mapping));
-  nlohmann::json doc = {{"command", "workflow"}, {"direction", direction}, {"layout", layout->name},
-                        {"mapping", mapping}, {"outputs", *written}, {"texels", report.texels},
-                        {"errors", to_json(report.errors)}};
+  nlohmann::json doc = {{"command", "workflow"}, {"layout", layout->name}, {"outputs", *written}};
+  doc.update(to_json(*converted, s.sources.options.mapping));
   const bool spec_gloss_source = *converted->direction == workflow::Direction::metal_rough_from_spec_gloss;
-  if (spec_gloss_source) {
-    doc["khronos_converter_errors"] = to_json(report.khronos_errors);
-    doc["dielectric_f0"] = to_json(report.dielectric);
-  }
   if (!s.report.empty()) {
     if (Status st = write_report(s.report, doc); !st) return report_error(st.error());
   }

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "matbake/ao.hpp"
+#include "matbake/enum_names.hpp"
 #include "matbake/export.hpp"
 #include "matbake/image.hpp"
 #include "matbake/pack.hpp"
@@ -126,6 +127,10 @@ struct Plan {
 Result<Plan> make_plan(const Manifest& manifest);
 
 enum class Outcome { built, up_to_date, failed, out_of_date /* --dry-run */ };
+inline constexpr NameTable<Outcome, 4> kOutcomeNames{{{Outcome::built, "built"},
+                                                      {Outcome::up_to_date, "up_to_date"},
+                                                      {Outcome::failed, "failed"},
+                                                      {Outcome::out_of_date, "out_of_date"}}};
 
 struct JobReport {
   const Job* job = nullptr;
@@ -153,6 +158,18 @@ struct Report {
 
 // Runs the out-of-date jobs of the plan (all jobs with force). Errors are per job, in the report.
 Result<Report> run(const Manifest& manifest, const Plan& plan, const RunOptions& options);
+
+// The run as `build --json` prints it (without "command", "dry_run" and "seconds"): the manifest,
+// the output folder, each job (name, outcome, inputs, outputs, seconds, warnings, reason, error,
+// details), the counts by outcome, images decoded and the plan's warnings.
+nlohmann::json json_report(const Manifest& manifest, const Plan& plan, const Report& report);
+
+// What a build step leaves for the build tool that runs it (CMake, Ninja): a Make depfile of the
+// manifest and every input the jobs read, whose targets are the jobs' outputs or, when given,
+// `stamp`; and `stamp` itself (a line naming the manifest) once no job failed. Either path may
+// be empty; a dry run should write neither.
+Status write_build_tool_files(const Manifest& manifest, const Report& report, const std::filesystem::path& depfile,
+                              const std::filesystem::path& stamp);
 
 // Make syntax: `targets: inputs`, spaces escaped, one prerequisite per line.
 std::string depfile_text(const std::vector<std::filesystem::path>& targets,

@@ -12,6 +12,10 @@ namespace matbake {
 nlohmann::json to_json(const workflow::ErrorStats& s);
 nlohmann::json to_json(const workflow::ConversionErrors& e);
 nlohmann::json to_json(const workflow::DielectricF0& d);
+// A workflow conversion (`workflow --json` and --report, a build's material job): direction,
+// mapping, texels, errors, and from spec-gloss the Khronos converter's errors and the dielectric
+// F0 extensions; null when nothing was converted.
+nlohmann::json to_json(const workflow::LayoutMaps& converted, workflow::RoughnessMapping mapping);
 // Counts by class and flag, the worst texels, F0 (and diffuse) statistics, and the material
 // comparison when options.material is set.
 nlohmann::json to_json(const validate::Report& r, const validate::Options& options);

@@ -180,12 +180,7 @@ Status run_material(const Job& job, const JobContext& ctx, JobReport& report) {
         return Error{m.origins.of("layout"), "materials." + m.name + ".layout: " + in_workflow.error().to_string()};
       }
       if (!converts) *maps = std::move(in_workflow->maps);
-      if (const auto& d = in_workflow->direction) {
-        report.details["conversion"] = {{"direction", workflow::direction_name(*d)},
-                                        {"mapping", workflow::roughness_mapping_name(m.options.mapping)},
-                                        {"texels", in_workflow->report.texels},
-                                        {"errors", to_json(in_workflow->report.errors)}};
-      }
+      if (converts) report.details["conversion"] = to_json(*in_workflow, m.options.mapping);
       const std::vector<std::string> outputs(job.outputs.textures.begin(), job.outputs.textures.end());
       auto written = pack::write_textures(*layout, converts ? in_workflow->maps : *maps,
                                           {outputs, m.options.bits, m.options.transfer, decoded_files(m), {}, m.encoding});

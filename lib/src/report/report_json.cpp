@@ -37,6 +37,20 @@ nlohmann::json to_json(const workflow::DielectricF0& d) {
           {"error_with_extensions", to_json(d.error_with_extensions)}};
 }
 
+nlohmann::json to_json(const workflow::LayoutMaps& converted, workflow::RoughnessMapping mapping) {
+  if (!converted.direction) return nullptr;
+  const workflow::ConversionReport& report = converted.report;
+  nlohmann::json j = {{"direction", workflow::direction_name(*converted.direction)},
+                      {"mapping", workflow::roughness_mapping_name(mapping)},
+                      {"texels", report.texels},
+                      {"errors", to_json(report.errors)}};
+  if (*converted.direction == workflow::Direction::metal_rough_from_spec_gloss) {
+    j["khronos_converter_errors"] = to_json(report.khronos_errors);
+    j["dielectric_f0"] = to_json(report.dielectric);
+  }
+  return j;
+}
+
 nlohmann::json to_json(const validate::Report& r, const validate::Options& options) {
   const bool has_diffuse = r.has_diffuse;
   nlohmann::json classes, flags, worst = nlohmann::json::array();
