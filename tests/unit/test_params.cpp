@@ -123,15 +123,27 @@ TEST(AoParams, EveryParameterReachesTheRequestFromBothDoorsAndRoundTripsThroughT
   }
 }
 
+// A request made by the command line from one parameter at its example (a flag on by default
+// given as --no-NAME).
+template <class T>
+T from_example_flag(const Group<T>& group, const Param<T>& p) {
+  CLI::App app;
+  T target;
+  cli::add_params(app, group, target, "", "Options");
+  const bool on = p.spec.kind == Kind::flag && to_json(group, T{}).at(p.spec.name) == true;
+  std::vector<std::string> args = {on ? "--no-" + flag_name(p.spec, "").substr(2) : flag_name(p.spec, "")};
+  if (p.spec.kind != Kind::flag) args.push_back(p.spec.example);
+  std::reverse(args.begin(), args.end());  // CLI11 takes them last first
+  app.parse(args);
+  return target;
+}
+
 TEST(ValidateParams, EveryParameterReachesTheMaterialsValidationFromBothDoors) {
   const Group<validate::Options>& group = validate::options_params();
   const nlohmann::json defaults = to_json(group, validate::Options{});
   for (const Param<validate::Options>& p : group.params) {
     SCOPED_TRACE(p.spec.name);
-    CLI::App app;
-    validate::Options from_flags;
-    cli::add_params(app, group, from_flags, "", "Options");
-    app.parse(std::vector<std::string>{p.spec.example, flag_name(p.spec, "")});
+    const validate::Options from_flags = from_example_flag(group, p);
     auto m = pipeline::parse_manifest("[materials.a]\nsources = { kd = 0.5 }\nvalidate = { " + p.spec.name + " = " +
                                           test::toml_literal(p.spec) + " }\n",
                                       "/p/assets.toml");
@@ -148,14 +160,7 @@ void walk_scene_keys(const Group<T>& group, Of of) {
   const nlohmann::json defaults = to_json(group, T{});
   for (const Param<T>& p : group.params) {
     SCOPED_TRACE(p.spec.name);
-    CLI::App app;
-    T from_flags;
-    cli::add_params(app, group, from_flags, "", "Options");
-    const bool on = p.spec.kind == Kind::flag && defaults.at(p.spec.name) == true;
-    std::vector<std::string> args = {on ? "--no-" + flag_name(p.spec, "").substr(2) : flag_name(p.spec, "")};
-    if (p.spec.kind != Kind::flag) args.push_back(p.spec.example);
-    std::reverse(args.begin(), args.end());
-    app.parse(args);
+    const T from_flags = from_example_flag(group, p);
     auto m = pipeline::parse_manifest("[scenes.s]\ninput = \"s.gltf\"\n" + p.spec.name + " = " + test::toml_literal(p.spec) + "\n",
                                       "/p/assets.toml");
     ASSERT_TRUE(m) << m.error().to_string();
@@ -176,13 +181,7 @@ TEST(MaterialParams, EveryParameterReachesTheMaterialFromBothDoorsAndTheTopLevel
   const nlohmann::json defaults = to_json(group, pack::MaterialOptions{});
   for (const Param<pack::MaterialOptions>& p : group.params) {
     SCOPED_TRACE(p.spec.name);
-    CLI::App app;
-    pack::MaterialOptions from_flags;
-    cli::add_params(app, group, from_flags, "", "Options");
-    std::vector<std::string> args = {flag_name(p.spec, "")};
-    if (p.spec.kind != Kind::flag) args.push_back(p.spec.example);
-    std::reverse(args.begin(), args.end());
-    app.parse(args);
+    const pack::MaterialOptions from_flags = from_example_flag(group, p);
     const std::string key = p.spec.name + " = " + test::toml_literal(p.spec) + "\n";
     auto in_material = pipeline::parse_manifest("[materials.a]\nsources = { kd = 0.5 }\n" + key, "/p/assets.toml");
     auto at_top = pipeline::parse_manifest(key + "[materials.a]\nsources = { kd = 0.5 }\n", "/p/assets.toml");
@@ -200,10 +199,7 @@ TEST(ConvertParams, EveryParameterIsAFlagWhoseExampleChangesTheEcho) {
   const nlohmann::json defaults = to_json(group, convert::Options{});
   for (const Param<convert::Options>& p : group.params) {
     SCOPED_TRACE(p.spec.name);
-    CLI::App app;
-    convert::Options options;
-    cli::add_params(app, group, options, "", "Options");
-    app.parse(std::vector<std::string>{p.spec.example, flag_name(p.spec, "")});
+    const convert::Options options = from_example_flag(group, p);
     nlohmann::json expected = defaults;
     expected[p.spec.name] = p.spec.example;
     EXPECT_EQ(to_json(group, options), expected);
