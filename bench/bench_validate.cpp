@@ -55,7 +55,7 @@ void BM_validate(benchmark::State& state) {
   tbb::global_control one_core(tbb::global_control::max_allowed_parallelism, 1);
   validate::Options options;
   options.class_map = state.range(0) != 0;
-  options.material = state.range(1) ? materials::find(materials::builtin_table(), "gold") : nullptr;
+  options.material = state.range(1) ? material_table::find(material_table::builtin_table(), "gold") : nullptr;
   const bool whole_pair = state.range(2) != 0;  // else pair B alone: the F0 map
   const validate::Inputs inputs{&m.f0, whole_pair ? &m.diffuse : nullptr, whole_pair ? &m.mask : nullptr};
   for (auto _ : state) {

@@ -6,7 +6,7 @@
 #include "commands.hpp"
 #include "matbake/validate_params.hpp"
 #include "params_cli.hpp"
-#include "matbake/materials.hpp"
+#include "matbake/material_table.hpp"
 #include "matbake/output_check.hpp"
 #include "matbake/report_json.hpp"
 #include "matbake/validate.hpp"
@@ -44,12 +44,12 @@ CLI::App* setup_materials(CLI::App& app, MaterialsSettings& s) {
 }
 
 int run_materials(const MaterialsSettings& s, const GlobalOptions& global) {
-  auto table = materials::table_or_builtin(s.table);
+  auto table = material_table::table_or_builtin(s.table);
   if (!table) return report_error(table.error());
   nlohmann::json list = nlohmann::json::array();
-  for (const materials::Material& m : *table) {
+  for (const material_table::Material& m : *table) {
     nlohmann::json j = {{"name", m.name},
-                        {"class", materials::class_name(m.material_class)},
+                        {"class", material_table::class_name(m.material_class)},
                         {"f0_linear", rgb(m.f0)},
                         {"code_gamma22", codes(m.f0, color::Transfer::gamma22)},
                         {"code_srgb", codes(m.f0, color::Transfer::srgb)},
@@ -65,7 +65,7 @@ int run_materials(const MaterialsSettings& s, const GlobalOptions& global) {
     return kOk;
   }
   std::printf("%-16s %-13s %-22s %-12s %-12s %s\n", "name", "class", "F0 (linear)", "8-bit g2.2", "8-bit sRGB", "IOR");
-  for (const materials::Material& m : *table) {
+  for (const material_table::Material& m : *table) {
     char f0[64];
     if (m.f0.r == m.f0.g && m.f0.g == m.f0.b) {
       std::snprintf(f0, sizeof f0, "%.4f", m.f0.r);
@@ -76,7 +76,7 @@ int run_materials(const MaterialsSettings& s, const GlobalOptions& global) {
     if (m.ior) std::snprintf(ior, sizeof ior, "%.4f", *m.ior);
     if (m.ior_n) std::snprintf(ior, sizeof ior, "n %.2f %.2f %.2f, k %.2f %.2f %.2f", m.ior_n->r, m.ior_n->g, m.ior_n->b,
                                m.ior_k->r, m.ior_k->g, m.ior_k->b);
-    std::printf("%-16s %-13s %-22s %-12s %-12s %s\n", m.name.c_str(), std::string(materials::class_name(m.material_class)).c_str(),
+    std::printf("%-16s %-13s %-22s %-12s %-12s %s\n", m.name.c_str(), std::string(material_table::class_name(m.material_class)).c_str(),
                 f0, join(codes(m.f0, color::Transfer::gamma22)).c_str(), join(codes(m.f0, color::Transfer::srgb)).c_str(),
                 ior);
   }
@@ -101,12 +101,12 @@ CLI::App* setup_validate(CLI::App& app, ValidateSettings& s) {
 }
 
 int run_validate(const ValidateSettings& s, const GlobalOptions& global) {
-  auto table = materials::table_or_builtin(s.table);
+  auto table = material_table::table_or_builtin(s.table);
   if (!table) return report_error(table.error());
   validate::Options options = s.options;
   options.class_map = !s.heatmap.empty();
   if (!s.material.empty()) {
-    auto material = materials::lookup(*table, s.material);
+    auto material = material_table::lookup(*table, s.material);
     if (!material) return report_error(material.error());
     options.material = *material;
   }
@@ -157,7 +157,7 @@ int run_validate(const ValidateSettings& s, const GlobalOptions& global) {
     }
     for (const validate::Texel& t : report->worst) {
       std::printf("    at (%d, %d): %s, F0 %.4f %.4f %.4f: %s\n", t.x, t.y,
-                  std::string(materials::f0_class_name(t.f0_class)).c_str(), t.f0.r, t.f0.g, t.f0.b,
+                  std::string(material_table::f0_class_name(t.f0_class)).c_str(), t.f0.r, t.f0.g, t.f0.b,
                   validate::flag_names(t.flags).c_str());
     }
   }

@@ -13,7 +13,7 @@
 #include "lib/src/gltf/document.hpp"
 #include "matbake/convert.hpp"
 #include "matbake/image.hpp"
-#include "matbake/materials.hpp"
+#include "matbake/material_table.hpp"
 #include "matbake/scene.hpp"
 #include "support/files.hpp"
 #include "support/gltf_validator.hpp"
@@ -192,7 +192,7 @@ TEST(PhysicallyBased, TableEntriesMatchTheDatabase) {
   std::ifstream in(kTestdata / "materials/physicallybased/materials.json");
   const auto db = nlohmann::json::parse(in)["data"];
   int checked = 0;
-  for (const materials::Material& m : materials::builtin_table()) {
+  for (const material_table::Material& m : material_table::builtin_table()) {
     const auto quote = m.source.find("entry '");
     if (m.source.rfind("physicallybased.info", 0) != 0 || quote == std::string::npos) continue;
     const std::string name = m.source.substr(quote + 7, m.source.rfind('\'') - quote - 7);

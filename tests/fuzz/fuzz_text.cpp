@@ -4,7 +4,7 @@
 #include <cstdint>
 #include <string_view>
 
-#include "matbake/materials.hpp"
+#include "matbake/material_table.hpp"
 #include "matbake/pack.hpp"
 #include "matbake/pipeline.hpp"
 
@@ -15,7 +15,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
 #elif MATBAKE_FUZZ_FORMAT == 1
   (void)matbake::pack::parse_layout(text, "fuzz-layout.json");
 #else
-  (void)matbake::materials::parse_table(text, "fuzz-materials.toml");
+  (void)matbake::material_table::parse_table(text, "fuzz-materials.toml");
 #endif
   return 0;
 }

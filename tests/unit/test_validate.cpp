@@ -12,7 +12,7 @@
 namespace matbake::validate {
 namespace {
 
-using materials::F0Class;
+using material_table::F0Class;
 
 image::Image rgb_image(int width, int height, const std::vector<float>& pixels) {
   image::Image im;
@@ -40,16 +40,16 @@ Report check(const Inputs& in, Options options = {}) {
 TEST(Validate, ClassBoundariesAtEightBitCodesUnderBothCurves) {
   for (color::Transfer t : {color::Transfer::srgb, color::Transfer::gamma22}) {
     const auto table = color::decode_table(t, 8);
-    for (double boundary : {materials::kBelowReal, materials::kGemFrom, materials::kSemiconductorFrom, materials::kMetalFrom}) {
+    for (double boundary : {material_table::kBelowReal, material_table::kGemFrom, material_table::kSemiconductorFrom, material_table::kMetalFrom}) {
       int code = 0;
       while (table[std::size_t(code) + 1] < boundary) ++code;  // the last code below the boundary
       const image::Image f0 = grey({table[std::size_t(code)], table[std::size_t(code) + 1]});
       Options o;
       o.class_map = true;
       const Report r = check({&f0, nullptr, nullptr}, o);
-      EXPECT_EQ(r.class_map[0] & 0x7f, std::uint8_t(materials::classify_f0(boundary) ) - 1)
+      EXPECT_EQ(r.class_map[0] & 0x7f, std::uint8_t(material_table::classify_f0(boundary) ) - 1)
           << color::transfer_name(t) << " boundary " << boundary << " code " << code;
-      EXPECT_EQ(r.class_map[1] & 0x7f, std::uint8_t(materials::classify_f0(boundary)))
+      EXPECT_EQ(r.class_map[1] & 0x7f, std::uint8_t(material_table::classify_f0(boundary)))
           << color::transfer_name(t) << " boundary " << boundary << " code " << code + 1;
     }
   }
@@ -87,7 +87,7 @@ TEST(Validate, EveryFlag) {
 }
 
 TEST(Validate, MaterialToleranceAndShareWithin) {
-  const materials::Material* gold = materials::find(materials::builtin_table(), "gold");
+  const material_table::Material* gold = material_table::find(material_table::builtin_table(), "gold");
   const Vec3 g = gold->f0;
   const image::Image f0 = rgb_image(3, 1, {float(g.r), float(g.g), float(g.b),
                                            float(g.r * 1.09), float(g.g * 0.92), float(g.b),
@@ -190,7 +190,7 @@ TEST(Validate, VectorPassMatchesThePerTexelRule) {
     m.channels = 1;
     Options options;
     options.class_map = true;
-    options.material = materials::find(materials::builtin_table(), "gold");
+    options.material = material_table::find(material_table::builtin_table(), "gold");
     const Report r = check({&specular, &diffuse, &m}, options);
     std::array<std::size_t, 5> classes{};
     std::size_t masked = 0, flagged = 0;
@@ -201,7 +201,7 @@ TEST(Validate, VectorPassMatchesThePerTexelRule) {
         EXPECT_EQ(r.class_map[i], kMaskedTexel) << i;
         continue;
       }
-      const F0Class expected = materials::classify_f0((double(f0[i * 3]) + f0[i * 3 + 1] + f0[i * 3 + 2]) / 3);
+      const F0Class expected = material_table::classify_f0((double(f0[i * 3]) + f0[i * 3 + 1] + f0[i * 3 + 2]) / 3);
       ++classes[std::size_t(expected)];
       EXPECT_EQ(r.class_map[i] & 0x7f, std::uint8_t(expected)) << width << "x" << height << " texel " << i;
       const bool is_flagged = (r.class_map[i] & kFlaggedTexel) != 0;

@@ -1,6 +1,6 @@
 #pragma once
 // Per-texel physical checks of a specular map (F0) and, when given, the diffuse colour and the
-// mask: the F0 class of every texel (materials::classify_f0) and what is wrong with it.
+// mask: the F0 class of every texel (material_table::classify_f0) and what is wrong with it.
 #include <array>
 #include <cstdint>
 #include <filesystem>
@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "matbake/image.hpp"
-#include "matbake/materials.hpp"
+#include "matbake/material_table.hpp"
 #include "matbake/pack.hpp"
 #include "matbake/result.hpp"
 
@@ -47,7 +47,7 @@ struct Inputs {
 };
 
 struct Options {
-  const materials::Material* material = nullptr;  // compare against this entry
+  const material_table::Material* material = nullptr;  // compare against this entry
   double tolerance = 0.1;                          // relative, per channel: |F0 − ref| ≤ tol · ref
   std::size_t worst_count = 10;
   bool class_map = false;  // keep the per-texel class map (for heatmap())
@@ -56,7 +56,7 @@ struct Options {
 
 struct Texel {
   int x = 0, y = 0;
-  materials::F0Class f0_class = materials::F0Class::dielectric;
+  material_table::F0Class f0_class = material_table::F0Class::dielectric;
   std::uint8_t flags = 0;
   double severity = 0;  // how far outside what is allowed (F0 or luminance units)
   Vec3 f0{0}, diffuse{0};
@@ -72,7 +72,7 @@ inline constexpr std::uint8_t kMaskedTexel = 5, kFlaggedTexel = 0x80;
 struct Report {
   int width = 0, height = 0;
   std::size_t texels = 0, masked = 0, checked = 0;
-  std::array<std::size_t, 5> class_counts{};  // by materials::F0Class
+  std::array<std::size_t, 5> class_counts{};  // by material_table::F0Class
   std::array<std::size_t, kFlagCount> flag_counts{};
   std::size_t violations = 0;        // checked texels with any flag
   std::size_t material_within = 0;   // checked texels within the material's tolerance

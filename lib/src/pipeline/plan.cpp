@@ -8,7 +8,7 @@
 #include "matbake/encoding_params.hpp"
 #include "matbake/material_params.hpp"
 #include "matbake/validate_params.hpp"
-#include "matbake/materials.hpp"
+#include "matbake/material_table.hpp"
 #include "matbake/near_names.hpp"
 #include "matbake/output_check.hpp"
 #include "matbake/pipeline.hpp"
@@ -66,7 +66,7 @@ std::optional<std::string> file_problem(const fs::path& file) {
   return Error{file.string(), fs::exists(file, ec) ? "is not a regular file" : "no such file"}.to_string();
 }
 
-std::optional<Error> material_problem(const MaterialSpec& m, const Result<std::vector<materials::Material>>& table,
+std::optional<Error> material_problem(const MaterialSpec& m, const Result<std::vector<material_table::Material>>& table,
                                       const Origins& manifest_origins) {
   for (const pack::SourceInput& s : m.sources) {
     if (auto problem = s.file.empty() ? std::nullopt : file_problem(s.file)) {
@@ -80,7 +80,7 @@ std::optional<Error> material_problem(const MaterialSpec& m, const Result<std::v
   }
   if (m.reference.empty() || !m.validation.enabled) return std::nullopt;
   if (!table) return Error{manifest_origins.of("table"), "table: " + table.error().to_string()};
-  if (auto found = materials::lookup(*table, m.reference); !found) {
+  if (auto found = material_table::lookup(*table, m.reference); !found) {
     return Error{m.origins.of("reference"), "materials." + m.name + ".reference: " + found.error().message};
   }
   return std::nullopt;
@@ -141,8 +141,8 @@ Result<Plan> make_plan(const Manifest& manifest) {
 
     const bool references = std::any_of(manifest.materials.begin(), manifest.materials.end(),
                                         [](const MaterialSpec& m) { return !m.reference.empty(); });
-    const auto table = references ? materials::table_or_builtin(manifest.table)
-                                  : Result<std::vector<materials::Material>>(std::vector<materials::Material>{});
+    const auto table = references ? material_table::table_or_builtin(manifest.table)
+                                  : Result<std::vector<material_table::Material>>(std::vector<material_table::Material>{});
     std::vector<std::optional<Error>> problems;
     for (const MaterialSpec& m : manifest.materials) problems.push_back(material_problem(m, table, manifest.origins));
 

@@ -11,7 +11,7 @@
 
 #include "matbake/atomic_file.hpp"
 #include "matbake/pipeline.hpp"
-#include "matbake/materials.hpp"
+#include "matbake/material_table.hpp"
 #include "matbake/report_json.hpp"
 #include "matbake/validate.hpp"
 #include "matbake/workflow_maps.hpp"
@@ -117,7 +117,7 @@ Result<material::Maps> load_material(const MaterialSpec& m, DecodeCache& cache) 
 struct JobContext {
   const Manifest& manifest;
   DecodeCache& cache;
-  const std::vector<materials::Material>* table;  // null when it could not be read
+  const std::vector<material_table::Material>* table;  // null when it could not be read
   const Error* table_error;
 };
 
@@ -135,7 +135,7 @@ Status validate_material(const MaterialSpec& m, const material::Maps& maps, cons
   options.class_map = m.validation.heatmap;
   if (!m.reference.empty()) {
     if (!ctx.table) return *ctx.table_error;
-    auto material = materials::lookup(*ctx.table, m.reference);
+    auto material = material_table::lookup(*ctx.table, m.reference);
     if (!material) return Error{m.origins.of("reference"), "materials." + m.name + ".reference: " + material.error().message};
     options.material = *material;
   }
@@ -264,8 +264,8 @@ Result<Report> run(const Manifest& manifest, const Plan& plan, const RunOptions&
     for (const fs::path& f : decoded_files(*report.jobs[i].job, manifest)) ++uses[f];
   }
   DecodeCache cache(uses);
-  auto table = manifest.table.empty() ? Result<std::vector<materials::Material>>(materials::builtin_table())
-                                      : materials::load_table(manifest.table);
+  auto table = manifest.table.empty() ? Result<std::vector<material_table::Material>>(material_table::builtin_table())
+                                      : material_table::load_table(manifest.table);
   const JobContext ctx{manifest, cache, table ? &*table : nullptr, table ? nullptr : &table.error()};
 
   std::mutex progress_mutex;

@@ -54,10 +54,10 @@ nlohmann::json to_json(const workflow::LayoutMaps& converted, workflow::Roughnes
 nlohmann::json to_json(const validate::Report& r, const validate::Options& options) {
   const bool has_diffuse = r.has_diffuse;
   nlohmann::json classes, flags, worst = nlohmann::json::array();
-  for (std::size_t c = 0; c < 5; ++c) classes[std::string(materials::f0_class_name(materials::F0Class(c)))] = r.class_counts[c];
+  for (std::size_t c = 0; c < 5; ++c) classes[std::string(material_table::f0_class_name(material_table::F0Class(c)))] = r.class_counts[c];
   for (int b = 0; b < validate::kFlagCount; ++b) flags[std::string(validate::flag_name(b))] = r.flag_counts[std::size_t(b)];
   for (const validate::Texel& t : r.worst) {
-    worst.push_back({{"x", t.x}, {"y", t.y}, {"class", materials::f0_class_name(t.f0_class)},
+    worst.push_back({{"x", t.x}, {"y", t.y}, {"class", material_table::f0_class_name(t.f0_class)},
                      {"flags", validate::flag_names(t.flags)}, {"severity", t.severity}, {"f0", rgb(t.f0)},
                      {"diffuse", rgb(t.diffuse)}});
   }

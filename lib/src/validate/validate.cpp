@@ -13,7 +13,7 @@
 namespace matbake::validate {
 namespace {
 
-using materials::F0Class;
+using material_table::F0Class;
 
 constexpr int kRowsPerBlock = 64;
 
@@ -67,7 +67,7 @@ struct RowSetup {
   const float* specular;
   const float* diffuse;  // or null
   const float* mask;     // or null
-  const materials::Material* material;
+  const material_table::Material* material;
   // Class boundaries on the channel sum (3 × the mean's), in float like the rest of the loop.
   float t0, t1, t2, t3;
   std::array<float, 3> reference{}, allowed{};  // the material's F0 and allowed deviation per channel
@@ -239,9 +239,9 @@ std::uint8_t check_texel(const RowSetup& r, std::size_t i, F0Class cls, double& 
     flags |= f;
     severity = std::max(severity, how_far);
   };
-  if (cls == F0Class::below) flag(kBelowReal, materials::kBelowReal - mean);
+  if (cls == F0Class::below) flag(kBelowReal, material_table::kBelowReal - mean);
   if (cls == F0Class::semiconductor) {
-    flag(kSemiconductorGap, std::min(mean - materials::kSemiconductorFrom, materials::kMetalFrom - mean));
+    flag(kSemiconductorGap, std::min(mean - material_table::kSemiconductorFrom, material_table::kMetalFrom - mean));
   }
   if (lo < 0 || hi > 1) flag(kNotReflectance, std::max(-lo, hi - 1.0f));
   if ((cls == F0Class::dielectric || cls == F0Class::gem) && hi - lo > float(kColouredRatio) * hi) {
@@ -269,8 +269,8 @@ void check_rows(const Inputs& in, const Options& options, int y0, int y1, Partia
   const int width = in.specular->width;
   RowSetup r{in.specular->pixels.data(), in.diffuse ? in.diffuse->pixels.data() : nullptr,
              in.mask ? in.mask->pixels.data() : nullptr, options.material,
-             float(3 * materials::kBelowReal), float(3 * materials::kGemFrom), float(3 * materials::kSemiconductorFrom),
-             float(3 * materials::kMetalFrom)};
+             float(3 * material_table::kBelowReal), float(3 * material_table::kGemFrom), float(3 * material_table::kSemiconductorFrom),
+             float(3 * material_table::kMetalFrom)};
   for (int c = 0; c < 3 && r.material; ++c) {
     r.reference[std::size_t(c)] = float(r.material->f0[c]);
     r.allowed[std::size_t(c)] = float(options.tolerance * r.material->f0[c]);

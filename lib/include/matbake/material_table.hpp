@@ -12,7 +12,7 @@
 
 #include "matbake/result.hpp"
 
-namespace matbake::materials {
+namespace matbake::material_table {
 
 using Vec3 = glm::dvec3;
 
@@ -57,4 +57,4 @@ inline F0Class classify_f0(double f0) {
                                 : F0Class::metal;
 }
 
-}  // namespace matbake::materials
+}  // namespace matbake::material_table

@@ -1,5 +1,5 @@
 #include "matbake/read_file.hpp"
-#include "matbake/materials.hpp"
+#include "matbake/material_table.hpp"
 #include "matbake/near_names.hpp"
 
 #include <toml++/toml.h>
@@ -9,7 +9,7 @@
 #include <fstream>
 #include <sstream>
 
-namespace matbake::materials {
+namespace matbake::material_table {
 
 extern const char* const builtin_table_toml;  // generated from presets/materials.toml
 
@@ -162,4 +162,4 @@ Result<std::vector<Material>> table_or_builtin(const std::filesystem::path& path
   return load_table(path);
 }
 
-}  // namespace matbake::materials
+}  // namespace matbake::material_table

@@ -5,9 +5,9 @@
 #include <cmath>
 
 #include "matbake/color.hpp"
-#include "matbake/materials.hpp"
+#include "matbake/material_table.hpp"
 
-namespace matbake::materials {
+namespace matbake::material_table {
 namespace {
 
 double decode(color::Transfer t, int code) { return color::linear_from_encoded(t, code / 255.0); }
@@ -121,4 +121,4 @@ TEST(F0Classes, BoundariesAreHalfOpen) {
 }
 
 }  // namespace
-}  // namespace matbake::materials
+}  // namespace matbake::material_table
