@@ -25,8 +25,8 @@ Result<ao::Request> ao_request(const AoSettings& s, const std::string& prefix) {
   return request;
 }
 
-void print_texture_reports(const std::vector<exporter::TextureReport>& textures) {
-  for (const exporter::TextureReport& t : textures) {
+void print_texture_reports(const std::vector<bake_ao::TextureReport>& textures) {
+  for (const bake_ao::TextureReport& t : textures) {
     const double mapped = double(t.covered + t.touched);
     if (t.node >= 0) std::printf("node %d, ", t.node);
     std::printf("material %d '%s': %s, %dx%d over TEXCOORD_%d, %zu texels mapped (%zu on seams), %.1f%% of them overlapped, "

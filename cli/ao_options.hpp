@@ -20,6 +20,6 @@ void add_ao_options(CLI::App& cmd, AoSettings& s, const std::string& prefix);
 // The request, checked across its options; errors name the option as given on the command line.
 Result<ao::Request> ao_request(const AoSettings& s, const std::string& prefix);
 // One line per baked texture (and one per problem it counted), as bake-ao and export print them.
-void print_texture_reports(const std::vector<exporter::TextureReport>& textures);
+void print_texture_reports(const std::vector<bake_ao::TextureReport>& textures);
 
 }  // namespace matbake::cli

@@ -29,10 +29,10 @@ CLI::App* setup_bake_ao(CLI::App& app, BakeAoSettings& s) {
 int run_bake_ao(const BakeAoSettings& s, const GlobalOptions& global) {
   auto request = ao_request(s.ao, "");
   if (!request) return report_error(request.error());
-  auto report = exporter::bake_ao_file(s.scene, {*request, s.output, s.dump, s.encoding});
+  auto report = bake_ao::bake_file(s.scene, {*request, s.output, s.dump, s.encoding});
   if (!report) return report_error(report.error());
   nlohmann::json textures = nlohmann::json::array();
-  for (const exporter::TextureReport& t : report->textures) textures.push_back(to_json(t));
+  for (const bake_ao::TextureReport& t : report->textures) textures.push_back(to_json(t));
   if (global.json) {
     std::cout << nlohmann::json{{"command", "bake-ao"}, {"scene", s.scene}, {"output", s.output}, {"dump", s.dump},
                                 {"instances", report->instances}, {"vertices", report->vertices},

@@ -9,7 +9,7 @@
 #include <string>
 
 #include "lib/src/ao/texels.hpp"
-#include "lib/src/export/occlusion_texture.hpp"
+#include "lib/src/bake_ao/textures.hpp"
 #include "lib/src/gltf/document.hpp"
 #include "lib/src/scene/from_document.hpp"
 
@@ -34,7 +34,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   // rasterization, tie rule and wrap modes see the file's UVs).
   auto scene = matbake::scene::scene_from_document(*doc, {.texcoords = true});
   if (scene) {
-    auto targets = matbake::exporter::occlusion_targets(*doc, *scene, matbake::ao::TextureRequest{});
+    auto targets = matbake::bake_ao::occlusion_targets(*doc, *scene, matbake::ao::TextureRequest{});
     for (std::size_t t = 0; targets && t < targets->targets.size(); ++t) {
       for (auto wrap : {matbake::ao::Wrap::repeat, matbake::ao::Wrap::mirrored_repeat, matbake::ao::Wrap::clamp_to_edge}) {
         auto target = targets->targets[t];

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "matbake/ao.hpp"
+#include "matbake/bake_ao.hpp"
 #include "matbake/pack.hpp"
 #include "matbake/result.hpp"
 #include "matbake/workflow_maps.hpp"
@@ -61,19 +62,6 @@ struct MaterialReport {
   std::optional<double> ior;                    // KHR_materials_ior, when written
 };
 
-// One material's baked occlusion texture.
-struct TextureReport {
-  int material = -1;  // as written (with per-instance bakes, a copy's index for further placements)
-  int node = -1;      // with per-instance bakes, the placing node
-  std::string name;   // the material's
-  std::string file;   // the new image's URI (beside a .gltf, or embedded in a .glb)
-  int width = 0, height = 0, texcoord = 0;
-  std::size_t covered = 0, touched = 0, overlapped = 0, padded = 0;  // texels (ao::TextureBake)
-  std::size_t triangles = 0, degenerate_uv = 0, wrapped = 0, too_large = 0, instances_without_uv = 0;
-  std::string existing;  // what happened to the material's own occlusion texture: "", "multiplied", "replaced"
-  double mean = 0;       // of the bake (before any multiplication), over covered and touched texels
-};
-
 struct Report {
   std::vector<MaterialReport> materials;  // every written material, in output order
   std::vector<std::string> skipped;       // what the scene does not reach: "material 2 'Unused'"
@@ -81,7 +69,7 @@ struct Report {
   std::size_t images_decoded = 0;
   std::size_t textures_made = 0;
   std::uint64_t ao_rays = 0;
-  std::vector<TextureReport> ao_textures;  // with ao.texture: each material's baked occlusion
+  std::vector<bake_ao::TextureReport> ao_textures;  // with ao.texture: each material's baked occlusion
   std::vector<std::string> ao_notes;       // what the texture bake skipped or averaged
 };
 
@@ -90,31 +78,5 @@ Result<Report> export_scene(const std::filesystem::path& input, const std::files
 
 // The files a glTF is read from (itself, its buffers' and images' files): what no output may be.
 Result<std::vector<std::filesystem::path>> scene_files(const std::filesystem::path& gltf);
-
-// `matbake bake-ao`: a scene's per-vertex AO (or, with ao.texture, its occlusion textures) written into the scene again (everything else kept as
-// written: nothing pruned or converted) and/or dumped as raw values (ao::write_dump). Neither output
-// may be a file the scene is read from.
-struct BakeAoOptions {
-  ao::Request ao;
-  std::filesystem::path output;  // .gltf or .glb; empty: none
-  std::filesystem::path dump;    // .csv or .bin; empty: none (per-vertex only)
-  image::Encoding encoding;      // of the occlusion textures' PNGs
-};
-struct BakeAoReport {
-  std::size_t instances = 0;
-  std::size_t vertices = 0;  // baked
-  std::uint64_t rays = 0;
-  double seconds = 0;        // of the bake: setup_seconds + ray_seconds
-  double setup_seconds = 0;  // normals, edge lengths, Embree's BVH
-  double ray_seconds = 0;    // casting the rays
-  double max_distance = 0;   // d_max as used
-  double mean = 0;           // over baked vertices (or mapped texels)
-  std::vector<TextureReport> textures;  // with --texture
-  std::uint64_t texels = 0;             // traced, with --texture
-  double texel_seconds = 0;             // rasterizing UVs and padding, with --texture
-  std::vector<std::string> notes;    // the scene's (what was skipped) and the bake's
-  std::vector<std::string> written;  // files
-};
-Result<BakeAoReport> bake_ao_file(const std::filesystem::path& input, const BakeAoOptions& options);
 
 }  // namespace matbake::exporter

@@ -29,7 +29,7 @@ nlohmann::json to_json(const exporter::Report& r);
 // Options by the names the manifest uses (a build's stamp records them; material maps not included).
 nlohmann::json to_json(const ao::Request& r);
 // One material's baked occlusion texture, as bake-ao and export report it.
-nlohmann::json to_json(const exporter::TextureReport& t);
+nlohmann::json to_json(const bake_ao::TextureReport& t);
 nlohmann::json to_json(const exporter::Options& o);
 
 }  // namespace matbake

@@ -8,10 +8,10 @@
 #include "../gltf/document.hpp"
 #include "../gltf/prune.hpp"
 #include "../scene/from_document.hpp"
-#include "occlusion.hpp"
-#include "occlusion_texture.hpp"
+#include "../bake_ao/vertices.hpp"
+#include "../bake_ao/textures.hpp"
 #include "matbake/output_check.hpp"
-#include "texture_files.hpp"
+#include "../gltf/texture_files.hpp"
 
 namespace matbake::exporter {
 namespace fs = std::filesystem;
@@ -53,7 +53,7 @@ void add_extension_used(Json& json, const char* name) {
 // What the export is doing, shared by the per-material steps.
 struct Exporter {
   gltf::Document& doc;
-  ImageCache& cache;
+  gltf::ImageCache& cache;
   const Options& options;
   std::string stem;  // of the output: names of the files made
   Report& report;
@@ -168,19 +168,19 @@ struct Exporter {
       textures[t] = *im;
       if (std::size_t((*im)->width) * (*im)->height > std::size_t(width) * height) width = (*im)->width, height = (*im)->height;
     }
-    const image::Image d = textures[0] ? at_size(*textures[0], width, height) : image::Image{};
-    const image::Image s = textures[1] ? at_size(*textures[1], width, height) : image::Image{};
+    const image::Image d = textures[0] ? gltf::at_size(*textures[0], width, height) : image::Image{};
+    const image::Image s = textures[1] ? gltf::at_size(*textures[1], width, height) : image::Image{};
     material::Maps maps;
     maps.width = width, maps.height = height;
-    image::Image kd = blank(width, height, 3), ks = blank(width, height, 3), g = blank(width, height, 1),
-                 alpha = blank(width, height, 1);
+    image::Image kd = gltf::blank(width, height, 3), ks = gltf::blank(width, height, 3), g = gltf::blank(width, height, 1),
+                 alpha = gltf::blank(width, height, 1);
     for (std::size_t p = 0; p < std::size_t(width) * height; ++p) {
       for (int c = 0; c < 3; ++c) {
-        kd.pixels[p * 3 + std::size_t(c)] = float(diffuse[std::size_t(c)]) * (textures[0] ? rgba(d, p, c) : 1.0f);
-        ks.pixels[p * 3 + std::size_t(c)] = float(specular[std::size_t(c)]) * (textures[1] ? rgba(s, p, c) : 1.0f);
+        kd.pixels[p * 3 + std::size_t(c)] = float(diffuse[std::size_t(c)]) * (textures[0] ? gltf::rgba(d, p, c) : 1.0f);
+        ks.pixels[p * 3 + std::size_t(c)] = float(specular[std::size_t(c)]) * (textures[1] ? gltf::rgba(s, p, c) : 1.0f);
       }
-      g.pixels[p] = float(gloss) * (textures[1] ? rgba(s, p, 3) : 1.0f);
-      alpha.pixels[p] = float(diffuse[3]) * (textures[0] ? rgba(d, p, 3) : 1.0f);
+      g.pixels[p] = float(gloss) * (textures[1] ? gltf::rgba(s, p, 3) : 1.0f);
+      alpha.pixels[p] = float(diffuse[3]) * (textures[0] ? gltf::rgba(d, p, 3) : 1.0f);
     }
     maps.maps["kd"] = std::move(kd);
     maps.maps["ks"] = std::move(ks);
@@ -282,12 +282,12 @@ struct Exporter {
       auto occlusion_image = cache.texture(occlusion_index, color::Transfer::linear);
       if (!occlusion_image) return occlusion_image.error();
       const image::Image& m = **mr_image;
-      const image::Image o = at_size(**occlusion_image, m.width, m.height);
-      image::Image packed = blank(m.width, m.height, 3);
+      const image::Image o = gltf::at_size(**occlusion_image, m.width, m.height);
+      image::Image packed = gltf::blank(m.width, m.height, 3);
       for (std::size_t p = 0; p < std::size_t(m.width) * m.height; ++p) {
-        packed.pixels[p * 3] = rgba(o, p, 0);
-        packed.pixels[p * 3 + 1] = rgba(m, p, 1);
-        packed.pixels[p * 3 + 2] = rgba(m, p, 2);
+        packed.pixels[p * 3] = gltf::rgba(o, p, 0);
+        packed.pixels[p * 3 + 1] = gltf::rgba(m, p, 1);
+        packed.pixels[p * 3 + 2] = gltf::rgba(m, p, 2);
       }
       auto texture = add_texture(packed, color::Transfer::linear, "orm" + std::to_string(orm_made.size()), mr_index);
       if (!texture) return texture.error();
@@ -366,18 +366,18 @@ Result<Report> export_scene(const fs::path& input, const fs::path& output, const
     // The flattened scene only when AO is baked: a plain export works on the document alone. Made
     // after pruning, so that its mesh and material indices are the written file's.
     std::optional<scene::Scene> scene;
-    std::optional<OcclusionTargets> occlusion;
+    std::optional<bake_ao::OcclusionTargets> occlusion;
     if (options.ao) {
       auto flattened = scene::scene_from_document(*doc, {.texcoords = options.ao->texture.has_value()});
       if (!flattened) return flattened.error();
       scene = std::move(*flattened);
       if (options.ao->texture) {
-        auto targets = occlusion_targets(*doc, *scene, *options.ao->texture);
+        auto targets = bake_ao::occlusion_targets(*doc, *scene, *options.ao->texture);
         if (!targets) return targets.error();
         occlusion = std::move(*targets);
         if (const fs::path& dump = options.ao->texture->dump; !dump.empty()) {
           std::vector<NamedOutput> dumped;
-          for (int m : occlusion->materials) dumped.push_back({dumped_texture(dump, output.stem().string(), m), "texture dump"});
+          for (int m : occlusion->materials) dumped.push_back({bake_ao::dumped_texture(dump, output.stem().string(), m), "texture dump"});
           if (Status s = check_outputs(dumped, gltf::source_files(doc->file, doc->json)); !s) return s.error();
         }
       }
@@ -390,7 +390,7 @@ Result<Report> export_scene(const fs::path& input, const fs::path& output, const
       given[*index] = &m;
     }
 
-    ImageCache cache(*doc, options.encoding);
+    gltf::ImageCache cache(*doc, options.encoding);
     for (std::size_t i = 0; doc->json.contains("images") && i < doc->json["images"].size(); ++i) {
       if (Status s = cache.check(i); !s) return s.error();
     }
@@ -431,14 +431,14 @@ Result<Report> export_scene(const fs::path& input, const fs::path& output, const
 
     if (occlusion) {
       ao::TextureBakes timing;
-      auto textures = bake_occlusion_textures(*doc, *scene, cache, *options.ao, *occlusion, output.stem().string(),
-                                              OcclusionInto::orm, timing);
+      auto textures = bake_ao::bake_occlusion_textures(*doc, *scene, cache, *options.ao, *occlusion, output.stem().string(),
+                                              bake_ao::OcclusionInto::orm, timing);
       if (!textures) return textures.error();
       report.ao_textures = std::move(*textures);
       report.ao_notes = occlusion->notes;
       report.ao_rays = timing.rays;
     } else if (options.ao) {
-      auto baked = bake_into(*doc, *scene, *options.ao);
+      auto baked = bake_ao::bake_into(*doc, *scene, *options.ao);
       if (!baked) return baked.error();
       report.ao_rays = baked->rays;
     }

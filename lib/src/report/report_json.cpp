@@ -79,7 +79,7 @@ nlohmann::json to_json(const validate::Report& r, const validate::Options& optio
 
 nlohmann::json to_json(const exporter::Report& r) {
   nlohmann::json textures = nlohmann::json::array();
-  for (const exporter::TextureReport& t : r.ao_textures) textures.push_back(to_json(t));
+  for (const bake_ao::TextureReport& t : r.ao_textures) textures.push_back(to_json(t));
   nlohmann::json materials = nlohmann::json::array();
   for (const exporter::MaterialReport& m : r.materials) {
     nlohmann::json j = {{"index", m.index}, {"name", m.name}, {"action", m.action}, {"alphaMode", m.alpha_mode}};
@@ -108,7 +108,7 @@ Status write_validation_report(const validate::Report& r, const validate::Option
 
 nlohmann::json to_json(const ao::Request& r) { return params::to_json(ao::request_params(), r); }
 
-nlohmann::json to_json(const exporter::TextureReport& t) {
+nlohmann::json to_json(const bake_ao::TextureReport& t) {
   return {{"material", t.material}, {"node", t.node}, {"name", t.name}, {"file", t.file}, {"width", t.width}, {"height", t.height},
           {"texcoord", t.texcoord}, {"covered", t.covered}, {"touched", t.touched}, {"overlapped", t.overlapped},
           {"padded", t.padded}, {"triangles", t.triangles}, {"degenerate_uv", t.degenerate_uv}, {"wrapped", t.wrapped},

@@ -6,11 +6,11 @@
 #include <vector>
 
 #include "../gltf/document.hpp"
-#include "texture_files.hpp"
+#include "../gltf/texture_files.hpp"
 #include "matbake/ao.hpp"
-#include "matbake/export.hpp"
+#include "matbake/bake_ao.hpp"
 
-namespace matbake::exporter {
+namespace matbake::bake_ao {
 
 // The materials the scene's instances use, each a texture target (UV set and wrap modes from the
 // request and the material's occlusionTexture), and what cannot be baked (instances without a
@@ -24,7 +24,7 @@ struct OcclusionTargets {
 Result<OcclusionTargets> occlusion_targets(const gltf::Document& doc, const scene::Scene& scene,
                                            const ao::TextureRequest& request);
 
-// Where bake_ao_file's --dump-texture puts material `material`'s float EXR.
+// Where bake_file's --dump-texture puts material `material`'s float EXR.
 std::filesystem::path dumped_texture(const std::filesystem::path& folder, const std::string& stem, int material);
 
 // Where a material's baked occlusion goes.
@@ -40,9 +40,9 @@ enum class OcclusionInto {
 // `<stem>_orm_ao_<material>.png`, encoded as `cache` says); the dump folder, when asked, gets each bake
 // as float EXR. `cache` is the document's: a metallic-roughness texture it decoded is not decoded again.
 Result<std::vector<TextureReport>> bake_occlusion_textures(gltf::Document& doc, const scene::Scene& scene,
-                                                           ImageCache& cache, const ao::Request& request,
+                                                           gltf::ImageCache& cache, const ao::Request& request,
                                                            const OcclusionTargets& targets,
                                                            const std::string& stem, OcclusionInto into,
                                                            ao::TextureBakes& timing);
 
-}  // namespace matbake::exporter
+}  // namespace matbake::bake_ao

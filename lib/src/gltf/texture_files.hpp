@@ -5,10 +5,10 @@
 #include <string>
 #include <utility>
 
-#include "../gltf/document.hpp"
+#include "document.hpp"
 #include "matbake/image.hpp"
 
-namespace matbake::exporter {
+namespace matbake::gltf {
 
 // A channel of a decoded image read as RGBA: grey spreads to RGB, a missing alpha is 1.
 float rgba(const image::Image& im, std::size_t pixel, int c);
@@ -40,4 +40,4 @@ class ImageCache {
   std::map<std::pair<int, color::Transfer>, image::Image> images_;  // by (image index, transfer)
 };
 
-}  // namespace matbake::exporter
+}  // namespace matbake::gltf

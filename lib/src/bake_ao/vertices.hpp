@@ -3,8 +3,8 @@
 #include "../gltf/document.hpp"
 #include "matbake/ao.hpp"
 
-namespace matbake::exporter {
+namespace matbake::bake_ao {
 
 Result<ao::Bake> bake_into(gltf::Document& doc, const scene::Scene& scene, const ao::Request& request);
 
-}  // namespace matbake::exporter
+}  // namespace matbake::bake_ao

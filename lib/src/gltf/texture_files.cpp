@@ -1,6 +1,6 @@
 #include "texture_files.hpp"
 
-namespace matbake::exporter {
+namespace matbake::gltf {
 namespace {
 
 // The extension OIIO picks its reader by, from the bytes' signature.
@@ -77,4 +77,4 @@ Result<std::string> ImageCache::encode_png(const image::Image& img, color::Trans
   return image::encode_image(img, "made.png", options);
 }
 
-}  // namespace matbake::exporter
+}  // namespace matbake::gltf

@@ -1,12 +1,12 @@
-#include "occlusion_texture.hpp"
+#include "textures.hpp"
 
 #include <algorithm>
 #include <map>
 #include <set>
 
-#include "texture_files.hpp"
+#include "../gltf/texture_files.hpp"
 
-namespace matbake::exporter {
+namespace matbake::bake_ao {
 namespace fs = std::filesystem;
 namespace {
 
@@ -181,7 +181,7 @@ fs::path dumped_texture(const fs::path& folder, const std::string& stem, int mat
 }
 
 Result<std::vector<TextureReport>> bake_occlusion_textures(gltf::Document& doc, const scene::Scene& scene,
-                                                           ImageCache& cache, const ao::Request& request,
+                                                           gltf::ImageCache& cache, const ao::Request& request,
                                                            const OcclusionTargets& targets,
                                                            const std::string& stem, OcclusionInto into,
                                                            ao::TextureBakes& timing) {
@@ -208,7 +208,7 @@ Result<std::vector<TextureReport>> bake_occlusion_textures(gltf::Document& doc, 
     report.wrapped = bake.wrapped, report.too_large = bake.too_large, report.instances_without_uv = bake.instances_without_uv;
     report.mean = bake.mean;
 
-    image::Image img = blank(bake.width, bake.height, 1);
+    image::Image img = gltf::blank(bake.width, bake.height, 1);
     img.channel_names = {"Y"};
     img.pixels = std::move(bake.values);
     const Json* existing = occlusion_of(material, doc.json);
@@ -220,8 +220,8 @@ Result<std::vector<TextureReport>> bake_occlusion_textures(gltf::Document& doc, 
       if (texture.multiply_existing && old_texcoord == report.texcoord) {
         auto decoded = cache.texture(old, color::Transfer::linear);
         if (!decoded) return decoded.error();
-        const image::Image own = at_size(**decoded, bake.width, bake.height);
-        for (std::size_t p = 0; p < img.pixels.size(); ++p) img.pixels[p] *= rgba(own, p, 0);
+        const image::Image own = gltf::at_size(**decoded, bake.width, bake.height);
+        for (std::size_t p = 0; p < img.pixels.size(); ++p) img.pixels[p] *= gltf::rgba(own, p, 0);
         report.existing = "multiplied";
       } else {
         report.existing = "replaced";
@@ -240,12 +240,12 @@ Result<std::vector<TextureReport>> bake_occlusion_textures(gltf::Document& doc, 
       auto decoded = cache.texture(mr_index, color::Transfer::linear);
       if (!decoded) return decoded.error();
       const image::Image& source = **decoded;
-      const image::Image occlusion = at_size(img, source.width, source.height);
-      image::Image orm = blank(source.width, source.height, 3);
+      const image::Image occlusion = gltf::at_size(img, source.width, source.height);
+      image::Image orm = gltf::blank(source.width, source.height, 3);
       for (std::size_t p = 0; p < std::size_t(source.width) * std::size_t(source.height); ++p) {
         orm.pixels[p * 3] = std::clamp(occlusion.pixels[p], 0.0f, 1.0f);  // the resize may ring past [0, 1]
-        orm.pixels[p * 3 + 1] = rgba(source, p, 1);
-        orm.pixels[p * 3 + 2] = rgba(source, p, 2);
+        orm.pixels[p * 3 + 1] = gltf::rgba(source, p, 1);
+        orm.pixels[p * 3 + 2] = gltf::rgba(source, p, 2);
       }
       auto bytes = cache.encode_png(orm, color::Transfer::linear);
       if (!bytes) return bytes.error();
@@ -274,4 +274,4 @@ Result<std::vector<TextureReport>> bake_occlusion_textures(gltf::Document& doc, 
   return reports;
 }
 
-}  // namespace matbake::exporter
+}  // namespace matbake::bake_ao

@@ -1,14 +1,14 @@
-#include "occlusion.hpp"
+#include "vertices.hpp"
 
 #include <chrono>
 
 #include "../gltf/vertex_occlusion.hpp"
-#include "occlusion_texture.hpp"
+#include "textures.hpp"
 #include "../scene/from_document.hpp"
-#include "matbake/export.hpp"
+#include "matbake/bake_ao.hpp"
 #include "matbake/output_check.hpp"
 
-namespace matbake::exporter {
+namespace matbake::bake_ao {
 namespace fs = std::filesystem;
 namespace {
 
@@ -23,7 +23,7 @@ std::vector<gltf::PlacedValues> placed_values(const scene::Scene& scene, const a
 
 // An output onto a file the scene is read from, or two outputs onto one file, is refused before
 // any work.
-Status check_outputs(const gltf::Document& doc, const BakeAoOptions& options, const std::vector<fs::path>& textures) {
+Status check_outputs(const gltf::Document& doc, const Options& options, const std::vector<fs::path>& textures) {
   std::vector<NamedOutput> outputs = {{options.output, "glTF output"}, {options.dump, "dump"}};
   for (const fs::path& t : textures) outputs.push_back({t, "texture dump"});
   return check_outputs(outputs, gltf::source_files(doc.file, doc.json));
@@ -48,8 +48,8 @@ Result<ao::Bake> bake_into(gltf::Document& doc, const scene::Scene& scene, const
   return baked;
 }
 
-Result<BakeAoReport> bake_ao_file(const fs::path& input, const BakeAoOptions& options) {
-  return guarded(input.string(), [&]() -> Result<BakeAoReport> {
+Result<Report> bake_file(const fs::path& input, const Options& options) {
+  return guarded(input.string(), [&]() -> Result<Report> {
     if (options.output.empty() && options.dump.empty()) return Error{"", "bake-ao writes a glTF, a dump or both", true};
     if (const fs::path ext = options.output.extension(); !options.output.empty() && ext != ".gltf" && ext != ".glb") {
       return Error{options.output.string(), "the output is .gltf or .glb", true};
@@ -82,13 +82,13 @@ Result<BakeAoReport> bake_ao_file(const fs::path& input, const BakeAoOptions& op
     }
     if (Status s = check_outputs(*doc, options, dumped); !s) return s.error();
 
-    BakeAoReport report;
+    Report report;
     report.notes = scene->notes;
     report.instances = scene->instances.size();
     const auto start = std::chrono::steady_clock::now();
     if (texture) {
       ao::TextureBakes timing;
-      ImageCache cache(*doc, options.encoding);
+      gltf::ImageCache cache(*doc, options.encoding);
       auto textures = bake_occlusion_textures(*doc, *scene, cache, options.ao, targets, stem, OcclusionInto::texture, timing);
       if (!textures) return textures.error();
       report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -133,4 +133,4 @@ Result<BakeAoReport> bake_ao_file(const fs::path& input, const BakeAoOptions& op
   });
 }
 
-}  // namespace matbake::exporter
+}  // namespace matbake::bake_ao
