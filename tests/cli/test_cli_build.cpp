@@ -188,6 +188,16 @@ TEST(CliBuild, RebuildsWhatChangedAndOnlyThat) {
   EXPECT_EQ(dry["out_of_date"], 2);
   ASSERT_EQ(matbake({"build", manifest}).exit_code, 0);
 
+  // A stamp of an older form (no "form": matbake before the parameter descriptions) rebuilds once, saying so.
+  json old_stamp = json::parse(read_bytes(dir / "out/.matbake/material-rubber.json"));
+  old_stamp.erase("form");
+  write_bytes(dir / "out/.matbake/material-rubber.json", old_stamp.dump());
+  dry = run_json({"build", manifest, "--dry-run"});
+  EXPECT_EQ(outcome_of(dry, "material:rubber"), "out_of_date: its stamp is from an older matbake (options recorded anew)");
+  EXPECT_EQ(dry["out_of_date"], 1);
+  ASSERT_EQ(matbake({"build", manifest}).exit_code, 0);
+  EXPECT_EQ(run_json({"build", manifest, "--dry-run"})["out_of_date"], 0);
+
   // A deleted or edited output is built again.
   fs::remove(dir / "out/materials/glass_orm.png");
   write_bytes(dir / "out/materials/painted_metal.validation.json", "{}");

@@ -40,6 +40,11 @@ std::string content_hash(const fs::path& p) {
   return hex;
 }
 
+// The form of a stamp's options: raised when the same manifest is recorded differently (2: options
+// by their parameter descriptions' names, sorted), so that an older stamp says why it rebuilds
+// once rather than "its options changed".
+constexpr int kStampForm = 2;
+
 fs::path stamp_path(const Job& job, const fs::path& state_folder) {
   return state_folder / (job_file_stem(job) + ".json");
 }
@@ -57,6 +62,7 @@ std::string out_of_date_reason(const Job& job, const fs::path& state_folder, boo
   if (!in) return "no earlier build";
   nlohmann::json stamp = nlohmann::json::parse(in, nullptr, false);
   if (stamp.is_discarded() || !stamp.is_object()) return "its stamp is unreadable";
+  if (stamp.value("form", 1) != kStampForm) return "its stamp is from an older matbake (options recorded anew)";
   if (stamp.value("matbake", "") != version) return "matbake's version changed";
   if (stamp.value("options", "") != job.options) return "its options changed";
   const nlohmann::json inputs = stamp.value("inputs", nlohmann::json::array());
@@ -100,7 +106,7 @@ Status write_stamp(const Job& job, const std::vector<fs::path>& read, const std:
     outputs.push_back({{"path", p.string()}, {"size", s.size}, {"mtime", s.mtime}});
   }
   const nlohmann::json stamp = {
-      {"matbake", version}, {"job", job.name}, {"options", job.options}, {"inputs", inputs}, {"outputs", outputs}};
+      {"form", kStampForm}, {"matbake", version}, {"job", job.name}, {"options", job.options}, {"inputs", inputs}, {"outputs", outputs}};
   std::error_code ec;
   fs::create_directories(state_folder, ec);
   return write_file_atomically(stamp_path(job, state_folder), stamp.dump(1) + "\n");
