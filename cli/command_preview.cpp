@@ -5,8 +5,11 @@
 
 #include "commands.hpp"
 #include "matbake/atomic_file.hpp"
+#include "matbake/encoding_params.hpp"
 #include "matbake/image.hpp"
+#include "matbake/preview_params.hpp"
 #include "matbake/shading_catalog.hpp"
+#include "params_cli.hpp"
 
 namespace fs = std::filesystem;
 
@@ -45,8 +48,6 @@ Status write_sidecar(const fs::path& path, const preview::Preview& result, const
 }  // namespace
 
 CLI::App* setup_preview(CLI::App& app, PreviewSettings& s) {
-  std::string model_names;
-  for (const auto& m : shading::models()) model_names += (model_names.empty() ? "" : ", ") + std::string(m.name);
   CLI::App* cmd = app.add_subcommand(
       "preview",
       "Render material balls (Schüler's two-hemisphere light plus two directional lights) to an sRGB PNG,\n"
@@ -56,9 +57,8 @@ CLI::App* setup_preview(CLI::App& app, PreviewSettings& s) {
   cmd->add_option("-o,--output", s.output, "Output .png")->required();
   add_source_options(*cmd, s.sources, {"transfer", "decode", "resize"});
   cmd->add_option("--materials", s.materials, "JSON list of materials, one row each (see docs/preview.md)");
-  cmd->add_option("--gloss-sweep", s.gloss_sweep, "Columns at these gloss values, e.g. 0.25,0.5,0.75,1")->delimiter(',');
-  cmd->add_option("--model", s.model, "BRDF for the direct lights: " + model_names)->capture_default_str();
-  cmd->add_option("--size", s.size, "Pixels per cell")->capture_default_str();
+  add_params(*cmd, preview::options_params(), s.options, "", "Options");
+  add_params(*cmd, image::encoding_params(), s.encoding, "", "Options");
   return cmd;
 }
 
@@ -67,24 +67,20 @@ int run_preview(const PreviewSettings& s, const GlobalOptions& global) {
   if (output.extension() != ".png") return report_error(Error{s.output, "preview writes .png", true});
   auto materials = materials_from(s);
   if (!materials) return report_error(materials.error());
-  preview::Options options;
-  options.model = s.model;
-  options.cell_size = s.size;
-  options.glosses = s.gloss_sweep;
-  auto result = preview::render(*materials, options);
+  auto result = preview::render(*materials, s.options);
   if (!result) return report_error(result.error());
-  const image::WriteOptions png{color::Transfer::srgb, image::SampleType::u8, "", "sRGB"};
+  const image::WriteOptions png{color::Transfer::srgb, image::SampleType::u8, "", "sRGB", s.encoding.png_level};
   if (Status st = image::write_image(result->image, output, png); !st) return report_error(st.error());
   fs::path sidecar = output;
   sidecar.replace_extension(".json");
-  if (Status st = write_sidecar(sidecar, *result, s.model); !st) return report_error(st.error());
+  if (Status st = write_sidecar(sidecar, *result, s.options.model); !st) return report_error(st.error());
   if (global.json) {
     std::cout << nlohmann::json{{"command", "preview"}, {"output", s.output}, {"sidecar", sidecar.string()},
                                 {"cells", result->cells.size()}}.dump(2)
               << "\n";
   } else if (!global.quiet) {
     std::cout << s.output << " (" << result->image.width << "x" << result->image.height << ", "
-              << result->cells.size() << " cells, " << s.model << ") and " << sidecar.string() << "\n";
+              << result->cells.size() << " cells, " << s.options.model << ") and " << sidecar.string() << "\n";
   }
   return kOk;
 }

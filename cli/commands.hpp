@@ -48,9 +48,8 @@ struct PreviewSettings {
   std::string output;
   SourceSettings sources;  // constants or textures, as pack reads them
   std::string materials;
-  std::vector<double> gloss_sweep;
-  std::string model = "schuler-optimized";
-  int size = 128;
+  preview::Options options;  // model, size, gloss_sweep
+  image::Encoding encoding;
 };
 CLI::App* setup_preview(CLI::App& app, PreviewSettings& settings);
 int run_preview(const PreviewSettings& settings, const GlobalOptions& global);

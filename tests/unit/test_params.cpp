@@ -13,6 +13,7 @@
 #include "matbake/export_params.hpp"
 #include "matbake/material_params.hpp"
 #include "matbake/params.hpp"
+#include "matbake/preview_params.hpp"
 #include "matbake/validate_params.hpp"
 #include "matbake/pipeline.hpp"
 #include "support/files.hpp"
@@ -206,6 +207,23 @@ TEST(ConvertParams, EveryParameterIsAFlagWhoseExampleChangesTheEcho) {
   }
 }
 
+TEST(PreviewParams, EveryParameterIsAFlagWhoseExampleChangesTheOptions) {
+  const Group<preview::Options> group = preview::options_params();
+  const nlohmann::json defaults = to_json(group, preview::Options{});
+  for (const Param<preview::Options>& p : group.params) {
+    SCOPED_TRACE(p.spec.name);
+    const preview::Options options = from_example_flag(group, p);
+    EXPECT_NE(to_json(group, options).at(p.spec.name), defaults.at(p.spec.name));
+  }
+  preview::Options sweep;
+  EXPECT_EQ(apply(*group.find("gloss_sweep"), sweep, Value(std::string("0,0.5,1"))), std::nullopt);
+  EXPECT_EQ(sweep.glosses, (std::vector<double>{0, 0.5, 1}));
+  for (const char* bad : {"0.5,", "1.5", "a", ""}) {
+    EXPECT_EQ(apply(*group.find("gloss_sweep"), sweep, Value(std::string(bad))), "gloss values 0 to 1, comma-separated") << bad;
+  }
+  EXPECT_EQ(apply(*group.find("model"), sweep, Value(std::string("ggxx"))).value_or("").rfind("use lambert", 0), 0u);
+}
+
 TEST(MaterialParams, AnOlderFlagWorksAsTheNewOne) {
   CLI::App app;
   pack::MaterialOptions options;
@@ -238,6 +256,7 @@ TEST(DocsTables, MatchTheParameterDescriptions) {
       {"docs/validate.md", "params:validate", markdown_table(validate::options_params(), "")},
       {"docs/build.md", "params:material", markdown_table(pack::material_params(), "")},
       {"docs/convert.md", "params:convert", markdown_table(convert::options_params(), "")},
+      {"docs/preview.md", "params:preview", markdown_table(preview::options_params(), "")},
   };
   for (const Table& t : tables) {
     const fs::path path = fs::path(MATBAKE_SOURCE_DIR) / t.file;
