@@ -32,7 +32,7 @@ void add_params(CLI::App& cmd, const params::Group<T>& group, T& target, const s
                 const std::set<std::string>& only = {}) {
   const nlohmann::json defaults = params::to_json(group, T{});
   for (const params::Param<T>& p : group.params) {
-    if (!only.empty() && !only.count(p.spec.name)) continue;
+    if (p.spec.manifest_only || (!only.empty() && !only.count(p.spec.name))) continue;
     const std::string flag = params::flag_name(p.spec, prefix);
     std::string help = p.spec.help;
     if (p.spec.kind == params::Kind::choice) help += ": " + params::type_text(p.spec);

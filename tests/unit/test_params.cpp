@@ -16,6 +16,7 @@
 #include "matbake/preview_params.hpp"
 #include "matbake/validate_params.hpp"
 #include "matbake/pipeline.hpp"
+#include "matbake/pipeline_params.hpp"
 #include "support/files.hpp"
 #include "support/param_values.hpp"
 
@@ -224,6 +225,32 @@ TEST(PreviewParams, EveryParameterIsAFlagWhoseExampleChangesTheOptions) {
   EXPECT_EQ(apply(*group.find("model"), sweep, Value(std::string("ggxx"))).value_or("").rfind("use lambert", 0), 0u);
 }
 
+// A build's own settings have one door: each at its example, through the manifest, changes the
+// entry (and so its stamp), and no command takes it as a flag.
+TEST(PipelineParams, EveryBuildSettingReachesItsEntryFromTheManifest) {
+  for (const Param<pipeline::ValidationRules>& p : pipeline::validation_params().params) {
+    SCOPED_TRACE(p.spec.name);
+    auto m = pipeline::parse_manifest("[validate]\n" + p.spec.name + " = " + test::toml_literal(p.spec) +
+                                          "\n[materials.a]\nsources = { kd = 0.5 }\n",
+                                      "/p/assets.toml");
+    ASSERT_TRUE(m) << m.error().to_string();
+    EXPECT_NE(to_json(pipeline::validation_params(), m->materials[0].validation),
+              to_json(pipeline::validation_params(), pipeline::ValidationRules{}));
+  }
+  for (const Param<pipeline::SceneSpec>& p : pipeline::scene_params().params) {
+    SCOPED_TRACE(p.spec.name);
+    auto m = pipeline::parse_manifest("[scenes.s]\ninput = \"s.gltf\"\n" + p.spec.name + " = " +
+                                          test::toml_literal(p.spec) + "\n",
+                                      "/p/assets.toml");
+    ASSERT_TRUE(m) << m.error().to_string();
+    EXPECT_NE(to_json(pipeline::scene_params(), m->scenes[0]), to_json(pipeline::scene_params(), pipeline::SceneSpec{}));
+  }
+  CLI::App app;
+  pipeline::ValidationRules rules;
+  cli::add_params(app, pipeline::validation_params(), rules, "", "Options");
+  EXPECT_THROW(app.parse(std::vector<std::string>{"--enabled"}), CLI::ParseError);
+}
+
 TEST(MaterialParams, AnOlderFlagWorksAsTheNewOne) {
   CLI::App app;
   pack::MaterialOptions options;
@@ -257,6 +284,8 @@ TEST(DocsTables, MatchTheParameterDescriptions) {
       {"docs/build.md", "params:material", markdown_table(pack::material_params(), "")},
       {"docs/convert.md", "params:convert", markdown_table(convert::options_params(), "")},
       {"docs/preview.md", "params:preview", markdown_table(preview::options_params(), "")},
+      {"docs/build.md", "params:validation", markdown_table(pipeline::validation_params(), "")},
+      {"docs/build.md", "params:scene", markdown_table(pipeline::scene_params(), "")},
   };
   for (const Table& t : tables) {
     const fs::path path = fs::path(MATBAKE_SOURCE_DIR) / t.file;

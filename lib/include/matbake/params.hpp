@@ -47,6 +47,7 @@ struct Spec {
   std::string example;               // a value other than the default, as a flag takes it
   std::vector<std::string> aliases;  // older manifest keys, still read, with a note
   std::string needs;                 // the parameter this one applies with (texcoord: texture)
+  bool manifest_only = false;        // a manifest key with no flag (a build's own setting)
 };
 
 // "--ao-relative-distance" for "relative_distance" with prefix "ao-".

@@ -143,7 +143,8 @@ std::string markdown_table(const std::vector<const Spec*>& specs, const nlohmann
     const std::string shown = d.is_null() ? "unset" : value_text(d);
     const bool off_flag = s->kind == Kind::flag && d.is_boolean() && d.get<bool>();
     const std::string flag = flag_name(*s, flag_prefix);
-    out += "| `" + (off_flag ? "--no-" + flag.substr(2) : flag) + "` | `" + s->name + "` | " + type_text(*s) + " | " + shown + " | " +
+    const std::string shown_flag = s->manifest_only ? "—" : "`" + (off_flag ? "--no-" + flag.substr(2) : flag) + "`";
+    out += "| " + shown_flag + " | `" + s->name + "` | " + type_text(*s) + " | " + shown + " | " +
            s->help + (s->needs.empty() ? "" : " (with `" + s->needs + "`)") +
            (s->aliases.empty() ? "" : "; older key: `" + s->aliases.front() + "`") + " |\n";
   }

@@ -12,6 +12,7 @@
 #include "matbake/export_params.hpp"
 #include "matbake/material_params.hpp"
 #include "matbake/near_names.hpp"
+#include "matbake/pipeline_params.hpp"
 #include "matbake/validate_params.hpp"
 #include "matbake/read_file.hpp"
 #include "matbake/pipeline.hpp"
@@ -155,8 +156,10 @@ Status read_params(const Reader& r, const toml::table& t, const std::string& whe
 
 Status read_validation(const Reader& r, const toml::table& t, const std::string& where, ValidationRules& rules,
                        std::vector<std::string>& notes) {
-  if (Status s = r.known_keys(t, where, with_keys_of(validate::options_params(), {"enabled", "heatmap"})); !s) return s;
-  for (Status s : {r.get(t, "enabled", where, rules.enabled), r.get(t, "heatmap", where, rules.heatmap),
+  if (Status s = r.known_keys(t, where, with_keys_of(validate::options_params(), keys_of(validation_params()))); !s) {
+    return s;
+  }
+  for (Status s : {read_params_in(r, t, where, validation_params(), rules, notes),
                    read_params_in(r, t, where, validate::options_params(), rules.options, notes)}) {
     if (!s) return s;
   }
@@ -281,7 +284,8 @@ Result<SceneSpec> read_scene(const Reader& r, const std::string& name, const tom
   if (!is_file_name_safe(name)) return r.at(node, "scene name '" + name + "': letters, digits, '_', '-' and '.' only");
   if (Status s = r.known_keys(*t, where, with_keys_of(image::encoding_params(),
                                                       with_keys_of(exporter::options_params(),
-                                                                   {"input", "output", "materials", "match_names", "ao"})));
+                                                                   with_keys_of(scene_params(),
+                                                                                {"input", "output", "materials", "ao"}))));
       !s) {
     return s.error();
   }
@@ -295,7 +299,7 @@ Result<SceneSpec> read_scene(const Reader& r, const std::string& name, const tom
   r.record(*t, "", spec.origins);
   std::string input, output = name + ".glb";
   for (Status s : {r.get(*t, "input", where, input), r.get(*t, "output", where, output),
-                   r.get(*t, "match_names", where, spec.match_names),
+                   read_params_in(r, *t, where, scene_params(), spec, notes),
                    read_params_in(r, *t, where, exporter::options_params(), spec.options, notes)}) {
     if (!s) return s.error();
   }

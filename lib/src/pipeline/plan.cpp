@@ -7,6 +7,7 @@
 #include "state.hpp"
 #include "matbake/encoding_params.hpp"
 #include "matbake/material_params.hpp"
+#include "matbake/pipeline_params.hpp"
 #include "matbake/validate_params.hpp"
 #include "matbake/material_table.hpp"
 #include "matbake/near_names.hpp"
@@ -39,7 +40,7 @@ nlohmann::json material_options(const MaterialSpec& m, const Manifest& manifest)
           {"layout", m.layout ? m.layout->reference : ""},
           {"reference", m.reference},
           {"table", manifest.table.string()},
-          {"validate", {{"enabled", m.validation.enabled}, {"heatmap", m.validation.heatmap}}}});
+          {"validate", params::to_json(validation_params(), m.validation)}});
   options["validate"].update(params::to_json(validate::options_params(), m.validation.options));
   return options;
 }
