@@ -1,5 +1,6 @@
 #include <tbb/global_control.h>
 
+#include <functional>
 #include <memory>
 #include <optional>
 
@@ -34,6 +35,20 @@ std::optional<std::string> unknown_option(const CLI::App& app, const CLI::ParseE
   return std::nullopt;
 }
 
+// A command of the table main() dispatches from: its subcommand, and its run over the settings
+// the subcommand's flags fill (kept alive by the run).
+struct Command {
+  CLI::App* app = nullptr;
+  std::function<int(const matbake::cli::GlobalOptions&)> run;
+};
+
+template <class Settings>
+Command command(CLI::App& app, CLI::App* (*setup)(CLI::App&, Settings&),
+                int (*run)(const Settings&, const matbake::cli::GlobalOptions&)) {
+  auto settings = std::make_shared<Settings>();
+  return {setup(app, *settings), [settings, run](const matbake::cli::GlobalOptions& global) { return run(*settings, global); }};
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -55,28 +70,15 @@ int main(int argc, char** argv) {
   app.add_option("--ocio-config", global.ocio_config,
                  "OpenColorIO config for colour-space names (default: $OCIO, else the shipped presets/ocio/config.ocio)");
 
-  ConvertSettings convert;
-  CLI::App* convert_app = setup_convert(app, convert);
-  PreviewSettings preview;
-  CLI::App* preview_app = setup_preview(app, preview);
-  PackSettings pack;
-  CLI::App* pack_app = setup_pack(app, pack);
-  UnpackSettings unpack;
-  CLI::App* unpack_app = setup_unpack(app, unpack);
-  WorkflowSettings workflow;
-  CLI::App* workflow_app = setup_workflow(app, workflow);
-  MaterialsSettings materials;
-  CLI::App* materials_app = setup_materials(app, materials);
-  ValidateSettings validate;
-  CLI::App* validate_app = setup_validate(app, validate);
-  BakeAoSettings bake_ao;
-  CLI::App* bake_ao_app = setup_bake_ao(app, bake_ao);
-  ExportSettings export_settings;
-  CLI::App* export_app = setup_export(app, export_settings);
-  BuildSettings build;
-  CLI::App* build_app = setup_build(app, build);
-  PlanSettings plan;
-  CLI::App* plan_app = setup_plan(app, plan);
+  // The commands, in --help's order: each one's settings filled by its flags, then its run.
+  const std::vector<Command> commands = {
+      command(app, setup_convert, run_convert),   command(app, setup_preview, run_preview),
+      command(app, setup_pack, run_pack),         command(app, setup_unpack, run_unpack),
+      command(app, setup_workflow, run_workflow), command(app, setup_materials, run_materials),
+      command(app, setup_validate, run_validate), command(app, setup_bake_ao, run_bake_ao),
+      command(app, setup_export, run_export),     command(app, setup_build, run_build),
+      command(app, setup_plan, run_plan),
+  };
 
   try {
     app.parse(argc, argv);
@@ -99,17 +101,9 @@ int main(int argc, char** argv) {
   // The library turns its dependencies' exceptions into errors at its edges; this is the last net,
   // so that nothing ends in abort (exit 134) without a line saying why.
   try {
-    if (convert_app->parsed()) return run_convert(convert, global);
-    if (preview_app->parsed()) return run_preview(preview, global);
-    if (pack_app->parsed()) return run_pack(pack, global);
-    if (unpack_app->parsed()) return run_unpack(unpack, global);
-    if (workflow_app->parsed()) return run_workflow(workflow, global);
-    if (materials_app->parsed()) return run_materials(materials, global);
-    if (validate_app->parsed()) return run_validate(validate, global);
-    if (bake_ao_app->parsed()) return run_bake_ao(bake_ao, global);
-    if (export_app->parsed()) return run_export(export_settings, global);
-    if (build_app->parsed()) return run_build(build, global);
-    if (plan_app->parsed()) return run_plan(plan, global);
+    for (const Command& c : commands) {
+      if (c.app->parsed()) return c.run(global);
+    }
   } catch (const std::bad_alloc&) {
     return report_error(matbake::Error{"", "out of memory"});
   } catch (const std::exception& e) {
