@@ -251,17 +251,16 @@ layout = "gltf-orm"
   std::sort(lines.begin(), lines.begin() + 3);
   // Each names the manifest's line and column of the value at fault, then the file.
   const std::string manifest = (dir / "m.toml").string();
-  EXPECT_EQ(lines[1].rfind("matbake: error: " + manifest + ":9:18: materials.corrupt: " + (dir / "corrupt.png").string() + ": ", 0),
-            0u)
-      << lines[1];
-  EXPECT_NE(lines[1].find("(material:corrupt)"), std::string::npos);
-  EXPECT_EQ(lines[0], "matbake: error: " + manifest + ":6:18: materials.missing.sources.kd: " + (dir / "missing.png").string() +
+  // Sorted by line: below_real (11), missing (6), corrupt (9) as text.
+  EXPECT_EQ(lines[0], "matbake: error: " + manifest + ":11:1: materials.below_real: validation: 1 of 1 texels flagged "
+                      "(100%; max_violations 0%); the texels are in " +
+                      (dir / "out/materials/below_real.validation.json").string() + " (material:below_real)");
+  EXPECT_EQ(lines[1], "matbake: error: " + manifest + ":6:18: materials.missing.sources.kd: " + (dir / "missing.png").string() +
                           ": no such file (material:missing)");
-  EXPECT_EQ(lines[2].rfind("matbake: error: " + (dir / "out/materials/below_real.validation.json").string() +
-                               ": validation: 1 of 1 texels flagged (100%; max_violations 0%) (material:below_real)",
-                           0),
+  EXPECT_EQ(lines[2].rfind("matbake: error: " + manifest + ":9:18: materials.corrupt: " + (dir / "corrupt.png").string() + ": ", 0),
             0u)
       << lines[2];
+  EXPECT_NE(lines[2].find("(material:corrupt)"), std::string::npos);
   EXPECT_EQ(lines[3], "matbake: error: " + (dir / "m.toml").string() + ": 3 of 4 jobs failed");
   // The good material is complete (a 1×1 texture of constants); the failed ones left no partial file.
   const RawImage good = read_raw(dir / "out/materials/good_base_color.png");
@@ -284,6 +283,20 @@ layout = "gltf-orm"
   EXPECT_EQ(allowed.exit_code, 0) << allowed.err;
   EXPECT_NE(allowed.err.find("matbake: warning: material:below_real: validation: 1 of 1 texels flagged"), std::string::npos)
       << allowed.err;
+}
+
+// A scene that fails while it is exported (its buffer is not there) names the manifest's line of
+// its input, then the file at fault.
+TEST(CliBuild, AFailingSceneNamesItsInputsLine) {
+  TempDir dir;
+  write_bytes(dir / "s.gltf", R"({"asset": {"version": "2.0"}, "buffers": [{"uri": "gone.bin", "byteLength": 12}]})");
+  write_bytes(dir / "m.toml", "[scenes.s]\ninput = \"s.gltf\"\n");
+  const RunResult r = matbake({"build", (dir / "m.toml").string()});
+  EXPECT_EQ(r.exit_code, 1);
+  const std::string first = r.err.substr(0, r.err.find('\n'));
+  EXPECT_EQ(first.rfind("matbake: error: " + (dir / "m.toml").string() + ":2:9: scenes.s: ", 0), 0u) << r.err;
+  EXPECT_NE(first.find("gone.bin"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "out/s.glb"));
 }
 
 // A layout file is named with or without its ".json", relative to the manifest whatever the current

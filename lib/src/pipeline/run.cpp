@@ -158,7 +158,11 @@ Status validate_material(const MaterialSpec& m, const material::Maps& maps, cons
   char line[160];
   std::snprintf(line, sizeof line, "validation: %zu of %zu texels flagged (%.3g%%; max_violations %.3g%%)",
                 result->violations, result->checked, 100 * result->violation_fraction(), 100 * options.max_violations);
-  if (!passed) return Error{json_file.string(), line};
+  // The failure is the material's (or its max_violations', when it sets one); the report says which texels.
+  if (!passed) {
+    return Error{m.origins.of("validate.max_violations"),
+                 "materials." + m.name + ": " + line + "; the texels are in " + json_file.string()};
+  }
   if (result->violations) report.warnings.push_back(line);
   return success();
 }
@@ -204,7 +208,7 @@ Result<std::vector<fs::path>> run_scene(const Job& job, const JobContext& ctx, J
     const fs::path& output = job.outputs.scene;
     if (Status st = ensure_folder(output.parent_path()); !st) return st.error();
     auto exported = exporter::export_scene(s.input, output, options);
-    if (!exported) return exported.error();
+    if (!exported) return Error{s.origins.of("input"), "scenes." + s.name + ": " + exported.error().to_string()};
     report.details = to_json(*exported);
     return std::vector<fs::path>(exported->written.begin(), exported->written.end());
   });
