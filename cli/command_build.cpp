@@ -27,6 +27,15 @@ Result<pipeline::Plan> load(const std::string& manifest_file, const std::string&
   return pipeline::make_plan(manifest);
 }
 
+void print_stale(const pipeline::StaleOutputs& stale, bool dry_run) {
+  for (const fs::path& p : stale.removed) std::printf("removed %s: no job makes it now\n", p.c_str());
+  const char* kept = dry_run ? "would remove" : "kept";
+  for (const fs::path& p : stale.kept) std::printf("%s %s: no job makes it now\n", kept, p.c_str());
+  for (const fs::path& p : stale.changed) {
+    std::printf("left %s: no job makes it now, but it changed since matbake wrote it\n", p.c_str());
+  }
+}
+
 void add_output_dir_option(CLI::App& cmd, std::string& output_dir) {
   cmd.add_option("--output-dir", output_dir,
                  "Write the outputs here instead of the manifest's `output` (e.g. inside a build tree)");
@@ -43,6 +52,8 @@ CLI::App* setup_build(CLI::App& app, BuildSettings& s) {
   add_output_dir_option(*cmd, s.output_dir);
   cmd->add_flag("--force", s.force, "Build every job, up to date or not");
   cmd->add_flag("-n,--dry-run", s.dry_run, "List what would be built, and why, without building it");
+  cmd->add_flag("--keep-stale", s.keep_stale,
+                "Keep the files an earlier build made that no job makes now (by default a full run with no failure removes them)");
   cmd->add_option("--only", s.only, "Build only this job (material:NAME or scene:NAME); repeatable");
   cmd->add_option("--depfile", s.depfile,
                   "Write a Make depfile of every input read, for CMake add_custom_command(DEPFILE) and Ninja");
@@ -98,9 +109,12 @@ int run_build(const BuildSettings& s, const GlobalOptions& global) {
   options.force = s.force;
   options.dry_run = s.dry_run;
   options.only = s.only;
+  options.keep_stale = s.keep_stale;
   options.progress = [&](const pipeline::JobReport& r, std::size_t done, std::size_t total) {
     if (r.outcome == pipeline::Outcome::failed) {
       bar.print_above("matbake: error: " + job_error(r));
+    } else if (r.outcome == pipeline::Outcome::skipped) {
+      bar.print_above("matbake: " + r.job->name + " skipped: " + r.reason);
     } else if (!global.quiet && !terminal) {
       char line[64];
       std::snprintf(line, sizeof line, "[%zu/%zu] ", done, total);
@@ -140,22 +154,33 @@ int run_build(const BuildSettings& s, const GlobalOptions& global) {
     for (const pipeline::JobReport& r : report->jobs) {
       for (const std::string& w : r.warnings) std::cerr << "matbake: warning: " << r.job->name << ": " << w << "\n";
     }
+    print_stale(report->stale, s.dry_run);
     const std::size_t built = report->count(pipeline::Outcome::built), current = report->count(pipeline::Outcome::up_to_date),
-                      pending = report->count(pipeline::Outcome::out_of_date);
-    if (built + failed + pending == 0) {
+                      pending = report->count(pipeline::Outcome::out_of_date), skipped = report->count(pipeline::Outcome::skipped);
+    if (built + failed + pending + skipped == 0) {
       std::printf("nothing to do: %zu jobs up to date\n", current);
     } else if (s.dry_run) {
       std::printf("%zu of %zu jobs would be built\n", pending, report->jobs.size());
     } else {
-      std::printf("built %zu, up to date %zu, failed %zu; %zu images decoded; %.2f s\n", built, current, failed,
-                  report->images_decoded, seconds);
+      std::string also = skipped ? ", skipped " + std::to_string(skipped) : "";
+      if (const std::size_t over = report->over_validation_limit()) {
+        also += "; " + std::to_string(over) + " over their validation limit (advisory)";
+      }
+      std::printf("built %zu, up to date %zu, failed %zu%s; %zu images decoded; %.2f s\n", built, current, failed,
+                  also.c_str(), report->images_decoded, seconds);
+    }
+  }
+  for (const pipeline::JobReport& r : report->jobs) {
+    for (const fs::path& p : r.moved) {
+      report_error(Error{p.string(), "changed while " + r.job->name +
+                                         " read it; its outputs are from the earlier bytes (as its stamp records): build again"});
     }
   }
   if (failed) {
     std::cerr << "matbake: error: " << s.manifest << ": " << failed << " of " << report->jobs.size() << " jobs failed\n";
     return kFailed;
   }
-  return kOk;
+  return report->moved() ? kFailed : kOk;
 }
 
 }  // namespace matbake::cli

@@ -128,12 +128,13 @@ int run_validate(const ValidateSettings& s, const GlobalOptions& global) {
     if (Status st = write_validation_report(*report, options, s.report); !st) return report_error(st.error());
   }
   const bool failed = !validate::passed(*report, options);
-  const int exit_code = failed ? kViolations : kOk;
+  const int exit_code = failed && options.gate ? kViolations : kOk;
 
   nlohmann::json doc = {{"command", "validate"}};
   doc.update(to_json(*report, options));
   doc["max_violations"] = options.max_violations;
   doc["passed"] = !failed;
+  doc["gate"] = options.gate;
   if (!s.heatmap.empty()) doc["heatmap"] = s.heatmap;
   if (global.json) {
     std::cout << doc.dump(2) << "\n";
@@ -149,7 +150,8 @@ int run_validate(const ValidateSettings& s, const GlobalOptions& global) {
                   report->checked ? 100.0 * double(report->material_within) / double(report->checked) : 0.0);
     }
     std::printf("  flagged: %zu texels (%.4f%%, allowed %.4f%%)%s\n", report->violations,
-                100 * report->violation_fraction(), 100 * options.max_violations, failed ? ": FAILED" : "");
+                100 * report->violation_fraction(), 100 * options.max_violations,
+                failed ? (options.gate ? ": FAILED" : ": over the limit (advisory: gate off)") : "");
     for (int b = 0; b < validate::kFlagCount; ++b) {
       if (report->flag_counts[std::size_t(b)]) {
         std::printf("    %-22s %zu\n", std::string(validate::flag_name(b)).c_str(), report->flag_counts[std::size_t(b)]);

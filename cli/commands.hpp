@@ -125,6 +125,7 @@ struct BuildSettings {
   std::string output_dir;
   bool force = false;
   bool dry_run = false;
+  bool keep_stale = false;
   std::vector<std::string> only;
   std::string depfile;
   std::string stamp;

@@ -160,7 +160,7 @@ TEST(CliBuild, RebuildsWhatChangedAndOnlyThat) {
   // A real run then records the new time, so the next one need not hash the file again.
   EXPECT_EQ(run_json({"build", manifest})["up_to_date"], 6);
   const json stamp = json::parse(read_bytes(dir / "out/.matbake/material-wood.json"));
-  EXPECT_EQ(stamp["inputs"][0]["path"], wood.string());
+  EXPECT_EQ(stamp["inputs"][0]["path"], "textures/wood_albedo.png");  // relative to the manifest's folder
   EXPECT_EQ(stamp["inputs"][0]["mtime"].get<std::int64_t>(),
             std::chrono::duration_cast<std::chrono::nanoseconds>(fs::last_write_time(wood).time_since_epoch()).count());
 
@@ -193,7 +193,7 @@ TEST(CliBuild, RebuildsWhatChangedAndOnlyThat) {
   old_stamp.erase("form");
   write_bytes(dir / "out/.matbake/material-rubber.json", old_stamp.dump());
   dry = run_json({"build", manifest, "--dry-run"});
-  EXPECT_EQ(outcome_of(dry, "material:rubber"), "out_of_date: its stamp is from an older matbake (options recorded anew)");
+  EXPECT_EQ(outcome_of(dry, "material:rubber"), "out_of_date: its stamp is from an older matbake (recorded anew)");
   EXPECT_EQ(dry["out_of_date"], 1);
   ASSERT_EQ(matbake({"build", manifest}).exit_code, 0);
   EXPECT_EQ(run_json({"build", manifest, "--dry-run"})["out_of_date"], 0);
@@ -213,6 +213,74 @@ TEST(CliBuild, RebuildsWhatChangedAndOnlyThat) {
   const RunResult unknown = matbake({"build", manifest, "--only", "material:nope"});
   EXPECT_EQ(unknown.exit_code, 2);
   EXPECT_NE(unknown.err.find("no job 'material:nope' (jobs: material:glass, "), std::string::npos) << unknown.err;
+}
+
+TEST(CliBuild, AMovedOrCopiedTreeIsUpToDate) {
+  TempDir dir;
+  fs::create_directories(dir / "a");
+  copy_example(dir / "a", true);
+  ASSERT_EQ(matbake({"build", (dir / "a/showroom.toml").string()}).exit_code, 0);
+  // Moved (times kept): nothing to do. Stamps hold paths relative to the manifest's and output folders.
+  fs::rename(dir / "a", dir / "b");
+  EXPECT_EQ(run_json({"build", (dir / "b/showroom.toml").string(), "--dry-run"})["out_of_date"], 0);
+  // Copied (new times, same bytes): the hashes decide, so nothing is built either.
+  fs::copy(dir / "b", dir / "c", fs::copy_options::recursive);
+  const json copied = run_json({"build", (dir / "c/showroom.toml").string()});
+  EXPECT_EQ(copied["built"], 0) << copied.dump();
+  EXPECT_EQ(copied["up_to_date"], 6);
+  // The same sources built from scratch elsewhere give the same bytes.
+  fs::create_directories(dir / "d");
+  copy_example(dir / "d", true);
+  ASSERT_EQ(matbake({"build", (dir / "d/showroom.toml").string(), "--jobs", "1"}).exit_code, 0);
+  EXPECT_EQ(outputs_under(dir / "d/out"), outputs_under(dir / "b/out"));
+}
+
+TEST(CliBuild, StaleOutputsAreRemovedAndOnlyThose) {
+  TempDir dir;
+  copy_example(dir.path(), true);
+  const std::string manifest = (dir / "showroom.toml").string();
+  ASSERT_EQ(matbake({"build", manifest}).exit_code, 0);
+  write_bytes(dir / "out/notes.txt", "mine");
+  write_bytes(dir / "out/materials/mine_orm.png", "mine too");
+  const auto edit = [&](const std::string& from, const std::string& to) {
+    std::string text = read_bytes(dir / "showroom.toml");
+    const std::size_t at = text.find(from);
+    ASSERT_NE(at, std::string::npos) << from;
+    text.replace(at, from.size(), to);
+    write_bytes(dir / "showroom.toml", text);
+  };
+  // Rubber moves to Unity HDRP's layout: its glTF ORM texture is stale. Kept when asked, and
+  // listed by a dry run, then removed by the next full run.
+  edit("metallic = 0.0, roughness = 0.85 }\nlayout = \"gltf-orm\"", "metallic = 0.0, roughness = 0.85 }\nlayout = \"unity-hdrp\"");
+  const fs::path rubber_orm = dir / "out/materials/rubber_orm.png";
+  ASSERT_TRUE(fs::exists(rubber_orm));
+  json kept = run_json({"build", manifest, "--keep-stale"});
+  EXPECT_EQ(kept["stale"]["kept"], json::array({rubber_orm.string()})) << kept["stale"].dump();
+  EXPECT_TRUE(fs::exists(rubber_orm));
+  const RunResult dry = matbake({"build", manifest, "-n"});
+  EXPECT_NE(dry.out.find("would remove " + rubber_orm.string() + ": no job makes it now"), std::string::npos) << dry.out;
+  const RunResult removed = matbake({"build", manifest});
+  EXPECT_NE(removed.out.find("removed " + rubber_orm.string() + ": no job makes it now"), std::string::npos) << removed.out;
+  EXPECT_FALSE(fs::exists(rubber_orm));
+
+  // Wood's validation turned off: its report goes. Gold trim removed from the manifest: its
+  // texture, report and stamp go; its texture changed by someone first stays (and is forgotten).
+  edit("decode = \"srgb\"", "decode = \"srgb\"\nvalidate = { enabled = false }");
+  edit("[materials.gold_trim]", "[materials.old_gold_trim]");
+  write_bytes(dir / "out/materials/gold_trim_orm.png", "changed by hand");
+  const json cleaned = run_json({"build", manifest});
+  std::vector<std::string> gone = cleaned["stale"]["removed"];
+  std::sort(gone.begin(), gone.end());
+  EXPECT_EQ(gone, (std::vector<std::string>{(dir / "out/materials/gold_trim.validation.json").string(),
+                                            (dir / "out/materials/gold_trim_base_color.png").string(),
+                                            (dir / "out/materials/wood.validation.json").string()}));
+  EXPECT_EQ(cleaned["stale"]["changed"], json::array({(dir / "out/materials/gold_trim_orm.png").string()}));
+  EXPECT_EQ(read_bytes(dir / "out/materials/gold_trim_orm.png"), "changed by hand");
+  EXPECT_FALSE(fs::exists(dir / "out/.matbake/material-gold_trim.json"));
+  EXPECT_TRUE(fs::exists(dir / "out/materials/old_gold_trim_orm.png"));
+  EXPECT_EQ(read_bytes(dir / "out/notes.txt"), "mine");
+  EXPECT_EQ(read_bytes(dir / "out/materials/mine_orm.png"), "mine too");
+  EXPECT_EQ(run_json({"build", manifest})["stale"]["removed"], json::array());
 }
 
 TEST(CliBuild, FailingJobsAreReportedAndTheOthersFinish) {
@@ -517,7 +585,7 @@ TEST(CliBuild, InterruptKeepsFinishedOutputsAndNoTemporaryFiles) {
       ++finished;
       const json stamp = json::parse(read_bytes(e.path()));
       for (const json& out : stamp["outputs"]) {
-        const RawImage image = read_raw(out["path"].get<std::string>());
+        const RawImage image = read_raw(dir / "out" / out["path"].get<std::string>());  // relative to the output folder
         EXPECT_EQ(image.width, kSize);
       }
     }

@@ -5,6 +5,7 @@
 
 #include <unistd.h>
 
+#include <atomic>
 #include <chrono>
 #include <thread>
 
@@ -244,6 +245,58 @@ TEST(BuildPlan, RefusesToWriteAnInputOrOneFileTwice) {
   plan = pipeline::make_plan(*m);
   ASSERT_FALSE(plan);
   EXPECT_NE(plan.error().message.find("written by both scene:one and scene:two"), std::string::npos);
+}
+
+// Rewriting a source after a job has written its outputs but before its stamp: the stamp records
+// the bytes the job decoded, so the next run rebuilds exactly the jobs built from the older bytes.
+TEST(BuildRun, ASourceRewrittenDuringTheRunRebuildsTheJobsThatReadTheOldBytes) {
+  TempDir dir;
+  write_raw(dir / "kd.png", 4, 4, 3, "uint8", std::vector<double>(48, 100));
+  write_raw(dir / "other.png", 4, 4, 3, "uint8", std::vector<double>(48, 30));
+  std::string text = "validate = { enabled = false }\n";
+  for (const char* name : {"a", "b", "c"}) {
+    text += std::string("[materials.") + name + "]\nsources = { base_color = \"kd.png\", metallic = 0.0, roughness = 0.5 }\n"
+            "layout = \"gltf-orm\"\n";
+  }
+  text += "[materials.d]\nsources = { base_color = \"other.png\", metallic = 0.0, roughness = 0.5 }\nlayout = \"gltf-orm\"\n";
+  write_bytes(dir / "build.toml", text);
+  auto m = pipeline::read_manifest(dir / "build.toml");
+  ASSERT_TRUE(m) << m.error().to_string();
+  auto plan = pipeline::make_plan(*m);
+  ASSERT_TRUE(plan) << plan.error().to_string();
+  std::atomic<bool> rewritten{false};
+  pipeline::RunOptions options;
+  options.before_stamp = [&](const pipeline::Job& job) {
+    if (job.name != "material:d" && !rewritten.exchange(true)) {
+      write_raw(dir / "kd.png", 4, 4, 3, "uint8", std::vector<double>(48, 200));
+    }
+  };
+  auto first = pipeline::run(*m, *plan, options);
+  ASSERT_TRUE(first);
+  EXPECT_EQ(first->count(pipeline::Outcome::built), 4u);
+  EXPECT_GE(first->moved(), 1u);  // at least the job during which it changed says so
+  for (const pipeline::JobReport& r : first->jobs) {
+    if (!r.moved.empty()) {
+      EXPECT_EQ(r.moved, std::vector<fs::path>{dir.path() / "kd.png"});
+    }
+  }
+  // Every job decoded the first bytes (once, shared): all three are out of date, d is not.
+  pipeline::RunOptions dry;
+  dry.dry_run = true;
+  auto check = pipeline::run(*m, *plan, dry);
+  ASSERT_TRUE(check);
+  for (const pipeline::JobReport& r : check->jobs) {
+    if (r.job->name == "material:d") {
+      EXPECT_EQ(r.outcome, pipeline::Outcome::up_to_date);
+    } else {
+      EXPECT_EQ(r.reason, "input changed: " + (dir.path() / "kd.png").string()) << r.job->name;
+    }
+  }
+  auto second = pipeline::run(*m, *plan, {});
+  ASSERT_TRUE(second);
+  EXPECT_EQ(second->count(pipeline::Outcome::built), 3u);
+  EXPECT_EQ(second->moved(), 0u);
+  EXPECT_EQ(read_raw(dir / "out/materials/b_base_color.png").samples[0], 200);
 }
 
 TEST(BuildDepfile, MakeSyntaxWithEscapes) {

@@ -74,6 +74,10 @@ struct ReadInfo {
 Result<Image> read_image(const std::filesystem::path& path, color::Transfer colour,
                          ReadInfo* info = nullptr);
 
+// Whether `path` can be read as an image file at all: it exists and is a regular file (not a
+// folder, FIFO or device); read_image's first check, for readers that take the bytes themselves.
+Status check_image_file(const std::filesystem::path& path);
+
 // An image held in memory (a glTF's embedded PNG, say): `name`'s extension picks the reader, and
 // names the image in errors. Same checks as read_image.
 Result<Image> decode_image(std::span<const unsigned char> bytes, const std::filesystem::path& name,

@@ -7,6 +7,8 @@
 //   inputs (size, time, content hash), its options and matbake's version.
 // - Jobs run in parallel (TBB), each source file is decoded once however many jobs read it, and a
 //   failing job does not stop the others.
+// - The build keeps a log of the files it made; after a full run with no failure, those no job
+//   makes now are removed (docs/build.md).
 // docs/build.md has the manifest's schema.
 #include <nlohmann/json.hpp>
 
@@ -110,6 +112,7 @@ struct Job {
   JobOutputs outputs;
   std::vector<std::filesystem::path> inputs;   // every file it reads
   std::map<std::string, std::size_t> materials;  // a scene: glTF material name → manifest material
+  std::vector<std::string> depends_on;  // jobs that must succeed first (a scene: its materials' jobs)
   std::string options;   // what besides the inputs decides the outputs (canonical JSON)
   std::optional<Error> problem;  // found while planning (a file or table entry that is not there):
                                  // the job fails with it, in a dry run too
@@ -126,10 +129,12 @@ struct Plan {
 // input, two jobs writing one file).
 Result<Plan> make_plan(const Manifest& manifest);
 
-enum class Outcome { built, up_to_date, failed, out_of_date /* --dry-run */ };
-inline constexpr NameTable<Outcome, 4> kOutcomeNames{{{Outcome::built, "built"},
+// skipped: a job it depends on failed in this run (as Make and Ninja do, it is not run).
+enum class Outcome { built, up_to_date, failed, skipped, out_of_date /* --dry-run */ };
+inline constexpr NameTable<Outcome, 5> kOutcomeNames{{{Outcome::built, "built"},
                                                       {Outcome::up_to_date, "up_to_date"},
                                                       {Outcome::failed, "failed"},
+                                                      {Outcome::skipped, "skipped"},
                                                       {Outcome::out_of_date, "out_of_date"}}};
 
 struct JobReport {
@@ -140,20 +145,38 @@ struct JobReport {
   std::vector<std::string> warnings;
   std::optional<Error> error;
   nlohmann::json details;  // validation, conversion errors, the export report
+  // Inputs that changed while the job ran: its outputs are from the bytes read before, as its stamp
+  // records, so it runs again next time (the build says so and exits 1).
+  std::vector<std::filesystem::path> moved;
+  std::map<std::filesystem::path, std::string> written;  // a built job's outputs, each with its content hash
+};
+
+// Files an earlier run made that no job of the manifest makes now (a material removed or renamed,
+// its layout changed, validation turned off).
+struct StaleOutputs {
+  std::vector<std::filesystem::path> removed;  // at the end of a full run with no failure
+  std::vector<std::filesystem::path> kept;     // --keep-stale, --only, a failed job or a dry run: removed later
+  std::vector<std::filesystem::path> changed;  // changed since matbake wrote them: left alone, forgotten
 };
 
 struct RunOptions {
   bool force = false;
   bool dry_run = false;
   std::vector<std::string> only;  // job names; empty: all
+  bool keep_stale = false;        // keep the files no job makes now (else removed after a full run)
   // Called as each job finishes (from worker threads, one call at a time).
   std::function<void(const JobReport&, std::size_t done, std::size_t total)> progress;
+  // Called when a job has written its outputs and before its stamp is (tests change a source here).
+  std::function<void(const Job&)> before_stamp;
 };
 
 struct Report {
   std::vector<JobReport> jobs;  // in plan order
   std::size_t images_decoded = 0;
+  StaleOutputs stale;
   std::size_t count(Outcome o) const;
+  std::size_t moved() const;  // jobs with an input that changed while they ran
+  std::size_t over_validation_limit() const;  // jobs whose advisory validation flagged more than allowed
 };
 
 // Runs the out-of-date jobs of the plan (all jobs with force). Errors are per job, in the report.

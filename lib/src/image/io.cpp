@@ -69,11 +69,7 @@ Result<std::unique_ptr<StoredReader>> open_with_oiio(const fs::path& path, std::
 class RowReader {
  public:
   static Result<RowReader> open(const fs::path& path, color::Transfer colour) {
-    std::error_code ec;
-    if (!fs::exists(path, ec)) return Error{path.string(), "no such file"};
-    if (fs::is_directory(path, ec)) return Error{path.string(), "is a folder, not an image"};
-    // A FIFO or a device (/dev/zero) never ends: only regular files are read.
-    if (!fs::is_regular_file(path, ec)) return Error{path.string(), "is not a regular file"};
+    if (Status s = check_image_file(path); !s) return s.error();
     unsigned char start[8] = {};
     std::ifstream(path, std::ios::binary).read(reinterpret_cast<char*>(start), sizeof start);
     return open(path, colour, start, {});
@@ -516,6 +512,15 @@ std::vector<std::string> default_channel_names(int channels) {
   if (channels == 1) return {"Y"};
   static const char* const kNames[] = {"R", "G", "B", "A"};
   return {kNames, kNames + std::min(channels, 4)};
+}
+
+Status check_image_file(const fs::path& path) {
+  std::error_code ec;
+  if (!fs::exists(path, ec)) return Error{path.string(), "no such file"};
+  if (fs::is_directory(path, ec)) return Error{path.string(), "is a folder, not an image"};
+  // A FIFO or a device (/dev/zero) never ends: only regular files are read.
+  if (!fs::is_regular_file(path, ec)) return Error{path.string(), "is not a regular file"};
+  return success();
 }
 
 Result<ReadInfo> probe_image(const fs::path& path) {

@@ -25,21 +25,28 @@ fs::path normalized(const fs::path& p) {
   return fs::absolute(p, ec).lexically_normal();
 }
 
+// A file the manifest names as its stamp's options hold it: relative to the manifest's folder, so
+// that the same manifest in a moved or copied tree has the same options.
+std::string manifest_relative(const fs::path& file, const Manifest& manifest) {
+  const fs::path relative = normalized(file).lexically_relative(manifest.folder);
+  return relative.empty() ? normalized(file).generic_string() : relative.generic_string();
+}
+
 // Everything in a material's spec that decides its outputs, for the stamp.
 nlohmann::json material_options(const MaterialSpec& m, const Manifest& manifest) {
   nlohmann::json options = params::to_json(image::encoding_params(), m.encoding);
   options.update(params::to_json(pack::material_params(), m.options));
   nlohmann::json sources = nlohmann::json::object();
   for (const pack::SourceInput& s : m.sources) {
-    sources[s.name] = s.file.empty() ? nlohmann::json(s.constant) : nlohmann::json(normalized(s.file).string());
+    sources[s.name] = s.file.empty() ? nlohmann::json(s.constant) : nlohmann::json(manifest_relative(s.file, manifest));
   }
   std::vector<std::string> packed;
-  for (const fs::path& f : m.packed_files) packed.push_back(normalized(f).string());
+  for (const fs::path& f : m.packed_files) packed.push_back(manifest_relative(f, manifest));
   options.update(nlohmann::json{{"sources", sources},
           {"packed", {{"layout", m.packed ? m.packed->reference : ""}, {"files", packed}}},
           {"layout", m.layout ? m.layout->reference : ""},
           {"reference", m.reference},
-          {"table", manifest.table.string()},
+          {"table", manifest.table.empty() ? "" : manifest_relative(manifest.table, manifest)},
           {"validate", params::to_json(validation_params(), m.validation)}});
   options["validate"].update(params::to_json(validate::options_params(), m.validation.options));
   return options;
@@ -126,6 +133,16 @@ std::size_t Report::count(Outcome o) const {
   return std::size_t(std::count_if(jobs.begin(), jobs.end(), [&](const JobReport& j) { return j.outcome == o; }));
 }
 
+std::size_t Report::moved() const {
+  return std::size_t(std::count_if(jobs.begin(), jobs.end(), [](const JobReport& j) { return !j.moved.empty(); }));
+}
+
+std::size_t Report::over_validation_limit() const {
+  return std::size_t(std::count_if(jobs.begin(), jobs.end(), [](const JobReport& j) {
+    return j.details.contains("validation") && !j.details["validation"].value("passed", true);
+  }));
+}
+
 Result<Plan> make_plan(const Manifest& manifest) {
   return guarded(manifest.file.string(), [&]() -> Result<Plan> {
     Plan plan;
@@ -194,7 +211,7 @@ Result<Plan> make_plan(const Manifest& manifest) {
         if (!job.problem) job.problem = problems[m];
         materials[gltf_name] = material_options(manifest.materials[m], manifest);
       }
-      job.options = nlohmann::json{{"input", normalized(s.input).string()},
+      job.options = nlohmann::json{{"input", manifest_relative(s.input, manifest)},
                                    {"output", s.output.string()},
                                    {"materials", materials},
                                    {"export", to_json(s.options)}}
@@ -228,7 +245,17 @@ Result<Plan> make_plan(const Manifest& manifest) {
       if (job.outputs.all().empty()) continue;  // used by scenes only, nothing of its own to write
       plan.jobs.push_back(std::move(job));
     }
-    for (Job& s : scenes) plan.jobs.push_back(std::move(s));
+    std::set<std::string> material_jobs;
+    for (const Job& j : plan.jobs) material_jobs.insert(j.name);
+    for (Job& s : scenes) {
+      std::set<std::string> needed;
+      for (const auto& [gltf_name, m] : s.materials) {
+        const std::string material_job = "material:" + manifest.materials[m].name;
+        if (material_jobs.count(material_job)) needed.insert(material_job);
+      }
+      s.depends_on.assign(needed.begin(), needed.end());
+      plan.jobs.push_back(std::move(s));
+    }
 
     // No file written twice, no input written at all (both by real path: links followed), and
     // nothing written outside the output folder's real path (a link inside it to elsewhere).
@@ -283,16 +310,22 @@ std::string ninja_text(const Manifest& manifest, const Plan& plan, const fs::pat
           "  depfile = $depfile_path\n"
           "  deps = gcc\n"
           "  restat = 1\n\n";
+  std::map<std::string, const Job*> by_name;
+  for (const Job& job : plan.jobs) by_name[job.name] = &job;
   for (const Job& job : plan.jobs) {
     text += "build";
     for (const fs::path& out : job.outputs.all()) text += " " + ninja_escape(out.string());
     text += ": matbake $manifest";
-    if (!job.inputs.empty()) {
+    // Implicit inputs: what it reads, and the outputs of the jobs it depends on (so a failed
+    // material stops the scenes that use it, as a build does).
+    std::vector<fs::path> implicit = job.inputs;
+    for (const std::string& name : job.depends_on) add_unique(implicit, by_name.at(name)->outputs.all());
+    if (!implicit.empty()) {
       text += " |";
-      for (const fs::path& in : job.inputs) text += " " + ninja_escape(in.string());
+      for (const fs::path& in : implicit) text += " " + ninja_escape(in.string());
     }
     text += "\n  job = " + job.name + "\n";
-    text += "  depfile_path = " + ninja_escape((plan.state_folder / (job_file_stem(job) + ".d")).string()) + "\n\n";
+    text += "  depfile_path = " + ninja_escape((plan.state_folder / (job_file_stem(job.name) + ".d")).string()) + "\n\n";
   }
   text += "rule matbake_plan\n"
           "  command = \"$matbake\" plan \"$manifest\" --output-dir \"$output\" -o \"$out\" --quiet\n"

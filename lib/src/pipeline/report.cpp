@@ -20,6 +20,8 @@ nlohmann::json job_json(const JobReport& r) {
                       {"seconds", r.seconds},
                       {"warnings", r.warnings}};
   if (!r.reason.empty()) j["reason"] = r.reason;
+  if (!r.job->depends_on.empty()) j["depends_on"] = r.job->depends_on;
+  if (!r.moved.empty()) j["moved"] = strings(r.moved);
   if (r.error) j["error"] = r.error->to_string();
   if (!r.details.is_null()) j["details"] = r.details;
   return j;
@@ -34,8 +36,12 @@ nlohmann::json json_report(const Manifest& manifest, const Plan& plan, const Rep
                       {"output", manifest.output.string()},
                       {"jobs", jobs},
                       {"images_decoded", report.images_decoded},
+                      {"stale", {{"removed", strings(report.stale.removed)},
+                                 {"kept", strings(report.stale.kept)},
+                                 {"changed", strings(report.stale.changed)}}},
                       {"warnings", plan.warnings}};
   for (const auto& [outcome, name] : kOutcomeNames) j[std::string(name)] = report.count(outcome);
+  j["over_validation_limit"] = report.over_validation_limit();
   return j;
 }
 
@@ -53,7 +59,7 @@ Status write_build_tool_files(const Manifest& manifest, const Report& report, co
     if (!stamp.empty()) targets = {fs::absolute(stamp).lexically_normal()};
     if (Status s = write_file_atomically(depfile, depfile_text(targets, inputs)); !s) return s;
   }
-  if (!stamp.empty() && report.count(Outcome::failed) == 0) {
+  if (!stamp.empty() && report.count(Outcome::failed) == 0 && report.moved() == 0) {
     const std::string text = "matbake build " + manifest.file.string() + ": " + std::to_string(report.jobs.size()) + " jobs\n";
     if (Status s = write_file_atomically(stamp, text); !s) return s;
   }

@@ -10,11 +10,13 @@
 #include <set>
 
 #include "matbake/atomic_file.hpp"
+#include "matbake/read_file.hpp"
 #include "matbake/pipeline.hpp"
 #include "matbake/material_table.hpp"
 #include "matbake/report_json.hpp"
 #include "matbake/validate.hpp"
 #include "matbake/workflow_maps.hpp"
+#include "made_log.hpp"
 #include "state.hpp"
 
 namespace matbake::pipeline {
@@ -30,23 +32,40 @@ class DecodeCache {
     for (const auto& [path, n] : uses) entries_[path] = std::make_unique<Entry>(n);
   }
 
+  // The file's bytes are read once per transfer, identified (size, time, hash) as they are read and
+  // decoded from memory, so a job's stamp records what it decoded, not what the file holds later.
   Result<std::shared_ptr<const image::Image>> read(const fs::path& file, color::Transfer transfer) {
-    const fs::path key = fs::absolute(file).lexically_normal();
     Entry* entry = nullptr;
     {
       std::lock_guard lock(mutex_);
-      auto& e = entries_[key];
+      auto& e = entries_[key(file)];
       if (!e) e = std::make_unique<Entry>(0);  // not declared: decoded, kept until the run ends
       entry = e.get();
     }
     std::lock_guard lock(entry->mutex);  // a second reader of the same file waits for the first decode
     if (const auto found = entry->images.find(transfer); found != entry->images.end()) return found->second;
-    auto decoded = image::read_image(file, transfer);
+    if (Status s = image::check_image_file(file); !s) return s.error();
+    const std::optional<std::int64_t> mtime = modification_time(file);
+    std::vector<unsigned char> bytes;
+    if (!mtime || !read_whole_file(file, bytes)) return Error{file.string(), "cannot be read"};
+    auto decoded = image::decode_image(bytes, file, transfer);
     if (!decoded) return decoded.error();
+    const FileIdentity read{bytes.size(), *mtime, content_hash(bytes)};
+    if (!entry->read) entry->read = read;
+    if (entry->read->hash != read.hash) entry->read->hash = "read twice, differently";  // matches no file
     ++decoded_;
     auto shared = std::make_shared<const image::Image>(std::move(*decoded));
     entry->images[transfer] = shared;
     return shared;
+  }
+
+  // What the run decoded of `file`, when it did.
+  std::optional<FileIdentity> identity(const fs::path& file) {
+    std::lock_guard lock(mutex_);
+    const auto found = entries_.find(key(file));
+    if (found == entries_.end()) return std::nullopt;
+    std::lock_guard entry_lock(found->second->mutex);
+    return found->second->read;
   }
 
   void release(const fs::path& file) {
@@ -62,10 +81,13 @@ class DecodeCache {
   std::size_t decoded() const { return decoded_; }
 
  private:
+  static fs::path key(const fs::path& file) { return fs::absolute(file).lexically_normal(); }
+
   struct Entry {
     explicit Entry(std::size_t n) : uses(n) {}
     std::mutex mutex;
     std::map<color::Transfer, std::shared_ptr<const image::Image>> images;
+    std::optional<FileIdentity> read;  // the bytes first decoded (kept when the images are freed)
     std::size_t uses;
   };
   std::mutex mutex_;
@@ -128,7 +150,8 @@ Status ensure_folder(const fs::path& folder) {
   return success();
 }
 
-// Validation of the material as authored; a job error when more texels are flagged than allowed.
+// Validation of the material as authored; a job error when more texels are flagged than allowed
+// and the check is a gate, else a warning (the report's `validation.passed` says so).
 Status validate_material(const MaterialSpec& m, const material::Maps& maps, const JobContext& ctx,
                          const JobOutputs& outputs, JobReport& report) {
   validate::Options options = m.validation.options;
@@ -148,18 +171,20 @@ Status validate_material(const MaterialSpec& m, const material::Maps& maps, cons
   report.details["validation"] = {{"checked", result->checked},
                                   {"violations", result->violations},
                                   {"violation_fraction", result->violation_fraction()},
-                                  {"passed", passed}};
+                                  {"passed", passed},
+                                  {"gate", options.gate}};
   const fs::path& json_file = outputs.validation_report;
   report.details["validation"]["report"] = json_file.string();
   if (Status s = write_validation_report(*result, options, json_file); !s) return s;
   if (m.validation.heatmap) {
     if (Status s = validate::write_heatmap(*result, outputs.heatmap); !s) return s;
   }
-  char line[160];
-  std::snprintf(line, sizeof line, "validation: %zu of %zu texels flagged (%.3g%%; max_violations %.3g%%)",
-                result->violations, result->checked, 100 * result->violation_fraction(), 100 * options.max_violations);
+  char line[200];
+  std::snprintf(line, sizeof line, "validation: %zu of %zu texels flagged (%.3g%%; max_violations %.3g%%)%s",
+                result->violations, result->checked, 100 * result->violation_fraction(), 100 * options.max_violations,
+                passed || options.gate ? "" : ", over the limit (advisory: validate.gate is off)");
   // The failure is the material's (or its max_violations', when it sets one); the report says which texels.
-  if (!passed) {
+  if (!passed && options.gate) {
     return Error{m.origins.of("validate.max_violations"),
                  "materials." + m.name + ": " + line + "; the texels are in " + json_file.string()};
   }
@@ -167,6 +192,23 @@ Status validate_material(const MaterialSpec& m, const material::Maps& maps, cons
   return success();
 }
 
+// The material's textures in its layout's workflow (converted when the layout needs the other one).
+Status write_layout(const Job& job, const MaterialSpec& m, material::Maps maps, JobReport& report) {
+  const pack::Layout& layout = m.layout->layout;
+  const bool converts = workflow::layout_direction(maps, layout).has_value();
+  auto in_workflow = workflow::in_layout_workflow(std::move(maps), layout, m.options.mapping);
+  if (!in_workflow) {
+    return Error{m.origins.of("layout"), "materials." + m.name + ".layout: " + in_workflow.error().to_string()};
+  }
+  if (converts) report.details["conversion"] = to_json(*in_workflow, m.options.mapping);
+  const std::vector<std::string> outputs(job.outputs.textures.begin(), job.outputs.textures.end());
+  auto written = pack::write_textures(layout, in_workflow->maps,
+                                      {outputs, m.options.bits, m.options.transfer, decoded_files(m), {}, m.encoding});
+  if (!written) return written.error();
+  return success();
+}
+
+// Validated first: a gate that fails writes no textures (a failed job's outputs are not fresh ones).
 Status run_material(const Job& job, const JobContext& ctx, JobReport& report) {
   return guarded(ctx.manifest.materials[job.spec].name, [&]() -> Status {
     const MaterialSpec& m = ctx.manifest.materials[job.spec];
@@ -174,23 +216,10 @@ Status run_material(const Job& job, const JobContext& ctx, JobReport& report) {
     if (!maps) return maps.error();
     report.details["size"] = {maps->width, maps->height};
     if (Status s = ensure_folder(ctx.manifest.output / "materials"); !s) return s;
-    if (m.layout) {
-      const pack::Layout* layout = &m.layout->layout;
-      // Validation reads the maps as loaded: the workflow gets a copy only when it converts them
-      // (else it hands them back, and validation reads them there).
-      const bool converts = workflow::layout_direction(*maps, *layout).has_value();
-      auto in_workflow = workflow::in_layout_workflow(converts ? material::Maps(*maps) : std::move(*maps), *layout, m.options.mapping);
-      if (!in_workflow) {
-        return Error{m.origins.of("layout"), "materials." + m.name + ".layout: " + in_workflow.error().to_string()};
-      }
-      if (!converts) *maps = std::move(in_workflow->maps);
-      if (converts) report.details["conversion"] = to_json(*in_workflow, m.options.mapping);
-      const std::vector<std::string> outputs(job.outputs.textures.begin(), job.outputs.textures.end());
-      auto written = pack::write_textures(*layout, converts ? in_workflow->maps : *maps,
-                                          {outputs, m.options.bits, m.options.transfer, decoded_files(m), {}, m.encoding});
-      if (!written) return written.error();
+    if (m.validation.enabled) {
+      if (Status s = validate_material(m, *maps, ctx, job.outputs, report); !s) return s;
     }
-    if (m.validation.enabled) return validate_material(m, *maps, ctx, job.outputs, report);
+    if (m.layout) return write_layout(job, m, std::move(*maps), report);
     return success();
   });
 }
@@ -214,9 +243,38 @@ Result<std::vector<fs::path>> run_scene(const Job& job, const JobContext& ctx, J
   });
 }
 
-void run_job(const Job& job, const JobContext& ctx, const fs::path& state_folder, JobReport& report) {
+// The inputs the decode cache does not read (layout files, the table, a scene's glTF, buffers and
+// images), identified before the job reads them: a change while it runs then shows as a difference
+// next time (a rebuild), never as an output from other bytes stamped fresh.
+std::vector<StampedFile> identify_other_inputs(const Job& job, const std::vector<fs::path>& decoded) {
+  std::vector<StampedFile> read;
+  for (const fs::path& in : job.inputs) {
+    if (std::binary_search(decoded.begin(), decoded.end(), in)) continue;
+    if (auto identity = identify(in)) read.push_back({in, *identity});  // else the job fails reading it
+  }
+  return read;
+}
+
+// Every input as the job read it; those that changed since are listed in `moved`.
+std::vector<StampedFile> inputs_as_read(std::vector<StampedFile> read, const std::vector<fs::path>& decoded,
+                                        DecodeCache& cache, std::vector<fs::path>& moved) {
+  for (const fs::path& f : decoded) {
+    std::optional<FileIdentity> identity = cache.identity(f);
+    if (!identity) identity = identify(f);  // declared but not decoded: it did not decide the outputs
+    if (identity) read.push_back({f, *identity});
+  }
+  for (const StampedFile& f : read) {
+    if (changed_since(f.path, f.identity)) moved.push_back(f.path);
+  }
+  return read;
+}
+
+void run_job(const Job& job, const JobContext& ctx, const RunOptions& run_options, const StampRoots& roots,
+             JobReport& report) {
   const auto start = std::chrono::steady_clock::now();
-  remove_stamp(job, state_folder);  // from here until it succeeds, the job is not up to date
+  remove_stamp(job.name, roots);  // from here until it succeeds, the job is not up to date
+  const std::vector<fs::path> decoded = decoded_files(job, ctx.manifest);
+  std::vector<StampedFile> read = identify_other_inputs(job, decoded);
   std::vector<fs::path> written = job.outputs.all();
   Status status = success();
   if (job.problem) {
@@ -228,10 +286,28 @@ void run_job(const Job& job, const JobContext& ctx, const fs::path& state_folder
   } else {
     status = files.error();
   }
-  if (status) status = write_stamp(job, job.inputs, written, state_folder);
+  if (status) {
+    if (run_options.before_stamp) run_options.before_stamp(job);
+    read = inputs_as_read(std::move(read), decoded, ctx.cache, report.moved);
+    auto made = identify_all(written);
+    status = made ? write_stamp(job, read, *made, roots) : Status(made.error());
+    if (made) {
+      for (const StampedFile& f : *made) report.written[f.path] = f.identity.hash;
+    }
+  }
   report.outcome = status ? Outcome::built : Outcome::failed;
   if (!status) report.error = status.error();
   report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// The log of files made, brought up to date, the stamps of jobs the manifest no longer has removed,
+// and after a full run with no failure the stale files too (unless kept).
+Status finish_run(const Plan& plan, const RunOptions& options, const StampRoots& roots, Report& report) {
+  MadeLog log = read_made_log(roots);
+  for (const std::string& name : record_run(log, plan, report, roots)) remove_stamp(name, roots);
+  const bool full = options.only.empty() && report.count(Outcome::failed) == 0;
+  report.stale = clean_stale(log, roots, full && !options.keep_stale);
+  return write_made_log(log, roots);
 }
 
 }  // namespace
@@ -244,13 +320,14 @@ Result<Report> run(const Manifest& manifest, const Plan& plan, const RunOptions&
       return Error{manifest.file.string(), "no job '" + name + "' (jobs: " + names + ")", true};
     }
   }
+  const StampRoots roots{plan.state_folder, manifest.folder, manifest.output};
   Report report;
   std::vector<std::size_t> to_run;
   for (const Job& job : plan.jobs) {
     if (!options.only.empty() && std::find(options.only.begin(), options.only.end(), job.name) == options.only.end()) continue;
     JobReport r;
     r.job = &job;
-    r.reason = options.force ? "forced" : out_of_date_reason(job, plan.state_folder, !options.dry_run);
+    r.reason = options.force ? "forced" : out_of_date_reason(job, roots, !options.dry_run);
     if (job.problem && options.dry_run) {  // it would fail: said now, not after a "would build"
       r.outcome = Outcome::failed;
       r.error = job.problem;
@@ -260,7 +337,12 @@ Result<Report> run(const Manifest& manifest, const Plan& plan, const RunOptions&
     }
     report.jobs.push_back(std::move(r));
   }
-  if (options.dry_run) return report;
+  if (options.dry_run) {
+    MadeLog log = read_made_log(roots);
+    record_run(log, plan, report, roots);
+    report.stale = clean_stale(log, roots, false);
+    return report;
+  }
   if (Status s = ensure_folder(plan.state_folder); !s) return s.error();
 
   std::map<fs::path, std::size_t> uses;
@@ -272,19 +354,42 @@ Result<Report> run(const Manifest& manifest, const Plan& plan, const RunOptions&
                                       : material_table::load_table(manifest.table);
   const JobContext ctx{manifest, cache, table ? &*table : nullptr, table ? nullptr : &table.error()};
 
+  // Jobs that depend on none first, then the others (a scene after its materials' jobs), each
+  // skipped when a job it depends on failed in this run.
+  std::map<std::string, const JobReport*> by_name;
+  for (const JobReport& r : report.jobs) by_name[r.job->name] = &r;
+  const auto failed_dependency = [&](const Job& job) -> std::string {
+    for (const std::string& name : job.depends_on) {
+      const auto found = by_name.find(name);
+      if (found != by_name.end() && (found->second->outcome == Outcome::failed || found->second->outcome == Outcome::skipped)) {
+        return name;
+      }
+    }
+    return {};
+  };
+  std::vector<std::size_t> waves[2];
+  for (std::size_t i : to_run) waves[report.jobs[i].job->depends_on.empty() ? 0 : 1].push_back(i);
   std::mutex progress_mutex;
   std::size_t done = 0;
-  tbb::parallel_for_each(to_run.begin(), to_run.end(), [&](std::size_t i) {
-    JobReport& r = report.jobs[i];
-    // Isolated: a worker waiting inside this job's own parallel loops does not start another job,
-    // which would hold a second job's images at once.
-    tbb::this_task_arena::isolate([&] { run_job(*r.job, ctx, plan.state_folder, r); });
-    for (const fs::path& f : decoded_files(*r.job, manifest)) cache.release(f);
-    std::lock_guard lock(progress_mutex);
-    ++done;
-    if (options.progress) options.progress(r, done, to_run.size());
-  });
+  for (const std::vector<std::size_t>& wave : waves) {
+    tbb::parallel_for_each(wave.begin(), wave.end(), [&](std::size_t i) {
+      JobReport& r = report.jobs[i];
+      if (const std::string failed = failed_dependency(*r.job); !failed.empty()) {
+        r.outcome = Outcome::skipped;
+        r.reason = failed + " failed";
+      } else {
+        // Isolated: a worker waiting inside this job's own parallel loops does not start another job,
+        // which would hold a second job's images at once.
+        tbb::this_task_arena::isolate([&] { run_job(*r.job, ctx, options, roots, r); });
+      }
+      for (const fs::path& f : decoded_files(*r.job, manifest)) cache.release(f);
+      std::lock_guard lock(progress_mutex);
+      ++done;
+      if (options.progress) options.progress(r, done, to_run.size());
+    });
+  }
   report.images_decoded = cache.decoded();
+  if (Status s = finish_run(plan, options, roots, report); !s) return s.error();
   return report;
 }
 

@@ -1,120 +1,149 @@
-#include "matbake/read_file.hpp"
 #include "state.hpp"
 
 #include <nlohmann/json.hpp>
 #include <xxhash.h>
 
-#include <fstream>
-#include <sstream>
-
 #include "matbake/atomic_file.hpp"
+#include "matbake/read_file.hpp"
 #include "matbake/version.hpp"
 
 namespace matbake::pipeline {
 namespace fs = std::filesystem;
 namespace {
 
-struct FileState {
-  bool exists = false;
-  std::uintmax_t size = 0;
-  std::int64_t mtime = 0;  // nanoseconds, as the file system keeps them
-};
+// The form of a stamp: raised when the same manifest is recorded differently (2: options by their
+// parameter descriptions' names, sorted; 3: paths relative to the manifest's and output folders,
+// outputs hashed), so that an older stamp says why it rebuilds once rather than "its options changed".
+constexpr int kStampForm = 3;
 
-FileState state_of(const fs::path& p) {
+fs::path stamp_path(const std::string& job_name, const StampRoots& roots) {
+  return roots.state_folder / (job_file_stem(job_name) + ".json");
+}
+
+nlohmann::json to_json(const FileIdentity& f, const std::string& path) {
+  return {{"path", path}, {"size", f.size}, {"mtime", f.mtime}, {"hash", f.hash}};
+}
+
+FileIdentity identity_in(const nlohmann::json& f) {
+  return {f.value("size", std::uintmax_t(0)), f.value("mtime", std::int64_t(0)), f.value("hash", "")};
+}
+
+// Empty when the recorded file is as it was (its time refreshed in `f` when only that moved),
+// else what is wrong with it.
+std::string check_recorded(nlohmann::json& f, const fs::path& p, const char* missing, const char* changed, bool& touched) {
+  const FileIdentity recorded = identity_in(f);
   std::error_code ec;
-  FileState s;
-  s.size = fs::file_size(p, ec);
-  if (ec) return s;
-  const auto time = fs::last_write_time(p, ec);
-  if (ec) return s;
-  s.exists = true;
-  s.mtime = std::int64_t(std::chrono::duration_cast<std::chrono::nanoseconds>(time.time_since_epoch()).count());
-  return s;
-}
-
-std::string content_hash(const fs::path& p) {
-  std::string b;  // a source that is not a regular file hashes as empty (its read refuses it)
-  if (!read_whole_file(p, b)) b.clear();
-  char hex[17];
-  std::snprintf(hex, sizeof hex, "%016llx", (unsigned long long)XXH64(b.data(), b.size(), 0));
-  return hex;
-}
-
-// The form of a stamp's options: raised when the same manifest is recorded differently (2: options
-// by their parameter descriptions' names, sorted), so that an older stamp says why it rebuilds
-// once rather than "its options changed".
-constexpr int kStampForm = 2;
-
-fs::path stamp_path(const Job& job, const fs::path& state_folder) {
-  return state_folder / (job_file_stem(job) + ".json");
+  const std::uintmax_t size = fs::file_size(p, ec);
+  const std::optional<std::int64_t> mtime = modification_time(p);
+  if (ec || !mtime) return missing + p.string();
+  if (size == recorded.size && *mtime == recorded.mtime) return {};
+  const std::optional<FileIdentity> now = identify(p);
+  if (!now || now->hash != recorded.hash) return changed + p.string();
+  f["mtime"] = now->mtime;
+  touched = true;
+  return {};
 }
 
 }  // namespace
 
-std::string job_file_stem(const Job& job) {
-  std::string stem = job.name;
-  stem[stem.find(':')] = '-';
+std::string job_file_stem(const std::string& job_name) {
+  std::string stem = job_name;
+  if (const std::size_t colon = stem.find(':'); colon != std::string::npos) stem[colon] = '-';
   return stem;
 }
 
-std::string out_of_date_reason(const Job& job, const fs::path& state_folder, bool refresh) {
-  std::ifstream in(stamp_path(job, state_folder));
-  if (!in) return "no earlier build";
-  nlohmann::json stamp = nlohmann::json::parse(in, nullptr, false);
+std::string stamped_path(const fs::path& p, const fs::path& root) {
+  const fs::path relative = p.lexically_relative(root);
+  return relative.empty() ? p.generic_string() : relative.generic_string();
+}
+
+fs::path resolved_path(const std::string& stamped, const fs::path& root) {
+  const fs::path p(stamped);
+  return p.is_absolute() ? p : (root / p).lexically_normal();
+}
+
+Result<std::vector<StampedFile>> identify_all(const std::vector<fs::path>& files) {
+  std::vector<StampedFile> identified;
+  for (const fs::path& p : files) {
+    const std::optional<FileIdentity> identity = identify(p);
+    if (!identity) return Error{p.string(), "cannot be read back after it was written"};
+    identified.push_back({p, *identity});
+  }
+  return identified;
+}
+
+std::string content_hash(std::span<const unsigned char> bytes) {
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx", (unsigned long long)XXH64(bytes.data(), bytes.size(), 0));
+  return hex;
+}
+
+std::optional<std::int64_t> modification_time(const fs::path& file) {
+  std::error_code ec;
+  const auto time = fs::last_write_time(file, ec);
+  if (ec) return std::nullopt;
+  return std::int64_t(std::chrono::duration_cast<std::chrono::nanoseconds>(time.time_since_epoch()).count());
+}
+
+std::optional<FileIdentity> identify(const fs::path& file) {
+  const std::optional<std::int64_t> mtime = modification_time(file);
+  std::vector<unsigned char> bytes;
+  if (!mtime || !read_whole_file(file, bytes)) return std::nullopt;
+  return FileIdentity{bytes.size(), *mtime, content_hash(bytes)};
+}
+
+bool changed_since(const fs::path& file, const FileIdentity& read) {
+  std::error_code ec;
+  const std::uintmax_t size = fs::file_size(file, ec);
+  if (!ec && size == read.size && modification_time(file) == read.mtime) return false;
+  const std::optional<FileIdentity> now = identify(file);
+  return !now || now->hash != read.hash;
+}
+
+std::string out_of_date_reason(const Job& job, const StampRoots& roots, bool refresh) {
+  std::string text;
+  if (!read_whole_file(stamp_path(job.name, roots), text)) return "no earlier build";
+  nlohmann::json stamp = nlohmann::json::parse(text, nullptr, false);
   if (stamp.is_discarded() || !stamp.is_object()) return "its stamp is unreadable";
-  if (stamp.value("form", 1) != kStampForm) return "its stamp is from an older matbake (options recorded anew)";
+  if (stamp.value("form", 1) != kStampForm) return "its stamp is from an older matbake (recorded anew)";
   if (stamp.value("matbake", "") != version) return "matbake's version changed";
   if (stamp.value("options", "") != job.options) return "its options changed";
-  const nlohmann::json inputs = stamp.value("inputs", nlohmann::json::array());
+  if (!stamp["inputs"].is_array() || !stamp["outputs"].is_array()) return "its stamp is unreadable";
   std::vector<fs::path> recorded;
-  for (const nlohmann::json& f : inputs) recorded.push_back(f.value("path", ""));
+  for (const nlohmann::json& f : stamp["inputs"]) recorded.push_back(resolved_path(f.value("path", ""), roots.inputs));
   for (const fs::path& p : job.inputs) {
     if (std::find(recorded.begin(), recorded.end(), p) == recorded.end()) return "new input: " + p.string();
   }
   bool touched = false;
-  for (nlohmann::json& f : stamp["inputs"]) {
-    const fs::path p = f.value("path", "");
-    const FileState now = state_of(p);
-    if (!now.exists) return "input missing: " + p.string();
-    if (now.size == f.value("size", std::uintmax_t(0)) && now.mtime == f.value("mtime", std::int64_t(0))) continue;
-    if (content_hash(p) != f.value("hash", "")) return "input changed: " + p.string();
-    f["mtime"] = now.mtime;
-    touched = true;
+  for (std::size_t i = 0; i < recorded.size(); ++i) {
+    std::string why = check_recorded(stamp["inputs"][i], recorded[i], "input missing: ", "input changed: ", touched);
+    if (!why.empty()) return why;
   }
-  for (const nlohmann::json& f : stamp.value("outputs", nlohmann::json::array())) {
-    const fs::path p = f.value("path", "");
-    const FileState now = state_of(p);
-    if (!now.exists) return "output missing: " + p.string();
-    if (now.size != f.value("size", std::uintmax_t(0)) || now.mtime != f.value("mtime", std::int64_t(0))) {
-      return "output changed since it was built: " + p.string();
-    }
+  for (nlohmann::json& f : stamp["outputs"]) {
+    const fs::path p = resolved_path(f.value("path", ""), roots.outputs);
+    std::string why = check_recorded(f, p, "output missing: ", "output changed since it was built: ", touched);
+    if (!why.empty()) return why;
   }
   // Best effort: a stamp that cannot be written again only costs the next run some hashing.
-  if (touched && refresh) (void)write_file_atomically(stamp_path(job, state_folder), stamp.dump(1) + "\n");
+  if (touched && refresh) (void)write_file_atomically(stamp_path(job.name, roots), stamp.dump(1) + "\n");
   return {};
 }
 
-Status write_stamp(const Job& job, const std::vector<fs::path>& read, const std::vector<fs::path>& written,
-                   const fs::path& state_folder) {
+Status write_stamp(const Job& job, const std::vector<StampedFile>& read, const std::vector<StampedFile>& written,
+                   const StampRoots& roots) {
   nlohmann::json inputs = nlohmann::json::array(), outputs = nlohmann::json::array();
-  for (const fs::path& p : read) {
-    const FileState s = state_of(p);
-    inputs.push_back({{"path", p.string()}, {"size", s.size}, {"mtime", s.mtime}, {"hash", content_hash(p)}});
-  }
-  for (const fs::path& p : written) {
-    const FileState s = state_of(p);
-    outputs.push_back({{"path", p.string()}, {"size", s.size}, {"mtime", s.mtime}});
-  }
-  const nlohmann::json stamp = {
-      {"form", kStampForm}, {"matbake", version}, {"job", job.name}, {"options", job.options}, {"inputs", inputs}, {"outputs", outputs}};
+  for (const StampedFile& f : read) inputs.push_back(to_json(f.identity, stamped_path(f.path, roots.inputs)));
+  for (const StampedFile& f : written) outputs.push_back(to_json(f.identity, stamped_path(f.path, roots.outputs)));
+  const nlohmann::json stamp = {{"form", kStampForm}, {"matbake", version}, {"job", job.name},
+                                {"options", job.options}, {"inputs", inputs},   {"outputs", outputs}};
   std::error_code ec;
-  fs::create_directories(state_folder, ec);
-  return write_file_atomically(stamp_path(job, state_folder), stamp.dump(1) + "\n");
+  fs::create_directories(roots.state_folder, ec);
+  return write_file_atomically(stamp_path(job.name, roots), stamp.dump(1) + "\n");
 }
 
-void remove_stamp(const Job& job, const fs::path& state_folder) {
+void remove_stamp(const std::string& job_name, const StampRoots& roots) {
   std::error_code ec;
-  fs::remove(stamp_path(job, state_folder), ec);
+  fs::remove(stamp_path(job_name, roots), ec);
 }
 
 }  // namespace matbake::pipeline

@@ -1,8 +1,13 @@
 #pragma once
 // Stamps: what each job's last successful run read and wrote, kept in <output>/.matbake/, so a
 // job runs again only when an input's content, its options or matbake's version changed, or an
-// output is missing or was changed by someone else.
+// output is missing or was changed by someone else. Paths in a stamp are relative to the
+// manifest's folder (inputs) and the output folder (outputs), so a moved or copied tree with the
+// same bytes is up to date.
+#include <cstdint>
 #include <filesystem>
+#include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -10,19 +15,53 @@
 
 namespace matbake::pipeline {
 
-std::string job_file_stem(const Job& job);  // "material-wood": the stamp's and the depfile's name
+std::string job_file_stem(const std::string& job_name);  // "material-wood": the stamp's and the depfile's name
 
-// Why the job must run, or empty when it is up to date. An input whose size and modification time
-// are as recorded is taken as unchanged; otherwise its content hash decides (a touched file or a
-// fresh checkout does not rebuild). With `refresh`, the stamp of an up-to-date job takes the new
-// times of such inputs, so that the next run need not hash them again.
-std::string out_of_date_reason(const Job& job, const std::filesystem::path& state_folder, bool refresh);
+// A file as a job read it: its size and modification time (nanoseconds) and the XXH64 of the bytes.
+struct FileIdentity {
+  std::uintmax_t size = 0;
+  std::int64_t mtime = 0;
+  std::string hash;  // 16 hex digits
+};
 
-// Records a successful run: the files it read and wrote, as they are now.
-Status write_stamp(const Job& job, const std::vector<std::filesystem::path>& read,
-                   const std::vector<std::filesystem::path>& written, const std::filesystem::path& state_folder);
+std::string content_hash(std::span<const unsigned char> bytes);
+std::optional<std::int64_t> modification_time(const std::filesystem::path& file);
+// The time first, then the bytes: a write in between leaves a time that differs from the file's
+// next time, and the hash then decides. Empty when the file cannot be read.
+std::optional<FileIdentity> identify(const std::filesystem::path& file);
+// Whether the file is no longer what `read` says (the size or time differ and so do the bytes).
+bool changed_since(const std::filesystem::path& file, const FileIdentity& read);
+
+struct StampedFile {
+  std::filesystem::path path;  // absolute
+  FileIdentity identity;
+};
+
+struct StampRoots {
+  std::filesystem::path state_folder;  // <output>/.matbake
+  std::filesystem::path inputs;        // the manifest's folder
+  std::filesystem::path outputs;       // the output folder
+};
+
+// Why the job must run, or empty when it is up to date. A file whose size and modification time are
+// as recorded is taken as unchanged; otherwise its content hash decides (a touched file, a fresh
+// checkout or a copied tree does not rebuild). With `refresh`, the stamp of an up-to-date job takes
+// the new times, so that the next run need not hash those files again.
+std::string out_of_date_reason(const Job& job, const StampRoots& roots, bool refresh);
+
+// The files as they are now; an error names the first that cannot be read.
+Result<std::vector<StampedFile>> identify_all(const std::vector<std::filesystem::path>& files);
+
+// Records a successful run: the inputs as they were read, the outputs as they were written.
+Status write_stamp(const Job& job, const std::vector<StampedFile>& read, const std::vector<StampedFile>& written,
+                   const StampRoots& roots);
 
 // Removes the stamp, so that a failed job runs again next time.
-void remove_stamp(const Job& job, const std::filesystem::path& state_folder);
+void remove_stamp(const std::string& job_name, const StampRoots& roots);
+
+// A path as a stamp or the state folder's logs hold it: relative to `root` where it lies below or
+// beside it; and back.
+std::string stamped_path(const std::filesystem::path& p, const std::filesystem::path& root);
+std::filesystem::path resolved_path(const std::string& stamped, const std::filesystem::path& root);
 
 }  // namespace matbake::pipeline

@@ -1,0 +1,32 @@
+#pragma once
+// The files a build made, by job, each with the hash it was written with, kept in
+// <output>/.matbake/made.json: a file no current job makes is removed at the end of a full,
+// successful run, and only when it is still as matbake wrote it (a file the user put in the output
+// folder, or changed there, is never touched).
+#include <map>
+#include <string>
+
+#include "matbake/pipeline.hpp"
+#include "state.hpp"
+
+namespace matbake::pipeline {
+
+struct MadeLog {
+  using Files = std::map<std::string, std::string>;  // path (relative to the output folder) → content hash
+  std::map<std::string, Files> jobs;  // by job name: what its last successful run wrote
+  Files stale;  // made by an earlier run, by no job since, not yet removed
+};
+
+MadeLog read_made_log(const StampRoots& roots);  // empty when there is none or it is unreadable
+Status write_made_log(const MadeLog& log, const StampRoots& roots);
+
+// The log after this run: a built job's entry becomes what it wrote; the files it no longer writes,
+// and every file of a job the plan no longer has, become stale (unless a current job writes them).
+// Returns the names of the jobs the plan no longer has.
+std::vector<std::string> record_run(MadeLog& log, const Plan& plan, const Report& report, const StampRoots& roots);
+
+// The stale files: removed when `remove` and still as written, else kept in the log; a file changed
+// since it was written (or gone) leaves the log untouched on disk.
+StaleOutputs clean_stale(MadeLog& log, const StampRoots& roots, bool remove);
+
+}  // namespace matbake::pipeline
