@@ -330,12 +330,12 @@ layout = "gltf-orm"
       << lines[2];
   EXPECT_NE(lines[2].find("(material:corrupt)"), std::string::npos);
   EXPECT_EQ(lines[3], "matbake: error: " + (dir / "m.toml").string() + ": 3 of 4 jobs failed");
-  // The good material is complete (a 1×1 texture of constants); the failed ones left no partial file.
+  // The good material is complete (a 1×1 texture of constants); the failed ones left no partial file,
+  // and the one over its validation gate only its report (no textures).
   const RawImage good = read_raw(dir / "out/materials/good_base_color.png");
   EXPECT_EQ(good.width, 1);
   EXPECT_EQ(list_folder(dir / "out/materials"),
-            (std::vector<std::string>{"below_real.validation.json", "below_real_base_color.png", "below_real_orm.png",
-                                      "good.validation.json", "good_base_color.png", "good_orm.png"}));
+            (std::vector<std::string>{"below_real.validation.json", "good.validation.json", "good_base_color.png", "good_orm.png"}));
   // Failed jobs run again next time; the finished one does not.
   const json dry = run_json({"build", (dir / "m.toml").string(), "-n"}, 1);  // exit 1: a job would fail
   EXPECT_EQ(outcome_of(dry, "material:good"), "up_to_date");
@@ -355,6 +355,36 @@ layout = "gltf-orm"
 
 // A scene that fails while it is exported (its buffer is not there) names the manifest's line of
 // its input, then the file at fault.
+// A material over its validation gate fails and writes no textures; the scene using it is skipped,
+// as Make and Ninja skip what depends on a failed target. With the gate off it is advisory.
+TEST(CliBuild, AFailedMaterialSkipsItsScenesAndValidationCanBeAdvisory) {
+  TempDir dir;
+  copy_example(dir.path(), true);
+  const std::string manifest = (dir / "showroom.toml").string();
+  std::string text = read_bytes(dir / "showroom.toml");
+  text.replace(text.find("reference = \"gold\""), 18, "reference = \"silver\"");
+  write_bytes(dir / "showroom.toml", text);
+  const RunResult gated = matbake({"build", manifest});
+  EXPECT_EQ(gated.exit_code, 1);
+  EXPECT_NE(gated.err.find("scene:showroom skipped: material:gold_trim failed"), std::string::npos) << gated.err;
+  const json report = run_json({"build", manifest}, 1);
+  EXPECT_EQ(outcome_of(report, "scene:showroom"), "skipped: material:gold_trim failed");
+  EXPECT_EQ(report["skipped"], 1);
+  EXPECT_FALSE(fs::exists(dir / "out/showroom.glb"));
+  EXPECT_FALSE(fs::exists(dir / "out/materials/gold_trim_orm.png"));
+  EXPECT_TRUE(fs::exists(dir / "out/materials/gold_trim.validation.json"));
+
+  text.replace(text.find("max_violations = 0.0"), 20, "max_violations = 0.0\ngate = false");
+  write_bytes(dir / "showroom.toml", text);
+  const RunResult advisory = matbake({"build", manifest});
+  EXPECT_EQ(advisory.exit_code, 0) << advisory.err;
+  EXPECT_NE(advisory.err.find("material:gold_trim: validation: "), std::string::npos) << advisory.err;
+  EXPECT_NE(advisory.err.find("over the limit (advisory: validate.gate is off)"), std::string::npos) << advisory.err;
+  EXPECT_NE(advisory.out.find("; 1 over their validation limit (advisory)"), std::string::npos) << advisory.out;
+  EXPECT_TRUE(fs::exists(dir / "out/showroom.glb"));
+  EXPECT_EQ(run_json({"build", manifest, "--force"})["over_validation_limit"], 1);
+}
+
 TEST(CliBuild, AFailingSceneNamesItsInputsLine) {
   TempDir dir;
   write_bytes(dir / "s.gltf", R"({"asset": {"version": "2.0"}, "buffers": [{"uri": "gone.bin", "byteLength": 12}]})");

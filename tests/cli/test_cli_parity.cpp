@@ -89,7 +89,8 @@ class Parity : public ::testing::Test {
   // Runs a command; its outputs go to cli/.
   void run_command(std::vector<std::string> args, int expected_exit = 0) {
     for (std::string& a : args) {
-      if (a.ends_with(".png") && !a.starts_with("cli/") && fs::exists(dir / a)) a = (dir / a).string();
+      const std::string file = a.substr(0, a.find(".png:") == std::string::npos ? a.size() : a.find(".png:") + 4);
+      if (file.ends_with(".png") && !a.starts_with("cli/") && fs::exists(dir / file)) a = (dir / a).string();
       if (a.starts_with("cli/")) a = (dir / a).string();
     }
     const RunResult r = matbake(args);
@@ -142,6 +143,18 @@ TEST_F(Parity, PackAndWorkflowGiveTheManifestsBytes) {
       {"small", "sources = { kd = \"kd.png\", ks = \"ks.png\", gloss = \"gloss.png\" }\nlayout = \"gltf-orm\"\npng_compression = \"small\"",
        {"workflow", "--to", "gltf-orm", "--kd", "kd.png", "--ks", "ks.png", "--gloss", "gloss.png", "--png-compression", "small"},
        {"base_color", "orm"}},
+      {"channels",
+       "sources = { kd = { file = \"pair_a.png\", channel = \"rgb\" }, mask = { file = \"pair_a.png\", channel = \"a\" }, "
+       "ks = { file = \"pair_b.png\", channel = \"rgb\" }, gloss = { file = \"pair_b.png\", channel = \"a\" } }\nlayout = \"schuler\"",
+       {"pack", "--kd", "pair_a.png:rgb", "--mask", "pair_a.png:a", "--ks", "pair_b.png:rgb", "--gloss", "pair_b.png:a"},
+       {"a", "b"}},
+      {"roughness_from_g",
+       "sources = { base_color = \"base.png\", metallic = 0.0, roughness = { file = \"base.png\", channel = \"g\" } }\n"
+       "layout = \"gltf-orm\"",
+       {"pack", "--layout", "gltf-orm", "--base-color", "base.png", "--metallic", "0", "--roughness", "base.png:g"},
+       {"base_color", "orm"}},
+      {"rgb_diffuse_pair", "packed = { layout = \"schuler\", files = [\"kd.png\", \"pair_b.png\"] }\nlayout = \"unreal-orm\"",
+       {"workflow", "--layout", "unreal-orm", "--from", "schuler", "kd.png", "pair_b.png"}, {"base_color", "orm"}},
       {"to_spec_gloss", "sources = { base_color = \"base.png\", metallic = \"metal.png\", roughness = \"rough.png\" }\nlayout = \"schuler\"",
        {"workflow", "--to", "schuler", "--base-color", "base.png", "--metallic", "metal.png", "--roughness", "rough.png"},
        {"a", "b"}},

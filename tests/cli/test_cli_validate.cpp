@@ -45,8 +45,13 @@ TEST(CliValidate, ExitCodesReportAndHeatmap) {
   EXPECT_EQ(doc["passed"], false);
   const RawImage map = read_raw(dir / "map.png");
   EXPECT_EQ(map.samples, std::vector<double>({40, 170, 70, 40, 170, 70, 40, 170, 70, 255, 150, 0}));
-  // Allowed share: passes.
+  // Allowed share: passes. Over it with the gate off: advisory (exit 0, said, not passed).
   EXPECT_EQ(matbake({"validate", "--ks", b, "--max-violations", "0.25"}).exit_code, 0);
+  const auto advisory = matbake({"--json", "validate", "--ks", b, "--no-gate"});
+  EXPECT_EQ(advisory.exit_code, 0) << advisory.err;
+  EXPECT_EQ(nlohmann::json::parse(advisory.out)["passed"], false);
+  EXPECT_EQ(nlohmann::json::parse(advisory.out)["gate"], false);
+  EXPECT_NE(matbake({"validate", "--ks", b, "--no-gate"}).out.find("over the limit (advisory: gate off)"), std::string::npos);
   // The curve moves the class: code 57 under gamma 2.2 is 0.0443 (still dielectric), 150 is 0.311.
   const auto g22 = matbake({"--json", "validate", "--ks", b, "--transfer", "gamma2.2"});
   EXPECT_NEAR(nlohmann::json::parse(g22.out)["f0_stats"][0]["min"].get<double>(), std::pow(57 / 255.0, 2.2), 1e-6);

@@ -160,6 +160,60 @@ TEST(Sources, ColourFilesDecodeBy8BitRuleGreyRepeats) {
   EXPECT_FLOAT_EQ(maps->find("ks")->pixels[1], 32768 / 65535.0f);  // 16-bit: linear
 }
 
+// One channel of a file (gloss from the alpha of a spec-gloss texture, roughness from G of an ORM),
+// its RGB, or as stored; a channel the file lacks is an error naming it.
+TEST(Sources, ChannelsOfAFile) {
+  TempDir dir;
+  test::write_raw(dir / "sg.png", 2, 1, 4, "uint8", {10, 20, 30, 40, 50, 60, 70, 80});
+  test::write_raw(dir / "orm.png", 1, 1, 3, "uint8", {255, 51, 102});
+  test::write_raw(dir / "grey.png", 1, 1, 1, "uint8", {51});
+  auto text = source_from_text("gloss", "sg.png:a", dir.path());
+  ASSERT_TRUE(text);
+  EXPECT_EQ(text->file, dir / "sg.png");
+  EXPECT_EQ(text->channels, FileChannels::a);
+  EXPECT_EQ(source_from_text("gloss", "sg.png", dir.path())->channels, FileChannels::as_stored);
+  EXPECT_EQ(source_from_text("gloss", "odd:name.png", dir.path())->file, dir / "odd:name.png");  // not a channel name
+  EXPECT_EQ(source_from_text("ks", "sg.png:rgb", dir.path())->channels, FileChannels::rgb);
+
+  const MaterialOptions linear{.transfer = color::Transfer::linear};
+  auto maps = load_sources({{"gloss", dir / "sg.png", {}, FileChannels::a},
+                            {"ks", dir / "sg.png", {}, FileChannels::rgb},
+                            {"kd", dir / "sg.png", {}, FileChannels::g}},
+                           linear);
+  ASSERT_TRUE(maps) << maps.error().to_string();
+  EXPECT_EQ(maps->find("gloss")->pixels, (std::vector<float>{40 / 255.0f, 80 / 255.0f}));
+  EXPECT_EQ(maps->find("ks")->pixels, (std::vector<float>{10 / 255.0f, 20 / 255.0f, 30 / 255.0f, 50 / 255.0f, 60 / 255.0f, 70 / 255.0f}));
+  EXPECT_EQ(maps->find("kd")->pixels, (std::vector<float>{20 / 255.0f, 20 / 255.0f, 20 / 255.0f, 60 / 255.0f, 60 / 255.0f, 60 / 255.0f}));
+  auto orm = load_sources({{"roughness", dir / "orm.png", {}, FileChannels::g}, {"metallic", dir / "orm.png", {}, FileChannels::b}}, {});
+  ASSERT_TRUE(orm);
+  EXPECT_FLOAT_EQ(orm->find("roughness")->pixels[0], 0.2f);  // scalar sources are linear
+  EXPECT_FLOAT_EQ(orm->find("metallic")->pixels[0], 0.4f);
+
+  const auto error_of = [&](const SourceInput& in) { return load_sources({in}, {}).error().to_string(); };
+  EXPECT_EQ(error_of({"gloss", dir / "orm.png", {}, FileChannels::a}),
+            (dir / "orm.png").string() + ": has no alpha channel (3 channels) for gloss");
+  EXPECT_EQ(error_of({"gloss", dir / "grey.png", {}, FileChannels::g}),
+            (dir / "grey.png").string() + ": has no channel g (1 channels) for gloss");
+  EXPECT_EQ(error_of({"gloss", dir / "orm.png", {}, FileChannels::rgb}), (dir / "orm.png").string() + ": gloss takes one channel, not rgb");
+}
+
+// A packed texture without the alpha its layout has a default for (Schüler's A as an RGB diffuse):
+// the mask takes the default; a missing channel with no default is still an error.
+TEST(Sources, PackedTexturesWithoutAlphaTakeTheLayoutsDefault) {
+  TempDir dir;
+  test::write_raw(dir / "a.png", 1, 1, 3, "uint8", {51, 102, 153});
+  test::write_raw(dir / "b.png", 1, 1, 3, "uint8", {10, 10, 10});
+  const Layout schuler = *find_layout("schuler");
+  auto maps = read_packed(schuler, {dir / "a.png", dir / "b.png"}, {.transfer = color::Transfer::linear});
+  ASSERT_FALSE(maps);  // B's gloss has no default
+  EXPECT_EQ(maps.error().to_string(), (dir / "b.png").string() + ": 3 channels; layout schuler texture b has 4 and channel 3 (gloss) has no default");
+  test::write_raw(dir / "b.png", 1, 1, 4, "uint8", {10, 10, 10, 128});
+  maps = read_packed(schuler, {dir / "a.png", dir / "b.png"}, {.transfer = color::Transfer::linear});
+  ASSERT_TRUE(maps) << maps.error().to_string();
+  EXPECT_EQ(maps->find("mask")->pixels, std::vector<float>{1.0f});
+  EXPECT_FLOAT_EQ(maps->find("kd")->pixels[1], 0.4f);
+}
+
 TEST(Sources, DifferentSizesAreAnErrorUnlessResized) {
   TempDir dir;
   test::write_raw(dir / "big.png", 4, 4, 1, "uint8", std::vector<double>(16, 128));

@@ -149,6 +149,12 @@ TEST(BuildManifest, ErrorsSayWhereAndWhat) {
       // A float where an integer goes: refused, never cast (toml++ casts 2e52 to int64 unchecked; fuzzing).
       {"[scenes.s]\ninput = \"a.gltf\"\nao = { samples = 2e52 }\n", "m.toml:3:", "samples: an integer expected"},
       {"", "m.toml", "nothing to build"},
+      // A source's table form: a file and one of its channels.
+      {"[materials.a]\nsources = { gloss = { file = \"sg.png\", chanel = \"a\" } }\n", "m.toml:2:",
+       "unknown key 'chanel' in materials.a.sources.gloss"},
+      {"[materials.a]\nsources = { gloss = { file = \"sg.png\", channel = \"alpha\" } }\n", "m.toml:2:50",
+       "materials.a.sources.gloss.channel: 'alpha' is not r, g, b, a or rgb"},
+      {"[materials.a]\nsources = { gloss = { channel = \"a\" } }\n", "m.toml:2:", "materials.a.sources.gloss: needs file"},
       {"png_compression = 13\n[materials.a]\nsources = { kd = 0.5 }\n", "m.toml:1:19",
        "manifest.png_compression: fast, default, small or a level 0 to 12"},
       {"[materials.a]\nsources = { kd = 0.5 }\npng_compression = \"quick\"\n", "m.toml:3:", "materials.a.png_compression"},
@@ -221,6 +227,13 @@ materials = { "other" = "scene_only" }
             std::string::npos)
       << ninja;
   EXPECT_NE(ninja.find("  job = scene:room\n  depfile_path = " + (out / ".matbake/scene-room.d").string()), std::string::npos);
+  // The scene's edge waits for its material's (a failed material stops it, as in a build).
+  EXPECT_EQ(room.depends_on, std::vector<std::string>{"material:paint"});
+  EXPECT_NE(ninja.find((dir.path() / "paint.png").string() + " " + (out / "materials/paint_base_color.png").string() + " " +
+                       (out / "materials/paint_orm.png").string() + " " + (out / "materials/paint.validation.json").string() +
+                       "\n  job = scene:room"),
+            std::string::npos)
+      << ninja;
   EXPECT_NE(ninja.find("build build.ninja: matbake_plan $manifest\n"), std::string::npos);
 }
 

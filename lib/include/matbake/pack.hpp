@@ -13,6 +13,7 @@
 #include <string_view>
 #include <vector>
 
+#include "matbake/enum_names.hpp"
 #include "matbake/image.hpp"
 #include "matbake/material.hpp"
 #include "matbake/output_check.hpp"
@@ -56,15 +57,24 @@ Result<ResolvedLayout> resolve_layout(const std::string& reference, const std::f
 Result<Layout> find_layout(const std::string& name_or_path);
 Result<Layout> parse_layout(std::string_view json_text, const std::string& origin);
 
+// Which of a file's channels a source takes. as_stored: a colour source its RGB (a grey file
+// repeated), a scalar one the first channel; r, g, b or a: that one channel (repeated for a colour
+// source); rgb: the three colour channels (colour sources only).
+enum class FileChannels { as_stored, r, g, b, a, rgb };
+inline constexpr NameTable<FileChannels, 5> kFileChannelNames{
+    {{FileChannels::r, "r"}, {FileChannels::g, "g"}, {FileChannels::b, "b"}, {FileChannels::a, "a"}, {FileChannels::rgb, "rgb"}}};
+
 struct SourceInput {
   std::string name;             // a material::sources() name
   std::filesystem::path file;   // an image, or
   std::vector<double> constant; // linear values: 1 (scalar, or grey) or 3 (colour)
+  FileChannels channels = FileChannels::as_stored;  // of `file`
 };
 
 // A source as text, the one rule of both doors: one number or three ("0.5", "0.9,0.6,0.2") are a
 // constant (linear, in [0, 1]), anything else a file relative to `folder` (write "./0.5" for a file
-// of that name). Errors say what is wrong with the text, not where it came from.
+// of that name), ending in ":r", ":g", ":b", ":a" or ":rgb" to take those channels of it
+// ("sg.png:a"). Errors say what is wrong with the text, not where it came from.
 Result<SourceInput> source_from_text(std::string_view name, const std::string& text, const std::filesystem::path& folder);
 
 // Decodes a file (read_image, or a cache in front of it that decodes each file once).

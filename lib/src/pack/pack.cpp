@@ -98,16 +98,46 @@ image::Image blank(int width, int height, int channels) {
   return image;
 }
 
-// A source as a map: its components from a file's channels (grey → RGB repeats it).
-image::Image source_from_file(const image::Image& file, SourceKind kind) {
+// The file channel a source takes (FileChannels), or -1 for its first `components` as stored.
+Result<int> picked_channel(const image::Image& file, SourceKind kind, FileChannels pick, const fs::path& path,
+                           std::string_view source) {
+  const int colour_channels = file.alpha_channel >= 0 ? file.channels - 1 : file.channels;
+  switch (pick) {
+    case FileChannels::as_stored: return -1;
+    case FileChannels::rgb:
+      if (kind != SourceKind::color) return Error{path.string(), std::string(source) + " takes one channel, not rgb"};
+      if (colour_channels < 3) return Error{path.string(), "has no RGB (" + std::to_string(file.channels) + " channels)"};
+      return -1;
+    case FileChannels::a:
+      if (file.alpha_channel < 0) {
+        return Error{path.string(), "has no alpha channel (" + std::to_string(file.channels) + " channels) for " + std::string(source)};
+      }
+      return file.alpha_channel;
+    default: {
+      const int index = int(pick) - int(FileChannels::r);
+      if (index >= colour_channels) {
+        return Error{path.string(), "has no channel " + std::string(name_in(kFileChannelNames, pick)) + " (" +
+                                        std::to_string(file.channels) + " channels) for " + std::string(source)};
+      }
+      return index;
+    }
+  }
+}
+
+// A source as a map: its components from a file's channels (grey → RGB repeats it), or from the
+// one channel it picks.
+Result<image::Image> source_from_file(const image::Image& file, SourceKind kind, FileChannels pick, const fs::path& path,
+                                      std::string_view source) {
+  auto picked = picked_channel(file, kind, pick, path, source);
+  if (!picked) return picked.error();
   const int components = component_count(kind);
   image::Image map = blank(file.width, file.height, components);
   const bool grey = file.channels < 3;
   const std::size_t texels = std::size_t(file.width) * std::size_t(file.height);
   for (std::size_t i = 0; i < texels; ++i) {
     for (int c = 0; c < components; ++c) {
-      map.pixels[i * std::size_t(components) + std::size_t(c)] =
-          file.pixels[i * std::size_t(file.channels) + std::size_t(grey ? 0 : c)];
+      const int from = *picked >= 0 ? *picked : grey ? 0 : c;
+      map.pixels[i * std::size_t(components) + std::size_t(c)] = file.pixels[i * std::size_t(file.channels) + std::size_t(from)];
     }
   }
   return map;
@@ -181,7 +211,7 @@ Result<ResolvedLayout> resolve_layout(const std::string& reference, const fs::pa
 }
 
 Result<SourceInput> source_from_text(std::string_view name, const std::string& text, const fs::path& folder) {
-  SourceInput input{std::string(name), {}, {}};
+  SourceInput input{std::string(name), {}, {}, FileChannels::as_stored};
   std::vector<double> numbers;
   for (std::size_t start = 0; start <= text.size();) {
     const std::size_t comma = std::min(text.find(',', start), text.size());
@@ -197,7 +227,10 @@ Result<SourceInput> source_from_text(std::string_view name, const std::string& t
   }
   if (numbers.empty()) {
     if (text.empty()) return Error{"", "a file name or 1 or 3 numbers expected", true};
-    input.file = folder / text;
+    const std::size_t colon = text.rfind(':');
+    const auto channels = colon == std::string::npos ? std::nullopt : value_in(kFileChannelNames, std::string_view(text).substr(colon + 1));
+    if (channels && colon > 0) input.channels = *channels;
+    input.file = folder / (channels && colon > 0 ? text.substr(0, colon) : text);
     return input;
   }
   if (numbers.size() != 1 && numbers.size() != 3) {
@@ -239,7 +272,9 @@ Result<material::Maps> load_sources(const std::vector<SourceInput>& inputs, cons
       }
       auto file = read ? read(input.file, decode) : read_shared(input.file, decode);
       if (!file) return file.error();
-      result.maps[input.name] = source_from_file(**file, source->kind);
+      auto map = source_from_file(**file, source->kind, input.channels, input.file, input.name);
+      if (!map) return map.error();
+      result.maps[input.name] = std::move(*map);
       origin[input.name] = input.file.string();
     }
     // One size for all: the largest by pixel count, the others resized to it or refused.
@@ -386,9 +421,14 @@ Result<material::Maps> unpack(const Layout& layout, std::span<const image::Image
                                            texture_paths[0] + " is " + std::to_string(result.width) + "x" +
                                            std::to_string(result.height)};
       }
-      if (in.channels < int(spec.channels.size())) {
-        return Error{texture_paths[t], std::to_string(in.channels) + " channels; layout " + layout.name + " texture " +
-                                           spec.name + " has " + std::to_string(spec.channels.size())};
+      // A file with fewer channels than the texture (an RGB diffuse for Schüler's RGB + mask) is
+      // read when each missing channel has a default: the source takes that default.
+      for (std::size_t c = std::size_t(in.channels); c < spec.channels.size(); ++c) {
+        if (!spec.channels[c].fallback) {
+          return Error{texture_paths[t], std::to_string(in.channels) + " channels; layout " + layout.name + " texture " +
+                                             spec.name + " has " + std::to_string(spec.channels.size()) + " and channel " +
+                                             std::to_string(c) + " (" + spec.channels[c].source + ") has no default"};
+        }
       }
       const std::size_t texels = std::size_t(in.width) * std::size_t(in.height);
       for (std::size_t c = 0; c < spec.channels.size(); ++c) {
@@ -398,9 +438,10 @@ Result<material::Maps> unpack(const Layout& layout, std::span<const image::Image
         auto [it, inserted] = result.maps.try_emplace(channel.source);
         if (inserted) it->second = blank(in.width, in.height, component_count(kind));
         image::Image& map = it->second;
+        const bool stored = c < std::size_t(in.channels);
         for (std::size_t i = 0; i < texels; ++i) {
           map.pixels[i * std::size_t(map.channels) + std::size_t(channel.component)] =
-              float(apply(channel.transform, in.pixels[i * std::size_t(in.channels) + c]));
+              stored ? float(apply(channel.transform, in.pixels[i * std::size_t(in.channels) + c])) : float(*channel.fallback);
         }
       }
     }

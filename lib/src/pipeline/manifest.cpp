@@ -180,6 +180,25 @@ Result<std::optional<LayoutChoice>> read_layout(const Reader& r, const toml::tab
 }
 
 // sources = { kd = "t/paint.png", ks = 0.04, gloss = "0.6" }: files or constants.
+// A source's table form: a file and which of its channels.
+Result<pack::SourceInput> read_file_source(const Reader& r, const toml::table& t, const std::string& where,
+                                           const Manifest& m) {
+  if (Status s = r.known_keys(t, where, {"file", "channel"}); !s) return s.error();
+  std::string file, channel;
+  for (Status s : {r.get(t, "file", where, file), r.get(t, "channel", where, channel)}) {
+    if (!s) return s.error();
+  }
+  if (file.empty()) return r.at(t, where + ": needs file = \"...\"");
+  pack::SourceInput in;
+  in.file = m.folder / file;
+  if (const toml::node* c = t.get("channel")) {
+    const auto picked = value_in(pack::kFileChannelNames, channel);
+    if (!picked) return r.at(*c, where + ".channel: '" + channel + "' is not " + names_in(pack::kFileChannelNames));
+    in.channels = *picked;
+  }
+  return in;
+}
+
 Status read_sources(const Reader& r, const toml::node& sources, const std::string& where, const Manifest& m,
                     MaterialSpec& spec) {
   if (!sources.is_table()) return r.at(sources, where + ".sources must be a table");
@@ -191,7 +210,12 @@ Status read_sources(const Reader& r, const toml::node& sources, const std::strin
       return r.at(key.source(), where + ".sources: unknown source '" + source + "' (known: " + known + ")");
     }
     pack::SourceInput in{source, {}, {}};
-    if (auto text = value.value<std::string>()) {  // a file, or numbers written as text (as on the command line)
+    if (const toml::table* file = value.as_table()) {  // { file = "sg.png", channel = "a" }
+      auto read = read_file_source(r, *file, where + ".sources." + source, m);
+      if (!read) return read.error();
+      in.file = read->file;
+      in.channels = read->channels;
+    } else if (auto text = value.value<std::string>()) {  // a file, or numbers written as text (as on the command line)
       auto parsed = pack::source_from_text(source, *text, m.folder);
       if (!parsed) return r.at(value, where + ".sources." + source + ": " + parsed.error().message);
       in = std::move(*parsed);
@@ -206,7 +230,8 @@ Status read_sources(const Reader& r, const toml::node& sources, const std::strin
         in.constant.push_back(*x);
       }
     } else {
-      return r.at(value, where + ".sources." + source + ": a file name, a number or a list of 3 numbers expected");
+      return r.at(value, where + ".sources." + source +
+                             ": a file name, a number, a list of 3 numbers or { file = ..., channel = ... } expected");
     }
     spec.sources.push_back(std::move(in));
   }

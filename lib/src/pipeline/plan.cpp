@@ -38,7 +38,8 @@ nlohmann::json material_options(const MaterialSpec& m, const Manifest& manifest)
   options.update(params::to_json(pack::material_params(), m.options));
   nlohmann::json sources = nlohmann::json::object();
   for (const pack::SourceInput& s : m.sources) {
-    sources[s.name] = s.file.empty() ? nlohmann::json(s.constant) : nlohmann::json(manifest_relative(s.file, manifest));
+    const std::string channels = s.channels == pack::FileChannels::as_stored ? "" : ":" + std::string(name_in(pack::kFileChannelNames, s.channels));
+    sources[s.name] = s.file.empty() ? nlohmann::json(s.constant) : nlohmann::json(manifest_relative(s.file, manifest) + channels);
   }
   std::vector<std::string> packed;
   for (const fs::path& f : m.packed_files) packed.push_back(manifest_relative(f, manifest));
