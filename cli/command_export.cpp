@@ -63,7 +63,7 @@ CLI::App* setup_export(CLI::App& app, ExportSettings& s) {
   cmd->add_option("--material", s.materials,
                   "NAME=A.png,B.png: material NAME (or its index) from a Schüler pair; NAME=LAYOUT:FILE,... from\n"
                   "any pack layout's textures (e.g. gltf-metal-rough:base.png,mr.png). Repeatable");
-  add_params(*cmd, pack::material_params(), s.material_options, "", "Options", nullptr, {"transfer", "decode"});
+  add_params(*cmd, pack::material_params(), s.material_options, "", "Options", nullptr, {"transfer", "decode", "normal_y"});
   add_params(*cmd, exporter::options_params(), s.options, "", "Options");
   add_params(*cmd, image::encoding_params(), s.options.encoding, "", "Options");
   add_ao_options(*cmd, s.ao, "ao-");  // AO is baked when any of them is given, as a manifest's ao = { ... }

@@ -28,7 +28,7 @@ CLI::App* setup_pack(CLI::App& app, PackSettings& s) {
       "metallicRoughness / ORM, Unreal ORM, Unity HDRP mask map, Unity URP. Constants are linear.\n"
       "Example: matbake pack --kd kd.png --mask 1 --ks 0.04 --gloss gloss.png -o out/brick_{texture}.png");
   cmd->add_option("--layout", s.layout, layout_help())->capture_default_str();
-  add_source_options(*cmd, s.sources, {"transfer", "decode", "resize", "size", "bits"});
+  add_source_options(*cmd, s.sources, {"transfer", "decode", "normal_y", "resize", "size", "bits"});
   add_output_options(*cmd, s.output, "textures");
   return cmd;
 }
@@ -58,7 +58,7 @@ CLI::App* setup_unpack(CLI::App& app, UnpackSettings& s) {
   cmd->add_option("--layout", s.layout, layout_help())->capture_default_str();
   cmd->add_option("inputs", s.inputs, "The packed textures, in the layout's order")->required();
   cmd->add_option("-o,--out-dir", s.out_dir, "Folder for the source maps")->required();
-  add_params(*cmd, pack::material_params(), s.options, "", "Options", nullptr, {"transfer", "decode", "bits", "format"});
+  add_params(*cmd, pack::material_params(), s.options, "", "Options", nullptr, {"transfer", "decode", "normal_y", "bits", "format"});
   add_params(*cmd, image::encoding_params(), s.encoding, "", "Options");
   return cmd;
 }

@@ -48,7 +48,7 @@ CLI::App* setup_workflow(CLI::App& app, WorkflowSettings& s) {
       "Example: matbake workflow --from schuler A.png B.png --layout gltf-orm -o out/brick_{texture}.png");
   cmd->add_option("--layout,--to", s.to, "Target layout: a preset or a layout JSON file (--to: its older name)")->required();
   cmd->add_option("--report", s.report, "Also write the error report as JSON to this file");
-  add_source_options(*cmd, s.sources, {"transfer", "decode", "resize", "size", "bits", "mapping"});
+  add_source_options(*cmd, s.sources, {"transfer", "decode", "normal_y", "resize", "size", "bits", "mapping"});
   add_output_options(*cmd, s.output, "textures");
   return cmd;
 }

@@ -24,9 +24,10 @@ std::string option_of(std::string_view source) {
 void add_source_options(CLI::App& cmd, SourceSettings& s, const std::set<std::string>& params) {
   const auto sources = material::sources();
   for (std::size_t i = 0; i < sources.size(); ++i) {
-    const bool colour = sources[i].kind == material::SourceKind::color;
-    cmd.add_option(option_of(sources[i].name), s.values[i],
-                   std::string(sources[i].description) + (colour ? ": image, or linear grey / r,g,b" : ": image, or a value"))
+    const char* forms = sources[i].kind == material::SourceKind::color    ? ": image, or linear grey / r,g,b"
+                        : sources[i].kind == material::SourceKind::vector ? ": image, or its stored r,g,b"
+                                                                          : ": image, or a value";
+    cmd.add_option(option_of(sources[i].name), s.values[i], std::string(sources[i].description) + forms)
         ->group("Sources");
   }
   cmd.add_option("--from", s.from, "Layout of packed input textures (the positional inputs), e.g. schuler")

@@ -14,7 +14,7 @@
 namespace matbake::cli {
 
 struct SourceSettings {
-  std::array<std::string, 9> values;  // by material::sources() index: a file, or numbers
+  std::array<std::string, material::kSourceCount> values;  // by material::sources() index: a file, or numbers
   std::string from;                   // layout of the packed inputs
   std::vector<std::string> inputs;    // packed inputs, one per texture of `from`
   pack::MaterialOptions options;      // those of pack::material_params() the command takes

@@ -439,10 +439,10 @@ TEST(CliBuild, LayoutAndMaterialReferencesResolveFromTheManifest) {
   // Typos: one error line at the value's line and column, from -n and from a real run, nothing written.
   const std::string at = manifest + ":4:10: materials.a.layout: layout ";
   const std::pair<std::string, std::string> typos[] = {
-      {"gltf-ormm", at + "'gltf-ormm': no preset of that name (presets: gltf-metal-rough, gltf-orm, schuler, unity-hdrp, "
+      {"gltf-ormm", at + "'gltf-ormm': no preset of that name (presets: gltf-metal-rough, gltf-orm, gltf-pbr, schuler, unity-hdrp, "
                          "unity-urp, unreal-orm; did you mean gltf-orm?) and no layout file " +
                          (dir / "project/gltf-ormm.json").string()},
-      {"layouts/typo.json", at + "'layouts/typo.json': no preset of that name (presets: gltf-metal-rough, gltf-orm, "
+      {"layouts/typo.json", at + "'layouts/typo.json': no preset of that name (presets: gltf-metal-rough, gltf-orm, gltf-pbr, "
                                  "schuler, unity-hdrp, unity-urp, unreal-orm) and no layout file " +
                                  (dir / "project/layouts/typo.json").string()},
   };

@@ -13,6 +13,7 @@
 #include "matbake/image.hpp"
 #include "support/files.hpp"
 #include "support/gltf_files.hpp"
+#include "support/gltf_validator.hpp"
 #include "support/param_values.hpp"
 #include "support/run.hpp"
 #include "support/temp_dir.hpp"
@@ -274,6 +275,65 @@ TEST_F(Parity, ExportAndAoGiveTheManifestsScene) {
     const RunResult r = matbake(args);
     EXPECT_EQ(r.exit_code, 0) << c.name << ": " << r.err;
     expect_same_files({dir / "cli" / c.name / "showroom.glb"}, {dir / "out" / c.name / "showroom.glb"}, c.name);
+  }
+}
+
+// Normal and emissive maps through both doors: `pack --layout gltf-pbr` and a manifest material
+// write the same textures (DirectX green flipped); those textures exported by `export --material
+// NAME=gltf-pbr:...` and by a manifest scene give the same scene, with normalTexture and
+// emissiveTexture.
+TEST_F(Parity, NormalAndEmissiveMapsReachTheExportedMaterial) {
+  for (const char* f : {"showroom.gltf", "showroom.bin"}) fs::copy_file(kExamples / f, dir / f);
+  std::mt19937 rng(11);
+  std::uniform_int_distribution<int> tilt(96, 160), up(230, 255);
+  std::vector<double> normal;
+  for (int i = 0; i < 64; ++i) normal.insert(normal.end(), {double(tilt(rng)), double(tilt(rng)), double(up(rng))});
+  write_raw(dir / "nrm.png", 8, 8, 3, "uint8", normal);
+  write_noise(dir / "em.png", 8, 3, 12);
+  const std::string sources =
+      "sources = { base_color = \"base.png\", metallic = \"metal.png\", roughness = \"rough.png\", normal = \"nrm.png\", "
+      "emissive = \"em.png\" }\nnormal_y = \"directx\"\nlayout = \"gltf-pbr\"\nvalidate = { enabled = false }\n";
+  run_command({"pack", "--layout", "gltf-pbr", "--base-color", "base.png", "--metallic", "metal.png", "--roughness", "rough.png",
+               "--normal", "nrm.png", "--emissive", "em.png", "--normal-y", "directx", "-o", "cli/glow_{texture}.png"});
+  const std::vector<std::string> textures = {"base_color", "orm", "normal", "emissive"};
+  std::string files;
+  for (const std::string& t : textures) files += std::string(files.empty() ? "" : ", ") + "\"cli/glow_" + t + ".png\"";
+  const json report = build("[materials.glow]\n" + sources + "\n[materials.packed]\npacked = { layout = \"gltf-pbr\", files = [" +
+                            files + "] }\nvalidate = { enabled = false }\n\n[scenes.scene]\ninput = \"showroom.gltf\"\n" +
+                            "materials = { painted_metal = \"packed\" }\n");
+  ASSERT_EQ(report.value("failed", -1), 0) << report.dump(2);
+  std::vector<fs::path> from_command, from_build;
+  std::string packed_files;
+  for (const std::string& t : textures) {
+    from_command.push_back(dir / "cli" / ("glow_" + t + ".png"));
+    from_build.push_back(dir / "out/materials" / ("glow_" + t + ".png"));
+    packed_files += (packed_files.empty() ? "" : ",") + (dir / "cli" / ("glow_" + t + ".png")).string();
+  }
+  expect_same_files(from_command, from_build, "gltf-pbr textures");
+  // The first texel as float64 says: decoded, green flipped, renormalised, stored.
+  const RawImage written = read_raw(dir / "cli/glow_normal.png");
+  double n[3] = {2 * normal[0] / 255 - 1, -(2 * normal[1] / 255 - 1), 2 * normal[2] / 255 - 1};
+  const double length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(written.samples[std::size_t(c)], 255 * (0.5 * n[c] / length + 0.5), 0.5001) << c;
+
+  run_command({"export", (dir / "showroom.gltf").string(), "-o", "cli/scene.glb", "--material", "painted_metal=gltf-pbr:" + packed_files});
+  expect_same_files({dir / "cli/scene.glb"}, {dir / "out/scene.glb"}, "scene");
+  auto doc = gltf::read_document(dir / "out/scene.glb");
+  ASSERT_TRUE(doc) << doc.error().to_string();
+  bool found = false;
+  for (const auto& m : doc->json["materials"]) {
+    if (m.value("name", "") != "painted_metal") continue;
+    found = true;
+    EXPECT_TRUE(m.contains("normalTexture")) << m.dump();
+    EXPECT_TRUE(m.contains("emissiveTexture")) << m.dump();
+    EXPECT_EQ(m["emissiveFactor"].dump(), "[1.0,1.0,1.0]");
+  }
+  EXPECT_TRUE(found);
+  MATBAKE_VALIDATE_OR_SKIP(validated, dir / "out/scene.glb");
+  EXPECT_EQ(validated->errors, 0) << validated->summary;
+  // The one warning: no TANGENT attribute, so runtimes compute MikkTSpace tangents (glTF 2.0, 3.7.2.1).
+  for (const std::string& code : validated->error_and_warning_codes) {
+    EXPECT_EQ(code.rfind("MESH_PRIMITIVE_GENERATED_TANGENT_SPACE ", 0), 0u) << validated->summary;
   }
 }
 

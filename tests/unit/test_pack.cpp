@@ -18,7 +18,8 @@ material::Maps all_sources() {
   std::vector<SourceInput> inputs = {
       {"kd", {}, {0.11, 0.12, 0.13}}, {"ks", {}, {0.21, 0.22, 0.23}}, {"mask", {}, {0.9}},
       {"gloss", {}, {0.35}},          {"base_color", {}, {0.41, 0.42, 0.43}}, {"metallic", {}, {0.7}},
-      {"roughness", {}, {0.25}},      {"occlusion", {}, {0.6}},               {"detail_mask", {}, {0.4}}};
+      {"roughness", {}, {0.25}},      {"occlusion", {}, {0.6}},               {"detail_mask", {}, {0.4}},
+      {"normal", {}, {0.5, 0.5, 1.0}}, {"emissive", {}, {0.51, 0.52, 0.53}}};
   auto maps = load_sources(inputs, {.width = 2, .height = 1});
   EXPECT_TRUE(maps) << maps.error().to_string();
   for (auto& [name, map] : maps->maps) {
@@ -39,7 +40,7 @@ void expect_texel(const image::Image& image, int i, std::vector<double> expected
 
 TEST(Layouts, EveryPresetParses) {
   const auto names = builtin_layout_names();
-  for (const char* name : {"schuler", "gltf-metal-rough", "gltf-orm", "unreal-orm", "unity-hdrp", "unity-urp"}) {
+  for (const char* name : {"schuler", "gltf-metal-rough", "gltf-orm", "gltf-pbr", "unreal-orm", "unity-hdrp", "unity-urp"}) {
     EXPECT_NE(std::find(names.begin(), names.end(), name), names.end()) << name;
     auto layout = find_layout(name);
     ASSERT_TRUE(layout) << layout.error().to_string();
@@ -212,6 +213,38 @@ TEST(Sources, PackedTexturesWithoutAlphaTakeTheLayoutsDefault) {
   ASSERT_TRUE(maps) << maps.error().to_string();
   EXPECT_EQ(maps->find("mask")->pixels, std::vector<float>{1.0f});
   EXPECT_FLOAT_EQ(maps->find("kd")->pixels[1], 0.4f);
+}
+
+// Normal maps: decoded to vectors, green flipped for DirectX's convention, renormalised and stored
+// as glTF does (0.5·n + 0.5, +Y up); a map that is not tangent-space (a height map) is refused.
+TEST(Sources, NormalMapsAreFlippedRenormalisedAndChecked) {
+  TempDir dir;
+  test::write_raw(dir / "n.png", 2, 1, 3, "uint8", {128, 64, 230, 128, 128, 255});
+  for (const NormalConvention convention : {NormalConvention::opengl, NormalConvention::directx}) {
+    auto maps = load_sources({{"normal", dir / "n.png", {}}}, {.normal_y = convention});
+    ASSERT_TRUE(maps) << maps.error().to_string();
+    double n[3] = {2 * 128 / 255.0 - 1, 2 * 64 / 255.0 - 1, 2 * 230 / 255.0 - 1};
+    if (convention == NormalConvention::directx) n[1] = -n[1];
+    const double length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    const std::vector<float>& got = maps->find("normal")->pixels;
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(got[std::size_t(c)], 0.5 * n[c] / length + 0.5, 1e-6) << c;
+    EXPECT_NEAR(got[5], 1.0, 1e-5);  // (128, 128, 255): +Z within a code, renormalised to it
+  }
+  // The same through a packed layout (gltf-pbr's normal texture).
+  const Layout pbr = *find_layout("gltf-pbr");
+  test::write_raw(dir / "base.png", 2, 1, 4, "uint8", std::vector<double>(8, 200));
+  test::write_raw(dir / "orm.png", 2, 1, 3, "uint8", std::vector<double>(6, 100));
+  test::write_raw(dir / "e.png", 2, 1, 3, "uint8", std::vector<double>(6, 0));
+  auto packed = read_packed(pbr, {dir / "base.png", dir / "orm.png", dir / "n.png", dir / "e.png"}, {.normal_y = NormalConvention::directx});
+  ASSERT_TRUE(packed) << packed.error().to_string();
+  EXPECT_GT(packed->find("normal")->pixels[1], 0.5f);  // green 64 under DirectX points up
+  // A grey height map: most texels below the surface or far from unit length.
+  test::write_raw(dir / "height.png", 2, 1, 3, "uint8", {100, 100, 100, 90, 90, 90});
+  auto refused = load_sources({{"normal", dir / "height.png", {}}}, {});
+  ASSERT_FALSE(refused);
+  EXPECT_EQ(refused.error().to_string(), (dir / "height.png").string() + ": normal: not a tangent-space normal map: 100% of its "
+                                         "texels point below the surface (z < 0) or are far from unit length (an object-space "
+                                         "normal map, or a height or colour map?)");
 }
 
 TEST(Sources, DifferentSizesAreAnErrorUnlessResized) {

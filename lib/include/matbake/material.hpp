@@ -20,10 +20,13 @@ inline constexpr std::string_view kMetallic = "metallic";
 inline constexpr std::string_view kRoughness = "roughness";
 inline constexpr std::string_view kOcclusion = "occlusion";
 inline constexpr std::string_view kDetailMask = "detail_mask";
+inline constexpr std::string_view kNormal = "normal";          // tangent space, stored 0.5·n + 0.5, +Y up (glTF's)
+inline constexpr std::string_view kEmissive = "emissive";      // emitted colour
+inline constexpr std::size_t kSourceCount = 11;
 
 // Colour sources are RGB and authored with a transfer (sRGB or gamma 2.2 in 8/16-bit files);
-// scalar sources are one linear channel.
-enum class SourceKind { color, scalar };
+// scalar sources are one linear channel; vector sources (the normal) are three linear channels.
+enum class SourceKind { color, scalar, vector };
 struct Source {
   std::string_view name;
   SourceKind kind;
@@ -31,7 +34,7 @@ struct Source {
 };
 std::span<const Source> sources();
 const Source* find_source(std::string_view name);
-inline int component_count(SourceKind kind) { return kind == SourceKind::color ? 3 : 1; }
+inline int component_count(SourceKind kind) { return kind == SourceKind::scalar ? 1 : 3; }
 // A source given as a number holds a texel value: finite and in [0, 1] (NaN fails both).
 inline bool is_valid_constant(double value) { return value >= 0.0 && value <= 1.0; }
 

@@ -83,6 +83,18 @@ using ImageReader = std::function<Result<std::shared_ptr<const image::Image>>(co
 // How a material's sources are read, converted and its textures written, whichever door asks
 // (pack, unpack, workflow, validate, preview, a manifest's material). Its parameters are described
 // once in pack::material_params() (material_params.hpp).
+// Which way a normal map's green channel points: OpenGL's +Y (glTF's, Blender's) or DirectX's −Y
+// (Unreal's, 3ds Max's), flipped when read so that every map in memory is glTF's.
+enum class NormalConvention { opengl, directx };
+inline constexpr NameTable<NormalConvention, 2> kNormalConventionNames{
+    {{NormalConvention::opengl, "opengl"}, {NormalConvention::directx, "directx"}}};
+
+// A tangent-space normal map is refused when more than this share of its texels point below the
+// surface (z < 0) or are further than kNormalLengthTolerance from unit length before renormalising
+// (8-bit storage is within 0.01, block compression within about 0.05).
+inline constexpr double kNormalBadShare = 0.01;
+inline constexpr double kNormalLengthTolerance = 0.25;
+
 struct MaterialOptions {
   color::Transfer transfer = color::Transfer::srgb;  // 8-bit colour: how sources were authored, how outputs are encoded
   std::optional<color::Transfer> decode;             // every colour file, overriding the rule below
@@ -92,10 +104,13 @@ struct MaterialOptions {
   std::optional<image::SampleType> bits;  // of written textures; unset: default_sample_type of each path
   std::string format = "png";             // extension of outputs that no path names (a manifest's, unpack's)
   workflow::RoughnessMapping mapping = workflow::kDefaultRoughnessMapping;  // gloss ⇄ roughness of a conversion
+  NormalConvention normal_y = NormalConvention::opengl;  // of normal map sources
 };
 Result<material::Maps> load_sources(const std::vector<SourceInput>& inputs, const MaterialOptions& options,
                                     const ImageReader& read = {});
 
+// A normal map source is decoded to vectors (green flipped for DirectX's convention), checked
+// (kNormalBadShare), renormalised and held as glTF stores it, by load_sources and read_packed alike.
 // The source maps held by `files`, the textures of `layout` in order: colour textures decoded with
 // `options.decode` when given, else as decode_transfer() says; the others linear.
 Result<material::Maps> read_packed(const Layout& layout, const std::vector<std::filesystem::path>& files,

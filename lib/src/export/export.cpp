@@ -112,6 +112,45 @@ struct Exporter {
     return success();
   }
 
+  // A given normal map as normalTexture (none when flat: every texel +Z) and a given emissive map as
+  // emissiveTexture with factor 1 (a constant one as emissiveFactor; none when black). They replace
+  // the material's own.
+  Status write_normal_and_emissive(Json& material, const material::Maps& given, const std::string& name, Json texture_info,
+                                   int sampler_of, MaterialReport& out) {
+    const auto uniform = [](const image::Image& map, std::initializer_list<float> value) {
+      for (std::size_t i = 0; i < map.pixels.size(); ++i) {
+        if (map.pixels[i] != value.begin()[i % 3]) return false;
+      }
+      return true;
+    };
+    if (const image::Image* normal = given.find(material::kNormal)) {
+      material.erase("normalTexture");
+      if (!uniform(*normal, {0.5f, 0.5f, 1.0f})) {
+        auto texture = add_texture(*normal, color::Transfer::linear, name + "_normal", sampler_of);
+        if (!texture) return texture.error();
+        Json info = {{"index", *texture}};
+        if (texture_info.contains("texCoord")) info["texCoord"] = texture_info["texCoord"];
+        material["normalTexture"] = info;
+        out.action += "; normal map";
+      }
+    }
+    if (const image::Image* emissive = given.find(material::kEmissive)) {
+      material.erase("emissiveTexture");
+      material.erase("emissiveFactor");
+      if (uniform(*emissive, {emissive->pixels[0], emissive->pixels[1], emissive->pixels[2]})) {
+        if (!uniform(*emissive, {0.0f, 0.0f, 0.0f})) material["emissiveFactor"] = {emissive->pixels[0], emissive->pixels[1], emissive->pixels[2]};
+      } else {
+        auto texture = add_texture(*emissive, color::Transfer::srgb, name + "_emissive", sampler_of);
+        if (!texture) return texture.error();
+        texture_info["index"] = *texture;
+        material["emissiveTexture"] = texture_info;
+        material["emissiveFactor"] = {1.0, 1.0, 1.0};
+        out.action += "; emissive map";
+      }
+    }
+    return success();
+  }
+
   // KHR_materials_specular or KHR_materials_ior for dielectric texels whose F0 is not glTF's 0.04.
   void add_dielectric_f0(Json& material, const workflow::ConversionReport& conversion, MaterialReport& out) {
     const auto& d = conversion.dielectric;
@@ -256,6 +295,7 @@ struct Exporter {
       if (Status s = write_metal_rough(material, given, name, info, sampler_of); !s) return s;
       out.action = "from metal-rough maps";
     }
+    if (Status s = write_normal_and_emissive(material, given, name, info, sampler_of, out); !s) return s;
     set_alpha_mode(material, given.find(material::kMask));
     return success();
   }

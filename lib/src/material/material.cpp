@@ -6,7 +6,7 @@
 namespace matbake::material {
 namespace {
 
-constexpr std::array<Source, 9> kSources = {{
+constexpr std::array<Source, kSourceCount> kSources = {{
     {kKd, SourceKind::color, "Schüler: diffuse colour"},
     {kKs, SourceKind::color, "Schüler: specular colour, F0"},
     {kMask, SourceKind::scalar, "mask / opacity (alpha of pair A and of base colour maps)"},
@@ -16,6 +16,8 @@ constexpr std::array<Source, 9> kSources = {{
     {kRoughness, SourceKind::scalar, "metalness workflow: perceptual roughness (GGX alpha = roughness^2)"},
     {kOcclusion, SourceKind::scalar, "ambient occlusion"},
     {kDetailMask, SourceKind::scalar, "Unity HDRP detail mask"},
+    {kNormal, SourceKind::vector, "tangent-space normal map (RGB = 0.5 XYZ + 0.5; normal_y says which way green points)"},
+    {kEmissive, SourceKind::color, "emitted colour (glTF emissiveTexture)"},
 }};
 
 }  // namespace

@@ -105,7 +105,7 @@ Result<int> picked_channel(const image::Image& file, SourceKind kind, FileChanne
   switch (pick) {
     case FileChannels::as_stored: return -1;
     case FileChannels::rgb:
-      if (kind != SourceKind::color) return Error{path.string(), std::string(source) + " takes one channel, not rgb"};
+      if (kind == SourceKind::scalar) return Error{path.string(), std::string(source) + " takes one channel, not rgb"};
       if (colour_channels < 3) return Error{path.string(), "has no RGB (" + std::to_string(file.channels) + " channels)"};
       return -1;
     case FileChannels::a:
@@ -141,6 +141,34 @@ Result<image::Image> source_from_file(const image::Image& file, SourceKind kind,
     }
   }
   return map;
+}
+
+// The normal map as glTF stores it: decoded to vectors (green flipped for DirectX's convention),
+// renormalised and stored again (0.5·n + 0.5); refused when it is not a tangent-space normal map.
+Status finish_normal_map(material::Maps& maps, NormalConvention convention, const std::string& origin) {
+  const auto found = maps.maps.find(material::kNormal);
+  if (found == maps.maps.end()) return success();
+  std::vector<float>& v = found->second.pixels;
+  const std::size_t texels = v.size() / 3;
+  std::size_t bad = 0;
+  for (std::size_t i = 0; i < texels; ++i) {
+    double n[3] = {2.0 * v[3 * i] - 1, 2.0 * v[3 * i + 1] - 1, 2.0 * v[3 * i + 2] - 1};
+    if (convention == NormalConvention::directx) n[1] = -n[1];
+    const double length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    bad += n[2] < 0 || std::abs(length - 1) > kNormalLengthTolerance;
+    for (int c = 0; c < 3; ++c) {
+      const double unit = length > 1e-6 ? n[c] / length : c == 2 ? 1.0 : 0.0;  // no direction: the surface's
+      v[3 * i + std::size_t(c)] = float(0.5 * unit + 0.5);
+    }
+  }
+  if (double(bad) > kNormalBadShare * double(texels)) {
+    char share[32];
+    std::snprintf(share, sizeof share, "%.3g%%", 100.0 * double(bad) / double(texels));
+    return Error{origin, "normal: not a tangent-space normal map: " + std::string(share) +
+                             " of its texels point below the surface (z < 0) or are far from unit length (an "
+                             "object-space normal map, or a height or colour map?)"};
+  }
+  return success();
 }
 
 Result<std::shared_ptr<const image::Image>> read_shared(const std::filesystem::path& path, color::Transfer decode) {
@@ -307,8 +335,8 @@ Result<material::Maps> load_sources(const std::vector<SourceInput>& inputs, cons
       const Source* source = find_source(input.name);
       const int components = component_count(source->kind);
       const std::size_t n = input.constant.size();
-      if (!(n == 1 || (n == 3 && source->kind == SourceKind::color))) {
-        return Error{"", input.name + ": " + (source->kind == SourceKind::color ? "1 or 3 values" : "one value") +
+      if (!(n == 1 || (n == 3 && source->kind != SourceKind::scalar))) {
+        return Error{"", input.name + ": " + (source->kind != SourceKind::scalar ? "1 or 3 values" : "one value") +
                              " expected, got " + std::to_string(n), true};
       }
       image::Image map = blank(result.width, result.height, components);
@@ -317,6 +345,7 @@ Result<material::Maps> load_sources(const std::vector<SourceInput>& inputs, cons
       }
       result.maps[input.name] = std::move(map);
     }
+    if (Status s = finish_normal_map(result, options.normal_y, origin[std::string(material::kNormal)]); !s) return s.error();
     return result;
   });
 }
@@ -342,7 +371,16 @@ Result<material::Maps> read_packed(const Layout& layout, const std::vector<std::
       textures.push_back(**image);
       paths.push_back(files[t].string());
     }
-    return unpack(layout, textures, paths);
+    auto maps = unpack(layout, textures, paths);
+    if (!maps) return maps.error();
+    std::string normal_file;
+    for (std::size_t t = 0; t < files.size(); ++t) {
+      for (const Channel& c : layout.textures[t].channels) {
+        if (c.source == material::kNormal) normal_file = files[t].string();
+      }
+    }
+    if (Status s = finish_normal_map(*maps, options.normal_y, normal_file); !s) return s.error();
+    return maps;
   });
 }
 

@@ -43,6 +43,11 @@ const params::Group<MaterialOptions>& material_params() {
                                            .example = "linear",
                                            .aliases = {"input_transfer"}},
                                       [](auto& o) -> auto& { return o.decode; }, color::kTransferNames),
+      params::choice<MaterialOptions>(Spec{.name = "normal_y",
+                                           .help = "Which way a normal map source's green channel points: opengl "
+                                                   "(+Y, glTF's and Blender's) or directx (-Y, Unreal's; flipped on read)",
+                                           .example = "directx"},
+                                      [](auto& o) -> auto& { return o.normal_y; }, kNormalConventionNames),
       params::flag<MaterialOptions>(Spec{.name = "resize",
                                          .help = "Resample sources of different sizes to the largest (in linear "
                                                  "light); else they are an error",
