@@ -140,6 +140,12 @@ int run_build(const BuildSettings& s, const GlobalOptions& global) {
     std::cout << doc.dump(2) << "\n";
   } else if (!global.quiet) {
     if (s.dry_run) {
+      for (const pipeline::MaterialRule& rule : manifest.rules) {
+        std::string names;
+        for (const std::string& n : rule.materials) names += (names.empty() ? "" : ", ") + n;
+        std::printf("material_rules.%s (%s): %zu materials: %s\n", rule.name.c_str(), rule.origin.c_str(),
+                    rule.materials.size(), names.c_str());
+      }
       for (const pipeline::JobReport& r : report->jobs) {
         if (r.outcome == pipeline::Outcome::out_of_date) std::printf("would build %s: %s\n", r.job->name.c_str(), r.reason.c_str());
       }

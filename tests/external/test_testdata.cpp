@@ -220,6 +220,64 @@ TEST(PhysicallyBased, TableEntriesMatchTheDatabase) {
 }
 
 // Every Khronos sample model loads; counts checked where the model's README states them.
+// A material rule over a folder of Khronos textures (base colour, metallic-roughness with roughness
+// in G and metallic in B, normal map), through both doors: each material's textures equal `pack`'s
+// with the same sources, and the Khronos scenes that use them export validator-clean.
+TEST(KhronosModels, AMaterialRuleOverTheirTextures) {
+  REQUIRE_TESTDATA("gltf/Cube");
+  test::TempDir dir;
+  fs::create_directories(dir / "textures");
+  fs::create_directories(dir / "scenes");
+  for (const char* model : {"Cube", "TwoSidedPlane"}) {
+    const fs::path from = kTestdata / "gltf" / model / "glTF";
+    fs::copy(from, dir / "scenes" / model, fs::copy_options::recursive);
+    for (const auto& f : fs::directory_iterator(from)) {
+      if (f.path().extension() == ".png") fs::copy_file(f.path(), dir / "textures" / f.path().filename());
+    }
+  }
+  test::write_bytes(dir / "assets.toml", R"(validate = { enabled = false }
+[material_rules.khronos]
+match = "textures/{name}_BaseColor.png"
+sources = { base_color = "textures/{name}_BaseColor.png", normal = "textures/{name}_Normal.png", roughness = { file = "textures/{name}_MetallicRoughness.png", channel = "g" }, metallic = { file = "textures/{name}_MetallicRoughness.png", channel = "b" } }
+layout = "gltf-pbr"
+[material_rules.khronos.overrides.Cube]
+sources = { normal = [0.5, 0.5, 1.0] }
+[scenes.cube]
+input = "scenes/Cube/Cube.gltf"
+[scenes.plane]
+input = "scenes/TwoSidedPlane/TwoSidedPlane.gltf"
+)");
+  const test::RunResult dry = test::matbake({"build", (dir / "assets.toml").string(), "-n"});
+  EXPECT_NE(dry.out.find("material_rules.khronos (" + (dir / "assets.toml").string() + ":2:1): 2 materials: Cube, TwoSidedPlane"),
+            std::string::npos)
+      << dry.out << dry.err;
+  const test::RunResult built = test::matbake({"--json", "build", (dir / "assets.toml").string()});
+  ASSERT_EQ(built.exit_code, 0) << built.err;
+  const nlohmann::json report = nlohmann::json::parse(built.out);
+  EXPECT_EQ(report["built"], 4);
+  EXPECT_EQ(report["material_rules"][0]["materials"], nlohmann::json::array({"Cube", "TwoSidedPlane"}));
+  for (const std::string name : {"Cube", "TwoSidedPlane"}) {
+    const std::string t = (dir / "textures" / name).string();
+    std::vector<std::string> args = {"pack", "--layout", "gltf-pbr", "--base-color", t + "_BaseColor.png",
+                                     "--roughness", t + "_MetallicRoughness.png:g", "--metallic", t + "_MetallicRoughness.png:b",
+                                     "--normal", name == "Cube" ? "0.5,0.5,1" : t + "_Normal.png",
+                                     "-o", (dir / "cli" / (name + "_{texture}.png")).string()};
+    const test::RunResult packed = test::matbake(args);
+    ASSERT_EQ(packed.exit_code, 0) << packed.err;
+    for (const char* texture : {"base_color", "orm", "normal", "emissive"}) {
+      const std::string file = name + "_" + texture + ".png";
+      EXPECT_TRUE(test::read_bytes(dir / "cli" / file) == test::read_bytes(dir / "out/materials" / file)) << file;
+    }
+  }
+  for (const char* scene : {"cube.glb", "plane.glb"}) {
+    MATBAKE_VALIDATE_OR_SKIP(validated, dir / "out" / scene);
+    EXPECT_EQ(validated->errors, 0) << validated->summary;
+    for (const std::string& code : validated->error_and_warning_codes) {
+      EXPECT_EQ(code.rfind("MESH_PRIMITIVE_GENERATED_TANGENT_SPACE ", 0), 0u) << validated->summary;
+    }
+  }
+}
+
 TEST(KhronosModels, EveryModelLoadsWithItsTriangleAndInstanceCounts) {
   REQUIRE_TESTDATA("gltf");
   int loaded = 0;

@@ -173,6 +173,62 @@ TEST(BuildManifest, ErrorsSayWhereAndWhat) {
   EXPECT_EQ(missing.error().path, "/nonexistent/m.toml");
 }
 
+// One entry, a material per file its pattern matches: {name} in its file names, per-name overrides,
+// names that cannot name files skipped with a note; clashes and stray overrides are errors.
+TEST(BuildManifest, MaterialRulesMakeAMaterialPerMatch) {
+  TempDir dir;
+  fs::create_directories(dir / "t");
+  for (const char* f : {"a_BaseColor.png", "b_BaseColor.png", "bad name_BaseColor.png", "c_Normal.png"}) write_bytes(dir / "t" / f, "");
+  const std::string rule = R"([material_rules.lib]
+match = "t/{name}_BaseColor.png"
+sources = { base_color = "t/{name}_BaseColor.png", roughness = { file = "t/{name}_ORM.png", channel = "g" }, metallic = 0.0 }
+layout = "gltf-orm"
+reference = "{name}"
+[material_rules.lib.overrides.b]
+sources = { roughness = 0.3 }
+layout = "gltf-metal-rough"
+)";
+  auto m = pipeline::parse_manifest(rule, dir / "m.toml");
+  ASSERT_TRUE(m) << m.error().to_string();
+  ASSERT_EQ(m->materials.size(), 2u);
+  const pipeline::MaterialSpec& a = m->materials[0];
+  EXPECT_EQ(a.name, "a");
+  EXPECT_EQ(a.reference, "a");
+  EXPECT_EQ(a.layout->reference, "gltf-orm");
+  const auto source = [](const pipeline::MaterialSpec& spec, const std::string& name) {
+    return *std::find_if(spec.sources.begin(), spec.sources.end(), [&](const pack::SourceInput& s) { return s.name == name; });
+  };
+  ASSERT_EQ(a.sources.size(), 3u);
+  EXPECT_EQ(source(a, "base_color").file, dir / "t/a_BaseColor.png");
+  EXPECT_EQ(source(a, "roughness").file, dir / "t/a_ORM.png");
+  EXPECT_EQ(source(a, "roughness").channels, pack::FileChannels::g);
+  EXPECT_EQ(a.origins.of(""), (dir / "m.toml").string() + ":1:1");  // errors point at the rule
+  const pipeline::MaterialSpec& b = m->materials[1];
+  EXPECT_EQ(b.layout->reference, "gltf-metal-rough");
+  ASSERT_EQ(b.sources.size(), 3u);
+  EXPECT_EQ(source(b, "roughness").constant, std::vector<double>{0.3});
+  EXPECT_EQ(source(b, "base_color").file, dir / "t/b_BaseColor.png");
+  ASSERT_EQ(m->rules.size(), 1u);
+  EXPECT_EQ(m->rules[0].materials, (std::vector<std::string>{"a", "b"}));
+  ASSERT_EQ(m->notes.size(), 1u);
+  EXPECT_NE(m->notes[0].find("'bad name' is not a material name"), std::string::npos) << m->notes[0];
+
+  const auto error_of = [&](const std::string& text) {
+    auto bad = pipeline::parse_manifest(text, dir / "m.toml");
+    return bad ? std::string("parsed") : bad.error().to_string();
+  };
+  EXPECT_NE(error_of("[materials.a]\nsources = { kd = 0.5 }\n" + rule).find("material_rules.lib: 'a' is also a material at "),
+            std::string::npos);
+  EXPECT_NE(error_of(rule + "[material_rules.lib.overrides.bb]\nlayout = \"schuler\"\n")
+                .find("material_rules.lib.overrides.bb: no such match; did you mean b or a?"),
+            std::string::npos)
+      << error_of(rule + "[material_rules.lib.overrides.bb]\nlayout = \"schuler\"\n");
+  EXPECT_NE(error_of("[material_rules.x]\nmatch = \"t/{name}/BaseColor.png\"\nsources = { kd = 0.5 }\n").find("m.toml:2:9: material_rules.x.match: a file pattern with {name} once"),
+            std::string::npos);
+  EXPECT_NE(error_of("[material_rules.x]\nmatch = \"t/{name}.png\"\nsources = { kd = 0.5 }\nlayot = 1\n").find("unknown key 'layot' in material_rules.x"),
+            std::string::npos);
+}
+
 TEST(BuildPlan, JobsWithTheirInputsAndOutputs) {
   TempDir dir;
   GltfBuilder scene;

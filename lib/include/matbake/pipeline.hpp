@@ -78,6 +78,13 @@ struct SceneSpec {
   exporter::Options options;  // as `matbake export` fills it; its materials are added when the job runs
 };
 
+// A [material_rules.NAME] entry and the materials it made, one per file its pattern matched.
+struct MaterialRule {
+  std::string name;
+  std::string origin;  // "assets.toml:12:1"
+  std::vector<std::string> materials;
+};
+
 struct Manifest {
   std::filesystem::path file;    // absolute
   std::filesystem::path folder;  // relative paths in the manifest resolve here
@@ -85,7 +92,8 @@ struct Manifest {
   std::filesystem::path table;   // material table (empty: the built-in one)
   Origins origins;               // of the top-level keys ("table", "output", ...)
   std::vector<std::string> notes;  // older key names read, each with its line (printed as warnings)
-  std::vector<MaterialSpec> materials;
+  std::vector<MaterialSpec> materials;  // its own, then those its rules made
+  std::vector<MaterialRule> rules;
   std::vector<SceneSpec> scenes;
 };
 

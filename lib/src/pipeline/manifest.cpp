@@ -233,6 +233,8 @@ Status read_sources(const Reader& r, const toml::node& sources, const std::strin
       return r.at(value, where + ".sources." + source +
                              ": a file name, a number, a list of 3 numbers or { file = ..., channel = ... } expected");
     }
+    // A material rule's override replaces the rule's source of that name.
+    std::erase_if(spec.sources, [&](const pack::SourceInput& s) { return s.name == source; });
     spec.sources.push_back(std::move(in));
   }
   if (spec.sources.empty()) return r.at(sources, where + ".sources is empty");
@@ -260,17 +262,18 @@ Status read_packed_entry(const Reader& r, const toml::node& packed, const std::s
   return success();
 }
 
-Result<MaterialSpec> read_material(const Reader& r, const std::string& name, const toml::node& node,
-                                   const Manifest& m, const MaterialSpec& defaults, std::vector<std::string>& notes) {
-  const std::string where = "materials." + name;
+// A material entry over `defaults` (the manifest's top level, or for a rule's override the rule's
+// material); `structure` are further keys the entry may hold (a rule's `match` and `overrides`).
+Result<MaterialSpec> read_material(const Reader& r, const std::string& name, const std::string& where,
+                                   const toml::node& node, const Manifest& m, const MaterialSpec& defaults,
+                                   std::vector<std::string>& notes, std::vector<std::string> structure = {}) {
   const toml::table* t = node.as_table();
   if (!t) return r.at(node, where + " must be a table");
   if (!is_file_name_safe(name)) {
     return r.at(node, "material name '" + name + "': letters, digits, '_', '-' and '.' only (it names files)");
   }
-  if (Status s = r.known_keys(*t, where, with_keys_of(pack::material_params(),
-                                                      with_keys_of(image::encoding_params(),
-                                                                   {"sources", "packed", "layout", "reference", "validate"})));
+  structure.insert(structure.end(), {"sources", "packed", "layout", "reference", "validate"});
+  if (Status s = r.known_keys(*t, where, with_keys_of(pack::material_params(), with_keys_of(image::encoding_params(), structure)));
       !s) {
     return s.error();
   }
@@ -285,7 +288,7 @@ Result<MaterialSpec> read_material(const Reader& r, const std::string& name, con
   }
   auto layout = read_layout(r, *t, "layout", where, m.folder);
   if (!layout) return layout.error();
-  spec.layout = std::move(*layout);
+  if (*layout) spec.layout = std::move(*layout);  // else the defaults' (a rule's, for its overrides)
   if (const toml::node* v = t->get("validate")) {
     if (!v->is_table()) return r.at(*v, where + ".validate must be a table");
     if (Status s = read_validation(r, *v->as_table(), where + ".validate", spec.validation, notes); !s) return s.error();
@@ -293,12 +296,99 @@ Result<MaterialSpec> read_material(const Reader& r, const std::string& name, con
 
   const toml::node* sources = t->get("sources");
   const toml::node* packed = t->get("packed");
-  if (!sources && !packed) {
+  if (!sources && !packed && spec.sources.empty() && !spec.packed) {
     return r.at(node, where + ": give sources = {...}, packed = {...} or both (the sources replace packed maps)");
   }
   if (Status s = sources ? read_sources(r, *sources, where, m, spec) : success(); !s) return s.error();
   if (Status s = packed ? read_packed_entry(r, *packed, where, m, spec) : success(); !s) return s.error();
   return spec;
+}
+
+// "{name}" in `text` replaced by `name`.
+std::string with_name(std::string text, const std::string& name) {
+  for (std::size_t at = text.find("{name}"); at != std::string::npos; at = text.find("{name}", at + name.size())) {
+    text.replace(at, 6, name);
+  }
+  return text;
+}
+
+// The names a rule's `match` finds: files of its folder named prefix{name}suffix, sorted.
+Result<std::vector<std::string>> rule_matches(const Reader& r, const toml::node& match, const std::string& where,
+                                              const Manifest& m, std::vector<std::string>& notes) {
+  const auto text = match.value<std::string>();
+  const fs::path pattern = text ? m.folder / *text : fs::path();
+  const std::string file = pattern.filename().string();
+  const std::size_t at = file.find("{name}");
+  if (!text || at == std::string::npos || file.find("{name}", at + 1) != std::string::npos ||
+      pattern.parent_path().string().find("{name}") != std::string::npos) {
+    return r.at(match, where + ".match: a file pattern with {name} once, in the file name (\"textures/{name}_BaseColor.png\")");
+  }
+  const std::string prefix = file.substr(0, at), suffix = file.substr(at + 6);
+  std::vector<std::string> names;
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(pattern.parent_path(), ec)) {
+    const std::string f = entry.path().filename().string();
+    if (f.size() <= prefix.size() + suffix.size() || !f.starts_with(prefix) || !f.ends_with(suffix) || !entry.is_regular_file(ec)) continue;
+    const std::string name = f.substr(prefix.size(), f.size() - prefix.size() - suffix.size());
+    if (is_file_name_safe(name)) {
+      names.push_back(name);
+    } else {
+      notes.push_back(r.origin(match.source()) + ": " + where + ": " + entry.path().string() + " skipped: '" + name +
+                      "' is not a material name (letters, digits, '_', '-', '.')");
+    }
+  }
+  if (ec) return r.at(match, where + ".match: " + pattern.parent_path().string() + ": " + ec.message());
+  std::sort(names.begin(), names.end());
+  if (names.empty()) notes.push_back(r.origin(match.source()) + ": " + where + ": '" + *text + "' matches no file");
+  return names;
+}
+
+// [material_rules.NAME]: a material per file `match` finds, its keys those of a material with
+// "{name}" in its file names, and `overrides.NAME` tables of material keys for some of them.
+Status read_material_rule(const Reader& r, const std::string& rule, const toml::node& node, Manifest& m,
+                          const MaterialSpec& defaults) {
+  const std::string where = "material_rules." + rule;
+  const toml::table* t = node.as_table();
+  if (!t) return r.at(node, where + " must be a table");
+  const toml::node* match = t->get("match");
+  if (!match) return r.at(node, where + ": needs match = \"textures/{name}_BaseColor.png\" (a file per material)");
+  auto names = rule_matches(r, *match, where, m, m.notes);
+  if (!names) return names.error();
+  auto shared = read_material(r, rule, where, node, m, defaults, m.notes, {"match", "overrides"});
+  if (!shared) return shared.error();
+  const toml::table* overrides = nullptr;
+  if (const toml::node* o = t->get("overrides")) {
+    overrides = o->as_table();
+    if (!overrides) return r.at(*o, where + ".overrides must be a table of tables: [" + where + ".overrides.NAME]");
+    for (const auto& [key, value] : *overrides) {
+      if (!std::binary_search(names->begin(), names->end(), std::string(key.str()))) {
+        return r.at(key.source(), where + ".overrides." + std::string(key.str()) + ": no such match" +
+                                      did_you_mean(std::string(key.str()), *names));
+      }
+    }
+  }
+  MaterialRule expanded{rule, r.origin(node.source()), {}};
+  for (const std::string& name : *names) {
+    MaterialSpec spec = *shared;
+    spec.name = name;
+    for (pack::SourceInput& s : spec.sources) s.file = with_name(s.file.string(), name);
+    for (fs::path& f : spec.packed_files) f = with_name(f.string(), name);
+    spec.reference = with_name(spec.reference, name);
+    if (const toml::node* own = overrides ? overrides->get(name) : nullptr) {
+      auto overridden = read_material(r, name, where + ".overrides." + name, *own, m, spec, m.notes);
+      if (!overridden) return overridden.error();
+      spec = std::move(*overridden);
+    }
+    for (const MaterialSpec& other : m.materials) {
+      if (other.name == name) {
+        return r.at(*match, where + ": '" + name + "' is also a material at " + other.origins.of("") + "; rename one");
+      }
+    }
+    m.materials.push_back(std::move(spec));
+    expanded.materials.push_back(name);
+  }
+  m.rules.push_back(std::move(expanded));
+  return success();
 }
 
 Result<SceneSpec> read_scene(const Reader& r, const std::string& name, const toml::node& node, const Manifest& m,
@@ -383,7 +473,7 @@ Result<Manifest> parse_manifest(std::string_view toml_text, const fs::path& file
     if (Status s = r.known_keys(doc, "the manifest",
                                 with_keys_of(pack::material_params(),
                                              with_keys_of(image::encoding_params(),
-                                                          {"output", "table", "validate", "materials", "scenes"})));
+                                                          {"output", "table", "validate", "materials", "material_rules", "scenes"})));
         !s) {
       return s.error();
     }
@@ -410,9 +500,15 @@ Result<Manifest> parse_manifest(std::string_view toml_text, const fs::path& file
     if (const toml::node* mats = doc.get("materials")) {
       if (!mats->is_table()) return r.at(*mats, "materials must be a table of tables: [materials.NAME]");
       for (const auto& [key, value] : *mats->as_table()) {
-        auto spec = read_material(r, std::string(key.str()), value, m, defaults, m.notes);
+        auto spec = read_material(r, std::string(key.str()), "materials." + std::string(key.str()), value, m, defaults, m.notes);
         if (!spec) return spec.error();
         m.materials.push_back(std::move(*spec));
+      }
+    }
+    if (const toml::node* rules = doc.get("material_rules")) {
+      if (!rules->is_table()) return r.at(*rules, "material_rules must be a table of tables: [material_rules.NAME]");
+      for (const auto& [key, value] : *rules->as_table()) {
+        if (Status s = read_material_rule(r, std::string(key.str()), value, m, defaults); !s) return s.error();
       }
     }
     if (const toml::node* scenes = doc.get("scenes")) {

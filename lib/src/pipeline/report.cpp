@@ -32,7 +32,12 @@ nlohmann::json job_json(const JobReport& r) {
 nlohmann::json json_report(const Manifest& manifest, const Plan& plan, const Report& report) {
   nlohmann::json jobs = nlohmann::json::array();
   for (const JobReport& r : report.jobs) jobs.push_back(job_json(r));
+  nlohmann::json rules = nlohmann::json::array();
+  for (const MaterialRule& rule : manifest.rules) {
+    rules.push_back({{"name", rule.name}, {"origin", rule.origin}, {"materials", rule.materials}});
+  }
   nlohmann::json j = {{"manifest", manifest.file.string()},
+                      {"material_rules", rules},
                       {"output", manifest.output.string()},
                       {"jobs", jobs},
                       {"images_decoded", report.images_decoded},
