@@ -7,8 +7,39 @@
 # The sources are generated once into WORK (default /tmp/matbake-bench-build, about 3 GB for
 # 200 × 2048²) and kept for later runs.
 #   scripts/bench-build.sh [N [SIZE [WORK]]]
+# With --noop [N [WORK]] instead: N materials (default 10,000) of one 4x4 source file each, built
+# once, then the time of runs with nothing to do (the stamps read and checked; the best of 5).
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+if [ "${1:-}" = "--noop" ]; then
+  n=${2:-10000}
+  work=${3:-/tmp/matbake-bench-noop}
+  bash "$root/scripts/build.sh" "$root/build" >/dev/null
+  matbake=$root/build/cli/matbake
+  if [ "$(cat "$work/made" 2>/dev/null)" != "$n" ]; then
+    rm -rf "$work" && mkdir -p "$work/src"
+    oiiotool --pattern constant:color=0.5,0.4,0.3 4x4 3 -d uint8 -o "$work/one.png"
+    {
+      echo 'validate = { enabled = false }'
+      for ((i = 0; i < n; i++)); do
+        cp "$work/one.png" "$work/src/m$i.png"
+        printf '[materials.m%05d]\nsources = { base_color = "src/m%d.png", metallic = 0.0, roughness = 0.5 }\nlayout = "gltf-orm"\n' "$i" "$i"
+      done
+    } >"$work/m.toml"
+    echo "$n" >"$work/made"
+  fi
+  rm -rf "$work/out"
+  /usr/bin/time -f "%e" -o "$work/time.txt" "$matbake" build "$work/m.toml" --quiet
+  echo "$n materials from scratch: $(cat "$work/time.txt") s"
+  best=
+  for _ in 1 2 3 4 5; do
+    /usr/bin/time -f "%e %M" -o "$work/time.txt" "$matbake" build "$work/m.toml" --quiet
+    read -r s kb <"$work/time.txt"
+    if [ -z "$best" ] || awk -v a="$s" -v b="$best" 'BEGIN { exit !(a < b) }'; then best=$s best_kb=$kb; fi
+  done
+  echo "nothing to do, $n materials: $best s (best of 5), peak RSS $((best_kb / 1024)) MB"
+  exit 0
+fi
 n=${1:-200}
 size=${2:-2048}
 work=${3:-/tmp/matbake-bench-build}

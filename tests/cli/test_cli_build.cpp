@@ -162,7 +162,9 @@ TEST(CliBuild, RebuildsWhatChangedAndOnlyThat) {
   const json stamp = json::parse(read_bytes(dir / "out/.matbake/material-wood.json"));
   EXPECT_EQ(stamp["inputs"][0]["path"], "textures/wood_albedo.png");  // relative to the manifest's folder
   EXPECT_EQ(stamp["inputs"][0]["mtime"].get<std::int64_t>(),
-            std::chrono::duration_cast<std::chrono::nanoseconds>(fs::last_write_time(wood).time_since_epoch()).count());
+            std::chrono::duration_cast<std::chrono::nanoseconds>(
+                std::chrono::file_clock::to_sys(fs::last_write_time(wood)).time_since_epoch())
+                .count());  // nanoseconds since 1970, as stat gives them
 
   // New bytes in the rubber texture: rubber and the scene (which uses it), nothing else.
   write_raw(dir / "textures/rubber_albedo.png", 2, 2, 1, "uint8", {50, 51, 52, 53});

@@ -214,12 +214,17 @@ Result<Layout> parse_layout(std::string_view json_text, const std::string& origi
 }
 
 Result<ResolvedLayout> resolve_layout(const std::string& reference, const fs::path& folder) {
-  for (const BuiltinLayout& b : builtin_layouts()) {
-    if (b.name == reference) {
-      auto layout = parse_layout(b.json, "presets/layouts/" + std::string(b.name) + ".json");
-      if (!layout) return layout.error();
-      return ResolvedLayout{std::move(*layout), {}};
+  // The presets parsed once (a manifest of 10,000 materials names one 10,000 times).
+  static const std::map<std::string_view, Result<Layout>> parsed_presets = [] {
+    std::map<std::string_view, Result<Layout>> parsed;
+    for (const BuiltinLayout& b : builtin_layouts()) {
+      parsed.emplace(b.name, parse_layout(b.json, "presets/layouts/" + std::string(b.name) + ".json"));
     }
+    return parsed;
+  }();
+  if (const auto preset = parsed_presets.find(reference); preset != parsed_presets.end()) {
+    if (!preset->second) return preset->second.error();
+    return ResolvedLayout{*preset->second, {}};
   }
   fs::path file = (folder / reference).lexically_normal();
   if (!file.has_extension()) file += ".json";

@@ -15,6 +15,7 @@ struct MadeLog {
   using Files = std::map<std::string, std::string>;  // path (relative to the output folder) → content hash
   std::map<std::string, Files> jobs;  // by job name: what its last successful run wrote
   Files stale;  // made by an earlier run, by no job since, not yet removed
+  bool operator==(const MadeLog&) const = default;
 };
 
 MadeLog read_made_log(const StampRoots& roots);  // empty when there is none or it is unreadable

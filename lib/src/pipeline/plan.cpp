@@ -1,7 +1,11 @@
 // The jobs of a manifest, what each reads and writes, and the files build systems read: Make
 // depfiles and a Ninja file.
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <set>
+#include <unordered_map>
+#include <unordered_set>
 
 #include "../gltf/document.hpp"
 #include "state.hpp"
@@ -95,6 +99,48 @@ std::optional<Error> material_problem(const MaterialSpec& m, const Result<std::v
   return std::nullopt;
 }
 
+// Real paths (links resolved, as fs::weakly_canonical gives them) of many files in few folders:
+// each folder is resolved and listed once (which of its entries are links), so a file costs no
+// system call (not a readlink per component, nor an lstat).
+class RealPaths {
+ public:
+  const fs::path& of(const fs::path& absolute) {
+    if (const auto found = known_.find(absolute.native()); found != known_.end()) return found->second;
+    fs::path real = absolute;
+    if (absolute.has_relative_path()) {
+      const fs::path& folder = of(absolute.parent_path());
+      real = folder / absolute.filename();
+      if (links_in(folder).count(absolute.filename().native())) {
+        std::error_code ec;
+        real = fs::weakly_canonical(real, ec);
+        if (ec) real = absolute;
+      }
+    }
+    return known_.emplace(absolute.native(), std::move(real)).first->second;
+  }
+  bool inside(const fs::path& folder, const fs::path& path) {
+    const fs::path& f = of(folder.has_filename() ? folder : folder.parent_path());  // "out/" is "out"
+    const fs::path& p = of(path);
+    const auto [end, rest] = std::mismatch(f.begin(), f.end(), p.begin(), p.end());
+    return end == f.end();
+  }
+
+ private:
+  const std::unordered_set<std::string>& links_in(const fs::path& folder) {
+    auto [found, added] = links_.try_emplace(folder.native());
+    if (added) {
+      std::error_code ec;
+      for (const auto& entry : fs::directory_iterator(folder, ec)) {
+        if (entry.is_symlink(ec)) found->second.insert(entry.path().filename().native());
+      }
+    }
+    return found->second;
+  }
+
+  std::unordered_map<std::string, fs::path> known_;  // by the native string: fs::path compares by component, slowly
+  std::unordered_map<std::string, std::unordered_set<std::string>> links_;  // folder → names of its links
+};
+
 void add_unique(std::vector<fs::path>& to, const std::vector<fs::path>& from) {
   for (const fs::path& p : from) {
     if (std::find(to.begin(), to.end(), p) == to.end()) to.push_back(p);
@@ -118,6 +164,30 @@ std::string make_escape(const std::string& path) {
     out += c;
   }
   return out;
+}
+
+
+// A material's job: what it reads and writes, its options, and what makes it fail before it starts.
+Result<Job> material_job(const Manifest& manifest, std::size_t i, const Result<std::vector<material_table::Material>>& table) {
+  const MaterialSpec& m = manifest.materials[i];
+  const fs::path materials_folder = manifest.output / "materials";
+  Job job;
+  job.kind = JobKind::material;
+  job.spec = i;
+  job.name = "material:" + m.name;
+  job.inputs = material_inputs(m, manifest);
+  job.options = material_options(m, manifest).dump();
+  job.problem = material_problem(m, table, manifest.origins);
+  if (m.layout) {
+    auto paths = pack::output_paths(m.layout->layout, {(materials_folder / (m.name + "_{texture}." + m.options.format)).string()});
+    if (!paths) return Error{m.origins.of("layout"), "materials." + m.name + ".layout: " + paths.error().to_string()};
+    job.outputs.textures = *paths;
+  }
+  if (m.validation.enabled) {
+    job.outputs.validation_report = materials_folder / (m.name + ".validation.json");
+    if (m.validation.heatmap) job.outputs.heatmap = materials_folder / (m.name + "_validation.png");
+  }
+  return job;
 }
 
 }  // namespace
@@ -149,7 +219,6 @@ Result<Plan> make_plan(const Manifest& manifest) {
     Plan plan;
     plan.warnings = manifest.notes;
     plan.state_folder = manifest.output / ".matbake";
-    const fs::path materials_folder = manifest.output / "materials";
     std::vector<bool> used(manifest.materials.size(), false);
     const auto material_index = [&](const std::string& name) -> std::optional<std::size_t> {
       for (std::size_t i = 0; i < manifest.materials.size(); ++i) {
@@ -162,8 +231,11 @@ Result<Plan> make_plan(const Manifest& manifest) {
                                         [](const MaterialSpec& m) { return !m.reference.empty(); });
     const auto table = references ? material_table::table_or_builtin(manifest.table)
                                   : Result<std::vector<material_table::Material>>(std::vector<material_table::Material>{});
-    std::vector<std::optional<Error>> problems;
-    for (const MaterialSpec& m : manifest.materials) problems.push_back(material_problem(m, table, manifest.origins));
+    // Each material's job made in parallel (its problems and options are most of a large plan).
+    std::vector<Result<Job>> material_jobs(manifest.materials.size(), Job{});
+    tbb::parallel_for(std::size_t(0), material_jobs.size(), [&](std::size_t i) {
+      material_jobs[i] = material_job(manifest, i, table);
+    });
 
     std::vector<Job> scenes;
     for (std::size_t i = 0; i < manifest.scenes.size(); ++i) {
@@ -209,7 +281,7 @@ Result<Plan> make_plan(const Manifest& manifest) {
         used[m] = true;
         job.materials[gltf_name] = m;
         add_unique(job.inputs, material_inputs(manifest.materials[m], manifest));
-        if (!job.problem) job.problem = problems[m];
+        if (!job.problem && material_jobs[m]) job.problem = material_jobs[m]->problem;
         materials[gltf_name] = material_options(manifest.materials[m], manifest);
       }
       job.options = nlohmann::json{{"input", manifest_relative(s.input, manifest)},
@@ -222,22 +294,8 @@ Result<Plan> make_plan(const Manifest& manifest) {
 
     for (std::size_t i = 0; i < manifest.materials.size(); ++i) {
       const MaterialSpec& m = manifest.materials[i];
-      Job job;
-      job.kind = JobKind::material;
-      job.spec = i;
-      job.name = "material:" + m.name;
-      job.inputs = material_inputs(m, manifest);
-      job.options = material_options(m, manifest).dump();
-      job.problem = problems[i];
-      if (m.layout) {
-        auto paths = pack::output_paths(m.layout->layout, {(materials_folder / (m.name + "_{texture}." + m.options.format)).string()});
-        if (!paths) return Error{m.origins.of("layout"), "materials." + m.name + ".layout: " + paths.error().to_string()};
-        job.outputs.textures = *paths;
-      }
-      if (m.validation.enabled) {
-        job.outputs.validation_report = materials_folder / (m.name + ".validation.json");
-        if (m.validation.heatmap) job.outputs.heatmap = materials_folder / (m.name + "_validation.png");
-      }
+      if (!material_jobs[i]) return material_jobs[i].error();
+      Job& job = *material_jobs[i];
       if (!m.layout && !used[i] && !m.validation.enabled) {
         plan.warnings.push_back("materials." + m.name +
                                 ": no layout, no validation and no scene uses it, so nothing is built from it");
@@ -246,13 +304,13 @@ Result<Plan> make_plan(const Manifest& manifest) {
       if (job.outputs.all().empty()) continue;  // used by scenes only, nothing of its own to write
       plan.jobs.push_back(std::move(job));
     }
-    std::set<std::string> material_jobs;
-    for (const Job& j : plan.jobs) material_jobs.insert(j.name);
+    std::set<std::string> made_jobs;
+    for (const Job& j : plan.jobs) made_jobs.insert(j.name);
     for (Job& s : scenes) {
       std::set<std::string> needed;
       for (const auto& [gltf_name, m] : s.materials) {
         const std::string material_job = "material:" + manifest.materials[m].name;
-        if (material_jobs.count(material_job)) needed.insert(material_job);
+        if (made_jobs.count(material_job)) needed.insert(material_job);
       }
       s.depends_on.assign(needed.begin(), needed.end());
       plan.jobs.push_back(std::move(s));
@@ -260,27 +318,23 @@ Result<Plan> make_plan(const Manifest& manifest) {
 
     // No file written twice, no input written at all (both by real path: links followed), and
     // nothing written outside the output folder's real path (a link inside it to elsewhere).
-    const auto real = [](const fs::path& p) {
-      std::error_code ec;
-      const fs::path r = fs::weakly_canonical(p, ec);
-      return ec ? p : r;
-    };
-    std::map<fs::path, std::string> writers;
-    std::set<fs::path> inputs;
+    RealPaths real;
+    std::unordered_map<std::string, std::string> writers;
+    std::unordered_set<std::string> inputs;
     for (const Job& job : plan.jobs) {
-      for (const fs::path& in : job.inputs) inputs.insert(real(in));
+      for (const fs::path& in : job.inputs) inputs.insert(real.of(in).native());
     }
-    inputs.insert(real(manifest.file));
-    if (!is_really_inside(manifest.output, plan.state_folder)) {
+    inputs.insert(real.of(manifest.file).native());
+    if (!real.inside(manifest.output, plan.state_folder)) {
       return Error{plan.state_folder.string(), "is a link out of the output folder; matbake writes only inside it"};
     }
     for (const Job& job : plan.jobs) {
       for (const fs::path& out : job.outputs.all()) {
-        if (!is_really_inside(manifest.output, out)) {
+        if (!real.inside(manifest.output, out)) {
           return Error{out.string(), job.name + " would be written outside the output folder (through a link); matbake writes only inside it"};
         }
-        if (inputs.count(real(out))) return Error{out.string(), job.name + " would overwrite an input; matbake never does"};
-        if (const auto [it, added] = writers.emplace(out, job.name); !added) {
+        if (inputs.count(real.of(out).native())) return Error{out.string(), job.name + " would overwrite an input; matbake never does"};
+        if (const auto [it, added] = writers.emplace(out.native(), job.name); !added) {
           return Error{out.string(), "written by both " + it->second + " and " + job.name};
         }
       }

@@ -1,5 +1,6 @@
 // Running a plan: the out-of-date jobs in parallel, each source file decoded once and freed when
 // the last job that reads it is done.
+#include <tbb/parallel_for.h>
 #include <tbb/parallel_for_each.h>
 #include <tbb/task_arena.h>
 
@@ -303,11 +304,12 @@ void run_job(const Job& job, const JobContext& ctx, const RunOptions& run_option
 // The log of files made, brought up to date, the stamps of jobs the manifest no longer has removed,
 // and after a full run with no failure the stale files too (unless kept).
 Status finish_run(const Plan& plan, const RunOptions& options, const StampRoots& roots, Report& report) {
-  MadeLog log = read_made_log(roots);
+  const MadeLog before = read_made_log(roots);
+  MadeLog log = before;
   for (const std::string& name : record_run(log, plan, report, roots)) remove_stamp(name, roots);
   const bool full = options.only.empty() && report.count(Outcome::failed) == 0;
   report.stale = clean_stale(log, roots, full && !options.keep_stale);
-  return write_made_log(log, roots);
+  return log == before ? success() : write_made_log(log, roots);  // a no-op run writes nothing
 }
 
 }  // namespace
@@ -322,12 +324,24 @@ Result<Report> run(const Manifest& manifest, const Plan& plan, const RunOptions&
   }
   const StampRoots roots{plan.state_folder, manifest.folder, manifest.output};
   Report report;
-  std::vector<std::size_t> to_run;
+  std::vector<const Job*> selected;
   for (const Job& job : plan.jobs) {
-    if (!options.only.empty() && std::find(options.only.begin(), options.only.end(), job.name) == options.only.end()) continue;
+    if (options.only.empty() || std::find(options.only.begin(), options.only.end(), job.name) != options.only.end()) {
+      selected.push_back(&job);
+    }
+  }
+  // The stamps read in parallel: a no-op run of a large manifest is mostly this.
+  std::vector<std::string> reasons(selected.size(), "forced");
+  if (!options.force) {
+    tbb::parallel_for(std::size_t(0), selected.size(),
+                      [&](std::size_t i) { reasons[i] = out_of_date_reason(*selected[i], roots, !options.dry_run); });
+  }
+  std::vector<std::size_t> to_run;
+  for (std::size_t i = 0; i < selected.size(); ++i) {
+    const Job& job = *selected[i];
     JobReport r;
     r.job = &job;
-    r.reason = options.force ? "forced" : out_of_date_reason(job, roots, !options.dry_run);
+    r.reason = std::move(reasons[i]);
     if (job.problem && options.dry_run) {  // it would fail: said now, not after a "would build"
       r.outcome = Outcome::failed;
       r.error = job.problem;

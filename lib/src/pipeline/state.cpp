@@ -1,6 +1,7 @@
 #include "state.hpp"
 
 #include <nlohmann/json.hpp>
+#include <sys/stat.h>
 #include <xxhash.h>
 
 #include "matbake/atomic_file.hpp"
@@ -32,11 +33,9 @@ FileIdentity identity_in(const nlohmann::json& f) {
 // else what is wrong with it.
 std::string check_recorded(nlohmann::json& f, const fs::path& p, const char* missing, const char* changed, bool& touched) {
   const FileIdentity recorded = identity_in(f);
-  std::error_code ec;
-  const std::uintmax_t size = fs::file_size(p, ec);
-  const std::optional<std::int64_t> mtime = modification_time(p);
-  if (ec || !mtime) return missing + p.string();
-  if (size == recorded.size && *mtime == recorded.mtime) return {};
+  const std::optional<FileStat> now_stat = stat_file(p);  // one system call: the common case
+  if (!now_stat) return missing + p.string();
+  if (now_stat->size == recorded.size && now_stat->mtime == recorded.mtime) return {};
   const std::optional<FileIdentity> now = identify(p);
   if (!now || now->hash != recorded.hash) return changed + p.string();
   f["mtime"] = now->mtime;
@@ -78,11 +77,16 @@ std::string content_hash(std::span<const unsigned char> bytes) {
   return hex;
 }
 
+std::optional<FileStat> stat_file(const fs::path& file) {
+  struct stat s;
+  if (::stat(file.c_str(), &s) != 0) return std::nullopt;
+  return FileStat{std::uintmax_t(s.st_size), std::int64_t(s.st_mtim.tv_sec) * 1000000000 + s.st_mtim.tv_nsec};
+}
+
 std::optional<std::int64_t> modification_time(const fs::path& file) {
-  std::error_code ec;
-  const auto time = fs::last_write_time(file, ec);
-  if (ec) return std::nullopt;
-  return std::int64_t(std::chrono::duration_cast<std::chrono::nanoseconds>(time.time_since_epoch()).count());
+  const std::optional<FileStat> s = stat_file(file);
+  if (!s) return std::nullopt;
+  return s->mtime;
 }
 
 std::optional<FileIdentity> identify(const fs::path& file) {
@@ -93,9 +97,8 @@ std::optional<FileIdentity> identify(const fs::path& file) {
 }
 
 bool changed_since(const fs::path& file, const FileIdentity& read) {
-  std::error_code ec;
-  const std::uintmax_t size = fs::file_size(file, ec);
-  if (!ec && size == read.size && modification_time(file) == read.mtime) return false;
+  const std::optional<FileStat> s = stat_file(file);
+  if (s && s->size == read.size && s->mtime == read.mtime) return false;
   const std::optional<FileIdentity> now = identify(file);
   return !now || now->hash != read.hash;
 }

@@ -25,6 +25,12 @@ struct FileIdentity {
 };
 
 std::string content_hash(std::span<const unsigned char> bytes);
+// Size and modification time (nanoseconds since 1970) in one system call; empty when missing.
+struct FileStat {
+  std::uintmax_t size = 0;
+  std::int64_t mtime = 0;
+};
+std::optional<FileStat> stat_file(const std::filesystem::path& file);
 std::optional<std::int64_t> modification_time(const std::filesystem::path& file);
 // The time first, then the bytes: a write in between leaves a time that differs from the file's
 // next time, and the hash then decides. Empty when the file cannot be read.
