@@ -161,6 +161,7 @@ int run_build(const BuildSettings& s, const GlobalOptions& global) {
       for (const std::string& w : r.warnings) std::cerr << "matbake: warning: " << r.job->name << ": " << w << "\n";
     }
     print_stale(report->stale, s.dry_run);
+    for (const std::string& w : report->warnings) std::cerr << "matbake: warning: " << w << "\n";
     const std::size_t built = report->count(pipeline::Outcome::built), current = report->count(pipeline::Outcome::up_to_date),
                       pending = report->count(pipeline::Outcome::out_of_date), skipped = report->count(pipeline::Outcome::skipped);
     if (built + failed + pending + skipped == 0) {

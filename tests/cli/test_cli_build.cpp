@@ -626,6 +626,9 @@ TEST(CliBuild, InterruptKeepsFinishedOutputsAndNoTemporaryFiles) {
     const json rest = run_json({"build", manifest_path});
     EXPECT_EQ(rest["up_to_date"], finished);
     EXPECT_EQ(rest["built"], kMaterials - finished);
+    // The interrupted run wrote no log of what it made; the next one logs its finished jobs too
+    // (from their stamps), so their files can be found stale later.
+    EXPECT_EQ(json::parse(read_bytes(state_folder / "made.json"))["jobs"].size(), std::size_t(kMaterials));
   }
 }
 

@@ -156,7 +156,8 @@ struct JobReport {
   // Inputs that changed while the job ran: its outputs are from the bytes read before, as its stamp
   // records, so it runs again next time (the build says so and exits 1).
   std::vector<std::filesystem::path> moved;
-  std::map<std::filesystem::path, std::string> written;  // a built job's outputs, each with its content hash
+  // Its outputs with their content hashes: as written (built) or as its stamp records them (up to date).
+  std::map<std::filesystem::path, std::string> written;
 };
 
 // Files an earlier run made that no job of the manifest makes now (a material removed or renamed,
@@ -182,6 +183,7 @@ struct Report {
   std::vector<JobReport> jobs;  // in plan order
   std::size_t images_decoded = 0;
   StaleOutputs stale;
+  std::vector<std::string> warnings;  // about the run as a whole
   std::size_t count(Outcome o) const;
   std::size_t moved() const;  // jobs with an input that changed while they ran
   std::size_t over_validation_limit() const;  // jobs whose advisory validation flagged more than allowed

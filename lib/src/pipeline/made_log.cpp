@@ -46,7 +46,9 @@ Status write_made_log(const MadeLog& log, const StampRoots& roots) {
 
 std::vector<std::string> record_run(MadeLog& log, const Plan& plan, const Report& report, const StampRoots& roots) {
   for (const JobReport& r : report.jobs) {
-    if (r.outcome != Outcome::built) continue;
+    // A built job's entry is what it wrote; an up-to-date one's what its stamp says (a run killed
+    // before it wrote the log leaves stamps the log does not have yet).
+    if (r.outcome != Outcome::built && r.outcome != Outcome::up_to_date) continue;
     MadeLog::Files now;
     for (const auto& [path, hash] : r.written) now[stamped_path(path, roots.outputs)] = hash;
     for (const auto& [path, hash] : log.jobs[r.job->name]) {

@@ -45,6 +45,7 @@ nlohmann::json json_report(const Manifest& manifest, const Plan& plan, const Rep
                                  {"kept", strings(report.stale.kept)},
                                  {"changed", strings(report.stale.changed)}}},
                       {"warnings", plan.warnings}};
+  for (const std::string& w : report.warnings) j["warnings"].push_back(w);
   for (const auto& [outcome, name] : kOutcomeNames) j[std::string(name)] = report.count(outcome);
   j["over_validation_limit"] = report.over_validation_limit();
   return j;

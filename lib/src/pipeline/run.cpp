@@ -332,9 +332,11 @@ Result<Report> run(const Manifest& manifest, const Plan& plan, const RunOptions&
   }
   // The stamps read in parallel: a no-op run of a large manifest is mostly this.
   std::vector<std::string> reasons(selected.size(), "forced");
+  std::vector<std::map<fs::path, std::string>> recorded(selected.size());
   if (!options.force) {
-    tbb::parallel_for(std::size_t(0), selected.size(),
-                      [&](std::size_t i) { reasons[i] = out_of_date_reason(*selected[i], roots, !options.dry_run); });
+    tbb::parallel_for(std::size_t(0), selected.size(), [&](std::size_t i) {
+      reasons[i] = out_of_date_reason(*selected[i], roots, !options.dry_run, &recorded[i]);
+    });
   }
   std::vector<std::size_t> to_run;
   for (std::size_t i = 0; i < selected.size(); ++i) {
@@ -342,6 +344,7 @@ Result<Report> run(const Manifest& manifest, const Plan& plan, const RunOptions&
     JobReport r;
     r.job = &job;
     r.reason = std::move(reasons[i]);
+    r.written = std::move(recorded[i]);  // up to date: its outputs as its stamp records them
     if (job.problem && options.dry_run) {  // it would fail: said now, not after a "would build"
       r.outcome = Outcome::failed;
       r.error = job.problem;
@@ -403,7 +406,11 @@ Result<Report> run(const Manifest& manifest, const Plan& plan, const RunOptions&
     });
   }
   report.images_decoded = cache.decoded();
-  if (Status s = finish_run(plan, options, roots, report); !s) return s.error();
+  // The log is a convenience (stale files found later), not an output: a full disk or a read-only
+  // folder that lets no job write has already failed the jobs, each with its error line.
+  if (Status s = finish_run(plan, options, roots, report); !s) {
+    report.warnings.push_back("the log of files made was not updated: " + s.error().to_string());
+  }
   return report;
 }
 

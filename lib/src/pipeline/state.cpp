@@ -103,7 +103,7 @@ bool changed_since(const fs::path& file, const FileIdentity& read) {
   return !now || now->hash != read.hash;
 }
 
-std::string out_of_date_reason(const Job& job, const StampRoots& roots, bool refresh) {
+std::string out_of_date_reason(const Job& job, const StampRoots& roots, bool refresh, std::map<fs::path, std::string>* recorded_outputs) {
   std::string text;
   if (!read_whole_file(stamp_path(job.name, roots), text)) return "no earlier build";
   nlohmann::json stamp = nlohmann::json::parse(text, nullptr, false);
@@ -129,6 +129,11 @@ std::string out_of_date_reason(const Job& job, const StampRoots& roots, bool ref
   }
   // Best effort: a stamp that cannot be written again only costs the next run some hashing.
   if (touched && refresh) (void)write_file_atomically(stamp_path(job.name, roots), stamp.dump(1) + "\n");
+  if (recorded_outputs) {
+    for (const nlohmann::json& f : stamp["outputs"]) {
+      (*recorded_outputs)[resolved_path(f.value("path", ""), roots.outputs)] = f.value("hash", "");
+    }
+  }
   return {};
 }
 

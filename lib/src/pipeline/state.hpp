@@ -6,6 +6,7 @@
 // same bytes is up to date.
 #include <cstdint>
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <span>
 #include <string>
@@ -53,7 +54,9 @@ struct StampRoots {
 // as recorded is taken as unchanged; otherwise its content hash decides (a touched file, a fresh
 // checkout or a copied tree does not rebuild). With `refresh`, the stamp of an up-to-date job takes
 // the new times, so that the next run need not hash those files again.
-std::string out_of_date_reason(const Job& job, const StampRoots& roots, bool refresh);
+// `recorded` (when given) receives the stamp's outputs with their hashes when the job is up to date.
+std::string out_of_date_reason(const Job& job, const StampRoots& roots, bool refresh,
+                               std::map<std::filesystem::path, std::string>* recorded = nullptr);
 
 // The files as they are now; an error names the first that cannot be read.
 Result<std::vector<StampedFile>> identify_all(const std::vector<std::filesystem::path>& files);
