@@ -31,9 +31,10 @@ void print_texture_reports(const std::vector<bake_ao::TextureReport>& textures) 
     if (t.node >= 0) std::printf("node %d, ", t.node);
     std::printf("material %d '%s': %s, %dx%d over TEXCOORD_%d, %zu texels mapped (%zu on seams), %.1f%% of them overlapped, "
                 "%zu padded, mean %.4f%s\n",
-                t.material, t.name.c_str(), t.file.c_str(), t.width, t.height, t.texcoord, t.covered + t.touched, t.touched,
+                t.material, escape_control(t.name).c_str(), t.file.c_str(), t.width, t.height, t.texcoord, t.covered + t.touched, t.touched,
                 mapped > 0 ? 100.0 * double(t.overlapped) / mapped : 0.0, t.padded, t.mean,
                 t.existing.empty() ? "" : (", its own occlusion texture " + t.existing).c_str());
+    if (!t.orm.empty()) std::printf("  ORM %s\n", t.orm.c_str());
     if (t.wrapped) std::printf("  %zu triangles reach outside [0, 1]: wrapped by the sampler's mode\n", t.wrapped);
     if (t.degenerate_uv) std::printf("  %zu triangles with no UV area skipped\n", t.degenerate_uv);
     if (t.too_large) std::printf("  %zu triangles spanning more than 64 copies of the texture skipped\n", t.too_large);

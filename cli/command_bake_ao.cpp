@@ -40,11 +40,12 @@ int run_bake_ao(const BakeAoSettings& s, const GlobalOptions& global) {
                                 {"setup_seconds", report->setup_seconds}, {"ray_seconds", report->ray_seconds},
                                 {"max_distance", report->max_distance}, {"mean_ao", report->mean},
                                 {"texels", report->texels}, {"texel_seconds", report->texel_seconds},
-                                {"textures", textures}, {"notes", report->notes}}
+                                {"textures", textures}, {"geometry", report->geometry}, {"notes", report->notes}}
                      .dump(2)
               << "\n";
   } else if (!global.quiet) {
-    for (const std::string& note : report->notes) std::cout << "note: " << note << "\n";
+    for (const std::string& note : report->geometry) std::cout << "geometry: " << escape_control(note) << "\n";
+    for (const std::string& note : report->notes) std::cout << "note: " << escape_control(note) << "\n";
     print_texture_reports(report->textures);
     if (!report->textures.empty()) {
       std::printf("%s: %zu textures, %llu texels, %.3g rays in %.2f s (%.1f M rays/s; UV setup %.2f s), d_max %.4g, mean %.4f\n",

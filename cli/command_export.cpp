@@ -112,8 +112,9 @@ int run_export(const ExportSettings& s, const GlobalOptions& global) {
       if (m.ior) std::printf("; KHR_materials_ior %.4g", *m.ior);
       std::printf("\n");
     }
-    for (const std::string& skipped : report->skipped) std::cout << "left out: " << skipped << "\n";
-    for (const std::string& note : report->ao_notes) std::cout << "note: " << note << "\n";
+    for (const std::string& skipped : report->skipped) std::cout << "left out: " << escape_control(skipped) << "\n";
+    for (const std::string& note : report->geometry) std::cout << "geometry: " << escape_control(note) << "\n";
+    for (const std::string& note : report->ao_notes) std::cout << "note: " << escape_control(note) << "\n";
     print_texture_reports(report->ao_textures);
   }
   return kOk;

@@ -23,6 +23,8 @@ struct TextureReport {
   std::size_t covered = 0, touched = 0, overlapped = 0, padded = 0;  // texels (ao::TextureBake)
   std::size_t triangles = 0, degenerate_uv = 0, wrapped = 0, too_large = 0, instances_without_uv = 0;
   std::string existing;  // what happened to the material's own occlusion texture: "", "multiplied", "replaced"
+                         // (each saying when it had a KHR_texture_transform)
+  std::string orm;       // with ORM asked for, why the bake was kept apart from metallic-roughness; "" otherwise
   double mean = 0;       // of the bake (before any multiplication), over covered and touched texels
 };
 
@@ -47,6 +49,8 @@ struct Report {
   std::vector<TextureReport> textures;  // with --texture
   std::uint64_t texels = 0;             // traced, with --texture
   double texel_seconds = 0;             // rasterizing UVs and padding, with --texture
+  std::vector<std::string> geometry;  // compressed or sparse geometry: decoded to read, and written
+                                      // back as it came or uncompressed (gltf::geometry_notes)
   std::vector<std::string> notes;    // the scene's (what was skipped) and the bake's
   std::vector<std::string> written;  // files
 };

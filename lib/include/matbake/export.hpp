@@ -71,6 +71,8 @@ struct Report {
   std::uint64_t ao_rays = 0;
   std::vector<bake_ao::TextureReport> ao_textures;  // with ao.texture: each material's baked occlusion
   std::vector<std::string> ao_notes;       // what the texture bake skipped or averaged
+  std::vector<std::string> geometry;       // compressed or sparse geometry: decoded to read, written back
+                                           // as it came or uncompressed (gltf::geometry_notes)
 };
 
 Result<Report> export_scene(const std::filesystem::path& input, const std::filesystem::path& output,

@@ -1,20 +1,47 @@
 #pragma once
 // Errors that user input can cause are values, not exceptions or prints: the library returns them
 // and only the CLI prints `matbake: error: <path>: <problem>` and picks the exit code.
+#include <cstdio>
 #include <exception>
 #include <new>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <variant>
 
 namespace matbake {
+
+// `text` with its control characters written as escapes (\n, \r, \t, \xNN): a name from a file
+// that holds a newline cannot split a message into two lines.
+inline std::string escape_control(std::string_view text) {
+  std::string out;
+  out.reserve(text.size());
+  for (const char c : text) {
+    const auto u = static_cast<unsigned char>(c);
+    if (u >= 0x20 && u != 0x7f) {
+      out += c;
+    } else if (c == '\n') {
+      out += "\\n";
+    } else if (c == '\r') {
+      out += "\\r";
+    } else if (c == '\t') {
+      out += "\\t";
+    } else {
+      char hex[8];
+      std::snprintf(hex, sizeof hex, "\\x%02x", u);
+      out += hex;
+    }
+  }
+  return out;
+}
 
 struct Error {
   std::string path;     // the file the problem is about; empty when it is about no file
   std::string message;  // one line, lower case, no trailing period
   bool usage = false;   // the command was called wrongly (exit 2), rather than given bad input (exit 1)
 
-  std::string to_string() const { return path.empty() ? message : path + ": " + message; }
+  // One line whatever the path and message hold.
+  std::string to_string() const { return escape_control(path.empty() ? message : path + ": " + message); }
 };
 
 template <class T>

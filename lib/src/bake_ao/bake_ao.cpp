@@ -2,6 +2,7 @@
 
 #include <chrono>
 
+#include "../gltf/decode.hpp"
 #include "../gltf/vertex_occlusion.hpp"
 #include "textures.hpp"
 #include "../scene/from_document.hpp"
@@ -124,6 +125,7 @@ Result<Report> bake_file(const fs::path& input, const Options& options) {
       report.ray_seconds = baked->ray_seconds;
       report.max_distance = baked->max_distance;
     }
+    report.geometry = gltf::geometry_notes(*doc);
     if (!options.output.empty()) {
       auto written = gltf::write_document(*doc, options.output);
       if (!written) return written.error();

@@ -5,17 +5,13 @@
 #include <set>
 
 #include "../gltf/texture_files.hpp"
+#include "../gltf/texture_transform.hpp"
 
 namespace matbake::bake_ao {
 namespace fs = std::filesystem;
 namespace {
 
 using gltf::Json;
-
-ao::Wrap wrap_of(const Json& sampler, const char* key) {
-  const int mode = gltf::integer_in<int>(sampler, key, 10497, 10497);
-  return mode == 33071 ? ao::Wrap::clamp_to_edge : mode == 33648 ? ao::Wrap::mirrored_repeat : ao::Wrap::repeat;
-}
 
 // The material's occlusionTexture, when it has a valid one.
 const Json* occlusion_of(const Json& material, const Json& json) {
@@ -35,6 +31,13 @@ const Json* metallic_roughness_of(const Json& material, const Json& json, int te
   if (gltf::size_in(info, "index", SIZE_MAX) >= gltf::array_in(json, "textures").size()) return nullptr;
   if (gltf::integer_in<int>(info, "texCoord", 0, -1) != texcoord || info.contains("extensions")) return nullptr;
   return &info;
+}
+
+bool has_transformed_metallic_roughness(const Json& material) {
+  const Json* pbr = material.contains("pbrMetallicRoughness") ? &material["pbrMetallicRoughness"] : nullptr;
+  if (pbr == nullptr || !pbr->is_object() || !pbr->contains("metallicRoughnessTexture")) return false;
+  const Json& info = (*pbr)["metallicRoughnessTexture"];
+  return info.is_object() && info.contains("extensions") && info["extensions"].contains("KHR_texture_transform");
 }
 
 // A new texture over a new PNG file in `doc`, with the sampler of texture `sampler_from` (none when -1).
@@ -153,8 +156,8 @@ Result<OcclusionTargets> occlusion_targets(const gltf::Document& doc, const scen
     }
     if (existing) {
       if (const Json* sampler = sampler_of(doc.json, gltf::size_in(*existing, "index", 0))) {
-        target.wrap_s = wrap_of(*sampler, "wrapS");
-        target.wrap_t = wrap_of(*sampler, "wrapT");
+        target.wrap_s = gltf::wrap_of(*sampler, "wrapS");
+        target.wrap_t = gltf::wrap_of(*sampler, "wrapT");
       }
     }
     // One texture cannot hold two placements of the same surface (without --per-instance).
@@ -217,14 +220,21 @@ Result<std::vector<TextureReport>> bake_occlusion_textures(gltf::Document& doc, 
       const int old = gltf::integer_in<int>(*existing, "index", -1, -1);
       sampler_from = old;
       const int old_texcoord = gltf::integer_in<int>(*existing, "texCoord", 0, 0);
-      if (texture.multiply_existing && old_texcoord == report.texcoord) {
+      const std::string where = "/materials/" + std::to_string(m) + "/occlusionTexture";
+      auto transform = gltf::uv_transform_of(*existing, doc.file, where);
+      if (!transform) return transform.error();
+      const int mapped_by = transform->texcoord >= 0 ? transform->texcoord : old_texcoord;
+      if (texture.multiply_existing && mapped_by == report.texcoord) {
         auto decoded = cache.texture(old, color::Transfer::linear);
         if (!decoded) return decoded.error();
-        const image::Image own = gltf::at_size(**decoded, bake.width, bake.height);
+        // The bake is over raw UVs; the file's texture is seen through its transform.
+        const image::Image own = transform->identity() ? gltf::at_size(**decoded, bake.width, bake.height)
+                                                       : gltf::sample_through(**decoded, *transform, targets.targets[t].wrap_s,
+                                                                              targets.targets[t].wrap_t, bake.width, bake.height);
         for (std::size_t p = 0; p < img.pixels.size(); ++p) img.pixels[p] *= gltf::rgba(own, p, 0);
-        report.existing = "multiplied";
+        report.existing = transform->identity() ? "multiplied" : "multiplied, sampled through its KHR_texture_transform";
       } else {
-        report.existing = "replaced";
+        report.existing = transform->identity() ? "replaced" : "replaced (its KHR_texture_transform with it: the bake is over raw UVs)";
       }
     }
     if (!texture.dump.empty()) {
@@ -233,6 +243,9 @@ Result<std::vector<TextureReport>> bake_occlusion_textures(gltf::Document& doc, 
       if (Status s = image::write_image(img, dumped_texture(texture.dump, stem, m), exr); !s) return s.error();
     }
     const Json* mr = into == OcclusionInto::orm ? metallic_roughness_of(material, doc.json, report.texcoord) : nullptr;
+    if (into == OcclusionInto::orm && mr == nullptr && has_transformed_metallic_roughness(material)) {
+      report.orm = "kept apart: the metallic-roughness texture has a KHR_texture_transform, the bake none";
+    }
     int index = -1;
     if (mr) {
       // Red: the bake at the metallic-roughness texture's size; green and blue: that texture's.

@@ -5,6 +5,7 @@
 #include <limits>
 #include <map>
 
+#include "../gltf/decode.hpp"
 #include "../gltf/document.hpp"
 #include "../gltf/prune.hpp"
 #include "../scene/from_document.hpp"
@@ -198,6 +199,14 @@ struct Exporter {
     const double gloss = (*gloss_factor)[0];
     const image::Image* textures[2] = {nullptr, nullptr};
     const char* keys[2] = {"diffuseTexture", "specularGlossinessTexture"};
+    if (ext.contains(keys[0]) && ext.contains(keys[1])) {
+      const auto mapping = [](const Json& info) { return Json{info.value("texCoord", Json(0)), info.value("extensions", Json::object())}; };
+      if (mapping(ext[keys[0]]) != mapping(ext[keys[1]])) {
+        return Error{doc.file, "/materials/" + std::to_string(index) + "/extensions/" + kSpecGloss +
+                                   ": diffuseTexture and specularGlossinessTexture are mapped differently (texCoord or "
+                                   "KHR_texture_transform); matbake converts them texel by texel and needs one mapping"};
+      }
+    }
     int width = 1, height = 1;
     for (int t = 0; t < 2; ++t) {
       if (!ext.contains(keys[t])) continue;
@@ -250,9 +259,11 @@ struct Exporter {
     workflow::ConversionReport conversion;
     auto maps = workflow::metal_rough_from_spec_gloss(*sources, options.mapping, conversion);
     if (!maps) return Error{doc.file, "material " + std::to_string(index) + ": " + maps.error().message};
-    Json info = ext.contains("diffuseTexture") ? ext["diffuseTexture"] : Json::object();
+    // The converted textures are mapped as their sources were (texCoord, KHR_texture_transform).
+    const char* mapped_by = ext.contains("diffuseTexture") ? "diffuseTexture" : "specularGlossinessTexture";
+    Json info = ext.contains(mapped_by) ? ext[mapped_by] : Json::object();
     info.erase("index");
-    const int sampler_of = ext.contains("diffuseTexture") ? int_in(ext["diffuseTexture"], "index", -1) : -1;
+    const int sampler_of = ext.contains(mapped_by) ? int_in(ext[mapped_by], "index", -1) : -1;
     if (Status s = write_metal_rough(material, *maps, "material" + std::to_string(index), info, sampler_of); !s) return s;
     add_dielectric_f0(material, conversion, out);
     out.conversion = conversion;
@@ -309,9 +320,14 @@ struct Exporter {
     Json& mr = material["pbrMetallicRoughness"]["metallicRoughnessTexture"];
     Json& occlusion = material["occlusionTexture"];
     const int mr_index = int_in(mr, "index", -1), occlusion_index = int_in(occlusion, "index", -1);
-    if (mr_index == occlusion_index || int_in(mr, "texCoord", 0) != int_in(occlusion, "texCoord", 0) ||
-        mr.contains("extensions") || occlusion.contains("extensions")) {
-      return success();  // already one texture, or mapped differently: nothing to pack
+    if (mr_index == occlusion_index) return success();  // already one texture
+    // One texture has one mapping: maps with different UV sets or KHR_texture_transforms stay apart.
+    const Json no_extensions = Json::object();
+    if (int_in(mr, "texCoord", 0) != int_in(occlusion, "texCoord", 0) ||
+        mr.value("extensions", no_extensions) != occlusion.value("extensions", no_extensions)) {
+      out.action = (out.action == "kept" ? "" : out.action + "; ") +
+                   "occlusion and metallic-roughness kept apart (mapped differently: texCoord or KHR_texture_transform)";
+      return success();
     }
     int orm = -1;
     if (const auto found = orm_made.find({mr_index, occlusion_index}); found != orm_made.end()) {
@@ -485,6 +501,7 @@ Result<Report> export_scene(const fs::path& input, const fs::path& output, const
     // What the conversions replaced (spec-gloss textures, separate occlusion maps, old colours).
     for (std::string& s : gltf::prune_unreachable(*doc)) report.skipped.push_back(s + ": replaced");
     report.images_decoded = cache.decoded();
+    report.geometry = gltf::geometry_notes(*doc);
 
     auto written = gltf::write_document(*doc, output);
     if (!written) return written.error();

@@ -7,7 +7,9 @@
 #include <fstream>
 #include <iterator>
 
+#include "decode.hpp"
 #include "load_model.hpp"
+#include "references.hpp"
 #include "matbake/read_file.hpp"
 #include "matbake/atomic_file.hpp"
 
@@ -102,34 +104,31 @@ struct Chunks {
   }
 };
 
-std::size_t components_of(const std::string& type) {
-  if (type == "SCALAR") return 1;
-  if (type == "VEC2") return 2;
-  if (type == "VEC3") return 3;
-  if (type == "VEC4" || type == "MAT2") return 4;
-  if (type == "MAT3") return 9;
-  if (type == "MAT4") return 16;
-  return 0;
-}
-
-std::size_t component_size_of(int type) {
-  switch (type) {
-    case 5120: case 5121: return 1;  // byte, unsigned byte
-    case 5122: case 5123: return 2;  // short, unsigned short
-    case 5125: case 5126: return 4;  // unsigned int, float
-    default: return 0;
+// The JSON tinygltf is given to read the buffers. It knows neither Draco (it refuses an indices
+// accessor without a view) nor meshopt's fallback buffers (it wants a URI), so meshes are left out
+// (check_references and the readers of accessors check them) and a fallback buffer becomes an
+// empty one. A GLB's buffer 0 is served from its BIN chunk (kGlbBinUri), cut to its byteLength.
+Json for_tinygltf(const Json& json, bool glb, std::vector<unsigned char>& glb_bin) {
+  Json copy = json;
+  copy.erase("meshes");
+  if (!copy.contains("buffers") || !copy["buffers"].is_array()) return copy;
+  Json& buffers = copy["buffers"];
+  for (std::size_t i = 0; i < buffers.size(); ++i) {
+    if (is_fallback_buffer(json, i)) buffers[i] = {{"byteLength", 1}, {"uri", kEmptyBufferUri}};
   }
+  if (glb && !buffers.empty() && buffers[0].is_object() && !buffers[0].contains("uri")) {
+    buffers[0]["uri"] = kGlbBinUri;
+    const std::size_t length = size_in(buffers[0], "byteLength", 0);  // the chunk may carry 3 bytes of padding
+    if (glb_bin.size() > length) glb_bin.resize(length);
+  }
+  return copy;
 }
 
 // Every view within its buffer and every accessor with a view within it (the bytes a writer copies).
 Status check_accessors(const Document& doc) {
   const Json& views = array_in(doc.json, "bufferViews");
   for (std::size_t v = 0; v < views.size(); ++v) {
-    const std::size_t buffer = size_in(views[v], "buffer", SIZE_MAX);
-    const std::size_t offset = size_in(views[v], "byteOffset", 0), length = size_in(views[v], "byteLength", 0);
-    if (buffer >= doc.buffers.size() || offset > doc.buffers[buffer].size() || length > doc.buffers[buffer].size() - offset) {
-      return Error{doc.file, "buffer view " + std::to_string(v) + " reaches beyond its buffer"};
-    }
+    if (auto bytes = view_bytes(doc, v); !bytes) return bytes.error();
   }
   const Json& accessors = array_in(doc.json, "accessors");
   for (std::size_t a = 0; a < accessors.size(); ++a) {
@@ -140,6 +139,25 @@ Status check_accessors(const Document& doc) {
 }
 
 }  // namespace
+
+std::size_t components_of(const std::string& type) {
+  if (type == "SCALAR") return 1;
+  if (type == "VEC2") return 2;
+  if (type == "VEC3") return 3;
+  if (type == "VEC4" || type == "MAT2") return 4;
+  if (type == "MAT3") return 9;
+  if (type == "MAT4") return 16;
+  return 0;
+}
+
+std::size_t component_size_of(int component_type) {
+  switch (component_type) {
+    case 5120: case 5121: return 1;  // byte, unsigned byte
+    case 5122: case 5123: return 2;  // short, unsigned short
+    case 5125: case 5126: return 4;  // unsigned int, float
+    default: return 0;
+  }
+}
 
 const Json& array_in(const Json& json, const char* key) {
   static const Json empty = Json::array();
@@ -195,14 +213,30 @@ Result<std::string> image_bytes(const Document& doc, std::size_t index) {
   });
 }
 
+Result<std::span<const unsigned char>> view_bytes(const Document& doc, std::size_t index) {
+  const std::string name = "buffer view " + std::to_string(index);
+  const Json& views = array_in(doc.json, "bufferViews");
+  if (index >= views.size()) return Error{doc.file, name + " does not exist"};
+  if (const auto decoded = doc.decoded.views.find(index); decoded != doc.decoded.views.end()) {
+    return std::span<const unsigned char>(decoded->second);
+  }
+  const Json& view = views[index];
+  const std::size_t buffer = size_in(view, "buffer", SIZE_MAX);
+  const std::size_t offset = size_in(view, "byteOffset", 0), length = size_in(view, "byteLength", 0);
+  if (buffer < doc.buffers.size() && is_fallback_buffer(doc.json, buffer)) {
+    return Error{doc.file, name + " lies in a meshopt fallback buffer (no bytes) but is not compressed"};
+  }
+  if (buffer >= doc.buffers.size() || offset > doc.buffers[buffer].size() || length > doc.buffers[buffer].size() - offset) {
+    return Error{doc.file, name + " reaches beyond its buffer"};
+  }
+  return std::span<const unsigned char>(doc.buffers[buffer].data() + offset, length);
+}
+
 Result<AccessorBytes> accessor_bytes(const Document& doc, std::size_t index) {
   const std::string name = "accessor " + std::to_string(index);
   const Json& accessors = array_in(doc.json, "accessors");
   if (index >= accessors.size()) return Error{doc.file, name + " does not exist"};
   const Json& accessor = accessors[index];
-  const Json& views = array_in(doc.json, "bufferViews");
-  const std::size_t v = size_in(accessor, "bufferView", SIZE_MAX);
-  if (v >= views.size()) return Error{doc.file, name + " has no buffer view"};
   AccessorBytes out;
   out.component_type = integer_in(accessor, "componentType", 0, 0);  // 0: an unknown type
   out.components = components_of(accessor.value("type", ""));
@@ -210,22 +244,23 @@ Result<AccessorBytes> accessor_bytes(const Document& doc, std::size_t index) {
   if (out.components == 0 || out.component_size == 0) return Error{doc.file, name + " has an unknown type"};
   out.count = size_in(accessor, "count", 0);
   out.normalized = accessor.value("normalized", false);
-  out.sparse = accessor.contains("sparse");
-  const Json& view = views[v];
-  const std::size_t buffer = size_in(view, "buffer", SIZE_MAX);
-  const std::size_t view_offset = size_in(view, "byteOffset", 0), length = size_in(view, "byteLength", 0);
-  if (buffer >= doc.buffers.size() || view_offset > doc.buffers[buffer].size() ||
-      length > doc.buffers[buffer].size() - view_offset) {
-    return Error{doc.file, "buffer view " + std::to_string(v) + " reaches beyond its buffer"};
-  }
   const std::size_t element = out.components * out.component_size;
-  out.stride = size_in(view, "byteStride", element);
+  if (const auto decoded = doc.decoded.accessors.find(index); decoded != doc.decoded.accessors.end()) {
+    out.first = decoded->second.data();  // sized count × element when decoded
+    out.stride = element;
+    return out;
+  }
+  if (!accessor.contains("bufferView")) return Error{doc.file, name + " has no buffer view"};
+  auto view = view_bytes(doc, size_in(accessor, "bufferView", SIZE_MAX));
+  if (!view) return view.error();
+  const std::size_t length = view->size();
+  out.stride = size_in(array_in(doc.json, "bufferViews")[size_in(accessor, "bufferView", 0)], "byteStride", element);
   const std::size_t offset = size_in(accessor, "byteOffset", 0);
   // offset + stride (count − 1) + element ≤ length, without overflow for a hostile count.
   const bool fits = out.count == 0 || (offset <= length && element <= length - offset &&
                                        (out.stride == 0 || out.count - 1 <= (length - offset - element) / out.stride));
   if (!fits) return Error{doc.file, name + " reaches beyond its buffer"};
-  out.first = doc.buffers[buffer].data() + view_offset + offset;
+  out.first = view->data() + offset;
   return out;
 }
 
@@ -274,39 +309,39 @@ Result<Document> read_document(const fs::path& path) {
     Document doc;
     doc.file = path.string();
     doc.folder = fs::absolute(path).parent_path();
-    tinygltf::Model model;  // tinygltf checks the JSON's structure, the URIs and the buffer sizes
+    std::vector<unsigned char> glb_bin;
     if (path.extension() == ".glb") {
       // The BIN chunk is read straight into the buffer tinygltf takes over: a large scene's bytes
       // are in memory once.
       auto glb = read_glb(path);
       if (!glb) return glb.error();
       doc.json = std::move(glb->json);
-      Json for_tinygltf = doc.json;
-      if (for_tinygltf.contains("buffers") && for_tinygltf["buffers"].is_array() && !for_tinygltf["buffers"].empty() &&
-          for_tinygltf["buffers"][0].is_object() && !for_tinygltf["buffers"][0].contains("uri")) {
-        for_tinygltf["buffers"][0]["uri"] = kGlbBinUri;
-        // The chunk may carry up to 3 bytes of padding beyond the buffer's byteLength.
-        const std::size_t length = size_in(for_tinygltf["buffers"][0], "byteLength", 0);
-        if (glb->bin.size() > length) glb->bin.resize(length);
-      }
-      if (Status loaded = load_model_json(path, for_tinygltf.dump(), glb->bin, model); !loaded) return loaded.error();
+      glb_bin = std::move(glb->bin);
     } else {
-      std::string bytes;  // read once: tinygltf and the JSON as written both come from these
+      std::string bytes;
       if (!read_whole_file(path, bytes)) return Error{path.string(), "cannot be read"};
-      if (Status loaded = load_model(path, bytes, model); !loaded) return loaded.error();
       auto json = json_of(path, bytes);
       if (!json) return json.error();
       doc.json = std::move(*json);
     }
-    const std::size_t declared = doc.json.contains("buffers") ? doc.json["buffers"].size() : 0;
+    if (Status s = check_references(doc.file, doc.json); !s) return s.error();
+    tinygltf::Model model;  // tinygltf reads the buffers: data: URIs, files beside the glTF, sizes
+    if (Status loaded = load_model_json(path, for_tinygltf(doc.json, path.extension() == ".glb", glb_bin).dump(), glb_bin, model);
+        !loaded) {
+      return loaded.error();
+    }
+    const std::size_t declared = array_in(doc.json, "buffers").size();
     if (declared != model.buffers.size()) return Error{doc.file, "not a valid glTF: buffers could not all be read"};
     for (std::size_t i = 0; i < model.buffers.size(); ++i) {
       std::vector<unsigned char> data = std::move(model.buffers[i].data);
+      if (is_fallback_buffer(doc.json, i)) data.clear();
       // A GLB's BIN chunk may carry up to 3 bytes of padding beyond the buffer's byteLength.
       data.resize(std::min(data.size(), std::size_t(size_in(doc.json["buffers"][i], "byteLength", 0))));
       doc.buffers.push_back(std::move(data));
     }
+    if (Status s = decode_meshopt_views(doc); !s) return s.error();
     if (Status s = check_accessors(doc); !s) return s.error();
+    if (Status s = decode_draco_and_sparse(doc); !s) return s.error();
     return doc;
   });
 }
@@ -355,21 +390,39 @@ Result<std::vector<fs::path>> write_document(const Document& doc, const fs::path
       return Error{out_name, "its buffer " + bin_path.filename().string() + " would overwrite an input; name the output differently", true};
     }
 
-    // All buffers become one: each starts 4-byte aligned, the views move with it.
+    // All buffers become one: each starts 4-byte aligned, the views move with it. Meshopt fallback
+    // buffers (no bytes) stay buffers of their own after it, and their views keep their offsets.
     Json json = doc.json;
     Chunks bin;  // the merged buffer as pieces of the document's own bytes: a large scene is not copied
     std::vector<std::size_t> base(doc.buffers.size());
+    Json fallbacks = Json::array();
     for (std::size_t i = 0; i < doc.buffers.size(); ++i) {
+      if (is_fallback_buffer(doc.json, i)) {
+        base[i] = SIZE_MAX;
+        fallbacks.push_back(doc.json["buffers"][i]);
+        continue;
+      }
       bin.pad();
       base[i] = bin.size;
       bin.add({reinterpret_cast<const char*>(doc.buffers[i].data()), doc.buffers[i].size()});
     }
+    const auto move_range = [&](Json& holder) -> bool {  // holder's buffer and byteOffset, in the merged layout
+      const std::size_t buffer = size_in(holder, "buffer", 0);
+      if (buffer >= base.size()) return false;
+      if (base[buffer] == SIZE_MAX) {
+        holder["buffer"] = 1 + std::count(base.begin(), base.begin() + std::ptrdiff_t(buffer), SIZE_MAX);
+        return true;
+      }
+      holder["buffer"] = 0;
+      holder["byteOffset"] = base[buffer] + size_in(holder, "byteOffset", 0);
+      return true;
+    };
     if (json.contains("bufferViews")) {
       for (Json& view : json["bufferViews"]) {
-        const std::size_t buffer = size_in(view, "buffer", 0);
-        if (buffer >= base.size()) return Error{doc.file, "a buffer view names a buffer that does not exist"};
-        view["buffer"] = 0;
-        view["byteOffset"] = base[buffer] + size_in(view, "byteOffset", 0);
+        if (!move_range(view)) return Error{doc.file, "a buffer view names a buffer that does not exist"};
+        if (view.contains("extensions") && view["extensions"].contains("EXT_meshopt_compression")) {
+          if (!move_range(view["extensions"]["EXT_meshopt_compression"])) return Error{doc.file, "a compressed view names a buffer that does not exist"};
+        }
       }
     }
 
@@ -403,11 +456,12 @@ Result<std::vector<fs::path>> write_document(const Document& doc, const fs::path
         image["mimeType"] = mime;
       }
     }
-    if (bin.size == 0) {
+    if (bin.size == 0 && fallbacks.empty()) {
       json.erase("buffers");
     } else {
       json["buffers"] = Json::array({{{"byteLength", bin.size}}});
       if (!glb) json["buffers"][0]["uri"] = bin_path.filename().string();
+      json["buffers"].insert(json["buffers"].end(), fallbacks.begin(), fallbacks.end());
     }
 
     std::vector<fs::path> written;

@@ -20,6 +20,15 @@ namespace matbake::gltf {
 
 using Json = nlohmann::ordered_json;
 
+// Geometry stored compressed or sparse, decoded when the document is read (decode.hpp): what
+// accessor_bytes reads in place of the stored bytes.
+struct DecodedGeometry {
+  std::map<std::size_t, std::vector<unsigned char>> views;      // EXT_meshopt_compression views
+  std::map<std::size_t, std::vector<unsigned char>> accessors;  // Draco primitives' and sparse
+                                                                // accessors' elements, tightly packed
+  std::vector<std::string> notes;  // what was decoded, for the report
+};
+
 struct Document {
   std::string file;               // as given, for errors
   std::filesystem::path folder;   // absolute: relative URIs resolve here
@@ -28,6 +37,7 @@ struct Document {
   int added_buffer = -1;          // the buffer add_view appends to, once there is one
   // Files made here, by relative URI (images): written beside a .gltf, embedded in a .glb.
   std::map<std::string, std::string> new_files;
+  DecodedGeometry decoded;
 };
 
 // .gltf or .glb, read once. Buffer and image URIs must stay inside the file's folder; image files
@@ -35,9 +45,9 @@ struct Document {
 // every view within its buffer.
 Result<Document> read_document(const std::filesystem::path& path);
 
-// Where accessor `index`'s elements lie in doc.buffers, checked against its buffer view and that
-// view against its buffer. Sparse substitutions are not applied (the caller decides whether it
-// reads sparse accessors); an accessor without a buffer view is refused.
+// Where accessor `index`'s elements lie: its decoded elements (Draco, sparse) when it has them, else
+// in doc.buffers or a decoded meshopt view, checked against its buffer view and that view against
+// its buffer. A plain accessor without a buffer view is refused.
 struct AccessorBytes {
   const unsigned char* first = nullptr;  // element 0
   std::size_t count = 0, stride = 0;     // stride: bytes from one element to the next
@@ -45,11 +55,18 @@ struct AccessorBytes {
   std::size_t components = 0;            // 1 (SCALAR) ... 16 (MAT4)
   std::size_t component_size = 0;        // bytes
   bool normalized = false;
-  bool sparse = false;
 };
 Result<AccessorBytes> accessor_bytes(const Document& doc, std::size_t index);
 
-constexpr int kArrayBuffer = 34962;  // bufferView.target of vertex attributes
+// The bytes of buffer view `index`: decoded (meshopt) or in its buffer, checked.
+Result<std::span<const unsigned char>> view_bytes(const Document& doc, std::size_t index);
+
+// Components of an accessor type ("VEC3": 3; 0 when unknown); bytes of a componentType (0 when unknown).
+std::size_t components_of(const std::string& type);
+std::size_t component_size_of(int component_type);
+
+constexpr int kArrayBuffer = 34962;         // bufferView.target of vertex attributes
+constexpr int kElementArrayBuffer = 34963;  // and of indices
 
 // Appends `bytes` (4-byte aligned) as a new buffer view; returns its index. target 0: none.
 int add_view(Document& doc, std::span<const unsigned char> bytes, int target);

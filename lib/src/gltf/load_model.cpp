@@ -21,13 +21,17 @@ bool is_glb_bin(const std::string& path, const ConfinedFolder* folder) {
   return folder->glb_bin != nullptr && path.ends_with(kGlbBinUri);
 }
 
+bool is_served(const std::string& path, const ConfinedFolder* folder) {
+  return is_glb_bin(path, folder) || path.ends_with(kEmptyBufferUri);
+}
+
 // tinygltf asks for the URI joined to the folder ("folder/" + uri, even when the URI is absolute),
 // then for "./" + uri. The URI as written decides: absolute, climbing above the folder with .., or
 // naming a scheme is refused (and remembered, so the error says which); otherwise the joined path
 // is the file, and the "./" retry finds nothing.
 std::string expand_path(const std::string& path, void* user) {
   auto* folder = static_cast<ConfinedFolder*>(user);
-  if (is_glb_bin(path, folder)) return path;
+  if (is_served(path, folder)) return path;
   const std::string prefix = folder->base.string() + "/";
   const bool joined = path.rfind(prefix, 0) == 0;
   const std::string uri = joined ? path.substr(prefix.size()) : path.rfind("./", 0) == 0 ? path.substr(2) : path;
@@ -44,7 +48,7 @@ std::string expand_path(const std::string& path, void* user) {
 }
 
 bool file_exists(const std::string& path, void* user) {
-  if (is_glb_bin(path, static_cast<ConfinedFolder*>(user))) return true;
+  if (is_served(path, static_cast<ConfinedFolder*>(user))) return true;
   auto* folder = static_cast<ConfinedFolder*>(user);
   if (path.empty() || !is_inside(folder->base, path)) return false;
   if (!is_really_inside(folder->base, path)) {
@@ -61,6 +65,10 @@ bool file_exists(const std::string& path, void* user) {
 bool read_file(std::vector<unsigned char>* out, std::string* err, const std::string& path, void* user) {
   if (auto* folder = static_cast<ConfinedFolder*>(user); is_glb_bin(path, folder)) {
     out->swap(*folder->glb_bin);
+    return true;
+  }
+  if (path.ends_with(kEmptyBufferUri)) {
+    out->assign(1, 0);  // tinygltf refuses an empty file
     return true;
   }
   if (!file_exists(path, user)) {
@@ -91,31 +99,6 @@ std::string first_line(const std::string& text) {
   return line.empty() ? "unknown error" : line;
 }
 
-Status load(const fs::path& path, const std::string& bytes, bool binary, std::vector<unsigned char>* glb_bin,
-            tinygltf::Model& model) {
-  const std::string file = path.string();
-  ConfinedFolder folder{fs::absolute(path).parent_path(), {}, glb_bin};
-  tinygltf::TinyGLTF loader;
-  loader.SetFsCallbacks({file_exists, expand_path, read_file, refuse_write, &folder});
-  loader.SetImageLoader(skip_image_decoding, nullptr);
-  if (bytes.size() > std::numeric_limits<unsigned>::max()) return Error{file, "larger than 4 GiB, which tinygltf cannot read"};
-  std::string err, warn;
-  const std::string base = folder.base.string();
-  const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
-  const bool ok = binary
-                      ? loader.LoadBinaryFromMemory(&model, &err, &warn, data, unsigned(bytes.size()), base)
-                      : loader.LoadASCIIFromString(&model, &err, &warn, bytes.data(), unsigned(bytes.size()), base);
-  if (!folder.refused.empty()) return Error{file, folder.refused};
-  if (!ok) return Error{file, "not a valid glTF: " + first_line(err)};
-  // Compressed geometry would be read as whatever bytes its accessors point at.
-  for (const std::string& name : model.extensionsRequired) {
-    if (name == "KHR_draco_mesh_compression" || name == "EXT_meshopt_compression") {
-      return Error{file, "uses " + name + ", which matbake does not decode; decompress it first"};
-    }
-  }
-  return success();
-}
-
 }  // namespace
 
 bool is_inside(const fs::path& base, const fs::path& path) {
@@ -124,23 +107,21 @@ bool is_inside(const fs::path& base, const fs::path& path) {
   return bi == b.end() || (std::next(bi) == b.end() && bi->empty());  // "dir/" ends in an empty element
 }
 
-
-
-Status load_model(const fs::path& path, tinygltf::Model& model) {
-  std::error_code ec;
-  if (!fs::is_regular_file(path, ec)) return Error{path.string(), "no such file"};
-  std::string bytes;
-  if (!read_whole_file(path, bytes)) return Error{path.string(), "cannot be read"};
-  return load_model(path, bytes, model);
-}
-
-Status load_model(const fs::path& path, const std::string& bytes, tinygltf::Model& model) {
-  return load(path, bytes, path.extension() == ".glb", nullptr, model);
-}
-
 Status load_model_json(const fs::path& path, const std::string& json_text, std::vector<unsigned char>& glb_bin,
                        tinygltf::Model& model) {
-  return load(path, json_text, false, &glb_bin, model);
+  const std::string& bytes = json_text;
+  const std::string file = path.string();
+  ConfinedFolder folder{fs::absolute(path).parent_path(), {}, &glb_bin};
+  tinygltf::TinyGLTF loader;
+  loader.SetFsCallbacks({file_exists, expand_path, read_file, refuse_write, &folder});
+  loader.SetImageLoader(skip_image_decoding, nullptr);
+  if (bytes.size() > std::numeric_limits<unsigned>::max()) return Error{file, "larger than 4 GiB, which tinygltf cannot read"};
+  std::string err, warn;
+  const std::string base = folder.base.string();
+  const bool ok = loader.LoadASCIIFromString(&model, &err, &warn, bytes.data(), unsigned(bytes.size()), base);
+  if (!folder.refused.empty()) return Error{file, folder.refused};
+  if (!ok) return Error{file, "not a valid glTF: " + first_line(err)};
+  return success();
 }
 
 }  // namespace matbake::gltf

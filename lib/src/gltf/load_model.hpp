@@ -12,13 +12,12 @@
 
 namespace matbake::gltf {
 
-// .glb by extension, else .gltf. Errors name `path` as given.
-Status load_model(const std::filesystem::path& path, tinygltf::Model& model);
-// The same from the file's bytes, already read (buffers and images are still looked up beside it).
-Status load_model(const std::filesystem::path& path, const std::string& bytes, tinygltf::Model& model);
-// A GLB's JSON as glTF text, its buffer 0 named kGlbBinUri and `glb_bin` its BIN chunk (at the
-// buffer's byteLength), which tinygltf then takes over without copying it.
+// glTF text (a GLB's JSON, its buffer 0 named kGlbBinUri and `glb_bin` its BIN chunk at the
+// buffer's byteLength, which tinygltf then takes over without copying it). Errors name `path` as
+// given; buffers and images are looked up beside it.
 inline constexpr const char* kGlbBinUri = "\x01glb-bin";
+// A buffer of one zero byte (what a meshopt fallback buffer, which has none, is given to tinygltf as).
+inline constexpr const char* kEmptyBufferUri = "\x01empty";
 Status load_model_json(const std::filesystem::path& path, const std::string& json_text, std::vector<unsigned char>& glb_bin,
                        tinygltf::Model& model);
 

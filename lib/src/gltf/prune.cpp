@@ -1,6 +1,7 @@
 #include "prune.hpp"
 
 #include <functional>
+#include <map>
 
 namespace matbake::gltf {
 namespace {
@@ -130,6 +131,24 @@ void for_each_sparse_view(Json& accessor, F f) {
   if (sparse.contains("values") && sparse["values"].contains("bufferView")) f(sparse["values"]["bufferView"]);
 }
 
+// The buffer view a primitive's Draco data lies in.
+template <class F>
+void for_each_draco_view(Json& primitive, F f) {
+  if (primitive.contains("extensions") && primitive["extensions"].contains("KHR_draco_mesh_compression")) {
+    Json& draco = primitive["extensions"]["KHR_draco_mesh_compression"];
+    if (draco.contains("bufferView")) f(draco["bufferView"]);
+  }
+}
+
+// Decoded bytes follow their accessor or view to its new index (and go with it when it is removed).
+void remap_keys(std::map<std::size_t, std::vector<unsigned char>>& decoded, const std::vector<int>& remap) {
+  std::map<std::size_t, std::vector<unsigned char>> moved;
+  for (auto& [index, bytes] : decoded) {
+    if (index < remap.size() && remap[index] >= 0) moved[std::size_t(remap[index])] = std::move(bytes);
+  }
+  decoded = std::move(moved);
+}
+
 void remap_value(Json& value, const std::vector<int>& remap) {
   if (!value.is_number_integer()) return;
   const long long i = value.get<long long>();
@@ -212,6 +231,9 @@ std::vector<std::string> prune_unreachable(Document& doc) {
   for (std::size_t i = 0; i < images.keep.size(); ++i) {
     if (images.keep[i] && json["images"][i].contains("bufferView")) views.mark(json, json["images"][i]["bufferView"]);
   }
+  for (std::size_t m = 0; m < meshes.keep.size(); ++m) {
+    if (meshes.keep[m]) for_each_in(json["meshes"][m], "primitives", [&](Json& p) { for_each_draco_view(p, [&](Json& v) { views.mark(json, v); }); });
+  }
 
   // Remove, then point every reference at the new indices.
   const auto mesh_remap = keep_marked(json, meshes, "mesh", removed);
@@ -229,7 +251,10 @@ std::vector<std::string> prune_unreachable(Document& doc) {
     remap_field(p, "material", material_remap);
     for_each_variant_material(p, [&](Json& material) { remap_value(material, material_remap); });
     for_each_primitive_accessor(p, [&](Json& a) { remap_value(a, accessor_remap); });
+    for_each_draco_view(p, [&](Json& v) { remap_value(v, view_remap); });
   });
+  remap_keys(doc.decoded.accessors, accessor_remap);
+  remap_keys(doc.decoded.views, view_remap);
   for_each_other_accessor(json, [&](Json& a) { remap_value(a, accessor_remap); });
   for_each_in(json, "materials", [&](Json& m) { for_each_texture_index(m, [&](Json& t) { remap_value(t, texture_remap); }); });
   for_each_in(json, "textures", [&](Json& t) {

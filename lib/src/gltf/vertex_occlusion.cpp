@@ -2,6 +2,8 @@
 
 #include <map>
 
+#include "decode.hpp"
+
 namespace matbake::gltf {
 
 void add_vertex_occlusion(Document& doc, std::span<const PlacedValues> placed, ao::Into into) {
@@ -28,6 +30,11 @@ void add_vertex_occlusion(Document& doc, std::span<const PlacedValues> placed, a
   for (const PlacedValues& p : placed) {
     const std::span<const float> w = p.values;
     if (w.empty()) continue;
+    const std::size_t mesh = std::size_t(mesh_of_node.at(p.node));
+    if (uncompress_draco_primitive(doc, mesh, std::size_t(p.primitive))) {
+      doc.decoded.notes.push_back("mesh " + std::to_string(mesh) + " primitive " + std::to_string(p.primitive) +
+                                  ": written uncompressed (KHR_draco_mesh_compression dropped), as its vertices gained occlusion");
+    }
     Json& attributes = json["meshes"][std::size_t(mesh_of_node.at(p.node))]["primitives"][std::size_t(p.primitive)]["attributes"];
     if (into == ao::Into::attribute) {
       attributes["_AO"] = add_float_accessor(doc, {w.begin(), w.end()}, w.size(), "SCALAR");

@@ -95,7 +95,8 @@ nlohmann::json to_json(const exporter::Report& r) {
   }
   return {{"materials", materials},           {"skipped", r.skipped},
           {"written", r.written},    {"images_decoded", r.images_decoded}, {"textures_made", r.textures_made},
-          {"ao_rays", r.ao_rays},    {"ao_textures", textures}, {"ao_notes", r.ao_notes}};
+          {"ao_rays", r.ao_rays},    {"ao_textures", textures}, {"ao_notes", r.ao_notes},
+          {"geometry", r.geometry}};
 }
 
 Status write_validation_report(const validate::Report& r, const validate::Options& options,
@@ -112,7 +113,7 @@ nlohmann::json to_json(const bake_ao::TextureReport& t) {
   return {{"material", t.material}, {"node", t.node}, {"name", t.name}, {"file", t.file}, {"width", t.width}, {"height", t.height},
           {"texcoord", t.texcoord}, {"covered", t.covered}, {"touched", t.touched}, {"overlapped", t.overlapped},
           {"padded", t.padded}, {"triangles", t.triangles}, {"degenerate_uv", t.degenerate_uv}, {"wrapped", t.wrapped},
-          {"too_large", t.too_large}, {"instances_without_uv", t.instances_without_uv}, {"existing", t.existing},
+          {"too_large", t.too_large}, {"instances_without_uv", t.instances_without_uv}, {"existing", t.existing}, {"orm", t.orm},
           {"mean_ao", t.mean}};
 }
 

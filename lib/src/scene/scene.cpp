@@ -73,13 +73,10 @@ struct Reader {
 
   Error error(const std::string& what) const { return Error{doc.file, what}; }
 
-  // A dense accessor's bytes; sparse ones are refused (matbake does not apply their substitutions).
+  // An accessor's elements (Draco, meshopt and sparse ones decoded when the document was read).
   Result<gltf::AccessorBytes> dense(int index) const {
     if (index < 0) return error("accessor " + std::to_string(index) + " does not exist");
-    auto bytes = gltf::accessor_bytes(doc, std::size_t(index));
-    if (!bytes) return bytes.error();
-    if (bytes->sparse) return error("accessor " + std::to_string(index) + " is sparse; matbake does not read sparse accessors");
-    return bytes;
+    return gltf::accessor_bytes(doc, std::size_t(index));
   }
 
   // `components` floats per element (2 to 4): FLOAT, or integers (KHR_mesh_quantization), normalized
