@@ -211,6 +211,102 @@ TEST(CliBakeAo, TextureMultipliesOrReplacesTheMaterialsOwn) {
   }
 }
 
+// The material's own occlusion texture seen through its KHR_texture_transform: columns 0–1 of a 4×4
+// texture are 0.25 and 2–3 are 1; an offset of half the width (repeat) lands each bake texel's centre
+// on the centre of the texel two columns on, so the bake's columns 0–1 are multiplied by 1 and 2–3
+// by 64/255 (a bilinear sample through the transform, in closed form). The new texture is over
+// raw UVs: no transform, and the report says what became of the old one.
+TEST(CliBakeAo, TextureMultipliesTheOwnThroughItsTransform) {
+  TempDir dir;
+  write_floor_scene(dir / "floor.gltf", true);
+  std::vector<double> codes;
+  for (int y = 0; y < 4; ++y) {
+    for (int x = 0; x < 4; ++x) codes.push_back(x < 2 ? 64 : 255);
+  }
+  test::write_raw(dir / "own.png", 4, 4, 1, "uint8", codes);
+  nlohmann::json doc = nlohmann::json::parse(read_bytes(dir / "floor.gltf"));
+  doc["materials"][0]["occlusionTexture"]["extensions"] = {{"KHR_texture_transform", {{"offset", {0.5, 0}}}}};
+  doc["extensionsUsed"] = {"KHR_texture_transform"};
+  write_bytes(dir / "floor.gltf", doc.dump());
+  const fs::path out = dir / "out.glb";
+  const int n = 4096;
+  const auto r = matbake({"--json", "bake-ao", (dir / "floor.gltf").string(), "-o", out.string(), "--texture", "4", "--samples",
+                          std::to_string(n), "--falloff", "none", "--max-distance", "2"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(nlohmann::json::parse(r.out)["textures"][0]["existing"], "multiplied, sampled through its KHR_texture_transform");
+  const std::vector<float> texels = occlusion_texels(out);
+  ASSERT_EQ(texels.size(), 16u);
+  for (std::size_t i = 0; i < 16; ++i) {
+    const double own = i % 4 < 2 ? 1.0 : 64.0 / 255;  // the bake itself is (h/D)² = 0.25 (see above)
+    EXPECT_NEAR(texels[i], 0.25 * own, own * 3 * std::sqrt(0.25 * 0.75 / n) + 0.5 / 255) << "texel " << i;
+  }
+  const auto written = gltf::read_document(out);
+  ASSERT_TRUE(written);
+  EXPECT_FALSE(written->json["materials"][0]["occlusionTexture"].contains("extensions"));
+  MATBAKE_VALIDATE_OR_SKIP(validated, out);
+  EXPECT_EQ(validated->errors, 0) << validated->summary;
+}
+
+// One texture holds one mapping: occlusion and metallic-roughness with the same KHR_texture_transform
+// are packed into one ORM texture that keeps it; mapped differently they stay apart and the report
+// says why, both in export's packing and in an ORM bake.
+TEST(CliBakeAo, OrmKeepsDifferentlyMappedMapsApart) {
+  TempDir dir;
+  write_floor_scene(dir / "floor.gltf", true);
+  std::vector<double> rgb(4 * 4 * 3, 128);
+  test::write_raw(dir / "mr.png", 4, 4, 3, "uint8", rgb);
+  const nlohmann::json base = nlohmann::json::parse(read_bytes(dir / "floor.gltf"));
+  const nlohmann::json shifted = {{"KHR_texture_transform", {{"offset", {0.5, 0}}}}};
+  const auto scene_with = [&](const nlohmann::json& occlusion_ext, const nlohmann::json& mr_ext) {
+    nlohmann::json doc = base;
+    doc["images"].push_back({{"uri", "mr.png"}});
+    doc["textures"].push_back({{"source", 1}});
+    doc["materials"][0]["pbrMetallicRoughness"] = {{"metallicRoughnessTexture", {{"index", 1}}}};
+    if (!occlusion_ext.is_null()) doc["materials"][0]["occlusionTexture"]["extensions"] = occlusion_ext;
+    if (!mr_ext.is_null()) doc["materials"][0]["pbrMetallicRoughness"]["metallicRoughnessTexture"]["extensions"] = mr_ext;
+    doc["extensionsUsed"] = {"KHR_texture_transform"};
+    write_bytes(dir / "scene.gltf", doc.dump());
+    return (dir / "scene.gltf").string();
+  };
+  const auto material_of = [](const fs::path& file) {
+    const auto doc = gltf::read_document(file);
+    EXPECT_TRUE(doc);
+    return doc ? nlohmann::json::parse(doc->json["materials"][0].dump()) : nlohmann::json();
+  };
+  {
+    const fs::path out = dir / "same.glb";
+    const auto r = matbake({"-q", "export", scene_with(shifted, shifted), "-o", out.string()});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const nlohmann::json m = material_of(out);
+    EXPECT_EQ(m["occlusionTexture"]["index"], m["pbrMetallicRoughness"]["metallicRoughnessTexture"]["index"]);
+    EXPECT_EQ(m["occlusionTexture"]["extensions"], shifted);
+    EXPECT_EQ(m["pbrMetallicRoughness"]["metallicRoughnessTexture"]["extensions"], shifted);
+    MATBAKE_VALIDATE_OR_SKIP(validated, out);
+    EXPECT_EQ(validated->errors, 0) << validated->summary;
+  }
+  {
+    const fs::path out = dir / "apart.glb";
+    const auto r = matbake({"--json", "export", scene_with(shifted, nullptr), "-o", out.string()});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(nlohmann::json::parse(r.out)["materials"][0]["action"].get<std::string>().find("kept apart (mapped differently"),
+              std::string::npos) << r.out;
+    const nlohmann::json m = material_of(out);
+    EXPECT_NE(m["occlusionTexture"]["index"], m["pbrMetallicRoughness"]["metallicRoughnessTexture"]["index"]);
+  }
+  {
+    const fs::path out = dir / "baked.glb";
+    const auto r = matbake({"--json", "export", scene_with(nullptr, shifted), "-o", out.string(), "--ao-texture", "4", "--ao-samples", "16"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(nlohmann::json::parse(r.out)["ao_textures"][0]["orm"],
+              "kept apart: the metallic-roughness texture has a KHR_texture_transform, the bake none");
+    const nlohmann::json m = material_of(out);
+    EXPECT_NE(m["occlusionTexture"]["index"], m["pbrMetallicRoughness"]["metallicRoughnessTexture"]["index"]);
+    EXPECT_EQ(m["pbrMetallicRoughness"]["metallicRoughnessTexture"]["extensions"], shifted);
+    MATBAKE_VALIDATE_OR_SKIP(validated, out);
+    EXPECT_EQ(validated->errors, 0) << validated->summary;
+  }
+}
+
 // One UV-mapped quad placed twice: under the ceiling ((h/D)² = 0.25) and 10 units away, open (1).
 // By default its texture averages the placements (0.625) and says so; --per-instance gives the
 // second placement a copy of the mesh and of the material, each with its own texture.

@@ -3,6 +3,8 @@
 // draco_transcoder and gltfpack) read like their plain twins and written back validator-clean.
 #include <gtest/gtest.h>
 
+#include <glm/geometric.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <fstream>
@@ -190,6 +192,109 @@ TEST(GltfInput, MalformedTransformIsAnErrorAtItsPointer) {
   auto t = gltf::uv_transform_of(info, "f.gltf", "/materials/0/occlusionTexture");
   ASSERT_FALSE(t);
   EXPECT_EQ(t.error().message, "/materials/0/occlusionTexture/extensions/KHR_texture_transform/offset: not two numbers");
+}
+
+}  // namespace
+}  // namespace matbake
+
+namespace matbake {
+namespace {
+
+// The example scene in compressed variants made by the tools users make them with (Debian's
+// draco_transcoder and gltfpack); empty, with `why_not` said, when a tool is missing.
+struct Variant {
+  std::string name;
+  std::string tool;
+  std::vector<std::string> args;  // between input and output
+  bool lossless;                  // not quantized: bakes like the plain scene (a quantized one moves
+                                  // vertices that touch another surface to either side of it)
+  double position_step;           // the largest distance quantization may move a vertex, in scene units
+};
+
+// Where `tool` is on PATH; empty when it is not.
+std::string tool_path(const std::string& tool) {
+  const test::RunResult r = test::run("/bin/sh", {"-c", "command -v " + tool});
+  return r.exit_code == 0 ? r.out.substr(0, r.out.find('\n')) : std::string();
+}
+
+double mean_ao(const std::vector<std::string>& args) {
+  const test::RunResult r = test::matbake(args);
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  return r.exit_code == 0 ? nlohmann::json::parse(r.out)["mean_ao"].get<double>() : -1.0;
+}
+
+// The largest distance from a vertex of `a` to the nearest vertex of `b`, over every instance.
+double farthest_vertex(const scene::Scene& a, const scene::Scene& b) {
+  double worst = 0;
+  for (const scene::Instance& i : a.instances) {
+    for (const scene::Vec3& p : i.positions) {
+      double nearest = INFINITY;
+      for (const scene::Instance& j : b.instances) {
+        for (const scene::Vec3& q : j.positions) nearest = std::min(nearest, double(glm::length(p - q)));
+      }
+      worst = std::max(worst, nearest);
+    }
+  }
+  return worst;
+}
+
+TEST(GltfInput, DracoAndMeshoptVariantsBakeAndExportLikeThePlainScene) {
+  for (const char* tool : {"draco_transcoder", "gltfpack"}) {
+    if (tool_path(tool).empty()) GTEST_SKIP() << tool << " is not installed (Debian packages draco and gltfpack; scripts/deps.sh)";
+  }
+  TempDir dir;
+  for (const char* f : {"showroom.gltf", "showroom.bin"}) fs::copy_file(fs::path(MATBAKE_SOURCE_DIR) / "examples" / f, dir / f);
+  const fs::path plain = dir / "showroom.gltf";
+  auto plain_scene = scene::load_scene(plain);
+  ASSERT_TRUE(plain_scene) << plain_scene.error().to_string();
+  const double extent = glm::length(plain_scene->bounds_max - plain_scene->bounds_min);
+  const std::vector<Variant> variants = {
+      {"draco_lossless.glb", "draco_transcoder", {"-qp", "0", "-qn", "0", "-qt", "0"}, true, 1e-6 * extent},
+      {"draco.glb", "draco_transcoder", {}, false, extent / 2048},  // 11-bit positions
+      {"meshopt.glb", "gltfpack", {"-c", "-noq"}, true, 1e-6 * extent},
+      {"meshopt_cc.gltf", "gltfpack", {"-cc", "-noq"}, true, 1e-6 * extent},
+      {"meshopt_quantized.glb", "gltfpack", {"-c"}, false, extent / 16384},  // 14-bit positions, KHR_mesh_quantization
+      {"meshopt_cc_quantized.glb", "gltfpack", {"-cc"}, false, extent / 16384},
+  };
+  const std::vector<std::string> bake = {"--samples", "512", "--seed", "3", "--json"};
+  const auto with = [](std::vector<std::string> a, const std::vector<std::string>& b) {
+    a.insert(a.end(), b.begin(), b.end());
+    return a;
+  };
+  const double plain_vertices = mean_ao(with({"bake-ao", plain.string(), "-o", (dir / "plain_ao.glb").string()}, bake));
+  const double plain_texels =
+      mean_ao(with({"bake-ao", plain.string(), "-o", (dir / "plain_tex.glb").string(), "--texture", "64"}, bake));
+  for (const Variant& v : variants) {
+    const fs::path file = dir / v.name;
+    std::vector<std::string> args = {"-i", plain.string()};
+    args = with(args, v.args);
+    args = with(args, {"-o", file.string()});
+    const test::RunResult made = test::run(tool_path(v.tool), args);
+    ASSERT_EQ(made.exit_code, 0) << v.tool << ": " << made.err;
+    auto decoded = scene::load_scene(file);
+    ASSERT_TRUE(decoded) << decoded.error().to_string();
+    EXPECT_LE(farthest_vertex(*decoded, *plain_scene), v.position_step) << v.name;
+    EXPECT_LE(farthest_vertex(*plain_scene, *decoded), v.position_step) << v.name;
+    const fs::path ao = dir / ("ao_" + v.name), textured = dir / ("tex_" + v.name), exported = dir / ("export_" + v.name);
+    const double vertices = mean_ao(with({"bake-ao", file.string(), "-o", ao.string()}, bake));
+    // gltfpack drops the UVs of materials without textures (the example's): no texture bake there.
+    const bool has_uvs = v.tool == "draco_transcoder";
+    const double texels = has_uvs ? mean_ao(with({"bake-ao", file.string(), "-o", textured.string(), "--texture", "64"}, bake)) : 0;
+    if (v.lossless) {
+      EXPECT_NEAR(vertices, plain_vertices, 1e-3) << v.name;
+      if (has_uvs) {
+        EXPECT_NEAR(texels, plain_texels, 1e-3) << v.name;
+      }
+    }
+    const test::RunResult e = test::matbake({"export", file.string(), "-o", exported.string(), "--ao-samples", "16"});
+    ASSERT_EQ(e.exit_code, 0) << e.err;
+    for (const fs::path& out : {ao, textured, exported}) {
+      if (out == textured && !has_uvs) continue;
+      MATBAKE_VALIDATE_OR_SKIP(report, out);
+      EXPECT_EQ(report->errors, 0) << out << ": " << report->summary;
+      EXPECT_EQ(report->warnings, 0) << out << ": " << report->summary;
+    }
+  }
 }
 
 }  // namespace
