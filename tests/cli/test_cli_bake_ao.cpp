@@ -307,6 +307,56 @@ TEST(CliBakeAo, OrmKeepsDifferentlyMappedMapsApart) {
   }
 }
 
+// Images as delivered files hold them: an occlusion texture only in WebP (EXT_texture_webp) is decoded
+// and multiplied in; one only in KTX2 (KHR_texture_basisu, no decoder here) is passed through byte for
+// byte when the work needs none of its texels, and is one error naming the texture when it does.
+TEST(CliBakeAo, WebpIsDecodedAndKtx2PassedThrough) {
+  TempDir dir;
+  write_floor_scene(dir / "floor.gltf", true);
+  const nlohmann::json base = nlohmann::json::parse(read_bytes(dir / "floor.gltf"));
+  const int n = 1024;
+  {
+    test::write_raw(dir / "own.webp", 4, 4, 3, "uint8", std::vector<double>(48, 128));
+    nlohmann::json doc = base;
+    doc["images"][0] = {{"uri", "own.webp"}};
+    doc["textures"][0] = {{"extensions", {{"EXT_texture_webp", {{"source", 0}}}}}};
+    doc["extensionsUsed"] = doc["extensionsRequired"] = {"EXT_texture_webp"};
+    write_bytes(dir / "webp.gltf", doc.dump());
+    const fs::path out = dir / "webp.glb";
+    const auto r = matbake({"-q", "bake-ao", (dir / "webp.gltf").string(), "-o", out.string(), "--texture", "4", "--samples",
+                            std::to_string(n), "--falloff", "none", "--max-distance", "2"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    for (float v : occlusion_texels(out)) EXPECT_NEAR(v, 0.25 * 128 / 255, 3 * std::sqrt(0.25 * 0.75 / n) + 2.0 / 255);
+    MATBAKE_VALIDATE_OR_SKIP(validated, out);
+    EXPECT_EQ(validated->errors, 0) << validated->summary;
+  }
+  const std::string ktx2 = std::string("\xabKTX 20\xbb\r\n\x1a\n", 12) + std::string(68, '\0');
+  write_bytes(dir / "own.ktx2", ktx2);
+  nlohmann::json doc = base;
+  doc["images"][0] = {{"uri", "own.ktx2"}, {"mimeType", "image/ktx2"}};
+  doc["textures"][0] = {{"extensions", {{"KHR_texture_basisu", {{"source", 0}}}}}};
+  doc["extensionsUsed"] = doc["extensionsRequired"] = {"KHR_texture_basisu"};
+  write_bytes(dir / "ktx2.gltf", doc.dump());
+  const auto needs_texels = matbake({"bake-ao", (dir / "ktx2.gltf").string(), "-o", (dir / "multiplied.glb").string(), "--texture", "4"});
+  EXPECT_EQ(needs_texels.exit_code, 1);
+  EXPECT_EQ(needs_texels.err, "matbake: error: " + (dir / "ktx2.gltf").string() +
+                                  ": /textures/0: its only image is KTX2 (KHR_texture_basisu), which matbake cannot decode, and this "
+                                  "work needs its texels\n");
+  EXPECT_FALSE(fs::exists(dir / "multiplied.glb"));
+  for (const std::vector<std::string>& args :
+       {std::vector<std::string>{"--texture", "4", "--existing-occlusion", "replace"}, std::vector<std::string>{}}) {
+    std::vector<std::string> command = {"-q", "bake-ao", (dir / "ktx2.gltf").string(), "-o", (dir / "out.glb").string()};
+    command.insert(command.end(), args.begin(), args.end());
+    const auto r = matbake(command);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const auto written = gltf::read_document(dir / "out.glb");
+    ASSERT_TRUE(written);
+    const auto bytes = gltf::image_bytes(*written, 0);
+    ASSERT_TRUE(bytes);
+    EXPECT_EQ(*bytes, ktx2);
+  }
+}
+
 // One UV-mapped quad placed twice: under the ceiling ((h/D)² = 0.25) and 10 units away, open (1).
 // By default its texture averages the placements (0.625) and says so; --per-instance gives the
 // second placement a copy of the mesh and of the material, each with its own texture.

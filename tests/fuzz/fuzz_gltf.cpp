@@ -1,4 +1,5 @@
-// glTF loading: the document (JSON, buffers, accessor checks) and the flattened scene built from it,
+// glTF loading: the document (JSON, references, buffers, Draco / meshopt / sparse decoding, accessor
+// checks) and the flattened scene built from it,
 // as export and bake-ao read them, and the texel coverage of a texture bake over its UVs. MATBAKE_FUZZ_EXTENSION is ".gltf" or ".glb" (two targets).
 #include <unistd.h>
 
@@ -11,6 +12,7 @@
 #include "lib/src/ao/texels.hpp"
 #include "lib/src/bake_ao/textures.hpp"
 #include "lib/src/gltf/document.hpp"
+#include "lib/src/gltf/texture_transform.hpp"
 #include "lib/src/scene/from_document.hpp"
 
 namespace {
@@ -42,6 +44,14 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         (void)matbake::ao::texels::cover(*scene, target, 16, 8);
       }
     }
+  }
+  // Each material's occlusion transform, sampled over a tiny texture.
+  matbake::image::Image tiny;
+  tiny.width = tiny.height = 2, tiny.channels = 1, tiny.pixels = {0.0f, 1.0f, 0.5f, 0.25f};
+  for (const auto& material : matbake::gltf::array_in(doc->json, "materials")) {
+    if (!material.is_object() || !material.contains("occlusionTexture")) continue;
+    auto transform = matbake::gltf::uv_transform_of(material["occlusionTexture"], doc->file, "/materials");
+    if (transform) (void)matbake::gltf::sample_through(tiny, *transform, matbake::ao::Wrap::mirrored_repeat, matbake::ao::Wrap::repeat, 3, 3);
   }
   for (std::size_t i = 0; doc->json.contains("images") && doc->json["images"].is_array() && i < doc->json["images"].size(); ++i) {
     (void)matbake::gltf::image_bytes(*doc, i);

@@ -11,6 +11,21 @@ const char* extension_of(const std::string& bytes) {
   return "";
 }
 
+constexpr int kOnlyKtx2 = -2;
+
+// The image a texture's texels are read from: its core source (PNG or JPEG), else its
+// EXT_texture_webp source; kOnlyKtx2 when it has only a KHR_texture_basisu one, −1 when none.
+int decodable_source(const Json& texture) {
+  const auto source_of = [](const Json& holder) { return integer_in<int>(holder, "source", -1, -1); };
+  if (const int core = source_of(texture); core >= 0) return core;
+  if (!texture.contains("extensions") || !texture["extensions"].is_object()) return -1;
+  const Json& extensions = texture["extensions"];
+  if (extensions.contains("EXT_texture_webp")) {
+    if (const int webp = source_of(extensions["EXT_texture_webp"]); webp >= 0) return webp;
+  }
+  return extensions.contains("KHR_texture_basisu") ? kOnlyKtx2 : -1;
+}
+
 std::span<const unsigned char> as_bytes(const std::string& s) {
   return {reinterpret_cast<const unsigned char*>(s.data()), s.size()};
 }
@@ -41,11 +56,13 @@ Result<const image::Image*> ImageCache::texture(int texture, color::Transfer col
   if (texture < 0 || !json.contains("textures") || std::size_t(texture) >= json["textures"].size()) {
     return Error{doc_.file, "texture " + std::to_string(texture) + " does not exist"};
   }
-  const gltf::Json& t = json["textures"][std::size_t(texture)];
-  if (!t.contains("source") || !t["source"].is_number_integer()) {
-    return Error{doc_.file, "texture " + std::to_string(texture) + " has no PNG or JPEG source matbake could read"};
+  const int source = decodable_source(json["textures"][std::size_t(texture)]);
+  if (source < 0) {
+    return Error{doc_.file, "/textures/" + std::to_string(texture) + ": " +
+                                (source == kOnlyKtx2 ? "its only image is KTX2 (KHR_texture_basisu), which matbake cannot decode, "
+                                                       "and this work needs its texels"
+                                                     : "no PNG, JPEG or WebP image to read")};
   }
-  const int source = t["source"].get<int>();
   if (const auto found = images_.find({source, colour}); found != images_.end()) return &found->second;
   auto bytes = gltf::image_bytes(doc_, std::size_t(source));
   if (!bytes) return bytes.error();
