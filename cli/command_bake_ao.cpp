@@ -22,6 +22,7 @@ CLI::App* setup_bake_ao(CLI::App& app, BakeAoSettings& s) {
                   "Output .gltf (+ .bin beside it) or .glb; everything but the baked attribute is kept as written");
   cmd->add_option("--dump", s.dump, "Raw values: .csv (node,mesh,primitive,vertex,x,y,z,ao) or .bin (float32)");
   add_params(*cmd, image::encoding_params(), s.encoding, "", "Options");
+  add_params(*cmd, image::gltf_texture_params(), s.encoding, "", "Options");
   add_ao_options(*cmd, s.ao, "");
   return cmd;
 }

@@ -66,6 +66,7 @@ CLI::App* setup_export(CLI::App& app, ExportSettings& s) {
   add_params(*cmd, pack::material_params(), s.material_options, "", "Options", nullptr, {"transfer", "decode", "normal_y"});
   add_params(*cmd, exporter::options_params(), s.options, "", "Options");
   add_params(*cmd, image::encoding_params(), s.options.encoding, "", "Options");
+  add_params(*cmd, image::gltf_texture_params(), s.options.encoding, "", "Options");
   add_ao_options(*cmd, s.ao, "ao-");  // AO is baked when any of them is given, as a manifest's ao = { ... }
   cmd->add_option("--report", s.report, "Also write the report as JSON to this file");
   return cmd;

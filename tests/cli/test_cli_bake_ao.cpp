@@ -139,18 +139,24 @@ void write_floor_scene(const fs::path& path, bool own_occlusion) {
   b.write(path, {b.add_node({{"mesh", floor}}), b.add_node({{"mesh", ceiling}})});
 }
 
-// The texture's texels, as a viewer reads the material's occlusion texture.
+// The texture's texels, as a viewer reads the material's occlusion texture (its red channel).
 std::vector<float> occlusion_texels(const fs::path& file, int material = 0) {
   const auto doc = gltf::read_document(file);
   EXPECT_TRUE(doc) << doc.error().to_string();
   if (!doc) return {};
   const auto& info = doc->json["materials"][material]["occlusionTexture"];
-  const auto bytes = gltf::image_bytes(*doc, doc->json["textures"][info["index"].get<std::size_t>()]["source"].get<std::size_t>());
+  const auto& texture = doc->json["textures"][info["index"].get<std::size_t>()];
+  const bool webp = !texture.contains("source");  // then named through EXT_texture_webp
+  const std::size_t source = (webp ? texture["extensions"]["EXT_texture_webp"]["source"] : texture["source"]).get<std::size_t>();
+  const auto bytes = gltf::image_bytes(*doc, source);
   EXPECT_TRUE(bytes);
   const auto img = image::decode_image({reinterpret_cast<const unsigned char*>(bytes->data()), bytes->size()},
-                                       "occlusion.png", color::Transfer::linear);
+                                       webp ? "occlusion.webp" : "occlusion.png", color::Transfer::linear);
   EXPECT_TRUE(img) << img.error().to_string();
-  return img ? img->pixels : std::vector<float>{};
+  if (!img) return {};
+  std::vector<float> red;  // what a viewer reads (a grey image's only channel)
+  for (std::size_t i = 0; i < img->pixels.size(); i += std::size_t(img->channels)) red.push_back(img->pixels[i]);
+  return red;
 }
 
 // The floor's texels are (h/D)² (binary AO of range D under an endless ceiling) in a 16-bit PNG,
@@ -355,6 +361,39 @@ TEST(CliBakeAo, WebpIsDecodedAndKtx2PassedThrough) {
     ASSERT_TRUE(bytes);
     EXPECT_EQ(*bytes, ktx2);
   }
+}
+
+// --texture-format webp: the occlusion texture as lossless WebP named through EXT_texture_webp (which
+// the file then requires), its texels the PNG run's exactly; 16 bits cannot be WebP.
+TEST(CliBakeAo, TexturesAreWrittenAsLosslessWebpWhenAsked) {
+  TempDir dir;
+  write_floor_scene(dir / "floor.gltf", false);
+  const std::vector<std::string> bake = {"-q", "bake-ao", (dir / "floor.gltf").string(), "--texture", "8", "--samples", "64"};
+  const auto with = [&](std::vector<std::string> extra) {
+    std::vector<std::string> args = bake;
+    args.insert(args.end(), extra.begin(), extra.end());
+    return matbake(args);
+  };
+  const auto png = with({"-o", (dir / "png.glb").string()});
+  ASSERT_EQ(png.exit_code, 0) << png.err;
+  const auto webp = with({"-o", (dir / "webp.gltf").string(), "--texture-format", "webp"});
+  ASSERT_EQ(webp.exit_code, 0) << webp.err;
+  EXPECT_TRUE(fs::exists(dir / "webp_occlusion_0.webp"));
+  EXPECT_EQ(occlusion_texels(dir / "png.glb"), occlusion_texels(dir / "webp.gltf"));
+  const auto doc = gltf::read_document(dir / "webp.gltf");
+  ASSERT_TRUE(doc);
+  const nlohmann::json& texture = doc->json["textures"][doc->json["materials"][0]["occlusionTexture"]["index"].get<std::size_t>()];
+  EXPECT_FALSE(texture.contains("source"));
+  EXPECT_EQ(doc->json["images"][texture["extensions"]["EXT_texture_webp"]["source"].get<std::size_t>()]["mimeType"], "image/webp");
+  EXPECT_EQ(doc->json["extensionsRequired"], nlohmann::json::array({"EXT_texture_webp"}));
+  MATBAKE_VALIDATE_OR_SKIP(validated, dir / "webp.gltf");
+  EXPECT_EQ(validated->errors, 0) << validated->summary;
+  EXPECT_EQ(validated->warnings, 0) << validated->summary;
+  const auto deep = with({"-o", (dir / "deep.glb").string(), "--texture-format", "webp", "--bits", "16"});
+  EXPECT_EQ(deep.exit_code, 1);
+  EXPECT_NE(deep.err.find("WebP holds 8 bits per channel"), std::string::npos) << deep.err;
+  EXPECT_EQ(std::count(deep.err.begin(), deep.err.end(), '\n'), 1) << deep.err;
+  EXPECT_FALSE(fs::exists(dir / "deep.glb"));
 }
 
 // One UV-mapped quad placed twice: under the ceiling ((h/D)² = 0.25) and 10 units away, open (1).

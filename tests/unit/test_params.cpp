@@ -174,6 +174,7 @@ void walk_scene_keys(const Group<T>& group, Of of) {
 TEST(SceneParams, EveryExportAndEncodingParameterReachesTheSceneFromBothDoors) {
   walk_scene_keys(exporter::options_params(), [](const pipeline::SceneSpec& s) { return s.options; });
   walk_scene_keys(image::encoding_params(), [](const pipeline::SceneSpec& s) { return s.options.encoding; });
+  walk_scene_keys(image::gltf_texture_params(), [](const pipeline::SceneSpec& s) { return s.options.encoding; });
 }
 
 // A material's options: each at its example through the flags, a material's key and the manifest's
@@ -279,6 +280,7 @@ TEST(DocsTables, MatchTheParameterDescriptions) {
   const Table tables[] = {
       {"docs/build.md", "params:ao", markdown_table(ao::request_params(), "")},
       {"docs/build.md", "params:encoding", markdown_table(image::encoding_params(), "")},
+      {"docs/export.md", "params:texture", markdown_table(image::gltf_texture_params(), "")},
       {"docs/export.md", "params:export", markdown_table(exporter::options_params(), "")},
       {"docs/validate.md", "params:validate", markdown_table(validate::options_params(), "")},
       {"docs/build.md", "params:material", markdown_table(pack::material_params(), "")},

@@ -96,8 +96,14 @@ std::optional<int> png_level_from_name(std::string_view name);
 
 // How matbake encodes the images it writes, whichever command writes them (convert, pack, unpack,
 // workflow, export, bake-ao's textures, a build): its parameters are image::encoding_params().
+// The format of the textures matbake writes into a glTF: PNG, or lossless 8-bit WebP (the texture
+// then names it through EXT_texture_webp, which the file requires).
+enum class TextureFormat { png, webp };
+inline constexpr NameTable<TextureFormat, 2> kTextureFormatNames{{{TextureFormat::png, "png"}, {TextureFormat::webp, "webp"}}};
+
 struct Encoding {
   int png_level = kPngLevelDefault;  // 8/16-bit PNG deflate effort
+  TextureFormat texture_format = TextureFormat::png;  // of textures written into a glTF
 };
 
 struct WriteOptions {

@@ -40,18 +40,6 @@ bool has_transformed_metallic_roughness(const Json& material) {
   return info.is_object() && info.contains("extensions") && info["extensions"].contains("KHR_texture_transform");
 }
 
-// A new texture over a new PNG file in `doc`, with the sampler of texture `sampler_from` (none when -1).
-int add_texture(gltf::Document& doc, std::string uri, std::string bytes, int sampler_from) {
-  doc.new_files[uri] = std::move(bytes);
-  doc.json["images"].push_back({{"uri", std::move(uri)}, {"mimeType", "image/png"}});
-  Json texture = {{"source", doc.json["images"].size() - 1}};
-  if (sampler_from >= 0 && doc.json["textures"][std::size_t(sampler_from)].contains("sampler")) {
-    texture["sampler"] = doc.json["textures"][std::size_t(sampler_from)]["sampler"];
-  }
-  doc.json["textures"].push_back(std::move(texture));
-  return int(doc.json["textures"].size()) - 1;
-}
-
 const Json* sampler_of(const Json& json, std::size_t texture) {
   const Json& t = gltf::array_in(json, "textures")[texture];
   const auto sampler = gltf::size_in(t, "sampler", SIZE_MAX);
@@ -260,17 +248,17 @@ Result<std::vector<TextureReport>> bake_occlusion_textures(gltf::Document& doc, 
         orm.pixels[p * 3 + 1] = gltf::rgba(source, p, 1);
         orm.pixels[p * 3 + 2] = gltf::rgba(source, p, 2);
       }
-      auto bytes = cache.encode_png(orm, color::Transfer::linear);
-      if (!bytes) return bytes.error();
-      report.file = stem + "_orm_ao_" + std::to_string(m) + ".png";
-      index = add_texture(doc, report.file, std::move(*bytes), mr_index);
+      auto made = cache.add_texture(doc, orm, color::Transfer::linear, stem + "_orm_ao_" + std::to_string(m), mr_index);
+      if (!made) return made.error();
+      report.file = made->uri;
+      index = made->texture;
       material["pbrMetallicRoughness"]["metallicRoughnessTexture"]["index"] = index;
     } else {
-      auto bytes = cache.encode_png(img, color::Transfer::linear,
+      auto made = cache.add_texture(doc, img, color::Transfer::linear, stem + "_occlusion_" + std::to_string(m), sampler_from,
                                     texture.bits == 16 ? image::SampleType::u16 : image::SampleType::u8);
-      if (!bytes) return bytes.error();
-      report.file = stem + "_occlusion_" + std::to_string(m) + ".png";
-      index = add_texture(doc, report.file, std::move(*bytes), sampler_from);
+      if (!made) return made.error();
+      report.file = made->uri;
+      index = made->texture;
     }
     // A transform (KHR_texture_transform) of the old texture does not apply to UVs baked as they are.
     Json info = {{"index", index}};

@@ -61,20 +61,13 @@ struct Exporter {
   std::map<std::string, Json> converted;         // spec-gloss block → the metal-rough it became
   std::map<std::pair<int, int>, int> orm_made;   // (metallic-roughness, occlusion) texture → ORM texture
 
-  // A new texture over a new PNG file, with the sampler of texture `sampler_of` (none when −1).
+  // A new texture over a new image file (the encoding's format), with the sampler of texture
+  // `sampler_of` (none when −1).
   Result<int> add_texture(const image::Image& img, color::Transfer colour, const std::string& name, int sampler_of) {
-    auto png = cache.encode_png(img, colour);
-    if (!png) return png.error();
-    const std::string uri = stem + "_" + name + ".png";
-    doc.new_files[uri] = std::move(*png);
-    doc.json["images"].push_back({{"uri", uri}, {"mimeType", "image/png"}});
-    Json texture = {{"source", doc.json["images"].size() - 1}};
-    if (sampler_of >= 0 && doc.json["textures"][std::size_t(sampler_of)].contains("sampler")) {
-      texture["sampler"] = doc.json["textures"][std::size_t(sampler_of)]["sampler"];
-    }
-    doc.json["textures"].push_back(std::move(texture));
+    auto made = cache.add_texture(doc, img, colour, stem + "_" + name, sampler_of);
+    if (!made) return made.error();
     ++report.textures_made;
-    return int(doc.json["textures"].size()) - 1;
+    return made->texture;
   }
 
   // The metal-rough maps written into `material`: factors when they are 1×1 (constants), else a

@@ -1,5 +1,7 @@
 #include "texture_files.hpp"
 
+#include <algorithm>
+
 namespace matbake::gltf {
 namespace {
 
@@ -28,6 +30,20 @@ int decodable_source(const Json& texture) {
 
 std::span<const unsigned char> as_bytes(const std::string& s) {
   return {reinterpret_cast<const unsigned char*>(s.data()), s.size()};
+}
+
+// Grey (and grey + alpha) spread to RGB (RGBA): WebP holds no one-channel image.
+image::Image as_rgb(const image::Image& grey) {
+  image::Image out;
+  out.width = grey.width, out.height = grey.height, out.channels = grey.channels + 2;
+  out.channel_names = out.channels == 4 ? std::vector<std::string>{"R", "G", "B", "A"} : std::vector<std::string>{"R", "G", "B"};
+  out.alpha_channel = out.channels == 4 ? 3 : -1;
+  const std::size_t pixels = std::size_t(grey.width) * std::size_t(grey.height);
+  out.pixels.resize(pixels * std::size_t(out.channels));
+  for (std::size_t p = 0; p < pixels; ++p) {
+    for (int c = 0; c < out.channels; ++c) out.pixels[p * std::size_t(out.channels) + std::size_t(c)] = rgba(grey, p, c == 3 ? 3 : c);
+  }
+  return out;
 }
 
 }  // namespace
@@ -86,12 +102,37 @@ Status ImageCache::check(std::size_t index) {
   return success();
 }
 
-Result<std::string> ImageCache::encode_png(const image::Image& img, color::Transfer colour, image::SampleType type) const {
+Result<ImageCache::Made> ImageCache::add_texture(Document& doc, const image::Image& img, color::Transfer colour,
+                                                 const std::string& name, int sampler_from, image::SampleType type) const {
+  const bool webp = encoding_.texture_format == image::TextureFormat::webp;
+  if (webp && type != image::SampleType::u8) {
+    return Error{doc.file, name + ": WebP holds 8 bits per channel; write 16-bit textures as PNG (--texture-format png)"};
+  }
   image::WriteOptions options;
   options.colour = colour;
   options.type = type;
   options.png_level = encoding_.png_level;
-  return image::encode_image(img, "made.png", options);
+  if (webp) options.compression = "lossless";  // data (occlusion, roughness) survives as written
+  Made made;
+  made.uri = name + (webp ? ".webp" : ".png");
+  auto bytes = image::encode_image(webp && img.channels < 3 ? as_rgb(img) : img, made.uri, options);
+  if (!bytes) return bytes.error();
+  doc.new_files[made.uri] = std::move(*bytes);
+  doc.json["images"].push_back({{"uri", made.uri}, {"mimeType", webp ? "image/webp" : "image/png"}});
+  const std::size_t image = doc.json["images"].size() - 1;
+  Json texture = webp ? Json{{"extensions", {{"EXT_texture_webp", {{"source", image}}}}}} : Json{{"source", image}};
+  if (sampler_from >= 0 && doc.json["textures"][std::size_t(sampler_from)].contains("sampler")) {
+    texture["sampler"] = doc.json["textures"][std::size_t(sampler_from)]["sampler"];
+  }
+  doc.json["textures"].push_back(std::move(texture));
+  if (webp) {
+    for (const char* list : {"extensionsUsed", "extensionsRequired"}) {
+      Json& names = doc.json[list];
+      if (std::find(names.begin(), names.end(), "EXT_texture_webp") == names.end()) names.push_back("EXT_texture_webp");
+    }
+  }
+  made.texture = int(doc.json["textures"].size()) - 1;
+  return made;
 }
 
 }  // namespace matbake::gltf

@@ -30,9 +30,16 @@ class ImageCache {
   // Image `index` is a PNG, JPEG or WebP whose header reads, or a KTX2 file (passed through).
   Status check(std::size_t index);
 
-  // PNG bytes of `img` (colour channels encoded with `colour`), at the document's encoding.
-  Result<std::string> encode_png(const image::Image& img, color::Transfer colour,
-                                 image::SampleType type = image::SampleType::u8) const;
+  // A new texture of `doc` (the cache's document) over `img`, its colour channels encoded with
+  // `colour`, in the encoding's texture format: a new file `<name>.png`, or `<name>.webp` (lossless,
+  // 8-bit) named through EXT_texture_webp, which the file then requires. With the sampler of
+  // texture `sampler_from` (none when −1). Returns the texture's index and the image's URI.
+  struct Made {
+    int texture = -1;
+    std::string uri;
+  };
+  Result<Made> add_texture(Document& doc, const image::Image& img, color::Transfer colour, const std::string& name,
+                           int sampler_from, image::SampleType type = image::SampleType::u8) const;
 
  private:
   const gltf::Document& doc_;

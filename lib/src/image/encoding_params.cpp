@@ -22,4 +22,14 @@ const params::Group<Encoding>& encoding_params() {
   return group;
 }
 
+const params::Group<Encoding>& gltf_texture_params() {
+  static const params::Group<Encoding> group{
+      {params::choice<Encoding>(params::Spec{.name = "texture_format",
+                                             .help = "Format of the textures written into a glTF (converted, ORM, occlusion): png, "
+                                                     "or webp (lossless, 8-bit; the file then requires EXT_texture_webp)",
+                                             .example = "webp"},
+                                [](auto& e) -> auto& { return e.texture_format; }, kTextureFormatNames)}};
+  return group;
+}
+
 }  // namespace matbake::image

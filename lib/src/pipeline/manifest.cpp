@@ -398,16 +398,18 @@ Result<SceneSpec> read_scene(const Reader& r, const std::string& name, const tom
   if (!t) return r.at(node, where + " must be a table");
   if (!is_file_name_safe(name)) return r.at(node, "scene name '" + name + "': letters, digits, '_', '-' and '.' only");
   if (Status s = r.known_keys(*t, where, with_keys_of(image::encoding_params(),
-                                                      with_keys_of(exporter::options_params(),
-                                                                   with_keys_of(scene_params(),
-                                                                                {"input", "output", "materials", "ao"}))));
+                                                      with_keys_of(image::gltf_texture_params(),
+                                                                   with_keys_of(exporter::options_params(),
+                                                                                with_keys_of(scene_params(),
+                                                                                             {"input", "output", "materials", "ao"})))));
       !s) {
     return s.error();
   }
   SceneSpec spec;
   spec.options.encoding = encoding;
-  if (Status s = read_params_in(r, *t, where, image::encoding_params(), spec.options.encoding, notes); !s) {
-    return s.error();
+  for (Status s : {read_params_in(r, *t, where, image::encoding_params(), spec.options.encoding, notes),
+                   read_params_in(r, *t, where, image::gltf_texture_params(), spec.options.encoding, notes)}) {
+    if (!s) return s.error();
   }
   spec.name = name;
   spec.origins.by_key[""] = r.origin(node.source());
@@ -473,7 +475,9 @@ Result<Manifest> parse_manifest(std::string_view toml_text, const fs::path& file
     if (Status s = r.known_keys(doc, "the manifest",
                                 with_keys_of(pack::material_params(),
                                              with_keys_of(image::encoding_params(),
-                                                          {"output", "table", "validate", "materials", "material_rules", "scenes"})));
+                                                          with_keys_of(image::gltf_texture_params(),
+                                                                       {"output", "table", "validate", "materials", "material_rules",
+                                                                        "scenes"}))));
         !s) {
       return s.error();
     }
@@ -487,10 +491,11 @@ Result<Manifest> parse_manifest(std::string_view toml_text, const fs::path& file
     m.output = (m.folder / output).lexically_normal();
     if (!table.empty()) m.table = m.folder / table;
     // The top level's material options, encoding and validation are every material's defaults (the
-    // encoding every scene's too), each of which may say otherwise.
+    // encoding and texture format every scene's too), each of which may say otherwise.
     MaterialSpec defaults;
     for (Status s : {read_params_in(r, doc, "manifest", pack::material_params(), defaults.options, m.notes),
-                     read_params_in(r, doc, "manifest", image::encoding_params(), defaults.encoding, m.notes)}) {
+                     read_params_in(r, doc, "manifest", image::encoding_params(), defaults.encoding, m.notes),
+                     read_params_in(r, doc, "manifest", image::gltf_texture_params(), defaults.encoding, m.notes)}) {
       if (!s) return s.error();
     }
     if (const toml::node* v = doc.get("validate")) {

@@ -120,6 +120,7 @@ nlohmann::json to_json(const bake_ao::TextureReport& t) {
 nlohmann::json to_json(const exporter::Options& o) {
   nlohmann::json j = params::to_json(exporter::options_params(), o);
   j.update(params::to_json(image::encoding_params(), o.encoding));
+  j.update(params::to_json(image::gltf_texture_params(), o.encoding));
   j["ao"] = o.ao ? to_json(*o.ao) : nlohmann::json(nullptr);
   return j;
 }
