@@ -50,8 +50,9 @@ struct Scene {
   float radius() const;            // half the bounding box diagonal
 };
 
-// Reads .gltf or .glb. Errors name the file: malformed JSON or GLB, accessors or buffer views out
-// of range, indices beyond the vertex count, sparse accessors (refused), buffer or image URIs that
+// Reads .gltf or .glb (Draco, meshopt, quantized and sparse geometry decoded). Errors name the file:
+// malformed JSON or GLB, any index out of range (at its JSON pointer), accessors or buffer views
+// beyond their buffers, compressed data its decoder refuses, indices beyond the vertex count, buffer or image URIs that
 // leave the file's folder (absolute or with ..), a node reached twice (a cycle, or two parents:
 // glTF nodes form strict trees), no default scene, no triangles. Node chains of any depth are
 // walked without recursion.
