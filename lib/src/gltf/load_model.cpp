@@ -109,16 +109,15 @@ bool is_inside(const fs::path& base, const fs::path& path) {
 
 Status load_model_json(const fs::path& path, const std::string& json_text, std::vector<unsigned char>& glb_bin,
                        tinygltf::Model& model) {
-  const std::string& bytes = json_text;
   const std::string file = path.string();
   ConfinedFolder folder{fs::absolute(path).parent_path(), {}, &glb_bin};
   tinygltf::TinyGLTF loader;
   loader.SetFsCallbacks({file_exists, expand_path, read_file, refuse_write, &folder});
   loader.SetImageLoader(skip_image_decoding, nullptr);
-  if (bytes.size() > std::numeric_limits<unsigned>::max()) return Error{file, "larger than 4 GiB, which tinygltf cannot read"};
+  if (json_text.size() > std::numeric_limits<unsigned>::max()) return Error{file, "larger than 4 GiB, which tinygltf cannot read"};
   std::string err, warn;
   const std::string base = folder.base.string();
-  const bool ok = loader.LoadASCIIFromString(&model, &err, &warn, bytes.data(), unsigned(bytes.size()), base);
+  const bool ok = loader.LoadASCIIFromString(&model, &err, &warn, json_text.data(), unsigned(json_text.size()), base);
   if (!folder.refused.empty()) return Error{file, folder.refused};
   if (!ok) return Error{file, "not a valid glTF: " + first_line(err)};
   return success();
