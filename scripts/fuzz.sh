@@ -21,7 +21,8 @@ fi
 bash "$root/scripts/deps.sh"
 CXX=clang++-14 cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMATBAKE_FUZZ=ON \
   -DMATBAKE_BUILD_TESTS=OFF -DMATBAKE_BUILD_BENCH=OFF >/dev/null
-cmake --build "$build" >/dev/null
+# The targets only (the command-line program is not fuzzed through its binary).
+cmake --build "$build" --target "${targets[@]/#/fuzz_}" >/dev/null
 
 # Seeds: copies of the matching files, flat (libFuzzer reads every file of a folder it is given).
 seed() {  # target, then find arguments
