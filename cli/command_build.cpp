@@ -5,10 +5,14 @@
 #include <chrono>
 #include <cstdio>
 #include <iostream>
+#include <map>
 #include <optional>
 
 #include "commands.hpp"
+#include "params_cli.hpp"
 #include "matbake/atomic_file.hpp"
+#include "matbake/cluster.hpp"
+#include "matbake/output_check.hpp"
 #include "matbake/pipeline.hpp"
 #include "progress_bar.hpp"
 #include "silenced_stderr.hpp"
@@ -41,6 +45,91 @@ void add_output_dir_option(CLI::App& cmd, std::string& output_dir) {
                  "Write the outputs here instead of the manifest's `output` (e.g. inside a build tree)");
 }
 
+// `build --status`: each job that is not up to date, with why; the counts; exit 1 when any failed.
+int run_status(const BuildSettings& s, const GlobalOptions& global, const pipeline::Manifest& manifest,
+               const pipeline::Plan& plan) {
+  auto statuses = pipeline::job_statuses(manifest, plan);
+  if (!statuses) return report_error(statuses.error());
+  std::map<pipeline::JobState, std::size_t> count;
+  nlohmann::json jobs = nlohmann::json::array();
+  for (const pipeline::JobStatus& st : *statuses) {
+    ++count[st.state];
+    const std::string state(name_in(pipeline::kJobStateNames, st.state));
+    jobs.push_back({{"name", st.job->name}, {"state", state}, {"detail", st.detail}});
+    if (st.state == pipeline::JobState::failed) {
+      std::cerr << "matbake: error: " << escape_control(st.detail) << " (" << st.job->name << ")\n";
+    } else if (st.state == pipeline::JobState::not_built && !global.json && !global.quiet) {
+      std::printf("not built %s: %s\n", st.job->name.c_str(), escape_control(st.detail).c_str());
+    }
+  }
+  const std::size_t failed = count[pipeline::JobState::failed];
+  if (global.json) {
+    std::cout << nlohmann::json{{"command", "build"}, {"status", true}, {"manifest", manifest.file}, {"jobs", jobs},
+                                {"counts", {{"up_to_date", count[pipeline::JobState::up_to_date]}, {"failed", failed},
+                                            {"not_built", count[pipeline::JobState::not_built]}}}}
+                     .dump(2)
+              << "\n";
+  } else if (!global.quiet) {
+    std::printf("up to date %zu, failed %zu, not built %zu\n", count[pipeline::JobState::up_to_date], failed,
+                count[pipeline::JobState::not_built]);
+  }
+  if (failed) std::cerr << "matbake: error: " << s.manifest << ": " << failed << " of " << statuses->size() << " jobs failed\n";
+  return failed ? kFailed : kOk;
+}
+
+// submit.sh and job.sh in `folder`, made if need be; neither may be an input of the manifest.
+Status write_slurm_scripts(const pipeline::Manifest& manifest, const pipeline::Plan& plan,
+                           const pipeline::SlurmScripts& scripts, const fs::path& folder) {
+  const NamedOutput outputs[] = {{folder / "submit.sh", "submission script"}, {folder / "job.sh", "job script"}};
+  std::vector<fs::path> inputs{manifest.file};
+  for (const pipeline::Job& job : plan.jobs) inputs.insert(inputs.end(), job.inputs.begin(), job.inputs.end());
+  if (Status st = check_outputs(outputs, inputs); !st) return st;
+  std::error_code ec;
+  fs::create_directories(folder, ec);
+  if (ec) return Error{folder.string(), "cannot make the folder: " + ec.message()};
+  for (const auto& [output, text] : {std::pair{outputs[0].path, &scripts.submit}, std::pair{outputs[1].path, &scripts.job}}) {
+    if (Status st = write_file_atomically(output, *text); !st) return st;
+    fs::permissions(output, fs::perms::owner_exec | fs::perms::group_exec | fs::perms::others_exec, fs::perm_options::add, ec);
+  }
+  return success();
+}
+
+// The out-of-date jobs as a Slurm submission in s.output (or, with --dry-run, its sbatch commands).
+int run_slurm_plan(const PlanSettings& s, const GlobalOptions& global, pipeline::Manifest& manifest,
+                   const pipeline::Plan& plan, const fs::path& self) {
+  params::copy_given(pipeline::cluster_params(), s.cluster, s.cluster_given, manifest.cluster);
+  if (global.jobs > 0) manifest.cluster.cpus = global.jobs;
+  pipeline::RunOptions dry;
+  dry.dry_run = true;
+  auto report = pipeline::run(manifest, plan, dry);
+  if (!report) return report_error(report.error());
+  const auto submission = pipeline::slurm_submission(
+      plan, *report, manifest.cluster, [](const pipeline::Job& job) { return pipeline::largest_image_pixels(job.inputs); });
+  const pipeline::SlurmTarget target{fs::absolute(s.output).lexically_normal(), self};
+  if (s.dry_run) {
+    for (const std::string& line : pipeline::sbatch_lines(submission, manifest.cluster, target)) std::printf("%s\n", line.c_str());
+  } else if (Status st = write_slurm_scripts(manifest, plan, pipeline::slurm_scripts(manifest, submission, manifest.cluster, target),
+                                             target.folder);
+             !st) {
+    return report_error(st.error());
+  }
+  if (global.json) {
+    nlohmann::json doc = {{"command", "plan"}, {"format", "slurm"}, {"folder", target.folder}, {"dry_run", s.dry_run},
+                          {"up_to_date", submission.up_to_date}, {"cluster", params::to_json(pipeline::cluster_params(), manifest.cluster)}};
+    doc["array"] = {{"memory_mb", submission.array_memory_mb}, {"jobs", nlohmann::json::array()}};
+    for (const pipeline::SlurmJob& j : submission.array) doc["array"]["jobs"].push_back(j.job->name);
+    doc["scenes"] = nlohmann::json::array();
+    for (const pipeline::SlurmJob& j : submission.scenes) {
+      doc["scenes"].push_back({{"job", j.job->name}, {"memory_mb", j.memory_mb}, {"after_tasks", j.after}});
+    }
+    std::cout << doc.dump(2) << "\n";
+  } else if (!global.quiet && !s.dry_run) {
+    std::printf("%s: %s\n", (target.folder / "submit.sh").c_str(), pipeline::submission_counts(submission).c_str());
+  }
+  for (const std::string& w : plan.warnings) std::cerr << "matbake: warning: " << w << "\n";
+  return kOk;
+}
+
 }  // namespace
 
 CLI::App* setup_build(CLI::App& app, BuildSettings& s) {
@@ -54,6 +143,9 @@ CLI::App* setup_build(CLI::App& app, BuildSettings& s) {
   cmd->add_flag("-n,--dry-run", s.dry_run, "List what would be built, and why, without building it");
   cmd->add_flag("--keep-stale", s.keep_stale,
                 "Keep the files an earlier build made that no job makes now (by default a full run with no failure removes them)");
+  cmd->add_flag("--status", s.status,
+                "Build nothing; say how each job stands after runs elsewhere (a cluster, docs/cluster.md): up to date,\n"
+                "failed (its error line) or not built. Exit 1 when any failed");
   cmd->add_option("--only", s.only, "Build only this job (material:NAME or scene:NAME); repeatable");
   cmd->add_option("--depfile", s.depfile,
                   "Write a Make depfile of every input read, for CMake add_custom_command(DEPFILE) and Ninja");
@@ -64,11 +156,21 @@ CLI::App* setup_build(CLI::App& app, BuildSettings& s) {
 
 CLI::App* setup_plan(CLI::App& app, PlanSettings& s) {
   CLI::App* cmd = app.add_subcommand(
-      "plan", "Write a Ninja file with one edge per job of a manifest: Ninja schedules them and re-runs what changed");
+      "plan",
+      "Hand a manifest's jobs to a scheduler: a Ninja file with one edge per job (Ninja re-runs what changed), or\n"
+      "a Slurm submission of the out-of-date jobs (docs/cluster.md)");
   cmd->add_option("manifest", s.manifest, "The manifest (TOML)")->required();
-  cmd->add_option("-o,--output", s.output, "The Ninja file to write (e.g. build.ninja)")->required();
-  cmd->add_option("--matbake", s.matbake, "The matbake the edges run (default: this one)");
+  cmd->add_option("-o,--output", s.output,
+                  "ninja: the Ninja file to write (e.g. build.ninja); slurm: the folder of submit.sh, job.sh and logs/")
+      ->required();
+  cmd->add_option("--format", s.format, "ninja, or slurm (a job array of the materials, each scene after its own)")
+      ->check(CLI::IsMember({"ninja", "slurm"}))
+      ->capture_default_str();
+  cmd->add_option("--matbake", s.matbake, "The matbake the jobs run (default: this one)");
+  cmd->add_flag("-n,--dry-run", s.dry_run, "slurm: print the sbatch commands the submission would run; write nothing");
   add_output_dir_option(*cmd, s.output_dir);
+  add_params(*cmd, pipeline::cluster_params(), s.cluster, "", "Slurm (--format slurm; also the manifest's [cluster])",
+             &s.cluster_given);
   return cmd;
 }
 
@@ -78,6 +180,7 @@ int run_plan(const PlanSettings& s, const GlobalOptions& global) {
   if (!plan) return report_error(plan.error());
   std::error_code ec;
   const fs::path self = s.matbake.empty() ? fs::read_symlink("/proc/self/exe", ec) : fs::absolute(s.matbake);
+  if (s.format == "slurm") return run_slurm_plan(s, global, manifest, *plan, self);
   if (Status st = write_file_atomically(s.output, pipeline::ninja_text(manifest, *plan, self, s.output)); !st) {
     return report_error(st.error());
   }
@@ -97,6 +200,7 @@ int run_build(const BuildSettings& s, const GlobalOptions& global) {
   pipeline::Manifest manifest;
   auto plan = load(s.manifest, s.output_dir, manifest);
   if (!plan) return report_error(plan.error());
+  if (s.status) return run_status(s, global, manifest, *plan);
   if (!global.quiet) {
     for (const std::string& w : plan->warnings) std::cerr << "matbake: warning: " << w << "\n";
   }

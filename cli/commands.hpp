@@ -4,6 +4,7 @@
 #include <CLI/CLI.hpp>
 
 #include <iostream>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -12,6 +13,7 @@
 #include "matbake/ao.hpp"
 #include "matbake/convert.hpp"
 #include "matbake/export.hpp"
+#include "matbake/pipeline.hpp"
 #include "matbake/preview.hpp"
 #include "matbake/result.hpp"
 #include "matbake/validate.hpp"
@@ -126,6 +128,7 @@ struct BuildSettings {
   bool force = false;
   bool dry_run = false;
   bool keep_stale = false;
+  bool status = false;  // report how the jobs stand (after a cluster run); build nothing
   std::vector<std::string> only;
   std::string depfile;
   std::string stamp;
@@ -138,6 +141,10 @@ struct PlanSettings {
   std::string output;
   std::string matbake;
   std::string output_dir;
+  std::string format = "ninja";            // ninja | slurm
+  bool dry_run = false;                    // slurm: print the sbatch commands, write nothing
+  pipeline::ClusterOptions cluster;        // slurm: the flags given, over the manifest's [cluster]
+  std::set<std::string> cluster_given;
 };
 CLI::App* setup_plan(CLI::App& app, PlanSettings& settings);
 int run_plan(const PlanSettings& settings, const GlobalOptions& global);

@@ -13,6 +13,8 @@ packages=(
   libdraco-dev libmeshoptimizer-dev libwebp-dev draco gltfpack
   clang-14 libclang-rt-14-dev llvm-14
 )
+# `deps.sh cluster`: also Slurm and munge, for scripts/test-cluster.sh.
+[ "${1:-}" = cluster ] && packages+=(slurm-wlm munge)
 
 missing=()
 for p in "${packages[@]}"; do

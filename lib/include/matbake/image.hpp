@@ -65,6 +65,7 @@ std::vector<color::Transfer> channel_transfers(const ImageLayout& layout, color:
 struct ReadInfo {
   SampleType stored_type = SampleType::u8;  // the closest of ours to what the file holds
   std::string format_name;                  // OIIO's names: "png", "openexr", "tiff", "jpeg", ...
+  int width = 0, height = 0;                // as the header declares them
 };
 
 // Reads any image OIIO can (PNG with libspng, other formats with OIIO, loaded on first need) and

@@ -127,6 +127,22 @@ nlohmann::json to_json(const Group<T>& group, const T& target) {
   return j;
 }
 
+// The parameters `given` by a later door (the command line over a manifest) copied from its
+// request into the other: each as its get() shows it, stored by its set().
+template <class T>
+void copy_given(const Group<T>& group, const T& from, const std::set<std::string>& given, T& into) {
+  for (const Param<T>& p : group.params) {
+    if (!given.count(p.spec.name)) continue;
+    const nlohmann::json shown = p.get(from);
+    Value value = std::string();  // null: an unset text
+    if (shown.is_boolean()) value = shown.get<bool>();
+    else if (shown.is_number_integer()) value = shown.get<std::int64_t>();
+    else if (shown.is_number()) value = shown.get<double>();
+    else if (shown.is_string()) value = shown.get<std::string>();
+    (void)p.set(into, value);  // accepted once already, by the door that gave it
+  }
+}
+
 // The docs' reference table: flag (with `flag_prefix`), manifest key, type, default, help.
 std::string markdown_table(const std::vector<const Spec*>& specs, const nlohmann::json& defaults,
                            std::string_view flag_prefix);

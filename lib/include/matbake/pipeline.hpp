@@ -85,6 +85,16 @@ struct MaterialRule {
   std::vector<std::string> materials;
 };
 
+// The manifest's [cluster] table: what `plan --format slurm` asks sbatch for (matbake/cluster.hpp).
+struct ClusterOptions {
+  std::string partition;            // sbatch --partition; empty: the cluster's default
+  std::string account;              // sbatch --account; empty: the user's default
+  std::string time_limit;           // sbatch --time of each job ("30:00", "2:00:00"); empty: the partition's
+  std::int64_t array_throttle = 0;  // at most this many material jobs at once (--array=...%N); 0: no limit
+  std::int64_t memory_mb = 0;       // each job's memory; 0: estimated from the largest image it holds
+  std::int64_t cpus = 1;            // cores per job (--cpus-per-task); the job runs with --jobs this
+};
+
 struct Manifest {
   std::filesystem::path file;    // absolute
   std::filesystem::path folder;  // relative paths in the manifest resolve here
@@ -95,6 +105,7 @@ struct Manifest {
   std::vector<MaterialSpec> materials;  // its own, then those its rules made
   std::vector<MaterialRule> rules;
   std::vector<SceneSpec> scenes;
+  ClusterOptions cluster;
 };
 
 // Errors name the manifest with line and column, and the key.
@@ -191,6 +202,19 @@ struct Report {
 
 // Runs the out-of-date jobs of the plan (all jobs with force). Errors are per job, in the report.
 Result<Report> run(const Manifest& manifest, const Plan& plan, const RunOptions& options);
+
+// How each job stands after runs elsewhere (a cluster's jobs, each its own `build --only`), read
+// from the stamps and the failures recorded beside them: up to date, failed (the error line of its
+// last run) or not built (never run, running, cancelled, or out of date since it ran).
+enum class JobState { up_to_date, failed, not_built };
+inline constexpr NameTable<JobState, 3> kJobStateNames{
+    {{JobState::up_to_date, "up_to_date"}, {JobState::failed, "failed"}, {JobState::not_built, "not_built"}}};
+struct JobStatus {
+  const Job* job = nullptr;
+  JobState state = JobState::not_built;
+  std::string detail;  // failed: the error line; not built: why ("no earlier build", "waits for material:x, which failed")
+};
+Result<std::vector<JobStatus>> job_statuses(const Manifest& manifest, const Plan& plan);
 
 // The run as `build --json` prints it (without "command", "dry_run" and "seconds"): the manifest,
 // the output folder, each job (name, outcome, inputs, outputs, seconds, warnings, reason, error,

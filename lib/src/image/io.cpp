@@ -99,7 +99,9 @@ class RowReader {
 
  public:
   const ImageLayout& layout() const { return stored_->format().layout; }
-  ReadInfo info() const { return {stored_->format().stored, stored_->format().format_name}; }
+  ReadInfo info() const {
+    return {stored_->format().stored, stored_->format().format_name, layout().width, layout().height};
+  }
 
   // Rows [y, y + rows) into `out`, decoded.
   Status read_rows(int y, int rows, std::span<float> out) {

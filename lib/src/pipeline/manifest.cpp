@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "matbake/ao_params.hpp"
+#include "matbake/cluster.hpp"
 #include "matbake/encoding_params.hpp"
 #include "matbake/export_params.hpp"
 #include "matbake/material_params.hpp"
@@ -477,7 +478,7 @@ Result<Manifest> parse_manifest(std::string_view toml_text, const fs::path& file
                                              with_keys_of(image::encoding_params(),
                                                           with_keys_of(image::gltf_texture_params(),
                                                                        {"output", "table", "validate", "materials", "material_rules",
-                                                                        "scenes"}))));
+                                                                        "scenes", "cluster"}))));
         !s) {
       return s.error();
     }
@@ -501,6 +502,10 @@ Result<Manifest> parse_manifest(std::string_view toml_text, const fs::path& file
     if (const toml::node* v = doc.get("validate")) {
       if (!v->is_table()) return r.at(*v, "validate must be a table");
       if (Status s = read_validation(r, *v->as_table(), "validate", defaults.validation, m.notes); !s) return s.error();
+    }
+    if (const toml::node* c = doc.get("cluster")) {
+      if (!c->is_table()) return r.at(*c, "cluster must be a table: [cluster]");
+      if (Status s = read_params(r, *c->as_table(), "cluster", cluster_params(), m.cluster, m.notes); !s) return s.error();
     }
     if (const toml::node* mats = doc.get("materials")) {
       if (!mats->is_table()) return r.at(*mats, "materials must be a table of tables: [materials.NAME]");

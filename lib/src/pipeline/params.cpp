@@ -1,3 +1,7 @@
+#include <algorithm>
+#include <cctype>
+
+#include "matbake/cluster.hpp"
 #include "matbake/pipeline_params.hpp"
 
 namespace matbake::pipeline {
@@ -29,6 +33,67 @@ const params::Group<SceneSpec>& scene_params() {
                                    .example = "false",
                                    .manifest_only = true},
                               [](auto& s) -> auto& { return s.match_names; }),
+  }};
+  return group;
+}
+
+namespace {
+
+// Text passed to sbatch as one argument: only the characters Slurm's names and times use, so that a
+// typing slip is refused here and not by sbatch on the cluster.
+params::Param<ClusterOptions> sbatch_text(params::Spec spec, std::string ClusterOptions::*field, std::string_view extra,
+                                          std::string what) {
+  params::Param<ClusterOptions> p = params::text<ClusterOptions>(std::move(spec), [field](auto& o) -> auto& { return o.*field; });
+  p.set = [field, extra, what](ClusterOptions& o, const params::Value& v) -> std::optional<std::string> {
+    const std::string& text = std::get<std::string>(v);
+    const bool fits = std::all_of(text.begin(), text.end(), [&](char c) {
+      return std::isdigit(static_cast<unsigned char>(c)) || extra.find(c) != std::string_view::npos;
+    });
+    if (!fits) return what;
+    o.*field = text;
+    return std::nullopt;
+  };
+  return p;
+}
+
+constexpr std::string_view kNameCharacters = "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ_-.,";
+
+}  // namespace
+
+const params::Group<ClusterOptions>& cluster_params() {
+  using params::Spec;
+  static const params::Group<ClusterOptions> group{{
+      sbatch_text(Spec{.name = "partition", .help = "Slurm partition of every job (unset: the cluster's default)", .example = "batch"},
+                  &ClusterOptions::partition, kNameCharacters, "letters, digits, '_', '-', '.' and ',' only"),
+      sbatch_text(Spec{.name = "account", .help = "Slurm account the jobs are charged to (unset: yours)", .example = "art"},
+                  &ClusterOptions::account, kNameCharacters, "letters, digits, '_', '-', '.' and ',' only"),
+      sbatch_text(Spec{.name = "time_limit",
+                       .help = "Time limit of each job, as sbatch --time takes it: MM, MM:SS, HH:MM:SS or D-HH:MM "
+                               "(unset: the partition's)",
+                       .example = "30:00"},
+                  &ClusterOptions::time_limit, ":-", "minutes, MM:SS, HH:MM:SS or D-HH:MM:SS"),
+      params::integer<ClusterOptions>(Spec{.name = "array_throttle",
+                                           .help = "At most this many material jobs running at once (sbatch "
+                                                   "--array=...%N; 0: no limit)",
+                                           .min = 0,
+                                           .max = 1e6,
+                                           .example = "16"},
+                                      [](auto& o) -> auto& { return o.array_throttle; }),
+      params::integer<ClusterOptions>(Spec{.name = "memory_mb",
+                                           .help = "Memory of each job in MB (0: estimated from the largest image it "
+                                                   "holds, docs/cluster.md)",
+                                           .min = 0,
+                                           .max = 1e8,
+                                           .example = "4096"},
+                                      [](auto& o) -> auto& { return o.memory_mb; }),
+      params::integer<ClusterOptions>(Spec{.name = "cpus",
+                                           .help = "Cores of each job (sbatch --cpus-per-task; the job runs with "
+                                                   "--jobs this); `plan --jobs N` sets it too",
+                                           .min = 1,
+                                           .max = 4096,
+                                           .example = "4",
+                                           .manifest_only = true},
+                                      [](auto& o) -> auto& { return o.cpus; }),
   }};
   return group;
 }

@@ -274,6 +274,7 @@ void run_job(const Job& job, const JobContext& ctx, const RunOptions& run_option
              JobReport& report) {
   const auto start = std::chrono::steady_clock::now();
   remove_stamp(job.name, roots);  // from here until it succeeds, the job is not up to date
+  remove_failure(job.name, roots);  // nor failed: running (or, if it is killed, not built)
   const std::vector<fs::path> decoded = decoded_files(job, ctx.manifest);
   std::vector<StampedFile> read = identify_other_inputs(job, decoded);
   std::vector<fs::path> written = job.outputs.all();
@@ -297,7 +298,10 @@ void run_job(const Job& job, const JobContext& ctx, const RunOptions& run_option
     }
   }
   report.outcome = status ? Outcome::built : Outcome::failed;
-  if (!status) report.error = status.error();
+  if (!status) {
+    report.error = status.error();
+    record_failure(job.name, status.error(), roots);
+  }
   report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
@@ -306,7 +310,10 @@ void run_job(const Job& job, const JobContext& ctx, const RunOptions& run_option
 Status finish_run(const Plan& plan, const RunOptions& options, const StampRoots& roots, Report& report) {
   const MadeLog before = read_made_log(roots);
   MadeLog log = before;
-  for (const std::string& name : record_run(log, plan, report, roots)) remove_stamp(name, roots);
+  for (const std::string& name : record_run(log, plan, report, roots)) {
+    remove_stamp(name, roots);
+    remove_failure(name, roots);
+  }
   const bool full = options.only.empty() && report.count(Outcome::failed) == 0;
   report.stale = clean_stale(log, roots, full && !options.keep_stale);
   return log == before ? success() : write_made_log(log, roots);  // a no-op run writes nothing

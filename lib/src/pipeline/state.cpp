@@ -154,4 +154,30 @@ void remove_stamp(const std::string& job_name, const StampRoots& roots) {
   fs::remove(stamp_path(job_name, roots), ec);
 }
 
+namespace {
+fs::path failure_path(const std::string& job_name, const StampRoots& roots) {
+  return roots.state_folder / (job_file_stem(job_name) + ".failed");
+}
+}  // namespace
+
+void record_failure(const std::string& job_name, const Error& error, const StampRoots& roots) {
+  std::error_code ec;
+  fs::create_directories(roots.state_folder, ec);
+  const nlohmann::json record = {{"job", job_name}, {"matbake", version}, {"error", error.to_string()}};
+  (void)write_file_atomically(failure_path(job_name, roots), record.dump(1) + "\n");
+}
+
+void remove_failure(const std::string& job_name, const StampRoots& roots) {
+  std::error_code ec;
+  fs::remove(failure_path(job_name, roots), ec);
+}
+
+std::optional<std::string> recorded_failure(const std::string& job_name, const StampRoots& roots) {
+  std::string text;
+  if (!read_whole_file(failure_path(job_name, roots), text)) return std::nullopt;
+  const nlohmann::json record = nlohmann::json::parse(text, nullptr, false);
+  if (!record.is_object() || !record.contains("error") || !record["error"].is_string()) return std::nullopt;
+  return record["error"].get<std::string>();
+}
+
 }  // namespace matbake::pipeline

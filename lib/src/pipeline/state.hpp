@@ -68,6 +68,13 @@ Status write_stamp(const Job& job, const std::vector<StampedFile>& read, const s
 // Removes the stamp, so that a failed job runs again next time.
 void remove_stamp(const std::string& job_name, const StampRoots& roots);
 
+// A failed run's error line, kept beside the stamps until the job runs again: what `build --status`
+// reports of a job that ran elsewhere (a cluster node) and failed. Best effort: a record that cannot
+// be written leaves the job "not built" in the status, never up to date.
+void record_failure(const std::string& job_name, const Error& error, const StampRoots& roots);
+void remove_failure(const std::string& job_name, const StampRoots& roots);
+std::optional<std::string> recorded_failure(const std::string& job_name, const StampRoots& roots);
+
 // A path as a stamp or the state folder's logs hold it: relative to `root` where it lies below or
 // beside it; and back.
 std::string stamped_path(const std::filesystem::path& p, const std::filesystem::path& root);

@@ -1,0 +1,77 @@
+#pragma once
+// `matbake plan --format slurm`: a manifest's out-of-date jobs handed to a Slurm cluster. The
+// material jobs go as one job array, and each scene job waits for exactly the array tasks whose
+// outputs it reads. Every task runs `matbake build MANIFEST --only JOB`, so a cluster run writes
+// and stamps as a local build does, and either is up to date after the other (docs/cluster.md).
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "matbake/params.hpp"
+#include "matbake/pipeline.hpp"
+
+namespace matbake::pipeline {
+
+// partition, account, time_limit, array_throttle, memory_mb (flags of `plan` and the manifest's
+// [cluster] table) and cpus (the manifest's; `plan --jobs` sets it too).
+const params::Group<ClusterOptions>& cluster_params();
+
+// The memory (MB) to ask for a job whose largest image has `pixels` texels: the program's own
+// footprint plus the bytes per texel a 2048² material job was measured to hold (docs/cluster.md),
+// with a quarter on top (Slurm ends a job that passes its request), rounded up to 64 MB.
+std::int64_t job_memory_mb(std::uint64_t pixels);
+
+// One job as it is submitted.
+struct SlurmJob {
+  const Job* job = nullptr;
+  std::uint64_t pixels = 0;          // of the largest image it holds (for a scene: its materials' too)
+  std::int64_t memory_mb = 0;        // asked for: the options' memory_mb, else job_memory_mb(pixels)
+  std::vector<std::size_t> after;    // a scene: the array tasks (indices) whose outputs it reads
+};
+
+struct SlurmSubmission {
+  std::vector<SlurmJob> array;    // the material jobs: array task i runs array[i]
+  std::int64_t array_memory_mb = 0;  // every task's (Slurm gives an array one size): the largest
+  std::vector<SlurmJob> scenes;   // each after its tasks
+  std::size_t up_to_date = 0;     // jobs left out
+};
+
+// The jobs a dry run found out of date (or failing: they run and fail where the status shows
+// them), and every scene that reads a material submitted with them. `pixels_of` gives a job's
+// largest image (largest_image_pixels of its inputs, in practice).
+SlurmSubmission slurm_submission(const Plan& plan, const Report& dry_run, const ClusterOptions& options,
+                                 const std::function<std::uint64_t(const Job&)>& pixels_of);
+
+// The largest width x height among `files` that are images (others, and unreadable ones, count 0).
+std::uint64_t largest_image_pixels(const std::vector<std::filesystem::path>& files);
+
+// Where the submission runs and what it runs.
+struct SlurmTarget {
+  std::filesystem::path folder;   // the scripts and logs/ (absolute)
+  std::filesystem::path matbake;  // the program every node runs (absolute, on the shared filesystem)
+};
+
+// The sbatch command of each submission as a shell line, in order (the array first, then the
+// scenes); a scene's dependency names the array by "$array" (its job id, known when the script runs).
+std::vector<std::string> sbatch_lines(const SlurmSubmission& submission, const ClusterOptions& options,
+                                      const SlurmTarget& target);
+
+// "5 material jobs (one array), 1 scene job; 0 up to date"
+std::string submission_counts(const SlurmSubmission& submission);
+
+// The two scripts written to target.folder: submit.sh (run where sbatch works: it submits the
+// array and the scenes, chaining their job ids) and job.sh (what each job runs).
+struct SlurmScripts {
+  std::string submit;
+  std::string job;
+};
+SlurmScripts slurm_scripts(const Manifest& manifest, const SlurmSubmission& submission, const ClusterOptions& options,
+                           const SlurmTarget& target);
+
+// A word as the shell reads it back unchanged: single-quoted where it holds anything but
+// [A-Za-z0-9_./:=%@+,-], with ' written as '\''.
+std::string shell_quoted(const std::string& word);
+
+}  // namespace matbake::pipeline

@@ -1,0 +1,204 @@
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <map>
+
+#include "matbake/cluster.hpp"
+#include "matbake/image.hpp"
+#include "matbake/version.hpp"
+#include "state.hpp"
+
+namespace matbake::pipeline {
+namespace fs = std::filesystem;
+namespace {
+
+// The memory model (docs/cluster.md, "Cost model"): a job holding no image still loads the program
+// and its libraries; a 2048² material job holds about 350 MB of images and maps.
+constexpr double kBaseMb = 100.0;
+constexpr double kMbPerTexel = 350.0 / (2048.0 * 2048.0);
+constexpr double kHeadroom = 1.25;
+constexpr std::int64_t kMemoryStepMb = 64;
+
+// Inputs that are never images: the scene files, the layout and table files.
+bool may_be_image(const fs::path& file) {
+  const std::string ext = file.extension().string();
+  return ext != ".gltf" && ext != ".glb" && ext != ".bin" && ext != ".json" && ext != ".toml";
+}
+
+std::string mem_argument(std::int64_t mb) { return "--mem=" + std::to_string(mb) + "M"; }
+
+// --output's file in `folder`: Slurm expands %-patterns, so the folder's own % are written %%.
+std::string log_pattern(const fs::path& folder, const std::string& file_pattern) {
+  std::string out;
+  for (char c : (folder / "logs").string() + "/") out += c == '%' ? std::string("%%") : std::string(1, c);
+  return out + file_pattern;
+}
+
+// What every sbatch call asks for besides its own job: cores, the options' partition, account, time.
+std::vector<std::string> common_arguments(const ClusterOptions& options) {
+  std::vector<std::string> args{"--cpus-per-task=" + std::to_string(options.cpus)};
+  if (!options.partition.empty()) args.push_back("--partition=" + options.partition);
+  if (!options.account.empty()) args.push_back("--account=" + options.account);
+  if (!options.time_limit.empty()) args.push_back("--time=" + options.time_limit);
+  return args;
+}
+
+std::vector<std::string> array_command(const SlurmSubmission& s, const ClusterOptions& options, const SlurmTarget& target) {
+  std::string range = "0-" + std::to_string(s.array.size() - 1);
+  if (options.array_throttle > 0) range += "%" + std::to_string(options.array_throttle);
+  std::vector<std::string> args{"--parsable", "--job-name=matbake-materials", "--array=" + range,
+                                mem_argument(s.array_memory_mb)};
+  for (std::string& a : common_arguments(options)) args.push_back(std::move(a));
+  args.push_back("--output=" + log_pattern(target.folder, "material-%a.log"));
+  args.push_back((target.folder / "job.sh").string());
+  return args;
+}
+
+std::vector<std::string> scene_command(const SlurmJob& scene, const ClusterOptions& options, const SlurmTarget& target) {
+  std::vector<std::string> args{"--parsable", "--job-name=matbake-" + scene.job->name};
+  if (!scene.after.empty()) {
+    std::string dependency = "--dependency=afterok";
+    for (std::size_t task : scene.after) dependency += ":$array_" + std::to_string(task);
+    args.push_back(dependency);
+    // A failed material cancels the scenes that wait for it (else they would wait for ever).
+    args.push_back("--kill-on-invalid-dep=yes");
+  }
+  args.push_back(mem_argument(scene.memory_mb));
+  for (std::string& a : common_arguments(options)) args.push_back(std::move(a));
+  args.push_back("--output=" + log_pattern(target.folder, job_file_stem(scene.job->name) + ".log"));
+  args.push_back((target.folder / "job.sh").string());
+  args.push_back(scene.job->name);
+  return args;
+}
+
+// An argument for the script: quoted, with "$array" left for the shell to expand.
+std::string script_word(const std::string& arg) {
+  std::string out;
+  std::size_t from = 0;
+  for (std::size_t at; (at = arg.find("$array", from)) != std::string::npos; from = at + 6) {
+    if (at > from) out += shell_quoted(arg.substr(from, at - from));
+    out += "\"$array\"";
+  }
+  if (from < arg.size() || out.empty()) out += shell_quoted(arg.substr(from));
+  return out;
+}
+
+
+}  // namespace
+
+std::int64_t job_memory_mb(std::uint64_t pixels) {
+  const double mb = (kBaseMb + kMbPerTexel * double(pixels)) * kHeadroom;
+  return std::int64_t(std::ceil(mb / double(kMemoryStepMb))) * kMemoryStepMb;
+}
+
+std::uint64_t largest_image_pixels(const std::vector<fs::path>& files) {
+  std::uint64_t largest = 0;
+  for (const fs::path& f : files) {
+    if (!may_be_image(f)) continue;
+    if (auto info = image::probe_image(f)) largest = std::max(largest, std::uint64_t(info->width) * std::uint64_t(info->height));
+  }
+  return largest;
+}
+
+SlurmSubmission slurm_submission(const Plan& plan, const Report& dry_run, const ClusterOptions& options,
+                                 const std::function<std::uint64_t(const Job&)>& pixels_of) {
+  const auto memory_for = [&](std::uint64_t pixels) {
+    return options.memory_mb > 0 ? options.memory_mb : job_memory_mb(pixels);
+  };
+  SlurmSubmission s;
+  std::map<std::string, std::size_t> task_of;  // material job name → array index
+  std::map<std::string, std::uint64_t> pixels_by_name;
+  for (const JobReport& r : dry_run.jobs) {
+    if (r.job->kind != JobKind::material) continue;
+    pixels_by_name[r.job->name] = pixels_of(*r.job);
+    if (r.outcome == Outcome::up_to_date) continue;
+    task_of[r.job->name] = s.array.size();
+    s.array.push_back({r.job, pixels_by_name[r.job->name], memory_for(pixels_by_name[r.job->name]), {}});
+    s.array_memory_mb = std::max(s.array_memory_mb, s.array.back().memory_mb);
+  }
+  for (const JobReport& r : dry_run.jobs) {
+    if (r.job->kind != JobKind::scene) continue;
+    SlurmJob scene{r.job, pixels_of(*r.job), 0, {}};
+    for (const std::string& name : r.job->depends_on) {
+      if (const auto t = task_of.find(name); t != task_of.end()) scene.after.push_back(t->second);
+      if (const auto p = pixels_by_name.find(name); p != pixels_by_name.end()) scene.pixels = std::max(scene.pixels, p->second);
+    }
+    scene.memory_mb = memory_for(scene.pixels);
+    if (r.outcome != Outcome::up_to_date || !scene.after.empty()) s.scenes.push_back(std::move(scene));
+  }
+  s.up_to_date = plan.jobs.size() - s.array.size() - s.scenes.size();
+  return s;
+}
+
+std::vector<std::string> sbatch_lines(const SlurmSubmission& submission, const ClusterOptions& options,
+                                      const SlurmTarget& target) {
+  std::vector<std::vector<std::string>> commands;
+  if (!submission.array.empty()) commands.push_back(array_command(submission, options, target));
+  for (const SlurmJob& scene : submission.scenes) commands.push_back(scene_command(scene, options, target));
+  std::vector<std::string> lines;
+  for (const auto& args : commands) {
+    std::string line = "sbatch";
+    for (const std::string& a : args) line += " " + script_word(a);
+    lines.push_back(std::move(line));
+  }
+  return lines;
+}
+
+std::string submission_counts(const SlurmSubmission& submission) {
+  return std::to_string(submission.array.size()) + " material jobs (one array), " + std::to_string(submission.scenes.size()) +
+         (submission.scenes.size() == 1 ? " scene job; " : " scene jobs; ") + std::to_string(submission.up_to_date) +
+         " up to date";
+}
+
+std::string shell_quoted(const std::string& word) {
+  const bool plain = !word.empty() && std::all_of(word.begin(), word.end(), [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) || std::string_view("_./:=%@+,-").find(c) != std::string_view::npos;
+  });
+  if (plain) return word;
+  std::string out = "'";
+  for (char c : word) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
+}
+
+SlurmScripts slurm_scripts(const Manifest& manifest, const SlurmSubmission& submission, const ClusterOptions& options,
+                           const SlurmTarget& target) {
+  const std::string header = "#!/usr/bin/env bash\n# Written by `matbake plan --format slurm` (matbake " +
+                             std::string(version) + ") from " + manifest.file.string() + ".\n";
+  SlurmScripts out;
+  out.job = header +
+            "# One job on a Slurm node: the material of this array task, or the job named as the argument\n"
+            "# (a scene). It builds and stamps as `matbake build --only JOB` does on any machine.\n"
+            "set -euo pipefail\nmaterials=(";
+  for (const SlurmJob& j : submission.array) out.job += (&j == submission.array.data() ? "" : " ") + shell_quoted(j.job->name);
+  out.job += ")\njob=${1:-${materials[$SLURM_ARRAY_TASK_ID]}}\nexec " + shell_quoted(target.matbake.string()) +
+             " --jobs " + std::to_string(options.cpus) + " build " + shell_quoted(manifest.file.string()) +
+             " --output-dir " + shell_quoted(manifest.output.string()) + " --only \"$job\"\n";
+
+  const std::string counts = submission_counts(submission);
+  out.submit = header + "# " + counts +
+               ".\n# Run it where sbatch works; every path is absolute (a filesystem every node shares). Then\n"
+               "# `matbake build " + shell_quoted(manifest.file.string()) + " --status` tells how the jobs went.\n"
+               "set -euo pipefail\n";
+  if (submission.array.empty() && submission.scenes.empty()) {
+    out.submit += "echo " + shell_quoted("matbake: nothing to submit: " + counts) + "\n";
+    return out;
+  }
+  out.submit += "sbatch=${SBATCH:-sbatch}\nmkdir -p " + shell_quoted((target.folder / "logs").string()) + "\n";
+  const std::vector<std::string> lines = sbatch_lines(submission, options, target);
+  const auto with_variable = [](const std::string& line) { return "\"$sbatch\"" + line.substr(6); };
+  std::size_t next = 0;
+  if (!submission.array.empty()) {
+    out.submit += "array=$(" + with_variable(lines[next++]) + ")\narray=${array%%;*}  # --parsable: id[;cluster]\n";
+  }
+  std::string ids;
+  for (; next < lines.size(); ++next) {
+    const std::string var = "scene_" + std::to_string(next);
+    out.submit += var + "=$(" + with_variable(lines[next]) + ")\n";
+    ids += " $" + var;
+  }
+  out.submit += "echo \"matbake: submitted " + counts + ":" + (submission.array.empty() ? "" : " array $array") +
+                (ids.empty() ? "" : " scenes" + ids) + "\"\n";
+  return out;
+}
+
+}  // namespace matbake::pipeline
