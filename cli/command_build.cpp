@@ -106,8 +106,11 @@ int run_slurm_plan(const PlanSettings& s, const GlobalOptions& global, pipeline:
   const auto submission = pipeline::slurm_submission(
       plan, *report, manifest.cluster, [](const pipeline::Job& job) { return pipeline::largest_image_pixels(job.inputs); });
   const pipeline::SlurmTarget target{fs::absolute(s.output).lexically_normal(), self};
+  const std::vector<std::string> lines = pipeline::sbatch_lines(submission, manifest.cluster, target);
   if (s.dry_run) {
-    for (const std::string& line : pipeline::sbatch_lines(submission, manifest.cluster, target)) std::printf("%s\n", line.c_str());
+    if (!global.json) {
+      for (const std::string& line : lines) std::printf("%s\n", line.c_str());
+    }
   } else if (Status st = write_slurm_scripts(manifest, plan, pipeline::slurm_scripts(manifest, submission, manifest.cluster, target),
                                              target.folder);
              !st) {
@@ -115,7 +118,8 @@ int run_slurm_plan(const PlanSettings& s, const GlobalOptions& global, pipeline:
   }
   if (global.json) {
     nlohmann::json doc = {{"command", "plan"}, {"format", "slurm"}, {"folder", target.folder}, {"dry_run", s.dry_run},
-                          {"up_to_date", submission.up_to_date}, {"cluster", params::to_json(pipeline::cluster_params(), manifest.cluster)}};
+                          {"up_to_date", submission.up_to_date}, {"cluster", params::to_json(pipeline::cluster_params(), manifest.cluster)},
+                          {"sbatch", lines}};
     doc["array"] = {{"memory_mb", submission.array_memory_mb}, {"jobs", nlohmann::json::array()}};
     for (const pipeline::SlurmJob& j : submission.array) doc["array"]["jobs"].push_back(j.job->name);
     doc["scenes"] = nlohmann::json::array();

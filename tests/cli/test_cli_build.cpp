@@ -11,10 +11,14 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <algorithm>
 #include <map>
+#include <sstream>
 #include <thread>
 
 #include "lib/src/gltf/document.hpp"
+#include "matbake/cluster.hpp"
+#include "matbake/params.hpp"
 #include "support/files.hpp"
 #include "support/gltf_validator.hpp"
 #include "support/run.hpp"
@@ -565,6 +569,170 @@ TEST(CliPlan, NinjaBuildsTheEdges) {
   ninja = run(ninja_exe, {"-C", dir.path().string()});
   EXPECT_NE(ninja.out.find("[1/2] matbake material:rubber"), std::string::npos) << ninja.out;
   EXPECT_NE(ninja.out.find("[2/2] matbake scene:showroom"), std::string::npos) << ninja.out;
+}
+
+// A stand-in for sbatch: records each call's arguments (one line, tab-separated), runs the job at
+// once (an array's tasks one by one, with SLURM_ARRAY_TASK_ID) and prints a job id from 101 on.
+fs::path stand_in_sbatch(const fs::path& dir) {
+  const fs::path script = dir / "sbatch";
+  write_bytes(script, "#!/usr/bin/env bash\n"
+                      "log=" + (dir / "sbatch.log").string() + "\n"
+                      "(IFS=$'\\t'; echo \"$*\") >>\"$log\"\n"
+                      "id=$((100 + $(wc -l <\"$log\")))\n"
+                      "array=\n"
+                      "while [ $# -gt 0 ]; do\n"
+                      "  case $1 in --array=*) array=${1#--array=}; array=${array%%\\%*} ;; --*) ;; *) break ;; esac\n"
+                      "  shift\n"
+                      "done\n"
+                      "if [ -n \"$array\" ]; then\n"
+                      "  for ((i = ${array%-*}; i <= ${array#*-}; i++)); do SLURM_ARRAY_TASK_ID=$i bash \"$@\" >/dev/null 2>&1; done\n"
+                      "else\n"
+                      "  bash \"$@\" >/dev/null 2>&1\n"
+                      "fi\n"
+                      "echo \"$id\"\n");
+  fs::permissions(script, fs::perms::owner_exec, fs::perm_options::add);
+  return script;
+}
+
+std::vector<std::vector<std::string>> sbatch_calls(const fs::path& dir) {
+  std::vector<std::vector<std::string>> calls;
+  if (!fs::exists(dir / "sbatch.log")) return calls;
+  std::istringstream lines(read_bytes(dir / "sbatch.log"));
+  for (std::string line; std::getline(lines, line);) {
+    std::vector<std::string> args;
+    std::istringstream fields(line);
+    for (std::string a; std::getline(fields, a, '\t');) args.push_back(a);
+    calls.push_back(args);
+  }
+  return calls;
+}
+
+bool has(const std::vector<std::string>& args, const std::string& arg) {
+  return std::find(args.begin(), args.end(), arg) != args.end();
+}
+
+// plan --format slurm's scripts run through the stand-in: the array and the scene's dependency on
+// each of its tasks as sbatch is given them, the outputs those of a local build byte for byte; then
+// nothing to submit, and after a source changes, its material and the scene only.
+TEST(CliPlan, SlurmSubmissionBuildsWhatALocalBuildBuilds) {
+  TempDir dir;
+  fs::create_directories(dir / "cluster");
+  fs::create_directories(dir / "local");
+  copy_example(dir / "cluster", true);
+  copy_example(dir / "local", true);
+  const fs::path sbatch = stand_in_sbatch(dir.path()), slurm = dir / "cluster/slurm";
+  const std::string manifest = (dir / "cluster/showroom.toml").string();
+  const json planned = run_json({"plan", manifest, "--format", "slurm", "-o", slurm.string()});
+  EXPECT_EQ(planned["array"]["jobs"], json({"material:glass", "material:gold_trim", "material:painted_metal",
+                                            "material:rubber", "material:wood"}));
+  ASSERT_EQ(planned["scenes"].size(), 1u);
+  EXPECT_EQ(planned["scenes"][0]["after_tasks"], json({0, 1, 2, 3, 4}));
+  const auto submit = [&] { return run("/bin/bash", {(slurm / "submit.sh").string()}, {"SBATCH=" + sbatch.string()}); };
+  RunResult r = submit();
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.out, "matbake: submitted 5 material jobs (one array), 1 scene job; 0 up to date: array 101 scenes 102\n");
+  auto calls = sbatch_calls(dir.path());
+  ASSERT_EQ(calls.size(), 2u);
+  const std::string mem = "--mem=" + std::to_string(planned["array"]["memory_mb"].get<int>()) + "M";
+  for (const char* arg : {"--parsable", "--array=0-4", "--cpus-per-task=1"}) EXPECT_TRUE(has(calls[0], arg)) << arg;
+  EXPECT_TRUE(has(calls[0], mem));
+  EXPECT_TRUE(has(calls[1], "--dependency=afterok:101_0:101_1:101_2:101_3:101_4"));
+  EXPECT_TRUE(has(calls[1], "--kill-on-invalid-dep=yes"));
+  EXPECT_EQ(calls[1].back(), "scene:showroom");
+  ASSERT_EQ(matbake({"build", (dir / "local/showroom.toml").string(), "--quiet"}).exit_code, 0);
+  EXPECT_EQ(outputs_under(dir / "cluster/out"), outputs_under(dir / "local/out"));
+
+  r = matbake({"plan", manifest, "--format", "slurm", "-o", slurm.string()});
+  EXPECT_EQ(r.out, (slurm / "submit.sh").string() + ": 0 material jobs (one array), 0 scene jobs; 6 up to date\n");
+  EXPECT_EQ(submit().out, "matbake: nothing to submit: 0 material jobs (one array), 0 scene jobs; 6 up to date\n");
+  EXPECT_EQ(sbatch_calls(dir.path()).size(), 2u);
+
+  fs::copy_file(dir / "cluster/textures/painted_metal_albedo.png", dir / "cluster/textures/rubber_albedo.png",
+                fs::copy_options::overwrite_existing);
+  const json again = run_json({"plan", manifest, "--format", "slurm", "-o", slurm.string()});
+  EXPECT_EQ(again["array"]["jobs"], json({"material:rubber"}));
+  EXPECT_EQ(again["scenes"][0]["after_tasks"], json({0}));
+  EXPECT_EQ(again["up_to_date"], 4);
+}
+
+// Each [cluster] parameter from either door (its example as a flag, or as a manifest key) reaches
+// the submission; a flag wins over the manifest; a dry run prints sbatch's lines and writes nothing.
+TEST(CliPlan, SlurmParametersFromBothDoors) {
+  TempDir dir;
+  copy_example(dir.path());
+  const std::string manifest = (dir / "showroom.toml").string(), slurm = (dir / "slurm").string();
+  const std::string original = read_bytes(manifest);
+  for (const params::Spec* spec : pipeline::cluster_params().specs()) {
+    const json example = spec->kind == params::Kind::integer ? json(std::stoll(spec->example)) : json(spec->example);
+    if (!spec->manifest_only) {
+      const json j = run_json({"plan", manifest, "--format", "slurm", "-o", slurm, "--dry-run",
+                               params::flag_name(*spec, ""), spec->example});
+      EXPECT_EQ(j["cluster"][spec->name], example) << spec->name << " as a flag";
+    }
+    write_bytes(manifest, original + "\n[cluster]\n" + spec->name + " = " + example.dump() + "\n");
+    const json j = run_json({"plan", manifest, "--format", "slurm", "-o", slurm, "--dry-run"});
+    EXPECT_EQ(j["cluster"][spec->name], example) << spec->name << " in the manifest";
+    write_bytes(manifest, original);
+  }
+  write_bytes(manifest, original + "\n[cluster]\npartition = \"gpu\"\ncpus = 3\n");
+  const RunResult r = matbake({"plan", manifest, "--format", "slurm", "-o", slurm, "--dry-run", "--partition", "cpu", "-j", "4"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.out.rfind("sbatch --parsable --job-name=matbake-materials --array=0-4 --mem=", 0), 0u) << r.out;
+  EXPECT_NE(r.out.find("--cpus-per-task=4 --partition=cpu --output=" + slurm + "/logs/material-%a.log " + slurm + "/job.sh\n"),
+            std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("--dependency=afterok:\"$array\"_0:\"$array\"_1:\"$array\"_2:\"$array\"_3:\"$array\"_4 "),
+            std::string::npos) << r.out;
+  EXPECT_FALSE(fs::exists(slurm));
+}
+
+TEST(CliPlan, SlurmRefusesBadValuesAndWritesNothing) {
+  TempDir dir;
+  copy_example(dir.path());
+  const std::string manifest = (dir / "showroom.toml").string(), slurm = (dir / "slurm").string();
+  RunResult r = matbake({"plan", manifest, "--format", "slurm", "-o", slurm, "--partition", "a b"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_EQ(r.err, "matbake: error: --partition: 'a b': letters, digits, '_', '-', '.' and ',' only (see matbake --help)\n");
+  write_bytes(manifest, read_bytes(manifest) + "\n[cluster]\ntime_limit = \"soon\"\n");
+  r = matbake({"plan", manifest, "--format", "slurm", "-o", slurm});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find(manifest + ":"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("cluster.time_limit: minutes, MM:SS, HH:MM:SS or D-HH:MM:SS"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(slurm));
+  // The output folder is a file (here the scene): refused, the file untouched.
+  fs::create_directories(dir / "again");
+  copy_example(dir / "again");
+  const std::string scene = read_bytes(dir / "again/showroom.gltf");
+  r = matbake({"plan", (dir / "again/showroom.toml").string(), "--format", "slurm", "-o", (dir / "again/showroom.gltf").string()});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_EQ(read_bytes(dir / "again/showroom.gltf"), scene);
+}
+
+// After jobs ran elsewhere (here: one at a time with --only), --status names the failed one with its
+// error line, the scene that waits for it, and the counts; exit 1 until the failure is built again.
+TEST(CliBuild, StatusNamesFailedJobsAndWhatWaitsForThem) {
+  TempDir dir;
+  copy_example(dir.path(), true);
+  const std::string manifest = (dir / "showroom.toml").string();
+  ASSERT_EQ(matbake({"build", manifest, "--quiet"}).exit_code, 0);
+  RunResult r = matbake({"build", manifest, "--status"});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.out, "up to date 6, failed 0, not built 0\n");
+  const std::string good = read_bytes(dir / "textures/rubber_albedo.png");
+  write_bytes(dir / "textures/rubber_albedo.png", good.substr(0, 100));
+  EXPECT_EQ(matbake({"build", manifest, "--only", "material:rubber", "--quiet"}).exit_code, 1);
+  r = matbake({"build", manifest, "--status"});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_EQ(r.out, "not built scene:showroom: waits for material:rubber, which failed\nup to date 4, failed 1, not built 1\n");
+  const std::string first_line = r.err.substr(0, r.err.find('\n'));
+  EXPECT_NE(first_line.find("rubber_albedo.png: "), std::string::npos) << r.err;
+  EXPECT_EQ(first_line.substr(first_line.size() - 18), " (material:rubber)") << r.err;
+  const json j = run_json({"build", manifest, "--status"}, 1);
+  EXPECT_EQ(j["counts"], json({{"up_to_date", 4}, {"failed", 1}, {"not_built", 1}}));
+  write_bytes(dir / "textures/rubber_albedo.png", good);
+  ASSERT_EQ(matbake({"build", manifest, "--quiet"}).exit_code, 0);
+  EXPECT_EQ(matbake({"build", manifest, "--status"}).out, "up to date 6, failed 0, not built 0\n");
+  EXPECT_FALSE(fs::exists(dir / "out/.matbake/material-rubber.failed"));
 }
 
 // A build of many large materials killed mid-way by SIGINT, then by SIGTERM: exit 128 + signal,

@@ -16,6 +16,7 @@
 #include "matbake/preview_params.hpp"
 #include "matbake/validate_params.hpp"
 #include "matbake/pipeline.hpp"
+#include "matbake/cluster.hpp"
 #include "matbake/pipeline_params.hpp"
 #include "support/files.hpp"
 #include "support/param_values.hpp"
@@ -288,6 +289,7 @@ TEST(DocsTables, MatchTheParameterDescriptions) {
       {"docs/preview.md", "params:preview", markdown_table(preview::options_params(), "")},
       {"docs/build.md", "params:validation", markdown_table(pipeline::validation_params(), "")},
       {"docs/build.md", "params:scene", markdown_table(pipeline::scene_params(), "")},
+      {"docs/cluster.md", "params:cluster", markdown_table(pipeline::cluster_params(), "")},
   };
   for (const Table& t : tables) {
     const fs::path path = fs::path(MATBAKE_SOURCE_DIR) / t.file;

@@ -10,9 +10,11 @@
 #include <thread>
 
 #include "cli/progress_bar.hpp"
+#include "matbake/cluster.hpp"
 #include "matbake/pipeline.hpp"
 #include "support/files.hpp"
 #include "support/gltf_files.hpp"
+#include "support/run.hpp"
 #include "support/temp_dir.hpp"
 
 namespace matbake::test {
@@ -398,6 +400,35 @@ TEST(ProgressBar, DrawsAfterAMomentAndClears) {
   EXPECT_NE(text.find("\r\033[Ka message\n"), std::string::npos);
   EXPECT_EQ(text.find("3/4"), std::string::npos);
   EXPECT_EQ(text.substr(text.size() - 14), "still printed\n");
+}
+
+// The memory model's closed form: (100 MB + 350 MB per 2048² texels) x 1.25, up to a multiple of 64.
+TEST(ClusterMemory, IsTheModelsClosedForm) {
+  EXPECT_EQ(pipeline::job_memory_mb(0), 128);                     // 125 → 128
+  EXPECT_EQ(pipeline::job_memory_mb(2048ull * 2048), 576);        // 562.5 → 576
+  EXPECT_EQ(pipeline::job_memory_mb(4096ull * 4096), 1920);       // 1875 → 1920
+  EXPECT_EQ(pipeline::job_memory_mb(16384ull * 16384), 28160);    // 28125 → 28160
+  for (std::uint64_t pixels : {0ull, 1ull, 1000ull, 1ull << 22, 1ull << 26, 1ull << 30}) {
+    const double exact = (100.0 + 350.0 * double(pixels) / (2048.0 * 2048.0)) * 1.25;
+    const std::int64_t mb = pipeline::job_memory_mb(pixels);
+    EXPECT_EQ(mb % 64, 0) << pixels;
+    EXPECT_GE(double(mb), exact) << pixels;
+    EXPECT_LT(double(mb), exact + 64) << pixels;
+  }
+}
+
+// Quoted words come back from bash unchanged, whatever they hold.
+TEST(ShellQuoted, WordsReadBackUnchanged) {
+  const std::vector<std::string> words = {"plain",  "with space", "it's",       "$HOME",     "`id`",  "back\\slash",
+                                          "new\nline", "ünïcode",   "*",          "a;b|c&d", "'", "--dependency=afterok:1_0",
+                                          "%a",     "\"quoted\"",  "tab\there", ""};
+  for (const std::string& w : words) {
+    const RunResult r = run("/bin/bash", {"-c", "printf '%s' " + pipeline::shell_quoted(w)});
+    EXPECT_EQ(r.exit_code, 0) << w;
+    EXPECT_EQ(r.out, w) << pipeline::shell_quoted(w);
+  }
+  EXPECT_EQ(pipeline::shell_quoted("/abs/path-1.2_x:y=z%a@b+c,d"), "/abs/path-1.2_x:y=z%a@b+c,d");
+  EXPECT_EQ(pipeline::shell_quoted("it's"), "'it'\\''s'");
 }
 
 }  // namespace
