@@ -69,7 +69,7 @@ run() {  # target, seconds, extra flags
     *) echo "scripts/fuzz.sh: unknown target '$target' (${targets[*]})" >&2; exit 2 ;;
   esac
   mkdir -p "$build/corpus/$target" "$build/artifacts/$target"
-  local log=$build/fuzz-$target.log
+  local log=$build/fuzz-$target.log started=$SECONDS
   # -rss_limit_mb: a decoder's legitimate peak stays far below; -max_len: large seeds are kept whole
   # (a -max_len among the target's flags, later on the line, overrides it).
   if ! "$build/tests/fuzz/fuzz_$target" "$build/corpus/$target" "$seeds" -max_total_time="$seconds" \
@@ -80,7 +80,7 @@ run() {  # target, seconds, extra flags
     return 1
   fi
   printf "fuzz %-9s %10s runs in %4s s, corpus %s files\n" "$target" \
-    "$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$')" "$seconds" \
+    "$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$')" "$((SECONDS - started))" \
     "$(find "$build/corpus/$target" -type f | wc -l)"
 }
 

@@ -12,6 +12,8 @@ bash "$root/scripts/install-gltf-validator.sh" || echo "matbake: glTF-Validator 
 
 bash "$root/scripts/build.sh" "$root/build" -DMATBAKE_WERROR=ON
 ctest --test-dir "$root/build" --output-on-failure -j "$jobs"
+# A real one-node Slurm cluster (docs/cluster.md), on request: about 2 minutes, past CI's budget.
+if [ "${MATBAKE_TEST_CLUSTER:-0}" = 1 ]; then bash "$root/scripts/test-cluster.sh" "$root/build"; fi
 
 # The benchmarks are built (and so compiled warning-free) by the release build only: no test runs
 # them, and under the sanitizers they are minutes of CI's budget.

@@ -402,14 +402,14 @@ TEST(ProgressBar, DrawsAfterAMomentAndClears) {
   EXPECT_EQ(text.substr(text.size() - 14), "still printed\n");
 }
 
-// The memory model's closed form: (100 MB + 350 MB per 2048² texels) x 1.25, up to a multiple of 64.
+// The memory model's closed form: (32 MB + 64 bytes a texel) x 1.25, up to a multiple of 64 MB.
 TEST(ClusterMemory, IsTheModelsClosedForm) {
-  EXPECT_EQ(pipeline::job_memory_mb(0), 128);                     // 125 → 128
-  EXPECT_EQ(pipeline::job_memory_mb(2048ull * 2048), 576);        // 562.5 → 576
-  EXPECT_EQ(pipeline::job_memory_mb(4096ull * 4096), 1920);       // 1875 → 1920
-  EXPECT_EQ(pipeline::job_memory_mb(16384ull * 16384), 28160);    // 28125 → 28160
+  EXPECT_EQ(pipeline::job_memory_mb(0), 64);                      // 40 → 64
+  EXPECT_EQ(pipeline::job_memory_mb(2048ull * 2048), 384);        // 360 → 384
+  EXPECT_EQ(pipeline::job_memory_mb(4096ull * 4096), 1344);       // 1320 → 1344
+  EXPECT_EQ(pipeline::job_memory_mb(16384ull * 16384), 20544);    // 20520 → 20544
   for (std::uint64_t pixels : {0ull, 1ull, 1000ull, 1ull << 22, 1ull << 26, 1ull << 30}) {
-    const double exact = (100.0 + 350.0 * double(pixels) / (2048.0 * 2048.0)) * 1.25;
+    const double exact = (32.0 + 64.0 * double(pixels) / (1024.0 * 1024.0)) * 1.25;
     const std::int64_t mb = pipeline::job_memory_mb(pixels);
     EXPECT_EQ(mb % 64, 0) << pixels;
     EXPECT_GE(double(mb), exact) << pixels;

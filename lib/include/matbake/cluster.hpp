@@ -18,9 +18,9 @@ namespace matbake::pipeline {
 // [cluster] table) and cpus (the manifest's; `plan --jobs` sets it too).
 const params::Group<ClusterOptions>& cluster_params();
 
-// The memory (MB) to ask for a job whose largest image has `pixels` texels: the program's own
-// footprint plus the bytes per texel a 2048² material job was measured to hold (docs/cluster.md),
-// with a quarter on top (Slurm ends a job that passes its request), rounded up to 64 MB.
+// The memory (MB) to ask for a job whose largest image has `pixels` texels: 32 MB for the program
+// and 64 bytes a texel, as material jobs were measured to peak (docs/cluster.md), with a quarter on
+// top (Slurm ends a job that passes its request), rounded up to a multiple of 64 MB.
 std::int64_t job_memory_mb(std::uint64_t pixels);
 
 // One job as it is submitted.

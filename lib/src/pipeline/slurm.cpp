@@ -12,10 +12,11 @@ namespace matbake::pipeline {
 namespace fs = std::filesystem;
 namespace {
 
-// The memory model (docs/cluster.md, "Cost model"): a job holding no image still loads the program
-// and its libraries; a 2048² material job holds about 350 MB of images and maps.
-constexpr double kBaseMb = 100.0;
-constexpr double kMbPerTexel = 350.0 / (2048.0 * 2048.0);
+// The memory model, fitted to scripts/bench-cluster.sh's peak memory of material jobs from 512² to
+// 4096² (docs/cluster.md, "Cost model"): the program and its libraries, then 64 bytes a texel (the
+// decoded sources, maps and packed textures of the largest image held at once).
+constexpr double kBaseMb = 32.0;
+constexpr double kMbPerTexel = 64.0 / (1024.0 * 1024.0);
 constexpr double kHeadroom = 1.25;
 constexpr std::int64_t kMemoryStepMb = 64;
 
