@@ -61,7 +61,7 @@ run() {  # target, seconds, extra flags
     # held this target near 100 runs/s. Draco streams are fuzzed through the gltf target.
     glb) seeds=$(seed glb -name '*.glb')
       mkdir -p "$build/corpus/glb"
-      grep -lZ KHR_draco_mesh_compression "$seeds"/* "$build/corpus/glb"/* 2>/dev/null | xargs -0r rm -f
+      { find "$seeds" "$build/corpus/glb" -type f -exec grep -lZ KHR_draco_mesh_compression {} + || true; } | xargs -0r rm -f
       set -- -max_len=65536 "$@" ;;
     manifest) seeds=$(seed manifest -name '*.toml' ! -name 'materials.toml') ;;
     layout) seeds=$(seed layout -path '*layouts*' -name '*.json') ;;
