@@ -800,6 +800,47 @@ TEST(CliBuild, InterruptKeepsFinishedOutputsAndNoTemporaryFiles) {
   }
 }
 
+// Twenty `build --only` runs at once in one output folder (Ninja edges, Slurm array tasks): each
+// job's files are in the log of files made, none lost to another run's write.
+TEST(CliBuild, RunsAtOnceKeepEveryJobInTheLogOfFilesMade) {
+  TempDir dir;
+  constexpr int kMaterials = 20;
+  write_raw(dir / "grey.png", 4, 4, 3, "uint8", std::vector<double>(4 * 4 * 3, 128.0));
+  std::string manifest;
+  for (int m = 0; m < kMaterials; ++m) {
+    manifest += "[materials.m" + std::to_string(m) + "]\nsources = { base_color = \"grey.png\", metallic = 0.0, roughness = 0.5 }\n"
+                "layout = \"gltf-orm\"\nvalidate = { enabled = false }\n";
+  }
+  write_bytes(dir / "m.toml", manifest);
+  const std::string exe = MATBAKE_EXE, manifest_path = (dir / "m.toml").string();
+  std::vector<pid_t> runs;
+  for (int m = 0; m < kMaterials; ++m) {
+    const std::string only = "material:m" + std::to_string(m);
+    std::vector<char*> argv = {const_cast<char*>(exe.c_str()), const_cast<char*>("build"), const_cast<char*>(manifest_path.c_str()),
+                               const_cast<char*>("--only"), const_cast<char*>(only.c_str()), const_cast<char*>("--quiet"), nullptr};
+    pid_t pid = 0;
+    ASSERT_EQ(posix_spawn(&pid, exe.c_str(), nullptr, nullptr, argv.data(), environ), 0);
+    runs.push_back(pid);
+  }
+  for (pid_t pid : runs) {
+    int status = 0;
+    ASSERT_EQ(waitpid(pid, &status, 0), pid);
+    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0);
+  }
+  const json log = json::parse(read_bytes(dir / "out/.matbake/made.json"));
+  ASSERT_EQ(log["jobs"].size(), std::size_t(kMaterials)) << log.dump(1);
+  for (int m = 0; m < kMaterials; ++m) {
+    const std::string job = "material:m" + std::to_string(m);
+    const json stamp = json::parse(read_bytes(dir / ("out/.matbake/material-m" + std::to_string(m) + ".json")));
+    json written = json::object();  // what the job's stamp says it wrote
+    for (const json& out : stamp["outputs"]) {
+      written[out["path"].get<std::string>()] = out["hash"];
+    }
+    EXPECT_EQ(written.size(), 2u);
+    EXPECT_EQ(log["jobs"][job], written) << job;
+  }
+}
+
 // examples/showroom.gltf and .bin are what examples/scene/make_example_scene writes.
 TEST(ExampleScene, GeneratorWritesTheCommittedFiles) {
   TempDir dir;

@@ -1,6 +1,7 @@
 #include "matbake/atomic_file.hpp"
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -19,6 +20,11 @@ namespace {
 
 // The temporary files that exist now, for remove_temporary_files_for_exit(). A name is added before
 // the file is made and taken out after it is renamed or removed, under one lock.
+//
+// They live in a hidden folder of this process's own in the target's folder (.matbake-PID), so that
+// an interrupt can close them off for good: writers (ours, OIIO's) open their temporary file by
+// name, and one that does so after the file was removed would make it again; once the folder is
+// gone, no open can.
 struct TemporaryFiles {
   std::mutex mutex;
   std::set<fs::path> paths;
@@ -29,10 +35,31 @@ TemporaryFiles& temporary_files() {
   return files;
 }
 
-void forget_temporary(const fs::path& temp) {
-  TemporaryFiles& files = temporary_files();
-  std::lock_guard lock(files.mutex);
+fs::path temporary_folder_in(const fs::path& folder) { return folder / (".matbake-" + std::to_string(getpid())); }
+
+// Under the lock: the folder goes when its last file does (another of ours may still be in it).
+void forget_temporary(TemporaryFiles& files, const fs::path& temp) {
   files.paths.erase(temp);
+  (void)::rmdir(temp.parent_path().c_str());
+}
+
+// Removes the folder even while writers make files in it: each pass removes what is there.
+void remove_temporary_folder(const fs::path& folder) {
+  for (int pass = 0; pass < 100; ++pass) {
+    if (::rmdir(folder.c_str()) == 0 || errno == ENOENT) return;
+    std::error_code ec;
+    for (const auto& entry : fs::directory_iterator(folder, ec)) ::unlink(entry.path().c_str());
+  }
+}
+
+// An existing name must be our folder, not a link planted to send outputs elsewhere.
+Status make_temporary_folder(const fs::path& temp_folder, const fs::path& target) {
+  if (::mkdir(temp_folder.c_str(), 0755) == 0) return success();
+  const int mkdir_errno = errno;
+  std::error_code ec;
+  if (mkdir_errno == EEXIST && fs::symlink_status(temp_folder, ec).type() == fs::file_type::directory) return success();
+  const std::string reason = mkdir_errno == EEXIST ? temp_folder.filename().string() + " is not a folder" : std::strerror(mkdir_errno);
+  return Error{target.string(), "cannot write in the output folder: " + reason};
 }
 
 }  // namespace
@@ -41,7 +68,12 @@ void remove_temporary_files_for_exit() {
   TemporaryFiles& files = temporary_files();
   files.mutex.lock();  // held until the process exits: no file is made or renamed after this
   files.closed = true;
-  for (const fs::path& p : files.paths) ::unlink(p.c_str());
+  std::set<fs::path> folders;
+  for (const fs::path& p : files.paths) {
+    ::unlink(p.c_str());
+    folders.insert(p.parent_path());
+  }
+  for (const fs::path& folder : folders) remove_temporary_folder(folder);
 }
 
 AtomicFile::AtomicFile(fs::path target, fs::path temp) : target_(std::move(target)), temp_(std::move(temp)) {}
@@ -53,9 +85,10 @@ AtomicFile::AtomicFile(AtomicFile&& other) noexcept
 
 AtomicFile::~AtomicFile() {
   if (!done_) {
-    std::error_code ec;
-    fs::remove(temp_, ec);
-    forget_temporary(temp_);
+    TemporaryFiles& files = temporary_files();
+    std::lock_guard lock(files.mutex);
+    ::unlink(temp_.c_str());
+    forget_temporary(files, temp_);
   }
 }
 
@@ -71,15 +104,16 @@ Result<AtomicFile> AtomicFile::create(const fs::path& target) {
     }
   }
 
-  // Hidden, unique within the process and across processes, same extension as the target.
+  // Unique within the process and across processes, same extension as the target.
   static std::atomic<unsigned> counter{0};
+  const fs::path temp_folder = temporary_folder_in(folder);
   for (int attempt = 0; attempt < 100; ++attempt) {
-    const fs::path temp = folder / ("." + target.stem().string() + ".matbake-" + std::to_string(getpid()) + "-" +
-                                    std::to_string(counter++) + target.extension().string());
+    const fs::path temp = temp_folder / (target.stem().string() + "-" + std::to_string(counter++) + target.extension().string());
     // Creating it reserves the name and tells, with the real reason, whether the folder takes files.
     TemporaryFiles& files = temporary_files();
     std::unique_lock lock(files.mutex);
     if (files.closed) return Error{target.string(), "interrupted"};
+    if (Status made = make_temporary_folder(temp_folder, target); !made) return made.error();
     const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
     const int open_errno = errno;
     if (fd >= 0) {
@@ -87,10 +121,10 @@ Result<AtomicFile> AtomicFile::create(const fs::path& target) {
       files.paths.insert(temp);
       return AtomicFile(target, temp);
     }
+    (void)::rmdir(temp_folder.c_str());  // when empty
     lock.unlock();
-    errno = open_errno;
-    if (errno != EEXIST) {
-      return Error{target.string(), std::string("cannot write in the output folder: ") + std::strerror(errno)};
+    if (open_errno != EEXIST) {
+      return Error{target.string(), std::string("cannot write in the output folder: ") + std::strerror(open_errno)};
     }
   }
   return Error{target.string(), "cannot find a free temporary name in the output folder"};
@@ -103,7 +137,7 @@ Status AtomicFile::commit() {
     TemporaryFiles& files = temporary_files();
     std::lock_guard lock(files.mutex);
     fs::rename(temp_, target_, ec);
-    if (!ec) files.paths.erase(temp_);
+    if (!ec) forget_temporary(files, temp_);
   }
   if (ec) return Error{target_.string(), "cannot replace the output: " + ec.message()};
   done_ = true;

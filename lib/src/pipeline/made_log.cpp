@@ -1,7 +1,12 @@
 #include "made_log.hpp"
 
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
+
 #include <nlohmann/json.hpp>
 
+#include <cerrno>
 #include <set>
 
 #include "matbake/atomic_file.hpp"
@@ -25,6 +30,16 @@ MadeLog::Files files_in(const nlohmann::json& j) {
 }
 
 }  // namespace
+
+MadeLogLock::MadeLogLock(const StampRoots& roots) {
+  fd_ = ::open((roots.state_folder / "made.lock").c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  while (fd_ >= 0 && ::flock(fd_, LOCK_EX) != 0 && errno == EINTR) {
+  }
+}
+
+MadeLogLock::~MadeLogLock() {
+  if (fd_ >= 0) ::close(fd_);
+}
 
 MadeLog read_made_log(const StampRoots& roots) {
   MadeLog log;

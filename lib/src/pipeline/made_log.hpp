@@ -18,6 +18,21 @@ struct MadeLog {
   bool operator==(const MadeLog&) const = default;
 };
 
+// Held from reading the log to writing it back: runs at once on one output folder (`build --only`
+// as Ninja edges or Slurm array tasks) would otherwise each write what they read and lose the
+// others' entries. An advisory lock on <output>/.matbake/made.lock, released when the process ends
+// however it ends; where the lock cannot be had (a read-only folder) it holds nothing.
+class MadeLogLock {
+ public:
+  explicit MadeLogLock(const StampRoots& roots);
+  MadeLogLock(const MadeLogLock&) = delete;
+  MadeLogLock& operator=(const MadeLogLock&) = delete;
+  ~MadeLogLock();
+
+ private:
+  int fd_ = -1;
+};
+
 MadeLog read_made_log(const StampRoots& roots);  // empty when there is none or it is unreadable
 Status write_made_log(const MadeLog& log, const StampRoots& roots);
 

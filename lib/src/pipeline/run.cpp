@@ -308,6 +308,7 @@ void run_job(const Job& job, const JobContext& ctx, const RunOptions& run_option
 // The log of files made, brought up to date, the stamps of jobs the manifest no longer has removed,
 // and after a full run with no failure the stale files too (unless kept).
 Status finish_run(const Plan& plan, const RunOptions& options, const StampRoots& roots, Report& report) {
+  const MadeLogLock lock(roots);
   const MadeLog before = read_made_log(roots);
   MadeLog log = before;
   for (const std::string& name : record_run(log, plan, report, roots)) {
