@@ -211,8 +211,8 @@ int run_build(const BuildSettings& s, const GlobalOptions& global) {
 
   // Progress: a bar on a terminal; elsewhere (build logs) one line per finished job.
   const bool terminal = isatty(STDERR_FILENO) != 0;
-  std::optional<SilencedStderr> quiet(std::in_place);  // the image libraries' own messages: each job's error line says it
-  ProgressBar bar(terminal && !global.quiet, quiet->original_fd());
+  SilencedStderr quiet;  // the image libraries' own messages: each job's error line says it
+  ProgressBar bar(terminal && !global.quiet, quiet.original_fd());
   pipeline::RunOptions options;
   options.force = s.force;
   options.dry_run = s.dry_run;
@@ -232,7 +232,7 @@ int run_build(const BuildSettings& s, const GlobalOptions& global) {
   };
   auto report = pipeline::run(manifest, *plan, options);
   bar.finish();
-  quiet.reset();
+  quiet.restore();
   if (!report) return report_error(report.error());
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const std::size_t failed = report->count(pipeline::Outcome::failed);

@@ -30,7 +30,7 @@ class SilencedStderr {
   SilencedStderr(const SilencedStderr&) = delete;
   SilencedStderr& operator=(const SilencedStderr&) = delete;
 
- private:
+  // fd 2 back to the real stderr before the scope ends (the destructor then does nothing).
   void restore() {
     if (saved_ < 0) return;
     std::fflush(stderr);
@@ -38,6 +38,8 @@ class SilencedStderr {
     ::close(saved_);
     saved_ = -1;
   }
+
+ private:
   int saved_ = -1;
 };
 

@@ -32,7 +32,6 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-const fs::path kExamples = fs::path(MATBAKE_SOURCE_DIR) / "examples";
 
 // The bundled example copied into `dir` (the manifest's output then goes to dir/out), optionally
 // with its AO samples lowered to keep the test quick.

@@ -24,7 +24,6 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-const fs::path kExamples = fs::path(MATBAKE_SOURCE_DIR) / "examples";
 
 // Noise images, so that every code path (sRGB curve, rounding) shows in the bytes.
 void write_noise(const fs::path& path, int size, int channels, unsigned seed, int lo = 0, int hi = 255) {

@@ -2,11 +2,18 @@
 // Scenes for the AO tests, built in memory: squares and the scene around them.
 #include <glm/geometric.hpp>
 
+#include <cmath>
 #include <vector>
 
 #include "matbake/scene.hpp"
 
 namespace matbake::test {
+
+inline const scene::Vec3 kX(1, 0, 0), kY(0, 1, 0), kZ(0, 0, 1);
+
+// Three standard deviations of a fraction p estimated from `samples` independent rays (binomial),
+// plus a little for the float sums.
+inline double three_sigma(double p, int samples) { return 3 * std::sqrt(p * (1 - p) / samples) + 1e-6; }
 
 // A square of half-size `half` in the plane through `center` spanned by u and v, facing u × v, as a
 // fan of 4 triangles around its centre vertex (vertex 0). TEXCOORD_0 maps it onto [0, 1]²: u along

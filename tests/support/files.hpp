@@ -8,6 +8,9 @@
 
 namespace matbake::test {
 
+// The bundled examples of this source tree.
+inline const std::filesystem::path kExamples = std::filesystem::path(MATBAKE_SOURCE_DIR) / "examples";
+
 struct RawImage {
   int width = 0;
   int height = 0;

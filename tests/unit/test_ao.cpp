@@ -19,10 +19,13 @@ namespace {
 using scene::Instance;
 using scene::Vec3;
 
+using test::kX;
+using test::kY;
+using test::kZ;
 using test::scene_of;
 using test::square;
+using test::three_sigma;
 
-const Vec3 kX(1, 0, 0), kY(0, 1, 0), kZ(0, 0, 1);
 constexpr float kHalf = 1000;
 
 Options binary(int samples) {
@@ -32,8 +35,6 @@ Options binary(int samples) {
   o.absolute_distance = 1e5;
   return o;
 }
-
-double three_sigma(double p, int samples) { return 3 * std::sqrt(p * (1 - p) / samples) + 1e-6; }
 
 float centre_value(const scene::Scene& s, const Options& o, std::size_t instance = 0) {
   auto r = bake(s, o);

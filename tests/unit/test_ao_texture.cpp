@@ -18,10 +18,13 @@ namespace {
 
 using scene::Instance;
 using scene::Vec3;
+using test::kX;
+using test::kY;
+using test::kZ;
 using test::scene_of;
 using test::square;
+using test::three_sigma;
 
-const Vec3 kX(1, 0, 0), kY(0, 1, 0), kZ(0, 0, 1);
 
 Options binary(int samples, double range) {
   Options o;
@@ -30,8 +33,6 @@ Options binary(int samples, double range) {
   o.absolute_distance = range;
   return o;
 }
-
-double three_sigma(double p, int samples) { return 3 * std::sqrt(p * (1 - p) / samples) + 1e-6; }
 
 TextureOptions size(int width, int height, int padding = 0) {
   TextureOptions t;

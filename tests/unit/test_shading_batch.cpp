@@ -78,7 +78,7 @@ struct Samples {
   }
 };
 
-Vec3 direction(double cos_theta, double phi) {
+Vec3 direction_from_cosine(double cos_theta, double phi) {
   const double s = std::sqrt(std::max(0.0, 1 - cos_theta * cos_theta));
   return {s * std::cos(phi), s * std::sin(phi), cos_theta};
 }
@@ -89,8 +89,8 @@ TEST(ShadingBatch, MatchesFloat64OnRandomSamples) {
   Samples s;
   for (int i = 0; i < 100000; ++i) {
     // v anywhere (also below the horizon), l near the mirror direction so the lobe is sampled.
-    const Vec3 v = direction(2 * u(rng) - 1, 6.283 * u(rng));
-    const Vec3 l = glm::normalize(Vec3(-v.x, -v.y, v.z) + 0.3 * direction(2 * u(rng) - 1, 6.283 * u(rng)));
+    const Vec3 v = direction_from_cosine(2 * u(rng) - 1, 6.283 * u(rng));
+    const Vec3 l = glm::normalize(Vec3(-v.x, -v.y, v.z) + 0.3 * direction_from_cosine(2 * u(rng) - 1, 6.283 * u(rng)));
     s.add(make_geometry({0, 0, 1}, l, v), 0.02 + 0.97 * u(rng), u(rng));
   }
   for (SchulerVariant variant : kVariants) {
@@ -115,12 +115,12 @@ TEST(ShadingBatch, HardCases) {
   for (double gloss : {0.0, 1.0}) {
     for (double ks : {0.0, 0.04, 1.0}) {
       s.add(make_geometry(n, n, n), ks, gloss);                                  // n·h = 1, e = 4096 at g = 1
-      s.add(make_geometry(n, direction(0.8, 0), direction(0.8, 3.14159265358979)), ks, gloss);  // mirror, n·h = 1
-      s.add(make_geometry(n, direction(1 - 1e-7, 0), direction(1, 0)), ks, gloss);  // n·h → 1
-      s.add(make_geometry(n, direction(1e-6, 0), direction(1e-6, 3.1415)), ks, gloss);  // l·h → 0
-      s.add(make_geometry(n, direction(1e-7, 0), direction(0.5, 1)), ks, gloss);     // n·l → 0+
-      s.add(make_geometry(n, direction(-0.2, 0), direction(0.5, 1)), ks, gloss);     // light below
-      s.add(make_geometry(n, direction(0.5, 0), direction(-0.1, 1)), ks, gloss);     // view below
+      s.add(make_geometry(n, direction_from_cosine(0.8, 0), direction_from_cosine(0.8, 3.14159265358979)), ks, gloss);  // mirror, n·h = 1
+      s.add(make_geometry(n, direction_from_cosine(1 - 1e-7, 0), direction_from_cosine(1, 0)), ks, gloss);  // n·h → 1
+      s.add(make_geometry(n, direction_from_cosine(1e-6, 0), direction_from_cosine(1e-6, 3.1415)), ks, gloss);  // l·h → 0
+      s.add(make_geometry(n, direction_from_cosine(1e-7, 0), direction_from_cosine(0.5, 1)), ks, gloss);     // n·l → 0+
+      s.add(make_geometry(n, direction_from_cosine(-0.2, 0), direction_from_cosine(0.5, 1)), ks, gloss);     // light below
+      s.add(make_geometry(n, direction_from_cosine(0.5, 0), direction_from_cosine(-0.1, 1)), ks, gloss);     // view below
     }
   }
   for (SchulerVariant variant : kVariants) {

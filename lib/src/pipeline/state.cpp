@@ -21,7 +21,7 @@ fs::path stamp_path(const std::string& job_name, const StampRoots& roots) {
   return roots.state_folder / (job_file_stem(job_name) + ".json");
 }
 
-nlohmann::json to_json(const FileIdentity& f, const std::string& path) {
+nlohmann::json stamped_file_json(const FileIdentity& f, const std::string& path) {
   return {{"path", path}, {"size", f.size}, {"mtime", f.mtime}, {"hash", f.hash}};
 }
 
@@ -140,8 +140,8 @@ std::string out_of_date_reason(const Job& job, const StampRoots& roots, bool ref
 Status write_stamp(const Job& job, const std::vector<StampedFile>& read, const std::vector<StampedFile>& written,
                    const StampRoots& roots) {
   nlohmann::json inputs = nlohmann::json::array(), outputs = nlohmann::json::array();
-  for (const StampedFile& f : read) inputs.push_back(to_json(f.identity, stamped_path(f.path, roots.inputs)));
-  for (const StampedFile& f : written) outputs.push_back(to_json(f.identity, stamped_path(f.path, roots.outputs)));
+  for (const StampedFile& f : read) inputs.push_back(stamped_file_json(f.identity, stamped_path(f.path, roots.inputs)));
+  for (const StampedFile& f : written) outputs.push_back(stamped_file_json(f.identity, stamped_path(f.path, roots.outputs)));
   const nlohmann::json stamp = {{"form", kStampForm}, {"matbake", version}, {"job", job.name},
                                 {"options", job.options}, {"inputs", inputs},   {"outputs", outputs}};
   std::error_code ec;

@@ -55,16 +55,15 @@ const ModelInfo* find_model(std::string_view name) {
 namespace {
 
 double albedo_sum(const ModelInfo& model, const MaterialSample& material, const Vec3& v, int steps) {
-  constexpr double kPi = std::numbers::pi;
   const Vec3 n(0, 0, 1);
   const int phi_steps = 2 * steps;
   double sum = 0;
   for (int i = 0; i < steps; ++i) {
     const double t = (i + 0.5) / steps;
-    const double theta = kPi / 2 * t * t, d_theta = kPi * t / steps;
+    const double theta = std::numbers::pi / 2 * t * t, d_theta = std::numbers::pi * t / steps;
     const double sin_theta = std::sin(theta), cos_theta = std::cos(theta);
     for (int j = 0; j < phi_steps; ++j) {
-      const double phi = 2 * kPi * (j + 0.5) / phi_steps;
+      const double phi = 2 * std::numbers::pi * (j + 0.5) / phi_steps;
       const Vec3 h(sin_theta * std::cos(phi), sin_theta * std::sin(phi), cos_theta);
       const double v_dot_h = glm::dot(v, h);
       if (v_dot_h <= 0) continue;
@@ -74,7 +73,7 @@ double albedo_sum(const ModelInfo& model, const MaterialSample& material, const 
       sum += f * l.z * 4.0 * v_dot_h * sin_theta * d_theta;
     }
   }
-  return sum * 2 * kPi / phi_steps;
+  return sum * 2 * std::numbers::pi / phi_steps;
 }
 
 }  // namespace

@@ -11,7 +11,6 @@
 namespace matbake::shading {
 namespace {
 
-constexpr double kPi = std::numbers::pi;
 
 // Normalized Blinn-Phong in Schüler's units: (1 + e)/2 (n·h)^e (appendix).
 double schuler_d(const Geometry& g, double e) { return (1.0 + e) / 2.0 * std::pow(std::max(g.n_dot_h, 0.0), e); }
@@ -29,7 +28,7 @@ double schuler_cook_torrance_full(const Geometry& g, double ks, double gloss) {
   // π·D: the Beckmann NDF in Schüler's units. The IOR comes from Ks; Ks = 1 is a perfect mirror.
   const double m = beckmann_m_from_exponent(schuler_exponent(gloss));
   const double f = ks >= 1.0 ? 1.0 : fresnel_cook_torrance(g.l_dot_h, ior_from_f0(ks));
-  return kPi * beckmann_d(g.n_dot_h, m) * f * torrance_sparrow_g(g) / (4.0 * g.n_dot_v);
+  return std::numbers::pi * beckmann_d(g.n_dot_h, m) * f * torrance_sparrow_g(g) / (4.0 * g.n_dot_v);
 }
 
 double schuler_cook_torrance_simplified(const Geometry& g, double ks, double gloss) {
@@ -66,7 +65,7 @@ double schuler_specular(SchulerVariant variant, const Geometry& g, double ks, do
 
 double schuler_specular_brdf(SchulerVariant variant, const Geometry& g, double ks, double gloss) {
   if (g.n_dot_l <= 0.0) return 0.0;
-  return schuler_specular(variant, g, ks, gloss) / (kPi * g.n_dot_l);
+  return schuler_specular(variant, g, ks, gloss) / (std::numbers::pi * g.n_dot_l);
 }
 
 double hemisphere_diffuse(const Vec3& n, double kd, const HemisphereLight& light) {

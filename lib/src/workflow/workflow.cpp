@@ -13,7 +13,6 @@
 namespace matbake::workflow {
 namespace {
 
-constexpr double kPi = std::numbers::pi;
 
 constexpr std::size_t kGlossSteps = 32;
 using RoughnessRow = std::array<double, kGlossSteps + 1>;
@@ -205,19 +204,19 @@ LobeQuadrature make_lobe_quadrature(int steps) {
   LobeQuadrature q;
   const int phi_steps = 2 * steps;
   for (double view_degrees : {0.0, 20.0, 40.0, 60.0, 75.0}) {
-    const double theta_v = view_degrees * kPi / 180;
+    const double theta_v = view_degrees * std::numbers::pi / 180;
     const Vec3 v(std::sin(theta_v), 0, std::cos(theta_v));
     for (int i = 0; i < steps; ++i) {
       const double t = (i + 0.5) / steps;
-      const double theta = kPi / 2 * t * t, d_theta = kPi * t / steps;
+      const double theta = std::numbers::pi / 2 * t * t, d_theta = std::numbers::pi * t / steps;
       for (int j = 0; j < phi_steps; ++j) {
-        const double phi = 2 * kPi * (j + 0.5) / phi_steps;
+        const double phi = 2 * std::numbers::pi * (j + 0.5) / phi_steps;
         const Vec3 h(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta));
         const double v_dot_h = glm::dot(v, h);
         if (v_dot_h <= 0) continue;
         const Vec3 l = 2.0 * v_dot_h * h - v;
         if (l.z <= 0) continue;
-        const double weight = 4 * v_dot_h * std::sin(theta) * d_theta * 2 * kPi / phi_steps;
+        const double weight = 4 * v_dot_h * std::sin(theta) * d_theta * 2 * std::numbers::pi / phi_steps;
         q.pairs.push_back({l.z, v.z, h.z, v_dot_h, weight});
       }
     }
