@@ -55,8 +55,9 @@ struct SlurmTarget {
 
 // The sbatch command of each submission as a shell line, in order (the array first, then the
 // scenes); a scene's dependency names the array by "$array" (its job id, known when the script runs).
+// `program` starts each line: sbatch, or submit.sh's "$sbatch" (a stand-in the tests set).
 std::vector<std::string> sbatch_lines(const SlurmSubmission& submission, const ClusterOptions& options,
-                                      const SlurmTarget& target);
+                                      const SlurmTarget& target, const std::string& program = "sbatch");
 
 // "5 material jobs (one array), 1 scene job; 0 up to date"
 std::string submission_counts(const SlurmSubmission& submission);

@@ -132,13 +132,13 @@ SlurmSubmission slurm_submission(const Plan& plan, const Report& dry_run, const 
 }
 
 std::vector<std::string> sbatch_lines(const SlurmSubmission& submission, const ClusterOptions& options,
-                                      const SlurmTarget& target) {
+                                      const SlurmTarget& target, const std::string& program) {
   std::vector<std::vector<std::string>> commands;
   if (!submission.array.empty()) commands.push_back(array_command(submission, options, target));
   for (const SlurmJob& scene : submission.scenes) commands.push_back(scene_command(scene, options, target));
   std::vector<std::string> lines;
   for (const auto& args : commands) {
-    std::string line = "sbatch";
+    std::string line = program;
     for (const std::string& a : args) line += " " + script_word(a);
     lines.push_back(std::move(line));
   }
@@ -185,16 +185,15 @@ SlurmScripts slurm_scripts(const Manifest& manifest, const SlurmSubmission& subm
     return out;
   }
   out.submit += "sbatch=${SBATCH:-sbatch}\nmkdir -p " + shell_quoted((target.folder / "logs").string()) + "\n";
-  const std::vector<std::string> lines = sbatch_lines(submission, options, target);
-  const auto with_variable = [](const std::string& line) { return "\"$sbatch\"" + line.substr(6); };
+  const std::vector<std::string> lines = sbatch_lines(submission, options, target, "\"$sbatch\"");
   std::size_t next = 0;
   if (!submission.array.empty()) {
-    out.submit += "array=$(" + with_variable(lines[next++]) + ")\narray=${array%%;*}  # --parsable: id[;cluster]\n";
+    out.submit += "array=$(" + lines[next++] + ")\narray=${array%%;*}  # --parsable: id[;cluster]\n";
   }
   std::string ids;
   for (; next < lines.size(); ++next) {
     const std::string var = "scene_" + std::to_string(next);
-    out.submit += var + "=$(" + with_variable(lines[next]) + ")\n";
+    out.submit += var + "=$(" + lines[next] + ")\n";
     ids += " $" + var;
   }
   out.submit += "echo \"matbake: submitted " + counts + ":" + (submission.array.empty() ? "" : " array $array") +
