@@ -35,7 +35,15 @@ void write_until_interrupted(const fs::path& folder, int writer) {
 // In a child process: remove_temporary_files_for_exit() is for a process about to end.
 int interrupted_child(const fs::path& folder) {
   for (int writer = 0; writer < 3; ++writer) std::thread(write_until_interrupted, folder, writer).detach();
-  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  // Interrupted once a file is finished (the writers are then at work), however slow the machine.
+  const auto finished = [&] {
+    for (const auto& entry : fs::directory_iterator(folder)) {
+      if (entry.path().filename().string()[0] != '.') return true;
+    }
+    return false;
+  };
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (!finished() && std::chrono::steady_clock::now() < deadline) std::this_thread::sleep_for(std::chrono::milliseconds(1));
   remove_temporary_files_for_exit();
   std::this_thread::sleep_for(std::chrono::milliseconds(30));  // the writers go on opening by name
   return 0;
