@@ -3,6 +3,7 @@
 #include <cstdio>
 
 #include "commands.hpp"
+#include "matbake/delivery_params.hpp"
 #include "matbake/encoding_params.hpp"
 #include "params_cli.hpp"
 #include "matbake/export.hpp"
@@ -23,6 +24,7 @@ CLI::App* setup_bake_ao(CLI::App& app, BakeAoSettings& s) {
   cmd->add_option("--dump", s.dump, "Raw values: .csv (node,mesh,primitive,vertex,x,y,z,ao) or .bin (float32)");
   add_params(*cmd, image::encoding_params(), s.encoding, "", "Options");
   add_params(*cmd, image::gltf_texture_params(), s.encoding, "", "Options");
+  add_params(*cmd, delivery::options_params(), s.delivery, "", "Texture delivery (docs/delivery.md)");
   add_ao_options(*cmd, s.ao, "");
   return cmd;
 }
@@ -30,7 +32,7 @@ CLI::App* setup_bake_ao(CLI::App& app, BakeAoSettings& s) {
 int run_bake_ao(const BakeAoSettings& s, const GlobalOptions& global) {
   auto request = ao_request(s.ao, "");
   if (!request) return report_error(request.error());
-  auto report = bake_ao::bake_file(s.scene, {*request, s.output, s.dump, s.encoding});
+  auto report = bake_ao::bake_file(s.scene, {*request, s.output, s.dump, s.encoding, s.delivery});
   if (!report) return report_error(report.error());
   nlohmann::json textures = nlohmann::json::array();
   for (const bake_ao::TextureReport& t : report->textures) textures.push_back(to_json(t));
@@ -41,7 +43,7 @@ int run_bake_ao(const BakeAoSettings& s, const GlobalOptions& global) {
                                 {"setup_seconds", report->setup_seconds}, {"ray_seconds", report->ray_seconds},
                                 {"max_distance", report->max_distance}, {"mean_ao", report->mean},
                                 {"texels", report->texels}, {"texel_seconds", report->texel_seconds},
-                                {"textures", textures}, {"geometry", report->geometry}, {"notes", report->notes}}
+                                {"textures", textures}, {"delivered", delivered_json(report->delivered)}, {"geometry", report->geometry}, {"notes", report->notes}}
                      .dump(2)
               << "\n";
   } else if (!global.quiet) {

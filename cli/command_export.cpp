@@ -3,6 +3,7 @@
 #include <cstdio>
 
 #include "commands.hpp"
+#include "matbake/delivery_params.hpp"
 #include "matbake/encoding_params.hpp"
 #include "matbake/export_params.hpp"
 #include "params_cli.hpp"
@@ -67,6 +68,7 @@ CLI::App* setup_export(CLI::App& app, ExportSettings& s) {
   add_params(*cmd, exporter::options_params(), s.options, "", "Options");
   add_params(*cmd, image::encoding_params(), s.options.encoding, "", "Options");
   add_params(*cmd, image::gltf_texture_params(), s.options.encoding, "", "Options");
+  add_params(*cmd, delivery::options_params(), s.options.delivery, "", "Texture delivery (docs/delivery.md)");
   add_ao_options(*cmd, s.ao, "ao-");  // AO is baked when any of them is given, as a manifest's ao = { ... }
   cmd->add_option("--report", s.report, "Also write the report as JSON to this file");
   return cmd;

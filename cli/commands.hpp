@@ -105,6 +105,7 @@ struct BakeAoSettings {
   std::string output;
   std::string dump;
   image::Encoding encoding;  // of the occlusion textures
+  delivery::Options delivery;
   AoSettings ao;
 };
 CLI::App* setup_bake_ao(CLI::App& app, BakeAoSettings& settings);

@@ -10,7 +10,7 @@ packages=(
   libopenexr-dev libimath-dev libglm-dev libtinygltf-dev libembree-dev
   libcli11-dev nlohmann-json3-dev libtbb-dev libtomlplusplus-dev
   libgtest-dev libbenchmark-dev zlib1g-dev libdeflate-dev libspng-dev libxxhash-dev time
-  libdraco-dev libmeshoptimizer-dev libwebp-dev draco gltfpack
+  libdraco-dev libmeshoptimizer-dev libwebp-dev libzstd-dev draco gltfpack
   clang-14 libclang-rt-14-dev llvm-14
 )
 # `deps.sh cluster`: also Slurm and munge, for scripts/test-cluster.sh.

@@ -9,6 +9,7 @@
 #include "cli/params_cli.hpp"
 #include "matbake/ao_params.hpp"
 #include "matbake/convert_params.hpp"
+#include "matbake/delivery_params.hpp"
 #include "matbake/encoding_params.hpp"
 #include "matbake/export_params.hpp"
 #include "matbake/material_params.hpp"
@@ -176,6 +177,7 @@ TEST(SceneParams, EveryExportAndEncodingParameterReachesTheSceneFromBothDoors) {
   walk_scene_keys(exporter::options_params(), [](const pipeline::SceneSpec& s) { return s.options; });
   walk_scene_keys(image::encoding_params(), [](const pipeline::SceneSpec& s) { return s.options.encoding; });
   walk_scene_keys(image::gltf_texture_params(), [](const pipeline::SceneSpec& s) { return s.options.encoding; });
+  walk_scene_keys(delivery::options_params(), [](const pipeline::SceneSpec& s) { return s.options.delivery; });
 }
 
 // A material's options: each at its example through the flags, a material's key and the manifest's
@@ -283,6 +285,7 @@ TEST(DocsTables, MatchTheParameterDescriptions) {
       {"docs/build.md", "params:encoding", markdown_table(image::encoding_params(), "")},
       {"docs/export.md", "params:texture", markdown_table(image::gltf_texture_params(), "")},
       {"docs/export.md", "params:export", markdown_table(exporter::options_params(), "")},
+      {"docs/delivery.md", "params:delivery", markdown_table(delivery::options_params(), "")},
       {"docs/validate.md", "params:validate", markdown_table(validate::options_params(), "")},
       {"docs/build.md", "params:material", markdown_table(pack::material_params(), "")},
       {"docs/convert.md", "params:convert", markdown_table(convert::options_params(), "")},

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "matbake/ao.hpp"
+#include "matbake/delivery.hpp"
 #include "matbake/image.hpp"
 #include "matbake/result.hpp"
 
@@ -36,6 +37,7 @@ struct Options {
   std::filesystem::path output;  // .gltf or .glb; empty: none
   std::filesystem::path dump;    // .csv or .bin; empty: none (per-vertex only)
   image::Encoding encoding;      // of the occlusion textures' PNGs
+  delivery::Options delivery;    // sizes and KTX2 of every texture the written scene uses
 };
 struct Report {
   std::size_t instances = 0;
@@ -53,6 +55,7 @@ struct Report {
                                       // back as it came or uncompressed (gltf::geometry_notes)
   std::vector<std::string> notes;    // the scene's (what was skipped) and the bake's
   std::vector<std::string> written;  // files
+  std::vector<delivery::TextureReport> delivered;  // what delivery did to each used texture
 };
 Result<Report> bake_file(const std::filesystem::path& input, const Options& options);
 

@@ -17,6 +17,7 @@
 
 #include "matbake/ao.hpp"
 #include "matbake/bake_ao.hpp"
+#include "matbake/delivery.hpp"
 #include "matbake/pack.hpp"
 #include "matbake/result.hpp"
 #include "matbake/workflow_maps.hpp"
@@ -48,6 +49,7 @@ struct Options {
   workflow::RoughnessMapping mapping = workflow::kDefaultRoughnessMapping;
   bool pack_orm = true;           // occlusion + metallic-roughness into one texture
   image::Encoding encoding;       // of the PNGs it makes (converted, ORM and occlusion textures)
+  delivery::Options delivery;     // sizes and KTX2 of every texture the scene uses
   std::optional<ao::Request> ao;  // bake AO when set: per vertex, or with ao->texture into each
                                   // material's ORM texture (red), or its own occlusion texture
 };
@@ -73,6 +75,7 @@ struct Report {
   std::vector<std::string> ao_notes;       // what the texture bake skipped or averaged
   std::vector<std::string> geometry;       // compressed or sparse geometry: decoded to read, written back
                                            // as it came or uncompressed (gltf::geometry_notes)
+  std::vector<delivery::TextureReport> textures;  // what delivery did to each used texture
 };
 
 Result<Report> export_scene(const std::filesystem::path& input, const std::filesystem::path& output,

@@ -31,5 +31,7 @@ nlohmann::json to_json(const ao::Request& r);
 // One material's baked occlusion texture, as bake-ao and export report it.
 nlohmann::json to_json(const bake_ao::TextureReport& t);
 nlohmann::json to_json(const exporter::Options& o);
+nlohmann::json to_json(const delivery::TextureReport& t);
+nlohmann::json delivered_json(const std::vector<delivery::TextureReport>& textures);
 
 }  // namespace matbake

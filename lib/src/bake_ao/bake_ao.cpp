@@ -2,7 +2,9 @@
 
 #include <chrono>
 
+#include "../delivery/deliver.hpp"
 #include "../gltf/decode.hpp"
+#include "../gltf/prune.hpp"
 #include "../gltf/vertex_occlusion.hpp"
 #include "textures.hpp"
 #include "../scene/from_document.hpp"
@@ -126,6 +128,13 @@ Result<Report> bake_file(const fs::path& input, const Options& options) {
       report.max_distance = baked->max_distance;
     }
     report.geometry = gltf::geometry_notes(*doc);
+    if (!options.output.empty() && delivery::changes_textures(options.delivery, options.encoding)) {
+      gltf::ImageCache cache(*doc, options.encoding);
+      auto delivered = delivery::deliver_textures(*doc, cache, options.delivery, options.output);
+      if (!delivered) return delivered.error();
+      report.delivered = std::move(*delivered);
+      (void)gltf::prune_unreachable(*doc);  // the images KTX2 or resized ones replaced
+    }
     if (!options.output.empty()) {
       auto written = gltf::write_document(*doc, options.output);
       if (!written) return written.error();

@@ -251,14 +251,14 @@ Result<std::vector<TextureReport>> bake_occlusion_textures(gltf::Document& doc, 
       auto made = cache.add_texture(doc, orm, color::Transfer::linear, stem + "_orm_ao_" + std::to_string(m), mr_index);
       if (!made) return made.error();
       report.file = made->uri;
-      index = made->texture;
+      index = made->index;
       material["pbrMetallicRoughness"]["metallicRoughnessTexture"]["index"] = index;
     } else {
       auto made = cache.add_texture(doc, img, color::Transfer::linear, stem + "_occlusion_" + std::to_string(m), sampler_from,
                                     texture.bits == 16 ? image::SampleType::u16 : image::SampleType::u8);
       if (!made) return made.error();
       report.file = made->uri;
-      index = made->texture;
+      index = made->index;
     }
     // A transform (KHR_texture_transform) of the old texture does not apply to UVs baked as they are.
     Json info = {{"index", index}};

@@ -11,6 +11,7 @@
 #include "../scene/from_document.hpp"
 #include "../bake_ao/vertices.hpp"
 #include "../bake_ao/textures.hpp"
+#include "../delivery/deliver.hpp"
 #include "matbake/output_check.hpp"
 #include "../gltf/texture_files.hpp"
 
@@ -67,7 +68,7 @@ struct Exporter {
     auto made = cache.add_texture(doc, img, colour, stem + "_" + name, sampler_of);
     if (!made) return made.error();
     ++report.textures_made;
-    return made->texture;
+    return made->index;
   }
 
   // The metal-rough maps written into `material`: factors when they are 1×1 (constants), else a
@@ -491,7 +492,11 @@ Result<Report> export_scene(const fs::path& input, const fs::path& output, const
       if (!baked) return baked.error();
       report.ao_rays = baked->rays;
     }
-    // What the conversions replaced (spec-gloss textures, separate occlusion maps, old colours).
+    auto delivered = delivery::deliver_textures(*doc, cache, options.delivery, output);
+    if (!delivered) return delivered.error();
+    report.textures = std::move(*delivered);
+    // What the conversions replaced (spec-gloss textures, separate occlusion maps, old colours) and
+    // what delivery did (resized or KTX2 images).
     for (std::string& s : gltf::prune_unreachable(*doc)) report.skipped.push_back(s + ": replaced");
     report.images_decoded = cache.decoded();
     report.geometry = gltf::geometry_notes(*doc);

@@ -102,37 +102,46 @@ Status ImageCache::check(std::size_t index) {
   return success();
 }
 
-Result<ImageCache::Made> ImageCache::add_texture(Document& doc, const image::Image& img, color::Transfer colour,
-                                                 const std::string& name, int sampler_from, image::SampleType type) const {
-  const bool webp = encoding_.texture_format == image::TextureFormat::webp;
-  if (webp && type != image::SampleType::u8) {
+Result<ImageCache::Made> ImageCache::add_image(Document& doc, const image::Image& img, color::Transfer colour,
+                                               const std::string& name, image::SampleType type) const {
+  if (webp() && type != image::SampleType::u8) {
     return Error{doc.file, name + ": WebP holds 8 bits per channel; write 16-bit textures as PNG (--texture-format png)"};
   }
   image::WriteOptions options;
   options.colour = colour;
   options.type = type;
   options.png_level = encoding_.png_level;
-  if (webp) options.compression = "lossless";  // data (occlusion, roughness) survives as written
+  if (webp()) options.compression = "lossless";  // data (occlusion, roughness) survives as written
   Made made;
-  made.uri = name + (webp ? ".webp" : ".png");
-  auto bytes = image::encode_image(webp && img.channels < 3 ? as_rgb(img) : img, made.uri, options);
+  made.uri = name + (webp() ? ".webp" : ".png");
+  auto bytes = image::encode_image(webp() && img.channels < 3 ? as_rgb(img) : img, made.uri, options);
   if (!bytes) return bytes.error();
   doc.new_files[made.uri] = std::move(*bytes);
-  doc.json["images"].push_back({{"uri", made.uri}, {"mimeType", webp ? "image/webp" : "image/png"}});
-  const std::size_t image = doc.json["images"].size() - 1;
-  Json texture = webp ? Json{{"extensions", {{"EXT_texture_webp", {{"source", image}}}}}} : Json{{"source", image}};
+  doc.json["images"].push_back({{"uri", made.uri}, {"mimeType", webp() ? "image/webp" : "image/png"}});
+  made.index = int(doc.json["images"].size()) - 1;
+  if (webp()) require_extension(doc, "EXT_texture_webp", true);
+  return made;
+}
+
+Result<ImageCache::Made> ImageCache::add_texture(Document& doc, const image::Image& img, color::Transfer colour,
+                                                 const std::string& name, int sampler_from, image::SampleType type) const {
+  auto made = add_image(doc, img, colour, name, type);
+  if (!made) return made.error();
+  Json texture = webp() ? Json{{"extensions", {{"EXT_texture_webp", {{"source", made->index}}}}}} : Json{{"source", made->index}};
   if (sampler_from >= 0 && doc.json["textures"][std::size_t(sampler_from)].contains("sampler")) {
     texture["sampler"] = doc.json["textures"][std::size_t(sampler_from)]["sampler"];
   }
   doc.json["textures"].push_back(std::move(texture));
-  if (webp) {
-    for (const char* list : {"extensionsUsed", "extensionsRequired"}) {
-      Json& names = doc.json[list];
-      if (std::find(names.begin(), names.end(), "EXT_texture_webp") == names.end()) names.push_back("EXT_texture_webp");
-    }
-  }
-  made.texture = int(doc.json["textures"].size()) - 1;
+  made->index = int(doc.json["textures"].size()) - 1;
   return made;
+}
+
+void require_extension(Document& doc, const std::string& name, bool required) {
+  for (const char* list : {"extensionsUsed", "extensionsRequired"}) {
+    if (list[9] == 'R' && !required) continue;
+    Json& names = doc.json[list];
+    if (std::find(names.begin(), names.end(), name) == names.end()) names.push_back(name);
+  }
 }
 
 }  // namespace matbake::gltf

@@ -17,6 +17,9 @@ image::Image blank(int width, int height, int channels);
 // `im` resampled to width × height (itself when it has that size).
 image::Image at_size(const image::Image& im, int width, int height);
 
+// Names `name` in extensionsUsed, and in extensionsRequired too when `required` (each once).
+void require_extension(Document& doc, const std::string& name, bool required);
+
 class ImageCache {
  public:
   ImageCache(const gltf::Document& doc, const image::Encoding& encoding) : doc_(doc), encoding_(encoding) {}
@@ -30,16 +33,21 @@ class ImageCache {
   // Image `index` is a PNG, JPEG or WebP whose header reads, or a KTX2 file (passed through).
   Status check(std::size_t index);
 
-  // A new texture of `doc` (the cache's document) over `img`, its colour channels encoded with
+  // A new image of `doc` (the cache's document) holding `img`, its colour channels encoded with
   // `colour`, in the encoding's texture format: a new file `<name>.png`, or `<name>.webp` (lossless,
-  // 8-bit) named through EXT_texture_webp, which the file then requires. With the sampler of
-  // texture `sampler_from` (none when −1). Returns the texture's index and the image's URI.
+  // 8-bit), which the file then requires EXT_texture_webp for. Returns the image's index and URI.
   struct Made {
-    int texture = -1;
+    int index = -1;  // of the image, or of the texture (add_texture)
     std::string uri;
   };
+  Result<Made> add_image(Document& doc, const image::Image& img, color::Transfer colour, const std::string& name,
+                         image::SampleType type = image::SampleType::u8) const;
+  // A new texture over a new image (add_image), through EXT_texture_webp when WebP, with the
+  // sampler of texture `sampler_from` (none when −1). Returns the texture's index and the image's URI.
   Result<Made> add_texture(Document& doc, const image::Image& img, color::Transfer colour, const std::string& name,
                            int sampler_from, image::SampleType type = image::SampleType::u8) const;
+  const image::Encoding& encoding() const { return encoding_; }
+  bool webp() const { return encoding_.texture_format == image::TextureFormat::webp; }
 
  private:
   const gltf::Document& doc_;

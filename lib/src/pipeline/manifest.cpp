@@ -9,6 +9,7 @@
 
 #include "matbake/ao_params.hpp"
 #include "matbake/cluster.hpp"
+#include "matbake/delivery_params.hpp"
 #include "matbake/encoding_params.hpp"
 #include "matbake/export_params.hpp"
 #include "matbake/material_params.hpp"
@@ -401,8 +402,10 @@ Result<SceneSpec> read_scene(const Reader& r, const std::string& name, const tom
   if (Status s = r.known_keys(*t, where, with_keys_of(image::encoding_params(),
                                                       with_keys_of(image::gltf_texture_params(),
                                                                    with_keys_of(exporter::options_params(),
-                                                                                with_keys_of(scene_params(),
-                                                                                             {"input", "output", "materials", "ao"})))));
+                                                                                with_keys_of(delivery::options_params(),
+                                                                                             with_keys_of(scene_params(),
+                                                                                                          {"input", "output", "materials",
+                                                                                                           "ao"}))))));
       !s) {
     return s.error();
   }
@@ -418,7 +421,8 @@ Result<SceneSpec> read_scene(const Reader& r, const std::string& name, const tom
   std::string input, output = name + ".glb";
   for (Status s : {r.get(*t, "input", where, input), r.get(*t, "output", where, output),
                    read_params_in(r, *t, where, scene_params(), spec, notes),
-                   read_params_in(r, *t, where, exporter::options_params(), spec.options, notes)}) {
+                   read_params_in(r, *t, where, exporter::options_params(), spec.options, notes),
+                   read_params_in(r, *t, where, delivery::options_params(), spec.options.delivery, notes)}) {
     if (!s) return s.error();
   }
   if (input.empty()) return r.at(node, where + ": input = \"scene.gltf\" is required");

@@ -2,6 +2,7 @@
 
 #include "matbake/ao_params.hpp"
 #include "matbake/atomic_file.hpp"
+#include "matbake/delivery_params.hpp"
 #include "matbake/encoding_params.hpp"
 #include "matbake/export_params.hpp"
 
@@ -77,6 +78,27 @@ nlohmann::json to_json(const validate::Report& r, const validate::Options& optio
   return doc;
 }
 
+nlohmann::json to_json(const delivery::TextureReport& t) {
+  nlohmann::json j = {{"texture", t.texture},
+                      {"class", name_in(delivery::kTextureClassNames, t.texture_class)},
+                      {"codec", name_in(delivery::kCodecNames, t.codec)},
+                      {"file", t.uri},
+                      {"source_size", {t.source.width, t.source.height}},
+                      {"size", {t.delivered.width, t.delivered.height}},
+                      {"levels", t.levels},
+                      {"source_bytes", t.source_bytes},
+                      {"bytes", t.bytes}};
+  if (t.alpha_cutoff) j["alpha_cutoff"] = *t.alpha_cutoff, j["coverage"] = t.coverage;
+  if (!t.note.empty()) j["note"] = t.note;
+  return j;
+}
+
+nlohmann::json delivered_json(const std::vector<delivery::TextureReport>& textures) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const delivery::TextureReport& t : textures) out.push_back(to_json(t));
+  return out;
+}
+
 nlohmann::json to_json(const exporter::Report& r) {
   nlohmann::json textures = nlohmann::json::array();
   for (const bake_ao::TextureReport& t : r.ao_textures) textures.push_back(to_json(t));
@@ -96,7 +118,7 @@ nlohmann::json to_json(const exporter::Report& r) {
   return {{"materials", materials},           {"skipped", r.skipped},
           {"written", r.written},    {"images_decoded", r.images_decoded}, {"textures_made", r.textures_made},
           {"ao_rays", r.ao_rays},    {"ao_textures", textures}, {"ao_notes", r.ao_notes},
-          {"geometry", r.geometry}};
+          {"geometry", r.geometry}, {"textures", delivered_json(r.textures)}};
 }
 
 Status write_validation_report(const validate::Report& r, const validate::Options& options,
@@ -121,6 +143,7 @@ nlohmann::json to_json(const exporter::Options& o) {
   nlohmann::json j = params::to_json(exporter::options_params(), o);
   j.update(params::to_json(image::encoding_params(), o.encoding));
   j.update(params::to_json(image::gltf_texture_params(), o.encoding));
+  j.update(params::to_json(delivery::options_params(), o.delivery));
   j["ao"] = o.ao ? to_json(*o.ao) : nlohmann::json(nullptr);
   return j;
 }

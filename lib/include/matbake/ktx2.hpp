@@ -1,0 +1,68 @@
+#pragma once
+// The KTX 2.0 container (Khronos KTX File Format Specification 2.0) as matbake writes and reads it:
+// 2D textures with a mip chain, Basis Universal payloads (ETC1S/BasisLZ or UASTC, optionally zstd-
+// supercompressed). Every offset and length is checked against the file before it is used.
+#include <cstdint>
+#include <span>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "matbake/result.hpp"
+
+namespace matbake::ktx2 {
+
+enum : std::uint32_t { kSupercompressionNone = 0, kSupercompressionBasisLZ = 1, kSupercompressionZstd = 2 };
+enum : std::uint8_t { kModelETC1S = 163, kModelUASTC = 166 };
+enum : std::uint8_t { kTransferLinear = 1, kTransferSRGB = 2 };
+// The channel id of a UASTC sample (KHR_DF_CHANNEL_UASTC_*): what the block holds.
+enum : std::uint8_t { kUastcRGB = 0, kUastcRGBA = 3, kUastcRRR = 4, kUastcRRRG = 5, kUastcRG = 6 };
+
+// The fields of the basic data format descriptor block that tell what a texture holds.
+struct Descriptor {
+  std::uint8_t model = 0, primaries = 0, transfer = 0, flags = 0;
+  std::uint8_t block_width = 1, block_height = 1;  // texel block, in texels
+  std::uint8_t bytes_plane0 = 0;
+  std::vector<std::uint8_t> channels;              // each sample's channel id, in order
+};
+
+struct Level {
+  std::vector<unsigned char> bytes;  // as stored (supercompressed when the file is)
+  std::uint64_t uncompressed_length = 0;
+};
+
+struct Texture {
+  std::uint32_t vk_format = 0;  // VK_FORMAT_UNDEFINED for Basis Universal
+  std::uint32_t type_size = 1;
+  std::uint32_t width = 0, height = 0;
+  std::uint32_t supercompression = kSupercompressionNone;
+  Descriptor descriptor;
+  std::vector<std::uint32_t> dfd;  // the descriptor as stored (its total size first)
+  std::vector<std::pair<std::string, std::string>> key_values;  // value without its terminating NUL
+  std::vector<unsigned char> global_data;                       // BasisLZ's codebooks
+  std::vector<Level> levels;                                     // level 0 (the largest) first
+};
+
+// A 2D KTX2 file read: header, level index, DFD, key/value pairs, global data. Errors name `name`.
+Result<Texture> read(std::span<const unsigned char> bytes, const std::string& name);
+
+// The DFD of a UASTC texture: one 128-bit sample of `channel`, sRGB or linear transfer; bytesPlane0
+// 16 unless zstd-supercompressed (then 0, as the specification asks).
+std::vector<std::uint32_t> uastc_descriptor(std::uint8_t transfer, std::uint8_t channel, bool supercompressed);
+
+// A UASTC texture of `levels` (raw UASTC blocks, level 0 first) as a KTX2 file: supercompressed with
+// zstd at `zstd_level` (1–22) unless it is 0, levels aligned as the specification asks (16 bytes
+// uncompressed), smallest level last in the index and first in the file. `writer` is KTXwriter's value.
+struct UastcFile {
+  std::uint32_t width = 0, height = 0;
+  std::uint8_t transfer = kTransferSRGB, channel = kUastcRGB;
+  std::vector<std::vector<unsigned char>> levels;
+  int zstd_level = 0;
+  std::string writer;
+};
+Result<std::vector<unsigned char>> write_uastc(const UastcFile& file);
+
+// The uncompressed bytes of a level (zstd inflated; as stored otherwise; BasisLZ is not inflated).
+Result<std::vector<unsigned char>> level_data(const Texture& texture, std::size_t level, const std::string& name);
+
+}  // namespace matbake::ktx2

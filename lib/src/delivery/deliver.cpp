@@ -1,0 +1,317 @@
+// The delivery pass: find each used texture's class, decode its image once, then (in parallel, each
+// texture its own task) resize or make its mip chain and encode it, then rewrite the document in
+// texture order, so that the written bytes do not depend on the thread count.
+#include "deliver.hpp"
+
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <set>
+
+#include "encode.hpp"
+#include "matbake/ktx2.hpp"
+#include "matbake/version.hpp"
+
+namespace matbake::delivery {
+namespace fs = std::filesystem;
+using gltf::Json;
+namespace {
+
+constexpr const char* kBasisu = "KHR_texture_basisu";
+constexpr const char* kWebp = "EXT_texture_webp";
+
+struct Use {
+  TextureClass texture_class = TextureClass::colour;
+  std::optional<float> alpha_cutoff;
+  std::string conflict;  // "used as colour and data": kept as it is
+};
+
+// The class of a material slot, by its name, for core and extension slots alike: normal maps
+// (normalTexture, clearcoatNormalTexture), colour (baseColor, emissive, *ColorTexture: specular
+// colour, sheen colour), data otherwise (metallic-roughness, occlusion, clearcoat, transmission...).
+TextureClass class_of_slot(const std::string& key) {
+  if (key.find("ormalTexture") != std::string::npos) return TextureClass::normal;
+  if (key == "baseColorTexture" || key == "emissiveTexture" || key.ends_with("ColorTexture")) return TextureClass::colour;
+  return TextureClass::data;
+}
+
+void record(std::map<int, Use>& uses, int texture, TextureClass c, std::optional<float> cutoff) {
+  auto [it, fresh] = uses.try_emplace(texture, Use{c, cutoff, ""});
+  if (fresh) return;
+  Use& use = it->second;
+  if (use.texture_class != c && use.conflict.empty()) {
+    use.conflict = "used as " + std::string(name_in(kTextureClassNames, use.texture_class)) + " and " +
+                   std::string(name_in(kTextureClassNames, c)) + ": kept as it is";
+  }
+  if (!use.alpha_cutoff) use.alpha_cutoff = cutoff;
+}
+
+// Every textureInfo under `node` (a material, its extensions): {"index": n} under a key "...Texture".
+void collect(const Json& node, std::optional<float> cutoff, std::map<int, Use>& uses) {
+  if (!node.is_object()) return;
+  for (const auto& [key, value] : node.items()) {
+    if (!value.is_object()) continue;
+    if (key.ends_with("Texture") && value.contains("index")) {
+      const int index = gltf::integer_in<int>(value, "index", -1, -1);
+      const bool mask_alpha = key == "baseColorTexture";
+      if (index >= 0) record(uses, index, class_of_slot(key), mask_alpha ? cutoff : std::nullopt);
+    } else {
+      collect(value, cutoff, uses);
+    }
+  }
+}
+
+std::map<int, Use> texture_uses(const Json& json) {
+  std::map<int, Use> uses;
+  for (const Json& material : gltf::array_in(json, "materials")) {
+    if (!material.is_object()) continue;
+    std::optional<float> cutoff;
+    if (material.value("alphaMode", "") == "MASK") {
+      const auto it = material.find("alphaCutoff");
+      cutoff = it != material.end() && it->is_number() ? it->get<float>() : 0.5f;
+    }
+    collect(material, cutoff, uses);
+  }
+  return uses;
+}
+
+// The image a texture's texels come from: its core source, else its WebP one; −1 when it has only
+// KTX2 (or none).
+int decodable_image(const Json& texture) {
+  if (const int core = gltf::integer_in<int>(texture, "source", -1, -1); core >= 0) return core;
+  if (texture.contains("extensions") && texture["extensions"].contains(kWebp)) {
+    return gltf::integer_in<int>(texture["extensions"][kWebp], "source", -1, -1);
+  }
+  return -1;
+}
+
+Sampling sampling_of(const Json& json, const Json& texture, Filter filter) {
+  Sampling s{.filter = filter};
+  const int sampler = gltf::integer_in<int>(texture, "sampler", -1, -1);
+  const Json& samplers = gltf::array_in(json, "samplers");
+  if (sampler >= 0 && std::size_t(sampler) < samplers.size()) {
+    s.wrap_s = wrap_from_gltf(gltf::integer_in<int>(samplers[std::size_t(sampler)], "wrapS", 10497, 10497));
+    s.wrap_t = wrap_from_gltf(gltf::integer_in<int>(samplers[std::size_t(sampler)], "wrapT", 10497, 10497));
+  }
+  return s;
+}
+
+// A file name for what replaces image `image`: its file's stem, else its name, else "<stem>_image<N>";
+// only characters safe in a URI.
+std::string base_name(const Json& json, int image, const std::string& stem) {
+  const Json& img = gltf::array_in(json, "images")[std::size_t(image)];
+  std::string name;
+  if (img.contains("uri") && img["uri"].is_string() && img["uri"].get<std::string>().rfind("data:", 0) != 0) {
+    name = fs::path(gltf::decode_uri(img["uri"].get<std::string>())).stem().string();
+  } else {
+    name = gltf::name_in(img, "");
+  }
+  name.erase(std::remove_if(name.begin(), name.end(), [](char c) { return !std::isalnum((unsigned char)c) && c != '_' && c != '-'; }),
+             name.end());
+  return name.empty() ? stem + "_image" + std::to_string(image) : name;
+}
+
+// `name` + `extension`, or name_2, name_3... when a file of the document already has that URI.
+std::string free_uri(const gltf::Document& doc, const std::string& name, const std::string& extension) {
+  std::set<std::string> taken;
+  for (const auto& [uri, bytes] : doc.new_files) taken.insert(uri);
+  for (const Json& img : gltf::array_in(doc.json, "images")) {
+    if (img.contains("uri") && img["uri"].is_string()) taken.insert(gltf::decode_uri(img["uri"].get<std::string>()));
+  }
+  std::string uri = name + extension;
+  for (int n = 2; taken.count(uri); ++n) uri = name + "_" + std::to_string(n) + extension;
+  return uri;
+}
+
+// One texture's work: what it is made from, and what was made.
+struct Work {
+  int texture = -1, image = -1;
+  Use use;
+  Sampling sampling;
+  const image::Image* source = nullptr;
+  Size size;
+  Codec codec = Codec::png;
+  std::string name;
+  // Made:
+  std::vector<unsigned char> ktx2;
+  image::Image level0;  // png: the resized texture
+  int levels = 1;
+  std::vector<double> coverage;
+  Status status = success();
+};
+
+bool sides_fit_ktx2(Size s) {
+  const auto fits = [](int side) { return side == 1 || side == 2 || side % 4 == 0; };
+  return fits(s.width) && fits(s.height);
+}
+
+Status make(Work& w, const Options& options, const Encoder* encoder, const fs::path& output, int threads) {
+  MipRequest request{w.use.texture_class, w.sampling, w.use.alpha_cutoff};
+  const bool chain = w.codec == Codec::uastc && options.mipmaps;
+  std::vector<image::Image> levels = mip_chain(*w.source, w.size, request, chain);
+  if (w.use.alpha_cutoff) {
+    w.coverage.push_back(alpha_coverage(*w.source, *w.use.alpha_cutoff));
+    for (const image::Image& l : levels) w.coverage.push_back(alpha_coverage(l, *w.use.alpha_cutoff));
+  }
+  if (w.codec == Codec::png) {
+    w.level0 = std::move(levels[0]);
+    return success();
+  }
+  EncodeRequest encode{.texture_class = w.use.texture_class, .options = options.of(w.use.texture_class), .sampling = w.sampling,
+                       .mipmaps = options.mipmaps, .alpha = has_alpha(levels[0]),
+                       .scratch = output.parent_path() / (w.name + ".ktx2"), .threads = threads};
+  if (w.codec == Codec::etc1s) {
+    auto file = encode_etc1s(*encoder, levels[0], encode);
+    if (!file) return file.error();
+    w.ktx2 = std::move(*file);
+    auto read = ktx2::read(w.ktx2, encode.scratch.string());
+    if (!read) return read.error();
+    w.levels = int(read->levels.size());
+    return success();
+  }
+  ktx2::UastcFile file{.width = unsigned(w.size.width), .height = unsigned(w.size.height),
+                       .transfer = w.use.texture_class == TextureClass::colour ? ktx2::kTransferSRGB : ktx2::kTransferLinear,
+                       .channel = encode.alpha ? ktx2::kUastcRGBA : ktx2::kUastcRGB,
+                       .zstd_level = encode.options.zstd,
+                       .writer = "matbake " + std::string(matbake::version) + " / basisu " + encoder->version};
+  for (const image::Image& level : levels) {
+    auto blocks = encode_uastc_level(*encoder, level, encode);
+    if (!blocks) return blocks.error();
+    file.levels.push_back(std::move(*blocks));
+  }
+  auto bytes = ktx2::write_uastc(file);
+  if (!bytes) return bytes.error();
+  w.ktx2 = std::move(*bytes);
+  w.levels = int(levels.size());
+  return success();
+}
+
+// The texture's sources replaced: KTX2 through KHR_texture_basisu (its PNG or WebP source kept only
+// as a fallback), or the resized image in place of the old one.
+void point_texture(gltf::Document& doc, const Work& w, int image, bool png_fallback) {
+  Json& texture = doc.json["textures"][std::size_t(w.texture)];
+  if (w.codec == Codec::png) {
+    if (texture.contains("source")) texture["source"] = image;
+    else texture["extensions"][kWebp]["source"] = image;
+    return;
+  }
+  texture["extensions"][kBasisu] = Json{{"source", image}};
+  if (!png_fallback) {
+    texture.erase("source");
+    texture["extensions"].erase(kWebp);
+  }
+}
+
+// EXT_texture_webp named only while a texture still uses it.
+void drop_unused_webp(gltf::Document& doc) {
+  for (const Json& t : gltf::array_in(doc.json, "textures")) {
+    if (t.contains("extensions") && t["extensions"].contains(kWebp)) return;
+  }
+  for (const char* list : {"extensionsUsed", "extensionsRequired"}) {
+    if (!doc.json.contains(list)) continue;
+    Json& names = doc.json[list];
+    names.erase(std::remove(names.begin(), names.end(), kWebp), names.end());
+    if (names.empty()) doc.json.erase(list);
+  }
+}
+
+}  // namespace
+
+bool changes_textures(const Options& options, const image::Encoding& encoding) {
+  if (encoding.texture_format == image::TextureFormat::ktx2 || options.texel_density > 0) return true;
+  for (TextureClass c : {TextureClass::colour, TextureClass::data, TextureClass::normal}) {
+    if (options.of(c).max_size > 0 || options.of(c).scale != 1) return true;
+  }
+  return false;
+}
+
+Result<std::vector<TextureReport>> deliver_textures(gltf::Document& doc, gltf::ImageCache& cache, const Options& options,
+                                                    const fs::path& output) {
+  if (!changes_textures(options, cache.encoding())) return std::vector<TextureReport>{};
+  const bool ktx2_out = cache.encoding().texture_format == image::TextureFormat::ktx2;
+  const std::string stem = output.stem().string();
+  std::vector<Work> work;
+  std::vector<TextureReport> reports;
+  for (const auto& [texture, use] : texture_uses(doc.json)) {
+    const Json& t = doc.json["textures"][std::size_t(texture)];
+    TextureReport report{.texture = texture, .texture_class = use.texture_class, .alpha_cutoff = use.alpha_cutoff};
+    const int image = decodable_image(t);
+    if (image < 0 || !use.conflict.empty()) {
+      report.note = !use.conflict.empty() ? use.conflict : "no PNG, JPEG or WebP source (already KTX2): kept as it is";
+      reports.push_back(std::move(report));
+      continue;
+    }
+    const color::Transfer transfer = use.texture_class == TextureClass::colour ? color::Transfer::srgb : color::Transfer::linear;
+    auto source = cache.texture(texture, transfer);
+    if (!source) return source.error();
+    Work w{.texture = texture, .image = image, .use = use, .sampling = sampling_of(doc.json, t, options.filter), .source = *source};
+    const ClassOptions& o = options.of(use.texture_class);
+    w.size = delivered_size({(*source)->width, (*source)->height}, o, options.rounding);
+    w.codec = ktx2_out ? o.codec : Codec::png;
+    w.name = base_name(doc.json, image, stem);
+    if (w.codec != Codec::png && !sides_fit_ktx2(w.size)) {
+      return Error{doc.file, "texture " + std::to_string(texture) + " (" + w.name + ") would be " + std::to_string(w.size.width) +
+                                 "x" + std::to_string(w.size.height) + ": KTX2 (KHR_texture_basisu) needs sides of 1, 2 or a "
+                                 "multiple of 4; use --texture-rounding multiple-of-4 or power-of-two", true};
+    }
+    work.push_back(std::move(w));
+  }
+  const Encoder* encoder = nullptr;
+  std::optional<Encoder> found;
+  if (std::any_of(work.begin(), work.end(), [](const Work& w) { return w.codec != Codec::png; })) {
+    auto e = find_encoder();
+    if (!e) return e.error();
+    found = std::move(*e);
+    encoder = &*found;
+  }
+  // Textures in parallel; an encoder run gets the threads the textures leave, never more in all.
+  const int jobs = tbb::this_task_arena::max_concurrency();
+  const int threads = std::max(1, jobs / std::max(1, std::min<int>(jobs, int(work.size()))));
+  tbb::parallel_for(std::size_t(0), work.size(), [&](std::size_t i) {
+    Work& w = work[i];
+    const bool unchanged = w.codec == Codec::png && w.size == Size{w.source->width, w.source->height};
+    if (!unchanged) w.status = guarded(doc.file, [&] { return make(w, options, encoder, output, threads); });
+  }, tbb::simple_partitioner());
+  for (Work& w : work) {
+    if (!w.status) return w.status.error();
+  }
+
+  for (Work& w : work) {
+    TextureReport report{.texture = w.texture, .texture_class = w.use.texture_class, .codec = w.codec,
+                         .source = {w.source->width, w.source->height}, .delivered = w.size, .levels = w.levels,
+                         .alpha_cutoff = w.use.alpha_cutoff, .coverage = w.coverage};
+    auto source_bytes = gltf::image_bytes(doc, std::size_t(w.image));
+    if (!source_bytes) return source_bytes.error();
+    report.source_bytes = source_bytes->size();
+    report.bytes = report.source_bytes;
+    if (!w.ktx2.empty()) {
+      report.uri = free_uri(doc, w.name, ".ktx2");
+      report.bytes = w.ktx2.size();
+      doc.new_files[report.uri] = std::string(w.ktx2.begin(), w.ktx2.end());
+      doc.json["images"].push_back({{"uri", report.uri}, {"mimeType", "image/ktx2"}});
+      point_texture(doc, w, int(doc.json["images"].size()) - 1, options.png_fallback);
+      gltf::require_extension(doc, kBasisu, !options.png_fallback);
+    } else if (!w.level0.pixels.empty()) {
+      const color::Transfer transfer = w.use.texture_class == TextureClass::colour ? color::Transfer::srgb : color::Transfer::linear;
+      const std::string extension = cache.webp() ? ".webp" : ".png";
+      const std::string uri =
+          free_uri(doc, w.name + "_" + std::to_string(w.size.width) + "x" + std::to_string(w.size.height), extension);
+      auto made = cache.add_image(doc, w.level0, transfer, uri.substr(0, uri.size() - extension.size()));
+      if (!made) return made.error();
+      report.uri = made->uri;
+      report.bytes = doc.new_files[made->uri].size();
+      point_texture(doc, w, made->index, options.png_fallback);
+    } else {
+      report.note = "kept as it is (its size and format are what was asked)";
+    }
+    reports.push_back(std::move(report));
+  }
+  drop_unused_webp(doc);
+  std::sort(reports.begin(), reports.end(), [](const TextureReport& a, const TextureReport& b) { return a.texture < b.texture; });
+  return reports;
+}
+
+}  // namespace matbake::delivery

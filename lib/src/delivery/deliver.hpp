@@ -1,0 +1,22 @@
+#pragma once
+// The delivery pass over a document about to be written (export, bake-ao, a build's scenes): every
+// texture a material uses, by the class of the slot it fills, resized and encoded as the options say.
+#include <filesystem>
+#include <vector>
+
+#include "../gltf/texture_files.hpp"
+#include "matbake/delivery.hpp"
+
+namespace matbake::delivery {
+
+// Whether the pass changes anything: KTX2 asked for, or a size setting.
+bool changes_textures(const Options& options, const image::Encoding& encoding);
+
+// Rewrites `doc`'s used textures: KTX2 (KHR_texture_basisu) when the encoding's texture format is
+// ktx2 and the class's codec is not png, else resized PNG/WebP when the sizes say so. Scratch files go
+// beside `output`. Textures already KTX2 are kept. Call gltf::prune_unreachable afterwards: replaced
+// images are left unreferenced.
+Result<std::vector<TextureReport>> deliver_textures(gltf::Document& doc, gltf::ImageCache& cache, const Options& options,
+                                                    const std::filesystem::path& output);
+
+}  // namespace matbake::delivery

@@ -1,0 +1,208 @@
+// Resampling and mip chains. A separable filter: per output column (then row) the source texels it
+// reads and their weights, computed once per axis; rows in parallel, each written by one task, so the
+// result does not depend on the thread count.
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "matbake/delivery.hpp"
+
+namespace matbake::delivery {
+namespace {
+
+constexpr double kKaiserRadius = 3;  // in output texels
+constexpr double kKaiserBeta = 4;
+
+// The modified Bessel function of the first kind, order 0, by its power series (converges fast for
+// the arguments the window takes, |x| ≤ β).
+double bessel_i0(double x) {
+  double sum = 1, term = 1;
+  for (int k = 1; term > 1e-17 * sum; ++k) {
+    term *= (x / (2 * k)) * (x / (2 * k));
+    sum += term;
+  }
+  return sum;
+}
+
+// The Kaiser-windowed sinc at distance x (in output texels) from a texel's centre.
+double kaiser(double x) {
+  if (std::abs(x) >= kKaiserRadius) return 0;
+  const double t = x / kKaiserRadius;
+  const double window = bessel_i0(kKaiserBeta * std::sqrt(1 - t * t)) / bessel_i0(kKaiserBeta);
+  const double px = std::numbers::pi * x;
+  return (x == 0 ? 1 : std::sin(px) / px) * window;
+}
+
+int wrapped(int i, int n, Wrap wrap) {
+  switch (wrap) {
+    case Wrap::clamp: return std::clamp(i, 0, n - 1);
+    case Wrap::mirror: {
+      const int m = ((i % (2 * n)) + 2 * n) % (2 * n);
+      return m < n ? m : 2 * n - 1 - m;
+    }
+    case Wrap::repeat: break;
+  }
+  return ((i % n) + n) % n;
+}
+
+struct Tap {
+  int index;
+  float weight;
+};
+
+// For each output coordinate of an axis, its taps: taps[first[x]] .. taps[first[x + 1]).
+struct Axis {
+  std::vector<std::size_t> first;
+  std::vector<Tap> taps;
+};
+
+Axis axis_taps(int source, int target, Filter filter, Wrap wrap) {
+  Axis axis;
+  const double step = double(source) / target;     // source texels per output texel
+  const double footprint = std::max(1.0, step);  // the filter's unit: an output texel when shrinking
+  axis.first.push_back(0);
+  std::vector<std::pair<int, double>> raw;
+  for (int x = 0; x < target; ++x) {
+    const double centre = (x + 0.5) * step;  // in source coordinates: texel i spans [i, i + 1)
+    raw.clear();
+    if (filter == Filter::box) {
+      const double lo = centre - footprint / 2, hi = centre + footprint / 2;
+      for (int i = int(std::floor(lo)); i < int(std::ceil(hi)); ++i) {
+        const double overlap = std::min(hi, i + 1.0) - std::max(lo, double(i));
+        if (overlap > 0) raw.emplace_back(i, overlap);
+      }
+    } else {
+      const double reach = kKaiserRadius * footprint;
+      for (int i = int(std::floor(centre - reach)); i <= int(std::ceil(centre + reach)); ++i) {
+        const double w = kaiser((i + 0.5 - centre) / footprint);
+        if (w != 0) raw.emplace_back(i, w);
+      }
+    }
+    double sum = 0;
+    for (const auto& [i, w] : raw) sum += w;
+    for (const auto& [i, w] : raw) axis.taps.push_back({wrapped(i, source, wrap), float(w / sum)});
+    axis.first.push_back(axis.taps.size());
+  }
+  return axis;
+}
+
+// The 8-bit code a linear alpha is stored as: round(a · 255), clamped.
+int alpha_code(float a) { return int(std::lround(std::clamp(a, 0.0f, 1.0f) * 255.0f)); }
+// The smallest code a MASK material renders opaque: code / 255 ≥ cutoff.
+int opaque_code(float cutoff) { return int(std::ceil(double(cutoff) * 255.0 - 1e-9)); }
+
+void renormalise_normals(image::Image& im) {
+  const std::size_t pixels = std::size_t(im.width) * std::size_t(im.height), ch = std::size_t(im.channels);
+  for (std::size_t p = 0; p < pixels; ++p) {
+    float* t = &im.pixels[p * ch];
+    double v[3] = {2.0 * t[0] - 1, 2.0 * t[1] - 1, 2.0 * t[2] - 1};
+    const double length = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    if (length < 1e-12) v[0] = 0, v[1] = 0, v[2] = 1;
+    else for (double& c : v) c /= length;
+    for (int c = 0; c < 3; ++c) t[c] = float(0.5 * v[c] + 0.5);
+  }
+}
+
+// Scales the level's alpha so that as many texels as `target` × texels render opaque: the
+// round(target · n) largest alphas reach the opaque code (ties with the last may add a few).
+void keep_coverage(image::Image& level, float cutoff, double target) {
+  const int a = level.alpha_channel;
+  const std::size_t pixels = std::size_t(level.width) * std::size_t(level.height), ch = std::size_t(level.channels);
+  const int opaque = opaque_code(cutoff);
+  if (a < 0 || opaque <= 0 || opaque > 255 || pixels == 0) return;
+  std::vector<float> alphas(pixels);
+  for (std::size_t p = 0; p < pixels; ++p) alphas[p] = level.pixels[p * ch + std::size_t(a)];
+  const auto wanted = std::size_t(std::llround(target * double(pixels)));
+  double scale = 1;
+  if (wanted == 0) {
+    const float largest = *std::max_element(alphas.begin(), alphas.end());
+    // Every alpha below the opaque code's lower edge, (opaque − 0.5) / 255.
+    if (largest > 0) scale = std::min(1.0, (opaque - 0.5) / 255.0 / largest * (1 - 1e-6));
+  } else {
+    std::nth_element(alphas.begin(), alphas.begin() + std::ptrdiff_t(wanted - 1), alphas.end(), std::greater<>());
+    const float nth = alphas[wanted - 1];  // the wanted-th largest alpha
+    if (nth <= 0) return;                 // fewer texels than wanted have any alpha: as high as it gets
+    scale = (opaque - 0.5) / 255.0 / nth * (1 + 1e-6);
+  }
+  for (std::size_t p = 0; p < pixels; ++p) {
+    float& v = level.pixels[p * ch + std::size_t(a)];
+    v = std::min(1.0f, float(v * scale));
+  }
+}
+
+}  // namespace
+
+Wrap wrap_from_gltf(int value) {
+  return value == 33071 ? Wrap::clamp : value == 33648 ? Wrap::mirror : Wrap::repeat;
+}
+
+std::vector<Size> mip_sizes(Size base) {
+  std::vector<Size> sizes{base};
+  while (sizes.back().width > 1 || sizes.back().height > 1) {
+    sizes.push_back({std::max(1, sizes.back().width / 2), std::max(1, sizes.back().height / 2)});
+  }
+  return sizes;
+}
+
+image::Image resample(const image::Image& in, Size size, const Sampling& sampling) {
+  if (in.width == size.width && in.height == size.height) return in;
+  const Axis columns = axis_taps(in.width, size.width, sampling.filter, sampling.wrap_s);
+  const Axis rows = axis_taps(in.height, size.height, sampling.filter, sampling.wrap_t);
+  const std::size_t ch = std::size_t(in.channels);
+  // Columns first: the source's rows at the output's width.
+  std::vector<float> across(std::size_t(in.height) * std::size_t(size.width) * ch);
+  tbb::parallel_for(0, in.height, [&](int y) {
+    const float* row = &in.pixels[std::size_t(y) * std::size_t(in.width) * ch];
+    float* out = &across[std::size_t(y) * std::size_t(size.width) * ch];
+    for (int x = 0; x < size.width; ++x) {
+      for (std::size_t t = columns.first[std::size_t(x)]; t < columns.first[std::size_t(x) + 1]; ++t) {
+        const float* texel = row + std::size_t(columns.taps[t].index) * ch;
+        for (std::size_t c = 0; c < ch; ++c) out[std::size_t(x) * ch + c] += columns.taps[t].weight * texel[c];
+      }
+    }
+  });
+  image::Image out;
+  static_cast<image::ImageLayout&>(out) = in;
+  out.width = size.width, out.height = size.height;
+  image::reserve_pixels(out.pixels, out.sample_count());
+  out.pixels.assign(out.sample_count(), 0.0f);
+  const std::size_t row_samples = std::size_t(size.width) * ch;
+  tbb::parallel_for(0, size.height, [&](int y) {
+    float* dst = &out.pixels[std::size_t(y) * row_samples];
+    for (std::size_t t = rows.first[std::size_t(y)]; t < rows.first[std::size_t(y) + 1]; ++t) {
+      const float* src = &across[std::size_t(rows.taps[t].index) * row_samples];
+      const float w = rows.taps[t].weight;
+      for (std::size_t i = 0; i < row_samples; ++i) dst[i] += w * src[i];
+    }
+  });
+  return out;
+}
+
+double alpha_coverage(const image::Image& im, float cutoff) {
+  const int a = im.alpha_channel;
+  const std::size_t pixels = std::size_t(im.width) * std::size_t(im.height);
+  if (a < 0 || pixels == 0) return 1;
+  const int opaque = opaque_code(cutoff);
+  std::size_t covered = 0;
+  for (std::size_t p = 0; p < pixels; ++p) covered += alpha_code(im.pixels[p * std::size_t(im.channels) + std::size_t(a)]) >= opaque;
+  return double(covered) / double(pixels);
+}
+
+std::vector<image::Image> mip_chain(const image::Image& source, Size base, const MipRequest& request, bool whole_chain) {
+  const std::vector<Size> sizes = whole_chain ? mip_sizes(base) : std::vector<Size>{base};
+  const float cutoff = request.alpha_cutoff.value_or(0.0f);
+  const double coverage = request.alpha_cutoff ? alpha_coverage(source, cutoff) : 1.0;
+  std::vector<image::Image> levels;
+  for (const Size& size : sizes) {
+    image::Image level = resample(source, size, request.sampling);
+    if (request.texture_class == TextureClass::normal && level.channels >= 3) renormalise_normals(level);
+    const bool resized = size.width != source.width || size.height != source.height;
+    if (request.alpha_cutoff && resized) keep_coverage(level, cutoff, coverage);
+    levels.push_back(std::move(level));
+  }
+  return levels;
+}
+
+}  // namespace matbake::delivery

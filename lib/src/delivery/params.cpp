@@ -1,0 +1,97 @@
+// delivery::Options' parameters. The per-class settings are made for each class from one list, so
+// colour_*, data_* and normal_* cannot drift apart.
+#include <cmath>
+
+#include "matbake/delivery_params.hpp"
+
+namespace matbake::delivery {
+namespace {
+
+using params::Param;
+using params::Spec;
+constexpr int kMaxSide = 16384;
+
+// An integer setting whose 0 means "none": shown as null (no value) rather than 0.
+Param<Options> optional_integer(Spec spec, TextureClass c, int ClassOptions::*field) {
+  auto p = params::integer<Options>(std::move(spec), [c, field](auto& o) -> auto& { return o.of(c).*field; });
+  p.get = [c, field](const Options& o) -> nlohmann::json {
+    if (o.of(c).*field == 0) return nullptr;
+    return o.of(c).*field;
+  };
+  return p;
+}
+
+void add_class(std::vector<Param<Options>>& out, TextureClass c) {
+  const std::string name(name_in(kTextureClassNames, c));
+  const std::string what = c == TextureClass::colour ? "colour textures (baseColor, emissive)"
+                           : c == TextureClass::data ? "data textures (metallic-roughness, occlusion, ORM)"
+                                                     : "normal maps";
+  const auto field = [c](auto member) { return [c, member](auto& o) -> auto& { return o.of(c).*member; }; };
+  out.push_back(params::choice<Options>(Spec{.name = name + "_codec",
+                                             .help = "Codec of " + what + " with --texture-format ktx2: etc1s, uastc, or png "
+                                                     "(kept as PNG)",
+                                             .example = c == TextureClass::colour ? "uastc" : "etc1s"},
+                                        field(&ClassOptions::codec), kCodecNames));
+  out.push_back(params::integer<Options>(Spec{.name = name + "_quality", .help = "ETC1S quality of " + what + " (basisu -q)",
+                                              .min = 1, .max = 255, .example = "200"},
+                                         field(&ClassOptions::quality)));
+  out.push_back(params::integer<Options>(Spec{.name = name + "_uastc_level",
+                                              .help = "UASTC encoding level of " + what + " (basisu -uastc_level; higher: "
+                                                      "slower, closer)",
+                                              .min = 0, .max = 4, .example = "3"},
+                                         field(&ClassOptions::uastc_level)));
+  out.push_back(params::number<Options>(Spec{.name = name + "_uastc_rdo",
+                                             .help = "UASTC rate-distortion λ of " + what + " (basisu -uastc_rdo_l): higher "
+                                                     "compresses better under zstd, with more error; 0 off",
+                                             .min = 0, .max = 100, .example = "1"},
+                                        field(&ClassOptions::uastc_rdo)));
+  out.push_back(params::integer<Options>(Spec{.name = name + "_zstd",
+                                              .help = "zstd supercompression level of UASTC " + what + "; 0 none",
+                                              .min = 0, .max = 22, .example = "6"},
+                                         field(&ClassOptions::zstd)));
+  out.push_back(optional_integer(Spec{.name = name + "_max_size",
+                                      .help = "Longest side of " + what + " at most this many texels (any texture "
+                                              "format); none when not given",
+                                      .min = 1, .max = kMaxSide, .example = "512"},
+                                 c, &ClassOptions::max_size));
+  out.push_back(params::number<Options>(Spec{.name = name + "_scale",
+                                             .help = "Scale of " + what + " (any texture format), before max_size and rounding",
+                                             .min = 0, .max = 1, .above_min = true, .example = "0.5"},
+                                        field(&ClassOptions::scale)));
+}
+
+}  // namespace
+
+const params::Group<Options>& options_params() {
+  static const params::Group<Options> group = [] {
+    params::Group<Options> g;
+    for (TextureClass c : {TextureClass::colour, TextureClass::data, TextureClass::normal}) add_class(g.params, c);
+    g.params.push_back(params::choice<Options>(Spec{.name = "texture_rounding",
+                                                    .help = "Rounding of resized textures' sides: power-of-two, multiple-of-4 "
+                                                            "(what KTX2 needs; 1 and 2 stay), or none; never above the source",
+                                                    .example = "power-of-two"},
+                                               [](auto& o) -> auto& { return o.rounding; }, kRoundingNames));
+    g.params.push_back(params::choice<Options>(Spec{.name = "mip_filter",
+                                                    .help = "Filter of resizes and mip levels: kaiser (windowed sinc) or box",
+                                                    .example = "box"},
+                                               [](auto& o) -> auto& { return o.filter; }, kFilterNames));
+    g.params.push_back(params::flag<Options>(Spec{.name = "mipmaps",
+                                                  .help = "Give KTX2 textures a full mip chain (--no-mipmaps: level 0 only)",
+                                                  .example = "false"},
+                                             [](auto& o) -> auto& { return o.mipmaps; }));
+    g.params.push_back(params::flag<Options>(Spec{.name = "png_fallback",
+                                                  .help = "Keep each KTX2 texture's PNG as its core source, so that "
+                                                          "KHR_texture_basisu is used but not required",
+                                                  .example = "true"},
+                                             [](auto& o) -> auto& { return o.png_fallback; }));
+    g.params.push_back(params::number<Options>(Spec{.name = "texel_density",
+                                                    .help = "Size each material's textures for this many texels per scene "
+                                                            "unit, from its UV mapping in the scene; 0 off",
+                                                    .min = 0, .max = 1e9, .example = "256"},
+                                               [](auto& o) -> auto& { return o.texel_density; }));
+    return g;
+  }();
+  return group;
+}
+
+}  // namespace matbake::delivery
