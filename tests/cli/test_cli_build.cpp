@@ -33,20 +33,6 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 
 
-// The bundled example copied into `dir` (the manifest's output then goes to dir/out), optionally
-// with its AO samples lowered to keep the test quick.
-void copy_example(const fs::path& dir, bool few_samples = false) {
-  for (const char* f : {"showroom.toml", "showroom.gltf", "showroom.bin"}) fs::copy_file(kExamples / f, dir / f);
-  fs::copy(kExamples / "textures", dir / "textures", fs::copy_options::recursive);
-  if (few_samples) {
-    std::string text = read_bytes(dir / "showroom.toml");
-    const std::size_t at = text.find("samples = 128");
-    ASSERT_NE(at, std::string::npos);
-    text.replace(at, 13, "samples = 16");
-    write_bytes(dir / "showroom.toml", text);
-  }
-}
-
 json run_json(const std::vector<std::string>& args, int expected_exit = 0) {
   std::vector<std::string> all = {"--json"};
   all.insert(all.end(), args.begin(), args.end());

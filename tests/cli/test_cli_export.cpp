@@ -43,13 +43,7 @@ GltfBuilder quad_scene(const json& materials) {
   return b;
 }
 
-// The written document (its JSON and buffers), and the pixels of texture `t` as stored (codes).
-gltf::Document read_output(const fs::path& path) {
-  auto doc = gltf::read_document(path);
-  EXPECT_TRUE(doc) << doc.error().to_string();
-  return std::move(*doc);
-}
-
+// The pixels of texture `t` as stored (codes).
 RawImage texture_pixels(const gltf::Document& doc, int texture, const fs::path& scratch) {
   const int image = doc.json["textures"][std::size_t(texture)]["source"];
   auto bytes = gltf::image_bytes(doc, std::size_t(image));

@@ -1,6 +1,7 @@
 #include "support/files.hpp"
 
 #include <OpenImageIO/imageio.h>
+#include <gtest/gtest.h>
 
 #include <algorithm>
 #include <fstream>
@@ -63,6 +64,19 @@ std::vector<std::string> list_folder(const std::filesystem::path& folder) {
   for (const auto& entry : std::filesystem::directory_iterator(folder)) names.push_back(entry.path().filename().string());
   std::sort(names.begin(), names.end());
   return names;
+}
+
+void copy_example(const std::filesystem::path& dir, bool few_samples) {
+  namespace fs = std::filesystem;
+  for (const char* f : {"showroom.toml", "showroom.gltf", "showroom.bin"}) fs::copy_file(kExamples / f, dir / f);
+  fs::copy(kExamples / "textures", dir / "textures", fs::copy_options::recursive);
+  if (few_samples) {
+    std::string text = read_bytes(dir / "showroom.toml");
+    const std::size_t at = text.find("samples = 128");
+    ASSERT_NE(at, std::string::npos);
+    text.replace(at, 13, "samples = 16");
+    write_bytes(dir / "showroom.toml", text);
+  }
 }
 
 }  // namespace matbake::test

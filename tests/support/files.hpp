@@ -11,6 +11,10 @@ namespace matbake::test {
 // The bundled examples of this source tree.
 inline const std::filesystem::path kExamples = std::filesystem::path(MATBAKE_SOURCE_DIR) / "examples";
 
+// The bundled example copied into `dir` (the manifest's output then goes to dir/out), optionally
+// with its AO samples lowered to keep the test quick.
+void copy_example(const std::filesystem::path& dir, bool few_samples = false);
+
 struct RawImage {
   int width = 0;
   int height = 0;

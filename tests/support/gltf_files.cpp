@@ -10,6 +10,12 @@
 
 namespace matbake::test {
 
+gltf::Document read_output(const std::filesystem::path& path) {
+  auto doc = gltf::read_document(path);
+  EXPECT_TRUE(doc) << doc.error().to_string();
+  return doc ? std::move(*doc) : gltf::Document{};
+}
+
 std::string base64(const std::vector<unsigned char>& bytes) {
   static const char* kAlphabet = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
   std::string out;

@@ -33,6 +33,9 @@ struct GltfBuilder {
 
 std::string base64(const std::vector<unsigned char>& bytes);
 
+// A written glTF read back (its JSON and buffers); a failure to read fails the test.
+gltf::Document read_output(const std::filesystem::path& path);
+
 // The floats of a float accessor (SCALAR, VEC2/3/4), read from a document's own bytes.
 std::vector<float> float_accessor(const gltf::Document& doc, int index);
 

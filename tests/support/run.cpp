@@ -70,7 +70,13 @@ RunResult run(const std::string& program, const std::vector<std::string>& args, 
 }
 
 RunResult matbake(const std::vector<std::string>& args, const std::vector<std::string>& env) {
-  return run(MATBAKE_EXE, args, env);
+  // The KTX2 encoder scripts/install-basisu.sh installs, unless the environment or `env` names one.
+  std::vector<std::string> with_encoder = env;
+  const std::filesystem::path installed = std::filesystem::path(MATBAKE_SOURCE_DIR) / "scripts" / "basisu" / "bin" / "basisu";
+  if (!std::getenv("MATBAKE_BASISU") && ::access(installed.c_str(), X_OK) == 0) {
+    with_encoder.insert(with_encoder.begin(), "MATBAKE_BASISU=" + installed.string());
+  }
+  return run(MATBAKE_EXE, args, with_encoder);
 }
 
 }  // namespace matbake::test

@@ -8,6 +8,7 @@
 #include "lib/src/delivery/encode.hpp"
 #include "matbake/delivery.hpp"
 #include "matbake/ktx2.hpp"
+#include "support/basisu.hpp"
 #include "support/files.hpp"
 #include "support/run.hpp"
 #include "support/temp_dir.hpp"
@@ -49,6 +50,23 @@ TEST(DeliverySizes, ScaleLimitAndRoundingNeverAboveTheSource) {
   EXPECT_EQ(size({1024, 1024}, {.max_size = 512}, Rounding::multiple_of_4, 300), (Size{300, 300}));
   EXPECT_EQ(size({1024, 1024}, {.max_size = 256}, Rounding::multiple_of_4, 300), (Size{256, 256}));
   EXPECT_EQ(size({1024, 1024}, {}, Rounding::multiple_of_4, 4096), (Size{1024, 1024}));
+}
+
+// A 2 × 1 quad (two triangles of world area 1) mapped onto UV [0, 1] × [0, 0.5] (UV area 0.25 each):
+// a square texture of side L gives it sqrt(0.25 L² / 1) = L / 2 texels per unit, so 100 texels per
+// unit need L = 200; a 2:1 texture (H = L / 2) gives L / (2√2), so L = 282.8 → 283.
+TEST(DeliverySizes, TexelDensityOfAQuadOfKnownAreas) {
+  const std::vector<MappedTriangle> quad{{1, 0.25}, {1, 0.25}};
+  EXPECT_EQ(needed_side(quad, {1024, 1024}, 100), 200);
+  EXPECT_EQ(needed_side(quad, {1024, 512}, 100), 283);
+  EXPECT_EQ(needed_side(quad, {512, 1024}, 100), 283);
+  EXPECT_EQ(delivered_size({1024, 512}, {}, Rounding::multiple_of_4, 283), (Size{284, 140}));
+  // Triangles without UV area (or world area) have no density; none at all: no need.
+  EXPECT_EQ(needed_side({{1, 0}, {0, 0.5}}, {1024, 1024}, 100), std::nullopt);
+  // The area-weighted 95th percentile: a stretched triangle of 4% of the area is not served, one of
+  // 6% is. (Needs: 100 · sqrt(w / u): 200 for the large one, 1000 for the small one.)
+  EXPECT_EQ(needed_side({{0.96, 0.24}, {0.04, 0.0004}}, {64, 64}, 100), 200);
+  EXPECT_EQ(needed_side({{0.94, 0.235}, {0.06, 0.0006}}, {64, 64}, 100), 1000);
 }
 
 TEST(DeliverySizes, MipChainDownToOneTexel) {
@@ -275,17 +293,14 @@ TEST(Ktx2, DamagedFilesAreRefusedWithTheirName) {
 
 // ---- With the encoder ------------------------------------------------------------------------------
 
-fs::path installed_basisu() { return fs::path(MATBAKE_SOURCE_DIR) / "scripts" / "basisu" / "bin" / "basisu"; }
-
-// The encoder, or a reason to skip: MATBAKE_BASISU, else the one scripts/install-basisu.sh installs.
+// The encoder, or a reason to skip (support/basisu.hpp).
 std::optional<Encoder> encoder_or_skip(std::string& why) {
-  if (!std::getenv("MATBAKE_BASISU") && fs::exists(installed_basisu())) setenv("MATBAKE_BASISU", installed_basisu().c_str(), 1);
+  const std::string path = test::basisu_for_tests(why);
+  if (path.empty()) return std::nullopt;
+  setenv("MATBAKE_BASISU", path.c_str(), 1);
   auto e = find_encoder();
-  if (!e) {
-    why = "basisu is not installed (bash scripts/install-basisu.sh): " + e.error().to_string();
-    return std::nullopt;
-  }
-  return *e;
+  if (!e) why = e.error().to_string();
+  return e ? std::optional(*e) : std::nullopt;
 }
 
 double psnr(const image::Image& a, const test::RawImage& b, int channel) {

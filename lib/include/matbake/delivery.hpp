@@ -77,6 +77,29 @@ struct Size {
 // the source, at least 1×1, aspect kept as closely as the rounding allows.
 Size delivered_size(Size source, const ClassOptions& options, Rounding rounding, std::optional<int> needed = {});
 
+// "basisu 1.16.4": the KTX2 encoder a run would use (for build stamps: a new encoder rebuilds the
+// KTX2 scenes), or "none: <why>" when there is none.
+std::string encoder_identity();
+
+// ---- Texel density: the size the scene needs ------------------------------------------------------
+
+// One triangle as a texture maps it: its area in the scene (world units², every placement counted)
+// and in UV space (the texture's [0, 1]² has area 1).
+struct MappedTriangle {
+  double world_area = 0, uv_area = 0;
+};
+
+// The area-weighted share of a texture's triangles that `needed_side` serves: the rest (the smallest
+// share of the scene's area, stretched the most) may get fewer texels than asked.
+inline constexpr double kDensityPercentile = 0.95;
+
+// The longer side a texture of `source`'s aspect needs so that its triangles get `density` texels
+// per scene unit: a triangle of UV area u and world area w mapped on a W × H texture gets
+// sqrt(u · W · H / w) texels per unit, so it needs a longer side L = density · sqrt(w / (u · a · b)),
+// a = W / L and b = H / L; the result is the kDensityPercentile point of L over the triangles weighted
+// by world area, rounded up. None when no triangle has both areas above 0.
+std::optional<int> needed_side(const std::vector<MappedTriangle>& triangles, Size source, double density);
+
 // Level k of a full chain: max(1, width >> k) × max(1, height >> k), down to 1×1.
 std::vector<Size> mip_sizes(Size base);
 
@@ -119,6 +142,8 @@ struct TextureReport {
   Codec codec = Codec::png;  // as written (png: kept or resized as PNG/WebP)
   std::string uri;           // the image written; empty when the texture was kept as it was
   Size source, delivered;
+  std::optional<int> needed;  // the longer side the texel density asks for, when it was set
+  std::vector<int> materials;  // the materials that use the texture
   int levels = 1;
   std::uint64_t source_bytes = 0, bytes = 0;  // the source image's file, the written one
   std::optional<float> alpha_cutoff;         // a MASK material's

@@ -1,5 +1,7 @@
 #include "basisu.hpp"
 
+#include "matbake/delivery.hpp"
+
 #include <fcntl.h>
 #include <spawn.h>
 #include <sys/wait.h>
@@ -96,6 +98,11 @@ Result<Encoder> find_encoder() {
   const fs::path found = on_path("basisu");
   if (found.empty()) return Error{"", std::string("the KTX2 encoder basisu is not on PATH; ") + kInstallHint};
   return probe(found, "basisu on PATH");
+}
+
+std::string encoder_identity() {
+  auto e = find_encoder();
+  return e ? "basisu " + e->version : "none: " + e.error().message;
 }
 
 Status run_encoder(const Encoder& encoder, const std::vector<std::string>& args, const fs::path& log, const std::string& what) {

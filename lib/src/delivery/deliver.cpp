@@ -6,11 +6,14 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include <glm/geometric.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <map>
 #include <set>
 
+#include "../scene/from_document.hpp"
 #include "encode.hpp"
 #include "matbake/ktx2.hpp"
 #include "matbake/version.hpp"
@@ -27,6 +30,7 @@ struct Use {
   TextureClass texture_class = TextureClass::colour;
   std::optional<float> alpha_cutoff;
   std::string conflict;  // "used as colour and data": kept as it is
+  std::set<std::pair<int, int>> placements;  // (material, texCoord) pairs that read it
 };
 
 // The class of a material slot, by its name, for core and extension slots alike: normal maps
@@ -38,10 +42,11 @@ TextureClass class_of_slot(const std::string& key) {
   return TextureClass::data;
 }
 
-void record(std::map<int, Use>& uses, int texture, TextureClass c, std::optional<float> cutoff) {
-  auto [it, fresh] = uses.try_emplace(texture, Use{c, cutoff, ""});
-  if (fresh) return;
+void record(std::map<int, Use>& uses, int texture, TextureClass c, std::optional<float> cutoff, std::pair<int, int> placement) {
+  auto [it, fresh] = uses.try_emplace(texture, Use{c, cutoff, "", {}});
   Use& use = it->second;
+  use.placements.insert(placement);
+  if (fresh) return;
   if (use.texture_class != c && use.conflict.empty()) {
     use.conflict = "used as " + std::string(name_in(kTextureClassNames, use.texture_class)) + " and " +
                    std::string(name_in(kTextureClassNames, c)) + ": kept as it is";
@@ -50,30 +55,33 @@ void record(std::map<int, Use>& uses, int texture, TextureClass c, std::optional
 }
 
 // Every textureInfo under `node` (a material, its extensions): {"index": n} under a key "...Texture".
-void collect(const Json& node, std::optional<float> cutoff, std::map<int, Use>& uses) {
+void collect(const Json& node, int material, std::optional<float> cutoff, std::map<int, Use>& uses) {
   if (!node.is_object()) return;
   for (const auto& [key, value] : node.items()) {
     if (!value.is_object()) continue;
     if (key.ends_with("Texture") && value.contains("index")) {
       const int index = gltf::integer_in<int>(value, "index", -1, -1);
       const bool mask_alpha = key == "baseColorTexture";
-      if (index >= 0) record(uses, index, class_of_slot(key), mask_alpha ? cutoff : std::nullopt);
+      const int texcoord = gltf::integer_in<int>(value, "texCoord", 0, -1);
+      if (index >= 0) record(uses, index, class_of_slot(key), mask_alpha ? cutoff : std::nullopt, {material, texcoord});
     } else {
-      collect(value, cutoff, uses);
+      collect(value, material, cutoff, uses);
     }
   }
 }
 
 std::map<int, Use> texture_uses(const Json& json) {
   std::map<int, Use> uses;
+  int index = 0;
   for (const Json& material : gltf::array_in(json, "materials")) {
+    const int m = index++;
     if (!material.is_object()) continue;
     std::optional<float> cutoff;
     if (material.value("alphaMode", "") == "MASK") {
       const auto it = material.find("alphaCutoff");
       cutoff = it != material.end() && it->is_number() ? it->get<float>() : 0.5f;
     }
-    collect(material, cutoff, uses);
+    collect(material, m, cutoff, uses);
   }
   return uses;
 }
@@ -126,6 +134,33 @@ std::string free_uri(const gltf::Document& doc, const std::string& name, const s
   return uri;
 }
 
+double triangle_area(glm::dvec3 a, glm::dvec3 b, glm::dvec3 c) { return 0.5 * glm::length(glm::cross(b - a, c - a)); }
+
+// Each used texture's triangles as the scene places them (world area, UV area of the texCoord set
+// each material reads it with).
+Result<std::map<int, std::vector<MappedTriangle>>> mapped_triangles(const gltf::Document& doc, const std::map<int, Use>& uses) {
+  auto scene = scene::scene_from_document(doc, {.texcoords = true});
+  if (!scene) return scene.error();
+  std::map<int, std::vector<MappedTriangle>> out;
+  for (const scene::Instance& instance : scene->instances) {
+    for (const auto& [texture, use] : uses) {
+      for (const auto& [material, texcoord] : use.placements) {
+        if (material != instance.material || texcoord < 0 || std::size_t(texcoord) >= instance.texcoords.size()) continue;
+        const std::vector<glm::vec2>& uv = instance.texcoords[std::size_t(texcoord)];
+        if (uv.size() != instance.positions.size()) continue;
+        for (const auto& t : instance.triangles) {
+          const auto& p = instance.positions;
+          const double uv_area =
+              0.5 * std::abs(double(uv[t[1]].x - uv[t[0]].x) * double(uv[t[2]].y - uv[t[0]].y) -
+                             double(uv[t[2]].x - uv[t[0]].x) * double(uv[t[1]].y - uv[t[0]].y));
+          out[texture].push_back({triangle_area(p[t[0]], p[t[1]], p[t[2]]), uv_area});
+        }
+      }
+    }
+  }
+  return out;
+}
+
 // One texture's work: what it is made from, and what was made.
 struct Work {
   int texture = -1, image = -1;
@@ -133,6 +168,7 @@ struct Work {
   Sampling sampling;
   const image::Image* source = nullptr;
   Size size;
+  std::optional<int> needed;
   Codec codec = Codec::png;
   std::string name;
   // Made:
@@ -218,6 +254,14 @@ void drop_unused_webp(gltf::Document& doc) {
   }
 }
 
+std::vector<int> materials_of(const Use& use) {
+  std::vector<int> out;
+  for (const auto& [material, texcoord] : use.placements) {
+    if (out.empty() || out.back() != material) out.push_back(material);
+  }
+  return out;
+}
+
 }  // namespace
 
 bool changes_textures(const Options& options, const image::Encoding& encoding) {
@@ -235,9 +279,17 @@ Result<std::vector<TextureReport>> deliver_textures(gltf::Document& doc, gltf::I
   const std::string stem = output.stem().string();
   std::vector<Work> work;
   std::vector<TextureReport> reports;
-  for (const auto& [texture, use] : texture_uses(doc.json)) {
+  const std::map<int, Use> uses = texture_uses(doc.json);
+  std::map<int, std::vector<MappedTriangle>> mapped;
+  if (options.texel_density > 0) {
+    auto found = mapped_triangles(doc, uses);
+    if (!found) return found.error();
+    mapped = std::move(*found);
+  }
+  for (const auto& [texture, use] : uses) {
     const Json& t = doc.json["textures"][std::size_t(texture)];
-    TextureReport report{.texture = texture, .texture_class = use.texture_class, .alpha_cutoff = use.alpha_cutoff};
+    TextureReport report{.texture = texture, .texture_class = use.texture_class, .materials = materials_of(use),
+                         .alpha_cutoff = use.alpha_cutoff};
     const int image = decodable_image(t);
     if (image < 0 || !use.conflict.empty()) {
       report.note = !use.conflict.empty() ? use.conflict : "no PNG, JPEG or WebP source (already KTX2): kept as it is";
@@ -249,7 +301,9 @@ Result<std::vector<TextureReport>> deliver_textures(gltf::Document& doc, gltf::I
     if (!source) return source.error();
     Work w{.texture = texture, .image = image, .use = use, .sampling = sampling_of(doc.json, t, options.filter), .source = *source};
     const ClassOptions& o = options.of(use.texture_class);
-    w.size = delivered_size({(*source)->width, (*source)->height}, o, options.rounding);
+    const Size source_size{(*source)->width, (*source)->height};
+    if (options.texel_density > 0) w.needed = needed_side(mapped[texture], source_size, options.texel_density);
+    w.size = delivered_size(source_size, o, options.rounding, w.needed);
     w.codec = ktx2_out ? o.codec : Codec::png;
     w.name = base_name(doc.json, image, stem);
     if (w.codec != Codec::png && !sides_fit_ktx2(w.size)) {
@@ -281,7 +335,8 @@ Result<std::vector<TextureReport>> deliver_textures(gltf::Document& doc, gltf::I
 
   for (Work& w : work) {
     TextureReport report{.texture = w.texture, .texture_class = w.use.texture_class, .codec = w.codec,
-                         .source = {w.source->width, w.source->height}, .delivered = w.size, .levels = w.levels,
+                         .source = {w.source->width, w.source->height}, .delivered = w.size, .needed = w.needed,
+                         .materials = materials_of(w.use), .levels = w.levels,
                          .alpha_cutoff = w.use.alpha_cutoff, .coverage = w.coverage};
     auto source_bytes = gltf::image_bytes(doc, std::size_t(w.image));
     if (!source_bytes) return source_bytes.error();

@@ -106,7 +106,8 @@ void renormalise_normals(image::Image& im) {
 }
 
 // Scales the level's alpha so that as many texels as `target` × texels render opaque: the
-// round(target · n) largest alphas reach the opaque code (ties with the last may add a few).
+// round(target · n) largest alphas reach the opaque code. Texels of equal alpha pass together, so
+// where the wanted-th largest alpha is shared, the nearer of the counts with and without them.
 void keep_coverage(image::Image& level, float cutoff, double target) {
   const int a = level.alpha_channel;
   const std::size_t pixels = std::size_t(level.width) * std::size_t(level.height), ch = std::size_t(level.channels);
@@ -122,8 +123,16 @@ void keep_coverage(image::Image& level, float cutoff, double target) {
     if (largest > 0) scale = std::min(1.0, (opaque - 0.5) / 255.0 / largest * (1 - 1e-6));
   } else {
     std::nth_element(alphas.begin(), alphas.begin() + std::ptrdiff_t(wanted - 1), alphas.end(), std::greater<>());
-    const float nth = alphas[wanted - 1];  // the wanted-th largest alpha
-    if (nth <= 0) return;                 // fewer texels than wanted have any alpha: as high as it gets
+    float nth = alphas[wanted - 1];  // the wanted-th largest alpha
+    if (nth <= 0) return;           // fewer texels than wanted have any alpha: as high as it gets
+    std::size_t with_ties = 0, above = 0;
+    float next_up = 2;  // the smallest alpha above nth
+    for (float v : alphas) {
+      with_ties += v >= nth;
+      above += v > nth;
+      if (v > nth) next_up = std::min(next_up, v);
+    }
+    if (with_ties - wanted > wanted - above && above > 0) nth = next_up;
     scale = (opaque - 0.5) / 255.0 / nth * (1 + 1e-6);
   }
   for (std::size_t p = 0; p < pixels; ++p) {

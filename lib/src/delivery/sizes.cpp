@@ -45,4 +45,24 @@ Size delivered_size(Size source, const ClassOptions& options, Rounding rounding,
   return {rounded_side(w, source.width, rounding), rounded_side(h, source.height, rounding)};
 }
 
+std::optional<int> needed_side(const std::vector<MappedTriangle>& triangles, Size source, double density) {
+  const double longer = std::max(source.width, source.height);
+  const double a = source.width / longer, b = source.height / longer;
+  std::vector<std::pair<double, double>> sides;  // (needed L, world area)
+  double total = 0;
+  for (const MappedTriangle& t : triangles) {
+    if (!(t.world_area > 0) || !(t.uv_area > 0) || !std::isfinite(t.world_area / t.uv_area)) continue;
+    sides.emplace_back(density * std::sqrt(t.world_area / (t.uv_area * a * b)), t.world_area);
+    total += t.world_area;
+  }
+  if (sides.empty()) return std::nullopt;
+  std::sort(sides.begin(), sides.end());
+  double below = 0;
+  for (const auto& [side, area] : sides) {
+    below += area;
+    if (below >= kDensityPercentile * total) return int(std::min(1e9, std::ceil(side - 1e-9)));
+  }
+  return int(std::min(1e9, std::ceil(sides.back().first - 1e-9)));
+}
+
 }  // namespace matbake::delivery

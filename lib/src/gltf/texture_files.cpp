@@ -137,9 +137,9 @@ Result<ImageCache::Made> ImageCache::add_texture(Document& doc, const image::Ima
 }
 
 void require_extension(Document& doc, const std::string& name, bool required) {
-  for (const char* list : {"extensionsUsed", "extensionsRequired"}) {
-    if (list[9] == 'R' && !required) continue;
-    Json& names = doc.json[list];
+  for (const std::string_view list : {"extensionsUsed", "extensionsRequired"}) {
+    if (list == "extensionsRequired" && !required) continue;
+    Json& names = doc.json[std::string(list)];
     if (std::find(names.begin(), names.end(), name) == names.end()) names.push_back(name);
   }
 }

@@ -9,6 +9,7 @@
 
 #include "../gltf/document.hpp"
 #include "state.hpp"
+#include "matbake/delivery.hpp"
 #include "matbake/encoding_params.hpp"
 #include "matbake/material_params.hpp"
 #include "matbake/pipeline_params.hpp"
@@ -284,11 +285,13 @@ Result<Plan> make_plan(const Manifest& manifest) {
         if (!job.problem && material_jobs[m]) job.problem = material_jobs[m]->problem;
         materials[gltf_name] = material_options(manifest.materials[m], manifest);
       }
-      job.options = nlohmann::json{{"input", manifest_relative(s.input, manifest)},
-                                   {"output", s.output.string()},
-                                   {"materials", materials},
-                                   {"export", to_json(s.options)}}
-                        .dump();
+      nlohmann::json options = {{"input", manifest_relative(s.input, manifest)},
+                                {"output", s.output.string()},
+                                {"materials", materials},
+                                {"export", to_json(s.options)}};
+      // The encoder's version too: a new basisu rebuilds the KTX2 scenes.
+      if (s.options.encoding.texture_format == image::TextureFormat::ktx2) options["encoder"] = delivery::encoder_identity();
+      job.options = options.dump();
       scenes.push_back(std::move(job));
     }
 

@@ -85,9 +85,11 @@ nlohmann::json to_json(const delivery::TextureReport& t) {
                       {"file", t.uri},
                       {"source_size", {t.source.width, t.source.height}},
                       {"size", {t.delivered.width, t.delivered.height}},
+                      {"materials", t.materials},
                       {"levels", t.levels},
                       {"source_bytes", t.source_bytes},
                       {"bytes", t.bytes}};
+  if (t.needed) j["needed_side"] = *t.needed;
   if (t.alpha_cutoff) j["alpha_cutoff"] = *t.alpha_cutoff, j["coverage"] = t.coverage;
   if (!t.note.empty()) j["note"] = t.note;
   return j;

@@ -1,0 +1,352 @@
+// KTX2 delivery end to end (`export --texture-format ktx2`, sizes, texel density) on a scene written
+// here: each KTX2 file read back field by field and validated by basisu, the glTF checked by the
+// Khronos validator, resizes in linear light against the closed form, the same bytes for any --jobs,
+// and one error line for each bad setting. Tests that need basisu skip without it, saying so.
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <fstream>
+
+#include "lib/src/gltf/document.hpp"
+#include "matbake/color.hpp"
+#include "matbake/ktx2.hpp"
+#include "support/basisu.hpp"
+#include "support/expect_error.hpp"
+#include "support/files.hpp"
+#include "support/gltf_files.hpp"
+#include "support/gltf_validator.hpp"
+#include "support/run.hpp"
+#include "support/temp_dir.hpp"
+
+namespace matbake::test {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+// A 1 × 1 quad (world area 1) mapped onto the whole UV square, drawn with one material that reads a
+// colour texture with alpha (MASK, cutoff 0.5), an ORM texture and a normal map, each 32 × 32.
+void write_textured_quad(const fs::path& dir, const std::string& alpha_mode = "MASK") {
+  GltfBuilder b;
+  const int positions = b.add_vec3({0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0});
+  const int uvs = b.add_floats({0, 1, 1, 1, 1, 0, 0, 0}, "VEC2", 2);
+  const int normals = b.add_vec3({0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1});
+  const int tangents = b.add_floats({1, 0, 0, 1, 1, 0, 0, 1, 1, 0, 0, 1, 1, 0, 0, 1}, "VEC4", 4);
+  const int indices = b.add_indices({0, 1, 2, 0, 2, 3});
+  b.doc["meshes"].push_back({{"primitives", {{{"attributes", {{"POSITION", positions}, {"TEXCOORD_0", uvs}, {"NORMAL", normals},
+                                                              {"TANGENT", tangents}}},
+                                              {"indices", indices}, {"material", 0}}}}});
+  b.add_node({{"mesh", 0}});
+  json material = {{"name", "leaves"},
+                   {"alphaMode", alpha_mode},
+                   {"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}, {"metallicRoughnessTexture", {{"index", 1}}}}},
+                   {"normalTexture", {{"index", 2}}}};
+  if (alpha_mode == "MASK") material["alphaCutoff"] = 0.5;
+  b.doc["materials"] = {material};
+  b.doc["samplers"] = {{{"wrapS", 33071}, {"wrapT", 33071}}};
+  b.doc["textures"] = {{{"source", 0}, {"sampler", 0}}, {{"source", 1}}, {{"source", 2}}};
+  b.doc["images"] = {{{"uri", "colour.png"}}, {{"uri", "orm.png"}}, {{"uri", "normal.png"}}};
+  std::vector<double> colour, orm, normal;
+  for (int y = 0; y < 32; ++y) {
+    for (int x = 0; x < 32; ++x) {
+      // Sparse leaves: one texel in four opaque (alpha 150 to 254), the rest nearly transparent.
+      const double alpha = (x % 2 == 0 && y % 2 == 0) ? 150 + (x * 7 + y * 13) % 105 : (x * 5 + y * 3) % 40;
+      colour.insert(colour.end(), {double(40 + 6 * x), double(120 + 3 * y), 60, alpha});
+      orm.insert(orm.end(), {255, double(8 * y), double(8 * x)});
+      const double nx = 0.3 * std::sin(0.4 * x), ny = 0.3 * std::cos(0.3 * y), nz = std::sqrt(1 - nx * nx - ny * ny);
+      normal.insert(normal.end(), {std::round(127.5 + 127.5 * nx), std::round(127.5 + 127.5 * ny), std::round(127.5 + 127.5 * nz)});
+    }
+  }
+  write_raw(dir / "colour.png", 32, 32, 4, "uint8", colour);
+  write_raw(dir / "orm.png", 32, 32, 3, "uint8", orm);
+  write_raw(dir / "normal.png", 32, 32, 3, "uint8", normal);
+  b.write(dir / "quad.gltf", {0});
+}
+
+std::vector<unsigned char> image_of(const gltf::Document& doc, int texture) {
+  const json& t = doc.json["textures"][std::size_t(texture)];
+  const int image = t["extensions"]["KHR_texture_basisu"]["source"];
+  auto bytes = gltf::image_bytes(doc, std::size_t(image));
+  EXPECT_TRUE(bytes);
+  return {bytes->begin(), bytes->end()};
+}
+
+json run_json(const std::vector<std::string>& args, const std::vector<std::string>& env) {
+  std::vector<std::string> all = {"--json"};
+  all.insert(all.end(), args.begin(), args.end());
+  const RunResult r = matbake(all, env);
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  return r.exit_code == 0 ? json::parse(r.out) : json();
+}
+
+TEST(CliDelivery, KtxTexturesPerClassReadBackFieldByFieldAndValidate) {
+  MATBAKE_BASISU_OR_SKIP(basisu);
+  TempDir dir;
+  write_textured_quad(dir.path());
+  const fs::path out = dir / "out" / "quad.glb";
+  const json report = run_json({"export", (dir / "quad.gltf").string(), "-o", out.string(), "--texture-format", "ktx2"},
+                               {"MATBAKE_BASISU=" + basisu});
+  const gltf::Document doc = read_output(out);
+  EXPECT_EQ(doc.json["extensionsUsed"], json::array({"KHR_texture_basisu"}));
+  EXPECT_EQ(doc.json["extensionsRequired"], json::array({"KHR_texture_basisu"}));
+  ASSERT_EQ(doc.json["images"].size(), 3u);  // the PNGs are gone
+  struct Expected {
+    std::uint8_t model, transfer;
+    std::uint32_t supercompression;
+  };
+  const Expected expected[] = {{ktx2::kModelETC1S, ktx2::kTransferSRGB, ktx2::kSupercompressionBasisLZ},
+                               {ktx2::kModelUASTC, ktx2::kTransferLinear, ktx2::kSupercompressionZstd},
+                               {ktx2::kModelUASTC, ktx2::kTransferLinear, ktx2::kSupercompressionZstd}};
+  for (int t = 0; t < 3; ++t) {
+    SCOPED_TRACE(t);
+    EXPECT_FALSE(doc.json["textures"][std::size_t(t)].contains("source"));
+    const int image = doc.json["textures"][std::size_t(t)]["extensions"]["KHR_texture_basisu"]["source"];
+    EXPECT_EQ(doc.json["images"][std::size_t(image)]["mimeType"], "image/ktx2");
+    const std::vector<unsigned char> bytes = image_of(doc, t);
+    auto k = ktx2::read(bytes, "texture");
+    ASSERT_TRUE(k) << k.error().to_string();
+    EXPECT_EQ(k->width, 32u);
+    EXPECT_EQ(k->height, 32u);
+    EXPECT_EQ(k->levels.size(), 6u);  // 32 … 1
+    EXPECT_EQ(k->descriptor.model, expected[t].model);
+    EXPECT_EQ(k->descriptor.transfer, expected[t].transfer);
+    EXPECT_EQ(k->supercompression, expected[t].supercompression);
+    if (expected[t].model == ktx2::kModelUASTC) {
+      EXPECT_EQ(k->descriptor.channels, std::vector<std::uint8_t>{ktx2::kUastcRGB});
+      for (std::size_t l = 0; l < 6; ++l) {
+        const std::size_t side = std::max<std::size_t>(1, 32 >> l);
+        auto data = ktx2::level_data(*k, l, "texture");
+        ASSERT_TRUE(data) << data.error().to_string();
+        EXPECT_EQ(data->size(), 16 * ((side + 3) / 4) * ((side + 3) / 4)) << l;
+      }
+    }
+    write_bytes(dir / ("t" + std::to_string(t) + ".ktx2"), std::string(bytes.begin(), bytes.end()));
+    const RunResult validated = run(basisu, {"-validate", "-file", (dir / ("t" + std::to_string(t) + ".ktx2")).string()});
+    EXPECT_EQ(validated.exit_code, 0) << validated.out;
+  }
+  // The colour texture's coverage: 25% of the source's texels pass the cutoff, and every level made
+  // keeps that within one texel's share (the ETC1S chain is basisu's: only level 0 is matbake's).
+  const json& colour = report["textures"][0];
+  EXPECT_EQ(colour["class"], "colour");
+  EXPECT_EQ(colour["codec"], "etc1s");
+  ASSERT_EQ(colour["coverage"].size(), 2u);
+  EXPECT_DOUBLE_EQ(colour["coverage"][0].get<double>(), 0.25);
+  EXPECT_DOUBLE_EQ(colour["coverage"][1].get<double>(), 0.25);
+  // The validator knows no KHR_texture_basisu (KhronosGroup/glTF-Validator#177): exactly its two
+  // warnings per KTX2 image, nothing else.
+  MATBAKE_VALIDATE_OR_SKIP(validator, out);
+  EXPECT_EQ(validator->errors, 0) << validator->summary;
+  for (const std::string& code : validator->error_and_warning_codes) {
+    EXPECT_TRUE(code.rfind("VALUE_NOT_IN_LIST /images/", 0) == 0 || code.rfind("IMAGE_UNRECOGNIZED_FORMAT /images/", 0) == 0)
+        << code;
+  }
+  EXPECT_EQ(validator->warnings, 6) << validator->summary;
+}
+
+TEST(CliDelivery, UastcColourKeepsCoverageAtEveryLevelAndJobsDoNotChangeBytes) {
+  MATBAKE_BASISU_OR_SKIP(basisu);
+  TempDir dir;
+  write_textured_quad(dir.path());
+  const std::vector<std::string> env = {"MATBAKE_BASISU=" + basisu};
+  std::string first;
+  for (const char* jobs : {"1", "2", "3"}) {
+    const fs::path out = dir / jobs / "quad.glb";
+    const json report = run_json({"--jobs", jobs, "export", (dir / "quad.gltf").string(), "-o", out.string(), "--texture-format",
+                                  "ktx2", "--colour-codec", "uastc"},
+                                 env);
+    const json& coverage = report["textures"][0]["coverage"];
+    ASSERT_EQ(coverage.size(), 7u);  // the source, then levels 0 … 5
+    for (std::size_t l = 1; l < coverage.size(); ++l) {
+      const double texels = std::pow(std::max(1.0, 32.0 / std::pow(2, double(l - 1))), 2);
+      EXPECT_NEAR(coverage[l].get<double>(), 0.25, std::max(0.01, 0.5 / texels)) << "level " << l - 1;
+    }
+    const std::string bytes = read_bytes(out);
+    if (first.empty()) first = bytes;
+    EXPECT_EQ(bytes, first) << "--jobs " << jobs;
+  }
+}
+
+TEST(CliDelivery, PngFallbackKeepsTheSourceAndTheExtensionIsOnlyUsed) {
+  MATBAKE_BASISU_OR_SKIP(basisu);
+  TempDir dir;
+  write_textured_quad(dir.path(), "OPAQUE");
+  const fs::path out = dir / "out" / "quad.gltf";
+  run_json({"export", (dir / "quad.gltf").string(), "-o", out.string(), "--texture-format", "ktx2", "--png-fallback",
+            "--normal-codec", "png"},
+           {"MATBAKE_BASISU=" + basisu});
+  const gltf::Document doc = read_output(out);
+  EXPECT_EQ(doc.json["extensionsUsed"], json::array({"KHR_texture_basisu"}));
+  EXPECT_FALSE(doc.json.contains("extensionsRequired"));
+  for (int t = 0; t < 2; ++t) {
+    EXPECT_TRUE(doc.json["textures"][std::size_t(t)].contains("source"));
+    EXPECT_TRUE(doc.json["textures"][std::size_t(t)]["extensions"].contains("KHR_texture_basisu"));
+  }
+  EXPECT_EQ(doc.json["textures"][2], (json{{"source", 2}}));  // the normal map kept as PNG
+  EXPECT_TRUE(fs::exists(dir / "out" / "colour.ktx2"));
+  EXPECT_TRUE(fs::exists(dir / "out" / "orm.ktx2"));
+  EXPECT_FALSE(fs::exists(dir / "out" / "normal.ktx2"));
+}
+
+// A checkerboard of sRGB codes 0 and 255 halved: its linear mean is 0.5, which sRGB stores as code
+// 188. Filtering the codes themselves (gamma space) would give 128. (The texture's sampler clamps:
+// within 3 texels of an edge the Kaiser window reads the edge texel again, so only the interior is
+// exact there.)
+TEST(CliDelivery, ResizesAreInLinearLightAndNeverAboveTheSource) {
+  TempDir dir;
+  write_textured_quad(dir.path(), "OPAQUE");
+  std::vector<double> checker;
+  for (int y = 0; y < 32; ++y) {
+    for (int x = 0; x < 32; ++x) {
+      const double v = (x + y) % 2 ? 255 : 0;
+      checker.insert(checker.end(), {v, v, v, 255});
+    }
+  }
+  write_raw(dir / "colour.png", 32, 32, 4, "uint8", checker);
+  const fs::path out = dir / "out" / "quad.gltf";
+  const json report = run_json({"export", (dir / "quad.gltf").string(), "-o", out.string(), "--colour-max-size", "16",
+                                "--data-max-size", "64", "--normal-scale", "0.25"},
+                               {});
+  const gltf::Document doc = read_output(out);
+  const int image = doc.json["textures"][0]["source"];
+  const std::string uri = doc.json["images"][std::size_t(image)]["uri"];
+  EXPECT_EQ(uri, "colour_16x16.png");
+  const RawImage half = read_raw(dir / "out" / uri);
+  ASSERT_EQ(half.width, 16);
+  const double expected = std::round(255 * color::encoded_from_linear(color::Transfer::srgb, 0.5));
+  EXPECT_EQ(expected, 188);
+  for (int y = 3; y < 13; ++y) {
+    for (int x = 3; x < 13; ++x) {
+      for (int c = 0; c < 4; ++c) EXPECT_EQ(half.samples[std::size_t((y * 16 + x) * 4 + c)], c == 3 ? 255 : expected) << x << " " << y;
+    }
+  }
+  // --data-max-size 64 is above the source: the ORM texture is kept as it was.
+  EXPECT_EQ(report["textures"][1]["size"], json::array({32, 32}));
+  EXPECT_EQ(report["textures"][1]["file"], "");
+  EXPECT_EQ(report["textures"][2]["size"], json::array({8, 8}));
+  EXPECT_EQ(doc.json["images"].size(), 3u);  // the replaced PNGs are not written
+  EXPECT_FALSE(fs::exists(dir / "out" / "colour.png"));
+}
+
+// The quad has world area 1 over the whole UV square: 8 texels per unit need an 8 × 8 texture.
+TEST(CliDelivery, TexelDensitySizesTexturesFromTheScene) {
+  TempDir dir;
+  write_textured_quad(dir.path(), "OPAQUE");
+  const json report = run_json({"export", (dir / "quad.gltf").string(), "-o", (dir / "out" / "quad.glb").string(),
+                                "--texel-density", "8"},
+                               {});
+  for (const json& t : report["textures"]) {
+    EXPECT_EQ(t["needed_side"], 8) << t;
+    EXPECT_EQ(t["size"], json::array({8, 8})) << t;
+    EXPECT_EQ(t["materials"], json::array({0})) << t;
+    EXPECT_LT(t["bytes"].get<int>(), t["source_bytes"].get<int>()) << t;
+  }
+}
+
+// README command 1's KTX2 variant: the example's scene, built, then exported with KTX2 textures.
+TEST(CliDelivery, TheExampleSceneAsKtx2HasNoValidatorErrors) {
+  MATBAKE_BASISU_OR_SKIP(basisu);
+  TempDir dir;
+  copy_example(dir.path(), true);
+  ASSERT_EQ(matbake({"build", (dir / "showroom.toml").string(), "--quiet"}).exit_code, 0);
+  const fs::path out = dir / "out" / "showroom-ktx2.glb";
+  const json report = run_json({"export", (dir / "out" / "showroom.glb").string(), "-o", out.string(), "--texture-format", "ktx2"},
+                               {"MATBAKE_BASISU=" + basisu});
+  std::size_t ktx2_images = 0;
+  for (const json& t : report["textures"]) {
+    ktx2_images += t["codec"] != "png";
+    EXPECT_TRUE(t["codec"] == "etc1s" || t["codec"] == "uastc") << t;
+  }
+  EXPECT_EQ(ktx2_images, 15u);  // 5 base colours, 10 ORM textures (one per placement, AO baked in)
+  MATBAKE_VALIDATE_OR_SKIP(validator, out);
+  EXPECT_EQ(validator->errors, 0) << validator->summary;
+  EXPECT_EQ(validator->warnings, int(2 * ktx2_images)) << validator->summary;
+}
+
+// A build's scene stamps every delivery setting and the encoder's version: a change to either
+// rebuilds the scene, and nothing else does.
+TEST(CliDelivery, TheStampHoldsEverySettingAndTheEncodersVersion) {
+  MATBAKE_BASISU_OR_SKIP(basisu);
+  TempDir dir;
+  write_textured_quad(dir.path());
+  const std::string manifest = (dir / "assets.toml").string();
+  std::ofstream(manifest) << "[scenes.s]\ninput = \"quad.gltf\"\ntexture_format = \"ktx2\"\n";
+  const std::vector<std::string> env = {"MATBAKE_BASISU=" + basisu};
+  ASSERT_EQ(run_json({"build", manifest}, env)["built"], 1);
+  EXPECT_EQ(run_json({"build", manifest, "--dry-run"}, env)["out_of_date"], 0);
+  // Another basisu version (a wrapper that says so) makes the scene out of date.
+  const fs::path wrapper = dir / "basisu-next";
+  std::ofstream(wrapper) << "#!/bin/sh\nif [ \"$1\" = -version ]; then echo 'Basis Universal GPU Texture Compressor v1.16.5'; "
+                            "else exec '" << basisu << "' \"$@\"; fi\n";
+  fs::permissions(wrapper, fs::perms::owner_all);
+  const json other = run_json({"build", manifest, "--dry-run"}, {"MATBAKE_BASISU=" + wrapper.string()});
+  EXPECT_EQ(other["out_of_date"], 1) << other.dump();
+  std::ofstream(manifest, std::ios::app) << "colour_quality = 200\n";
+  const json changed = run_json({"build", manifest, "--dry-run"}, env);
+  EXPECT_EQ(changed["jobs"][0]["reason"], "its options changed") << changed.dump();
+}
+
+// bake-ao's door: the occlusion textures it bakes, and every other texture, delivered as KTX2.
+TEST(CliDelivery, BakeAoWritesItsTexturesAsKtx2) {
+  MATBAKE_BASISU_OR_SKIP(basisu);
+  TempDir dir;
+  write_textured_quad(dir.path(), "OPAQUE");
+  const fs::path out = dir / "out" / "baked.glb";
+  const json report = run_json({"bake-ao", (dir / "quad.gltf").string(), "-o", out.string(), "--texture", "16", "--samples", "4",
+                                "--texture-format", "ktx2", "--data-uastc-level", "0"},
+                               {"MATBAKE_BASISU=" + basisu});
+  ASSERT_EQ(report["delivered"].size(), 4u);  // colour, ORM, normal, and the baked occlusion
+  for (const json& t : report["delivered"]) EXPECT_NE(t["codec"], "png") << t;
+  const gltf::Document doc = read_output(out);
+  EXPECT_EQ(doc.json["extensionsRequired"], json::array({"KHR_texture_basisu"}));
+  for (const auto& image : doc.json["images"]) EXPECT_EQ(image["mimeType"], "image/ktx2");
+}
+
+TEST(CliDelivery, BadSettingsAndAMissingEncoderAreOneErrorLineAndNothingIsWritten) {
+  TempDir dir;
+  write_textured_quad(dir.path());
+  const std::string in = (dir / "quad.gltf").string(), out = (dir / "out" / "quad.glb").string();
+  const RunResult missing = matbake({"export", in, "-o", out, "--texture-format", "ktx2"}, {"MATBAKE_BASISU=/nonexistent/basisu"});
+  EXPECT_EQ(missing.exit_code, 1);
+  expect_one_error_line(missing, "/nonexistent/basisu", "the KTX2 encoder (MATBAKE_BASISU) does not run as basisu");
+  EXPECT_NE(missing.err.find("scripts/install-basisu.sh"), std::string::npos);
+  const RunResult none = matbake({"export", in, "-o", out, "--texture-format", "ktx2"}, {"MATBAKE_BASISU=", "PATH=/nonexistent"});
+  EXPECT_EQ(none.exit_code, 1);
+  expect_one_error_line(none, "", "the KTX2 encoder basisu is not on PATH");
+  const RunResult failing = matbake({"export", in, "-o", out, "--texture-format", "ktx2"}, {"MATBAKE_BASISU=/bin/false"});
+  EXPECT_EQ(failing.exit_code, 1);
+  EXPECT_EQ(std::count(failing.err.begin(), failing.err.end(), '\n'), 1) << failing.err;
+  for (const auto& args : std::vector<std::vector<std::string>>{{"--colour-max-size", "0"},
+                                                                {"--normal-max-size", "16385"},
+                                                                {"--data-codec", "astc"},
+                                                                {"--colr-codec", "uastc"},
+                                                                {"--colour-scale", "0"},
+                                                                {"--texture-format", "ktx"}}) {
+    std::vector<std::string> all = {"export", in, "-o", out};
+    all.insert(all.end(), args.begin(), args.end());
+    const RunResult r = matbake(all);
+    EXPECT_EQ(r.exit_code, 2) << args[0] << " " << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_NE(r.err.find(args[0]), std::string::npos) << r.err;
+  }
+  // No rounding: a 30-texel side cannot be KTX2 (sides of 1, 2 or a multiple of 4).
+  MATBAKE_BASISU_OR_SKIP(basisu);
+  const RunResult odd = matbake({"export", in, "-o", out, "--texture-format", "ktx2", "--texture-rounding", "none",
+                                 "--colour-max-size", "30"},
+                                {"MATBAKE_BASISU=" + basisu});
+  EXPECT_EQ(odd.exit_code, 2) << odd.err;
+  expect_one_error_line(odd, in, "texture 0 (colour) would be 30x30: KTX2 (KHR_texture_basisu) needs sides of 1, 2 or a multiple of 4");
+  EXPECT_TRUE(!fs::exists(dir / "out") || list_folder(dir / "out").empty());
+  // The manifest's door: the same checks at the key's line and column.
+  std::ofstream(dir / "assets.toml") << "[scenes.s]\ninput = \"quad.gltf\"\ntexture_format = \"ktx2\"\ncolour_max_size = 0\n";
+  const RunResult manifest = matbake({"build", (dir / "assets.toml").string(), "-n"});
+  EXPECT_EQ(manifest.exit_code, 1) << manifest.err;
+  EXPECT_NE(manifest.err.find("assets.toml:4:19"), std::string::npos) << manifest.err;
+  std::ofstream(dir / "assets.toml") << "[scenes.s]\ninput = \"quad.gltf\"\ncolor_codec = \"uastc\"\n";
+  const RunResult unknown = matbake({"build", (dir / "assets.toml").string(), "-n"});
+  EXPECT_NE(unknown.exit_code, 0);
+  EXPECT_NE(unknown.err.find("colour_codec"), std::string::npos) << unknown.err;
+}
+
+}  // namespace
+}  // namespace matbake::test
