@@ -231,9 +231,13 @@ std::vector<unsigned char> bytes_of(std::size_t n, unsigned seed) {
 TEST(Ktx2, AUastcFileReadsBackFieldByField) {
   for (int zstd : {0, 9}) {
     SCOPED_TRACE(zstd);
-    ktx2::UastcFile file{.width = 20, .height = 12, .transfer = ktx2::kTransferSRGB, .channel = ktx2::kUastcRGBA,
-                         .zstd_level = zstd, .writer = "matbake test"};
-    for (Size s : mip_sizes({20, 12})) file.levels.push_back(bytes_of(16 * std::size_t((s.width + 3) / 4) * std::size_t((s.height + 3) / 4), unsigned(s.width)));
+    ktx2::UastcFile file{.width = 20, .height = 12, .transfer = ktx2::kTransferSRGB, .channel = ktx2::kUastcRGBA, .levels = {},
+                         .zstd = zstd > 0, .writer = "matbake test"};
+    std::vector<std::vector<unsigned char>> raw;
+    for (Size s : mip_sizes({20, 12})) {
+      raw.push_back(bytes_of(16 * std::size_t((s.width + 3) / 4) * std::size_t((s.height + 3) / 4), unsigned(s.width)));
+      file.levels.push_back(*ktx2::uastc_level(raw.back(), zstd));
+    }
     auto bytes = ktx2::write_uastc(file);
     ASSERT_TRUE(bytes) << bytes.error().to_string();
     auto t = ktx2::read(*bytes, "t.ktx2");
@@ -257,8 +261,8 @@ TEST(Ktx2, AUastcFileReadsBackFieldByField) {
     for (std::size_t l = 0; l < 5; ++l) {
       auto data = ktx2::level_data(*t, l, "t.ktx2");
       ASSERT_TRUE(data) << data.error().to_string();
-      EXPECT_EQ(*data, file.levels[l]);
-      EXPECT_EQ(t->levels[l].uncompressed_length, file.levels[l].size());
+      EXPECT_EQ(*data, raw[l]);
+      EXPECT_EQ(t->levels[l].uncompressed_length, raw[l].size());
       // Smallest level first in the file; uncompressed levels on 16-byte boundaries.
       std::uint64_t offset;
       std::memcpy(&offset, bytes->data() + 80 + 24 * l, 8);
@@ -272,7 +276,7 @@ TEST(Ktx2, AUastcFileReadsBackFieldByField) {
 }
 
 TEST(Ktx2, DamagedFilesAreRefusedWithTheirName) {
-  ktx2::UastcFile file{.width = 4, .height = 4, .levels = {bytes_of(16, 1)}, .writer = "w"};
+  ktx2::UastcFile file{.width = 4, .height = 4, .levels = {*ktx2::uastc_level(bytes_of(16, 1), 0)}, .writer = "w"};
   auto bytes = ktx2::write_uastc(file);
   ASSERT_TRUE(bytes);
   const auto refused = [](std::vector<unsigned char> b) {
@@ -327,16 +331,16 @@ TEST(DeliveryEncoder, AUastcChainAssembledHereIsValidAndDecodesNearItsLevels) {
   });
   const auto levels = mip_chain(smooth, {32, 16}, {TextureClass::data, {}, {}});
   EncodeRequest request{.texture_class = TextureClass::data, .options = {.codec = Codec::uastc}, .scratch = dir.path() / "t.ktx2"};
-  ktx2::UastcFile file{.width = 32, .height = 16, .transfer = ktx2::kTransferLinear, .channel = ktx2::kUastcRGB, .zstd_level = 18,
-                       .writer = "matbake test"};
-  for (const image::Image& l : levels) {
-    auto blocks = encode_uastc_level(*encoder, l, request);
-    ASSERT_TRUE(blocks) << blocks.error().to_string();
-    EXPECT_EQ(blocks->size(), 16 * std::size_t((l.width + 3) / 4) * std::size_t((l.height + 3) / 4));
-    file.levels.push_back(std::move(*blocks));
+  auto encoded = encode_texture(*encoder, smooth, {32, 16}, {TextureClass::data, {}, {}}, request, "matbake test");
+  ASSERT_TRUE(encoded) << encoded.error().to_string();
+  const std::vector<unsigned char>* bytes = &encoded->file;
+  auto read = ktx2::read(*bytes, "chain.ktx2");
+  ASSERT_TRUE(read);
+  EXPECT_EQ(read->dfd, ktx2::uastc_descriptor(ktx2::kTransferLinear, ktx2::kUastcRGB, true));
+  for (std::size_t l = 0; l < levels.size(); ++l) {
+    EXPECT_EQ(read->levels[l].uncompressed_length,
+              16 * std::size_t((levels[l].width + 3) / 4) * std::size_t((levels[l].height + 3) / 4));
   }
-  auto bytes = ktx2::write_uastc(file);
-  ASSERT_TRUE(bytes);
   const fs::path path = dir.path() / "chain.ktx2";
   test::write_bytes(path, std::string(bytes->begin(), bytes->end()));
   const test::RunResult validated = test::run(encoder->program.string(), {"-validate", "-file", path.string()});

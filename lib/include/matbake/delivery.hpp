@@ -129,6 +129,8 @@ struct MipRequest {
 // source's as closely as its texel count allows.
 std::vector<image::Image> mip_chain(const image::Image& source, Size base, const MipRequest& request,
                                     bool whole_chain = true);
+// The same for the levels of `sizes` alone (of a chain whose other levels are made elsewhere).
+std::vector<image::Image> mip_levels(const image::Image& source, const std::vector<Size>& sizes, const MipRequest& request);
 
 // The fraction of texels whose alpha, stored in 8 bits, is at least `cutoff` (what a MASK material
 // renders). 1 when the image has no alpha.

@@ -50,14 +50,18 @@ Result<Texture> read(std::span<const unsigned char> bytes, const std::string& na
 // 16 unless zstd-supercompressed (then 0, as the specification asks).
 std::vector<std::uint32_t> uastc_descriptor(std::uint8_t transfer, std::uint8_t channel, bool supercompressed);
 
-// A UASTC texture of `levels` (raw UASTC blocks, level 0 first) as a KTX2 file: supercompressed with
-// zstd at `zstd_level` (1–22) unless it is 0, levels aligned as the specification asks (16 bytes
-// uncompressed), smallest level last in the index and first in the file. `writer` is KTXwriter's value.
+// A level of raw UASTC blocks as a file stores it: supercompressed with zstd at `zstd_level` (1–22),
+// or as it is when 0.
+Result<Level> uastc_level(std::vector<unsigned char> blocks, int zstd_level);
+
+// A UASTC texture of `levels` (uastc_level's, level 0 first, all supercompressed or none) as a KTX2
+// file: levels aligned as the specification asks (16 bytes uncompressed), smallest level last in the
+// index and first in the file. `writer` is KTXwriter's value.
 struct UastcFile {
   std::uint32_t width = 0, height = 0;
   std::uint8_t transfer = kTransferSRGB, channel = kUastcRGB;
-  std::vector<std::vector<unsigned char>> levels;
-  int zstd_level = 0;
+  std::vector<Level> levels;
+  bool zstd = false;
   std::string writer;
 };
 Result<std::vector<unsigned char>> write_uastc(const UastcFile& file);

@@ -185,43 +185,21 @@ bool sides_fit_ktx2(Size s) {
 }
 
 Status make(Work& w, const Options& options, const Encoder* encoder, const fs::path& output, int threads) {
-  MipRequest request{w.use.texture_class, w.sampling, w.use.alpha_cutoff};
-  const bool chain = w.codec == Codec::uastc && options.mipmaps;
-  std::vector<image::Image> levels = mip_chain(*w.source, w.size, request, chain);
-  if (w.use.alpha_cutoff) {
-    w.coverage.push_back(alpha_coverage(*w.source, *w.use.alpha_cutoff));
-    for (const image::Image& l : levels) w.coverage.push_back(alpha_coverage(l, *w.use.alpha_cutoff));
-  }
+  const MipRequest request{w.use.texture_class, w.sampling, w.use.alpha_cutoff};
   if (w.codec == Codec::png) {
-    w.level0 = std::move(levels[0]);
+    w.level0 = std::move(mip_chain(*w.source, w.size, request, false)[0]);
+    if (w.use.alpha_cutoff) w.coverage = {alpha_coverage(*w.source, *w.use.alpha_cutoff), alpha_coverage(w.level0, *w.use.alpha_cutoff)};
     return success();
   }
   EncodeRequest encode{.texture_class = w.use.texture_class, .options = options.of(w.use.texture_class), .sampling = w.sampling,
-                       .mipmaps = options.mipmaps, .alpha = has_alpha(levels[0]),
+                       .mipmaps = options.mipmaps, .alpha = has_alpha(*w.source),
                        .scratch = output.parent_path() / (w.name + ".ktx2"), .threads = threads};
-  if (w.codec == Codec::etc1s) {
-    auto file = encode_etc1s(*encoder, levels[0], encode);
-    if (!file) return file.error();
-    w.ktx2 = std::move(*file);
-    auto read = ktx2::read(w.ktx2, encode.scratch.string());
-    if (!read) return read.error();
-    w.levels = int(read->levels.size());
-    return success();
-  }
-  ktx2::UastcFile file{.width = unsigned(w.size.width), .height = unsigned(w.size.height),
-                       .transfer = w.use.texture_class == TextureClass::colour ? ktx2::kTransferSRGB : ktx2::kTransferLinear,
-                       .channel = encode.alpha ? ktx2::kUastcRGBA : ktx2::kUastcRGB,
-                       .zstd_level = encode.options.zstd,
-                       .writer = "matbake " + std::string(matbake::version) + " / basisu " + encoder->version};
-  for (const image::Image& level : levels) {
-    auto blocks = encode_uastc_level(*encoder, level, encode);
-    if (!blocks) return blocks.error();
-    file.levels.push_back(std::move(*blocks));
-  }
-  auto bytes = ktx2::write_uastc(file);
-  if (!bytes) return bytes.error();
-  w.ktx2 = std::move(*bytes);
-  w.levels = int(levels.size());
+  auto made = encode_texture(*encoder, *w.source, w.size, request, encode,
+                             "matbake " + std::string(matbake::version) + " / basisu " + encoder->version);
+  if (!made) return made.error();
+  w.ktx2 = std::move(made->file);
+  w.levels = made->levels;
+  w.coverage = std::move(made->coverage);
   return success();
 }
 

@@ -1,5 +1,8 @@
 #include "encode.hpp"
 
+#include <tbb/task_group.h>
+#include <unistd.h>
+
 #include <fstream>
 #include <iterator>
 
@@ -11,7 +14,7 @@ namespace fs = std::filesystem;
 namespace {
 
 // The level as 8-bit RGB or RGBA, grey spread to RGB, colour channels encoded as the class stores
-// them (sRGB for colour), alpha linear.
+// them (sRGB for colour), alpha linear; deflate level 0 (stored): read once, then removed.
 Result<std::string> png_bytes(const image::Image& level, const EncodeRequest& request) {
   image::Image rgb;
   static_cast<image::ImageLayout&>(rgb) = level;
@@ -29,37 +32,106 @@ Result<std::string> png_bytes(const image::Image& level, const EncodeRequest& re
   image::WriteOptions options;
   options.type = image::SampleType::u8;
   options.colour = request.texture_class == TextureClass::colour ? color::Transfer::srgb : color::Transfer::linear;
-  options.png_level = 1;  // read once by the encoder, then removed
+  options.png_level = 0;
   return image::encode_image(rgb, "level.png", options);
 }
 
 Result<std::vector<unsigned char>> read_all(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);
-  std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (!in.good() && !in.eof()) return Error{path.string(), "cannot read the encoder's output"};
-  return bytes;
+  if (!in) return Error{path.string(), "the encoder wrote no file"};
+  return std::vector<unsigned char>((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
 }
 
-// Writes the level as a scratch PNG, runs basisu on it into a scratch KTX2 and returns that file.
-Result<std::vector<unsigned char>> run_on(const Encoder& encoder, const image::Image& level, const EncodeRequest& request,
-                                          std::vector<std::string> args) {
-  auto png = png_bytes(level, request);
-  if (!png) return png.error();
-  const fs::path stem = request.scratch;
-  auto input = AtomicFile::create(fs::path(stem).replace_extension(".basisu-in.png"));
-  auto output = AtomicFile::create(fs::path(stem).replace_extension(".basisu-out.ktx2"));
-  auto log = AtomicFile::create(fs::path(stem).replace_extension(".basisu.log"));
-  for (const auto* made : {&input, &output, &log}) {
-    if (!*made) return made->error();
+// Files basisu names itself (after its inputs), removed when the run's scratch files go.
+struct EncoderOutputs {
+  std::vector<fs::path> paths;
+  ~EncoderOutputs() {
+    for (const fs::path& p : paths) ::unlink(p.c_str());
   }
-  {
+};
+
+// One basisu run over `levels`: each written as a scratch PNG, each encoded into a KTX2 file beside
+// it; their bytes, in order.
+Result<std::vector<std::vector<unsigned char>>> run_on(const Encoder& encoder, const std::vector<const image::Image*>& levels,
+                                                       const EncodeRequest& request, std::vector<std::string> args) {
+  std::vector<AtomicFile> inputs;
+  auto log = AtomicFile::create(fs::path(request.scratch).replace_extension(".basisu.log"));
+  if (!log) return log.error();
+  for (const image::Image* level : levels) {
+    auto png = png_bytes(*level, request);
+    if (!png) return png.error();
+    auto input = AtomicFile::create(fs::path(request.scratch).replace_extension(".basisu-in.png"));
+    if (!input) return input.error();
     std::ofstream out(input->temp_path(), std::ios::binary);
     out.write(png->data(), std::streamsize(png->size()));
     if (!out) return Error{input->temp_path().string(), "cannot write the encoder's input"};
+    inputs.push_back(std::move(*input));
   }
-  args.insert(args.end(), {"-output_file", output->temp_path().string(), input->temp_path().string()});
+  EncoderOutputs outputs;  // declared after the inputs: removed first, so their folder can go with them
+  args.insert(args.end(), {"-max_threads", std::to_string(request.threads), "-output_path", log->temp_path().parent_path().string()});
+  for (const AtomicFile& input : inputs) {
+    args.push_back(input.temp_path().string());
+    outputs.paths.push_back(fs::path(input.temp_path()).replace_extension(".ktx2"));
+  }
   if (Status s = run_encoder(encoder, args, log->temp_path(), request.scratch.string()); !s) return s.error();
-  return read_all(output->temp_path());
+  std::vector<std::vector<unsigned char>> files;
+  for (const fs::path& p : outputs.paths) {
+    auto bytes = read_all(p);
+    if (!bytes) return bytes.error();
+    files.push_back(std::move(*bytes));
+  }
+  return files;
+}
+
+// The UASTC blocks of each file basisu wrote for one level.
+Result<std::vector<unsigned char>> blocks_of(const Encoder& encoder, const std::vector<unsigned char>& file, const image::Image& level,
+                                             const std::string& name) {
+  auto texture = ktx2::read(file, name + " (basisu's output)");
+  if (!texture) return texture.error();
+  if (texture->descriptor.model != ktx2::kModelUASTC || texture->supercompression != ktx2::kSupercompressionNone ||
+      texture->width != unsigned(level.width) || texture->height != unsigned(level.height)) {
+    return Error{name, "basisu " + encoder.version + " wrote an unexpected KTX2 file (not plain UASTC of the level's size)"};
+  }
+  return ktx2::level_data(*texture, 0, name);
+}
+
+// UASTC: level 0 encoded while the other levels are made, then the other levels in one run while
+// level 0 is supercompressed.
+Result<std::vector<ktx2::Level>> uastc_levels(const Encoder& encoder, const image::Image& level0, tbb::task_group& work,
+                                              const std::vector<image::Image>& rest, const EncodeRequest& request) {
+  const std::vector<std::string> args = encoder_arguments(request);
+  std::vector<Result<ktx2::Level>> stored;
+  auto first = run_on(encoder, {&level0}, request, args);
+  work.wait();  // the other levels
+  if (!first) return first.error();
+  std::vector<const image::Image*> others;
+  for (const image::Image& l : rest) others.push_back(&l);
+  std::vector<std::vector<unsigned char>> blocks(1 + rest.size());
+  stored.assign(blocks.size(), Error{"", "not encoded"});
+  const std::string name = request.scratch.string();
+  auto supercompress = [&](std::size_t l, const image::Image& level, const std::vector<unsigned char>& file) {
+    auto b = blocks_of(encoder, file, level, name);
+    if (!b) {
+      stored[l] = b.error();
+      return;
+    }
+    blocks[l] = std::move(*b);
+    work.run([&stored, &blocks, l, zstd = request.options.zstd] { stored[l] = ktx2::uastc_level(std::move(blocks[l]), zstd); });
+  };
+  supercompress(0, level0, (*first)[0]);
+  auto later = others.empty() ? Result<std::vector<std::vector<unsigned char>>>(std::vector<std::vector<unsigned char>>{})
+                              : run_on(encoder, others, request, args);
+  if (later) {
+    for (std::size_t i = 0; i < rest.size(); ++i) supercompress(i + 1, rest[i], (*later)[i]);
+  }
+  work.wait();
+  if (!later) return later.error();
+  std::vector<ktx2::Level> levels;
+  for (Result<ktx2::Level>& l : stored) {
+    if (!l) return l.error();
+    levels.push_back(std::move(*l));
+  }
+  return levels;
 }
 
 }  // namespace
@@ -86,8 +158,9 @@ std::vector<std::string> encoder_arguments(const EncodeRequest& request) {
   }
   args.insert(args.end(), {"-q", std::to_string(o.quality)});
   if (request.mipmaps) {
-    // From the base at every level, in linear light for colour, renormalised normals.
-    args.insert(args.end(), {"-mipmap", "-mip_slow", "-mip_filter", request.sampling.filter == Filter::box ? "box" : "kaiser",
+    // basisu's chain (each level from the one before: -mip_slow's levels from the base cost 50% more
+    // time for no measured gain, docs/delivery.md), in linear light for colour, renormalised normals.
+    args.insert(args.end(), {"-mipmap", "-mip_filter", request.sampling.filter == Filter::box ? "box" : "kaiser",
                              request.texture_class == TextureClass::colour ? "-mip_srgb" : "-mip_linear"});
     if (request.texture_class == TextureClass::normal) args.push_back("-mip_renorm");
     if (request.sampling.wrap_s == Wrap::clamp || request.sampling.wrap_t == Wrap::clamp) args.push_back("-mip_clamp");
@@ -95,24 +168,40 @@ std::vector<std::string> encoder_arguments(const EncodeRequest& request) {
   return args;
 }
 
-Result<std::vector<unsigned char>> encode_uastc_level(const Encoder& encoder, const image::Image& level, const EncodeRequest& request) {
-  std::vector<std::string> args = encoder_arguments(request);
-  args.insert(args.end(), {"-max_threads", std::to_string(request.threads)});
-  auto file = run_on(encoder, level, request, args);
-  if (!file) return file.error();
-  auto texture = ktx2::read(*file, request.scratch.string() + " (basisu's output)");
-  if (!texture) return texture.error();
-  if (texture->descriptor.model != ktx2::kModelUASTC || texture->supercompression != ktx2::kSupercompressionNone ||
-      texture->width != unsigned(level.width) || texture->height != unsigned(level.height)) {
-    return Error{request.scratch.string(), "basisu " + encoder.version + " wrote an unexpected KTX2 file (not plain UASTC of the level's size)"};
+Result<Encoded> encode_texture(const Encoder& encoder, const image::Image& source, Size base, const MipRequest& mips,
+                               const EncodeRequest& request, const std::string& writer) {
+  const bool uastc = request.options.codec == Codec::uastc;
+  std::vector<Size> sizes = uastc && request.mipmaps ? mip_sizes(base) : std::vector<Size>{base};
+  const image::Image level0 = std::move(mip_levels(source, {base}, mips)[0]);
+  std::vector<image::Image> rest;
+  tbb::task_group work;
+  if (sizes.size() > 1) work.run([&] { rest = mip_levels(source, {sizes.begin() + 1, sizes.end()}, mips); });
+  Encoded out;
+  if (!uastc) {
+    auto file = run_on(encoder, {&level0}, request, encoder_arguments(request));
+    work.wait();
+    if (!file) return file.error();
+    out.file = std::move((*file)[0]);
+    auto read = ktx2::read(out.file, request.scratch.string());  // basisu's own chain: its level count
+    if (!read) return read.error();
+    out.levels = int(read->levels.size());
+  } else {
+    auto levels = uastc_levels(encoder, level0, work, rest, request);
+    if (!levels) return levels.error();
+    ktx2::UastcFile file{.width = unsigned(base.width), .height = unsigned(base.height),
+                         .transfer = request.texture_class == TextureClass::colour ? ktx2::kTransferSRGB : ktx2::kTransferLinear,
+                         .channel = request.alpha ? ktx2::kUastcRGBA : ktx2::kUastcRGB, .levels = std::move(*levels),
+                         .zstd = request.options.zstd > 0, .writer = writer};
+    auto bytes = ktx2::write_uastc(file);
+    if (!bytes) return bytes.error();
+    out.file = std::move(*bytes);
+    out.levels = int(sizes.size());
   }
-  return ktx2::level_data(*texture, 0, request.scratch.string());
-}
-
-Result<std::vector<unsigned char>> encode_etc1s(const Encoder& encoder, const image::Image& base, const EncodeRequest& request) {
-  std::vector<std::string> args = encoder_arguments(request);
-  args.insert(args.end(), {"-max_threads", std::to_string(request.threads)});
-  return run_on(encoder, base, request, args);
+  if (mips.alpha_cutoff) {
+    out.coverage = {alpha_coverage(source, *mips.alpha_cutoff), alpha_coverage(level0, *mips.alpha_cutoff)};
+    for (const image::Image& l : rest) out.coverage.push_back(alpha_coverage(l, *mips.alpha_cutoff));
+  }
+  return out;
 }
 
 }  // namespace matbake::delivery

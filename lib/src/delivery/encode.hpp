@@ -1,7 +1,8 @@
 #pragma once
-// A texture's levels through basisu: UASTC level by level (each level an 8-bit PNG in, one KTX2 of
-// one level out, its blocks taken), assembled by ktx2::write_uastc; ETC1S in one run from level 0,
-// basisu making the mips (its BasisLZ codebooks span every level, so given levels cannot be joined).
+// A texture through basisu. UASTC: matbake's levels, each an 8-bit PNG in and a one-level KTX2 out
+// (level 0 in one run, the others in a second), their blocks assembled by ktx2::write_uastc with zstd
+// supercompression running beside the encoder. ETC1S: one run from level 0, basisu making the mips
+// (its BasisLZ codebooks span every level, so given levels cannot be joined).
 #include <filesystem>
 #include <vector>
 
@@ -14,7 +15,7 @@ struct EncodeRequest {
   TextureClass texture_class = TextureClass::colour;
   ClassOptions options;
   Sampling sampling;            // ETC1S: basisu's own mip filter and edges
-  bool mipmaps = true;          // ETC1S: basisu makes the chain
+  bool mipmaps = true;
   bool alpha = false;           // RGBA, else RGB (has_alpha)
   std::filesystem::path scratch;  // a file name in the output folder: scratch files go beside it,
                                   // in the process's temporary folder (removed on an interrupt)
@@ -24,13 +25,18 @@ struct EncodeRequest {
 // Whether a texture needs its alpha: it has an alpha channel with a texel below 1 in 8 bits.
 bool has_alpha(const image::Image& im);
 
-// The UASTC blocks of one level (16 bytes per 4 × 4 block, rows of blocks top first).
-Result<std::vector<unsigned char>> encode_uastc_level(const Encoder& encoder, const image::Image& level,
-                                                      const EncodeRequest& request);
-// A whole ETC1S KTX2 file from level 0, as basisu writes it.
-Result<std::vector<unsigned char>> encode_etc1s(const Encoder& encoder, const image::Image& base, const EncodeRequest& request);
+struct Encoded {
+  std::vector<unsigned char> file;  // the KTX2 file
+  int levels = 0;
+  std::vector<double> coverage;     // with an alpha cutoff: the source's, then each level made here
+};
 
-// basisu's arguments for a class's codec settings, without files (for stamps and the docs too).
+// `source` as a KTX2 file of level 0 at `base`: the chain made with `mips` (level 1 onwards while
+// level 0 is encoded), encoded as the request says. `writer` is KTXwriter's value for files made here.
+Result<Encoded> encode_texture(const Encoder& encoder, const image::Image& source, Size base, const MipRequest& mips,
+                               const EncodeRequest& request, const std::string& writer);
+
+// basisu's arguments for a class's codec settings, without files.
 std::vector<std::string> encoder_arguments(const EncodeRequest& request);
 
 }  // namespace matbake::delivery

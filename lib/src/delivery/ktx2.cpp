@@ -142,22 +142,24 @@ std::vector<std::uint32_t> uastc_descriptor(std::uint8_t transfer, std::uint8_t 
   };
 }
 
+Result<Level> uastc_level(std::vector<unsigned char> blocks, int zstd_level) {
+  Level level;
+  level.uncompressed_length = blocks.size();
+  if (zstd_level <= 0) {
+    level.bytes = std::move(blocks);
+    return level;
+  }
+  level.bytes.resize(ZSTD_compressBound(blocks.size()));
+  const std::size_t made = ZSTD_compress(level.bytes.data(), level.bytes.size(), blocks.data(), blocks.size(), zstd_level);
+  if (ZSTD_isError(made)) return Error{"", std::string("zstd: ") + ZSTD_getErrorName(made)};
+  level.bytes.resize(made);
+  return level;
+}
+
 Result<std::vector<unsigned char>> write_uastc(const UastcFile& file) {
   const std::size_t count = file.levels.size();
   if (count == 0 || count > kMaxLevels) return Error{"", "a KTX2 file of " + std::to_string(count) + " levels"};
-  const bool zstd = file.zstd_level > 0;
-  std::vector<std::vector<unsigned char>> stored(count);
-  for (std::size_t l = 0; l < count; ++l) {
-    const auto& raw = file.levels[l];
-    if (!zstd) {
-      stored[l] = raw;
-      continue;
-    }
-    stored[l].resize(ZSTD_compressBound(raw.size()));
-    const std::size_t made = ZSTD_compress(stored[l].data(), stored[l].size(), raw.data(), raw.size(), file.zstd_level);
-    if (ZSTD_isError(made)) return Error{"", std::string("zstd: ") + ZSTD_getErrorName(made)};
-    stored[l].resize(made);
-  }
+  const bool zstd = file.zstd;
   std::vector<unsigned char> kvd;
   const std::string entry = std::string("KTXwriter") + '\0' + file.writer + '\0';
   append_u32(kvd, std::uint32_t(entry.size()));
@@ -182,9 +184,10 @@ Result<std::vector<unsigned char>> write_uastc(const UastcFile& file) {
     out.resize(aligned(out.size(), alignment));
     const std::size_t entry_at = kHeaderBytes + l * kLevelIndexEntryBytes;
     put_u64(out, entry_at, out.size());
-    put_u64(out, entry_at + 8, stored[l].size());
-    put_u64(out, entry_at + 16, file.levels[l].size());
-    out.insert(out.end(), stored[l].begin(), stored[l].end());
+    const Level& level = file.levels[l];
+    put_u64(out, entry_at + 8, level.bytes.size());
+    put_u64(out, entry_at + 16, level.uncompressed_length);
+    out.insert(out.end(), level.bytes.begin(), level.bytes.end());
   }
   return out;
 }

@@ -200,7 +200,10 @@ double alpha_coverage(const image::Image& im, float cutoff) {
 }
 
 std::vector<image::Image> mip_chain(const image::Image& source, Size base, const MipRequest& request, bool whole_chain) {
-  const std::vector<Size> sizes = whole_chain ? mip_sizes(base) : std::vector<Size>{base};
+  return mip_levels(source, whole_chain ? mip_sizes(base) : std::vector<Size>{base}, request);
+}
+
+std::vector<image::Image> mip_levels(const image::Image& source, const std::vector<Size>& sizes, const MipRequest& request) {
   const float cutoff = request.alpha_cutoff.value_or(0.0f);
   const double coverage = request.alpha_cutoff ? alpha_coverage(source, cutoff) : 1.0;
   std::vector<image::Image> levels;
