@@ -144,7 +144,7 @@ LevelError compare(const Plane& ref, const image::Image& decoded, TextureClass c
                        255.0 * decoded.pixels[p * std::size_t(decoded.channels) + std::size_t(c)];
       sum += d * d;
     }
-    e.psnr[c] = sum == 0 ? 99 : 10 * std::log10(255.0 * 255.0 / (sum / double(pixels)));
+    e.psnr[c] = std::min(99.0, sum == 0 ? 99 : 10 * std::log10(255.0 * 255.0 / (sum / double(pixels))));  // 99: exact
   }
   if (cls == TextureClass::normal) {
     std::vector<double> angles;
