@@ -12,7 +12,7 @@ set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 testdata=$root/../shared/testdata
 build=$root/build-fuzz
-targets=(image gltf glb manifest layout materials)
+targets=(image gltf glb manifest layout materials ktx2)
 
 if [ $# -lt 2 ]; then
   echo "usage: scripts/fuzz.sh TARGET|--smoke SECONDS [libFuzzer flags...]  (targets: ${targets[*]})" >&2
@@ -66,6 +66,7 @@ run() {  # target, seconds, extra flags
     manifest) seeds=$(seed manifest -name '*.toml' ! -name 'materials.toml') ;;
     layout) seeds=$(seed layout -path '*layouts*' -name '*.json') ;;
     materials) seeds=$(seed materials -name 'materials*.toml') ;;
+    ktx2) seeds=$(seed ktx2 -name '*.ktx2') ;;
     *) echo "scripts/fuzz.sh: unknown target '$target' (${targets[*]})" >&2; exit 2 ;;
   esac
   mkdir -p "$build/corpus/$target" "$build/artifacts/$target"

@@ -293,6 +293,21 @@ TEST(Ktx2, DamagedFilesAreRefusedWithTheirName) {
   std::vector<unsigned char> cube = *bytes;
   cube[36] = 6;
   EXPECT_EQ(refused(cube), "bad.ktx2: KTX2 file is not a plain 2D texture (depth, layers or faces)");
+  std::vector<unsigned char> huge = *bytes;  // 4 × 2^31: refused before any level is read
+  huge[27] = 0x80;
+  EXPECT_EQ(refused(huge).rfind("bad.ktx2: ", 0), 0u);
+  EXPECT_NE(refused(huge), "read");
+  // A zstd level whose declared length its frame does not have (found by fuzzing: 4 GB allocated).
+  ktx2::UastcFile zstd{.width = 4, .height = 4, .levels = {*ktx2::uastc_level(bytes_of(16, 2), 3)}, .zstd = true, .writer = "w"};
+  auto packed = ktx2::write_uastc(zstd);
+  ASSERT_TRUE(packed);
+  std::vector<unsigned char> longer = *packed;
+  longer[80 + 16] = 32;  // uncompressedByteLength of level 0: 32 of a 16-byte level
+  auto t = ktx2::read(longer, "bad.ktx2");
+  ASSERT_TRUE(t);
+  auto level = ktx2::level_data(*t, 0, "bad.ktx2");
+  ASSERT_FALSE(level);
+  EXPECT_EQ(level.error().to_string(), "bad.ktx2: KTX2 level 0 declares a length its size or its zstd frame does not have");
 }
 
 // ---- With the encoder ------------------------------------------------------------------------------

@@ -2,6 +2,8 @@
 // data, the supercompression global data, then the levels, smallest first.
 #include "matbake/ktx2.hpp"
 
+#include "matbake/image.hpp"
+
 #include <zstd.h>
 
 #include <algorithm>
@@ -80,7 +82,8 @@ Result<Texture> read(std::span<const unsigned char> bytes, const std::string& na
   const std::uint32_t level_count = std::max<std::uint32_t>(1, u32_at(bytes, 40));
   t.supercompression = u32_at(bytes, 44);
   if (depth != 0 || layers != 0 || faces != 1) return Error{name, "KTX2 file is not a plain 2D texture (depth, layers or faces)"};
-  if (t.width == 0 || t.height == 0) return Error{name, "KTX2 file of width or height 0"};
+  // Within the pixel limit of every image matbake holds, before any level is inflated.
+  if (Status s = image::check_image_size(name, t.width, t.height); !s) return s.error();
   if (level_count > kMaxLevels) return Error{name, "KTX2 file declares " + std::to_string(level_count) + " levels"};
   const std::uint32_t dfd_offset = u32_at(bytes, 48), dfd_length = u32_at(bytes, 52);
   const std::uint32_t kvd_offset = u32_at(bytes, 56), kvd_length = u32_at(bytes, 60);
@@ -114,9 +117,12 @@ Result<std::vector<unsigned char>> level_data(const Texture& texture, std::size_
   if (level >= texture.levels.size()) return Error{name, "KTX2 file has no level " + std::to_string(level)};
   const Level& l = texture.levels[level];
   if (texture.supercompression != kSupercompressionZstd) return l.bytes;
-  // A level holds at most 16 bytes per texel (the largest block format per texel there is).
+  // A Basis Universal level holds 16 bytes per 4 × 4 block, and the zstd frame says its own size.
   const std::uint64_t w = std::max<std::uint64_t>(1, texture.width >> level), h = std::max<std::uint64_t>(1, texture.height >> level);
-  if (l.uncompressed_length > 16 * (w + 3) * (h + 3)) return Error{name, "KTX2 level " + std::to_string(level) + " declares too many bytes"};
+  const unsigned long long framed = ZSTD_getFrameContentSize(l.bytes.data(), l.bytes.size());
+  if (l.uncompressed_length > 16 * ((w + 3) / 4) * ((h + 3) / 4) || framed != l.uncompressed_length) {
+    return Error{name, "KTX2 level " + std::to_string(level) + " declares a length its size or its zstd frame does not have"};
+  }
   std::vector<unsigned char> out(l.uncompressed_length);
   const std::size_t made = ZSTD_decompress(out.data(), out.size(), l.bytes.data(), l.bytes.size());
   if (ZSTD_isError(made) || made != out.size()) {
