@@ -31,22 +31,7 @@ using namespace matbake::delivery;
 
 namespace {
 
-// ---- The float64 reference: the documented Kaiser filter, separable, repeat edges ------------------
-
-double bessel_i0(double x) {
-  double sum = 1, term = 1;
-  for (int k = 1; term > 1e-17 * sum; ++k) {
-    term *= (x / (2 * k)) * (x / (2 * k));
-    sum += term;
-  }
-  return sum;
-}
-
-double kaiser(double x) {
-  if (std::abs(x) >= 3) return 0;
-  const double t = x / 3, px = std::numbers::pi * x;
-  return (x == 0 ? 1 : std::sin(px) / px) * bessel_i0(4 * std::sqrt(1 - t * t)) / bessel_i0(4);
-}
+// ---- The float64 reference: the documented Kaiser weights, separable, summed in float64, repeat edges
 
 struct Plane {
   int width = 0, height = 0, channels = 0;
@@ -66,7 +51,7 @@ Plane shrink_axis(const Plane& in, int size, bool along_x) {
     std::vector<std::pair<int, double>> taps;
     double sum = 0;
     for (int i = int(std::floor(centre - 3 * footprint)); i <= int(std::ceil(centre + 3 * footprint)); ++i) {
-      const double w = kaiser((i + 0.5 - centre) / footprint);
+      const double w = kaiser_weight((i + 0.5 - centre) / footprint);
       if (w == 0) continue;
       taps.emplace_back(((i % n) + n) % n, w);
       sum += w;

@@ -105,6 +105,10 @@ std::vector<Size> mip_sizes(Size base);
 
 // ---- Resampling and mip chains ---------------------------------------------------------------------
 
+// The Kaiser-windowed sinc's weight at distance x (in output texels) from a texel's centre: radius
+// 3, β = 4 (what resample uses, and the bench's float64 reference).
+double kaiser_weight(double x);
+
 struct Sampling {
   Filter filter = Filter::kaiser;
   Wrap wrap_s = Wrap::repeat, wrap_t = Wrap::repeat;

@@ -26,14 +26,17 @@ double bessel_i0(double x) {
   return sum;
 }
 
-// The Kaiser-windowed sinc at distance x (in output texels) from a texel's centre.
-double kaiser(double x) {
+}  // namespace
+
+double kaiser_weight(double x) {
   if (std::abs(x) >= kKaiserRadius) return 0;
   const double t = x / kKaiserRadius;
   const double window = bessel_i0(kKaiserBeta * std::sqrt(1 - t * t)) / bessel_i0(kKaiserBeta);
   const double px = std::numbers::pi * x;
   return (x == 0 ? 1 : std::sin(px) / px) * window;
 }
+
+namespace {
 
 int wrapped(int i, int n, Wrap wrap) {
   switch (wrap) {
@@ -76,7 +79,7 @@ Axis axis_taps(int source, int target, Filter filter, Wrap wrap) {
     } else {
       const double reach = kKaiserRadius * footprint;
       for (int i = int(std::floor(centre - reach)); i <= int(std::ceil(centre + reach)); ++i) {
-        const double w = kaiser((i + 0.5 - centre) / footprint);
+        const double w = kaiser_weight((i + 0.5 - centre) / footprint);
         if (w != 0) raw.emplace_back(i, w);
       }
     }
