@@ -38,6 +38,9 @@ void print_stale(const pipeline::StaleOutputs& stale, bool dry_run) {
   for (const fs::path& p : stale.changed) {
     std::printf("left %s: no job makes it now, but it changed since matbake wrote it\n", p.c_str());
   }
+  for (const std::string& entry : stale.refused) {
+    std::cerr << "matbake: warning: made.json lists " << escape_control(entry) << "; not removed (matbake removes only files it provably made)\n";
+  }
 }
 
 void add_output_dir_option(CLI::App& cmd, std::string& output_dir) {
@@ -77,13 +80,11 @@ int run_status(const BuildSettings& s, const GlobalOptions& global, const pipeli
   return failed ? kFailed : kOk;
 }
 
-// submit.sh and job.sh in `folder`, made if need be; neither may be an input of the manifest.
+// submit.sh and job.sh in `folder`, made if need be; neither may be a file the build reads or writes.
 Status write_slurm_scripts(const pipeline::Manifest& manifest, const pipeline::Plan& plan,
                            const pipeline::SlurmScripts& scripts, const fs::path& folder) {
-  const NamedOutput outputs[] = {{folder / "submit.sh", "submission script"}, {folder / "job.sh", "job script"}};
-  std::vector<fs::path> inputs{manifest.file};
-  for (const pipeline::Job& job : plan.jobs) inputs.insert(inputs.end(), job.inputs.begin(), job.inputs.end());
-  if (Status st = check_outputs(outputs, inputs); !st) return st;
+  const NamedOutput outputs[] = {{folder / "submit.sh", "-o"}, {folder / "job.sh", "-o"}};
+  if (Status st = pipeline::check_side_outputs(manifest, plan, outputs); !st) return st;
   std::error_code ec;
   fs::create_directories(folder, ec);
   if (ec) return Error{folder.string(), "cannot make the folder: " + ec.message()};
@@ -185,6 +186,8 @@ int run_plan(const PlanSettings& s, const GlobalOptions& global) {
   std::error_code ec;
   const fs::path self = s.matbake.empty() ? fs::read_symlink("/proc/self/exe", ec) : fs::absolute(s.matbake);
   if (s.format == "slurm") return run_slurm_plan(s, global, manifest, *plan, self);
+  const NamedOutput ninja_file[] = {{s.output, "-o"}};
+  if (Status st = pipeline::check_side_outputs(manifest, *plan, ninja_file); !st) return report_error(st.error());
   if (Status st = write_file_atomically(s.output, pipeline::ninja_text(manifest, *plan, self, s.output)); !st) {
     return report_error(st.error());
   }
@@ -205,6 +208,8 @@ int run_build(const BuildSettings& s, const GlobalOptions& global) {
   auto plan = load(s.manifest, s.output_dir, manifest);
   if (!plan) return report_error(plan.error());
   if (s.status) return run_status(s, global, manifest, *plan);
+  const NamedOutput side_outputs[] = {{s.depfile, "--depfile"}, {s.stamp, "--stamp"}};
+  if (Status st = pipeline::check_side_outputs(manifest, *plan, side_outputs); !st) return report_error(st.error());
   if (!global.quiet) {
     for (const std::string& w : plan->warnings) std::cerr << "matbake: warning: " << w << "\n";
   }

@@ -76,7 +76,9 @@ RunResult matbake(const std::vector<std::string>& args, const std::vector<std::s
   if (!std::getenv("MATBAKE_BASISU") && ::access(installed.c_str(), X_OK) == 0) {
     with_encoder.insert(with_encoder.begin(), "MATBAKE_BASISU=" + installed.string());
   }
-  return run(MATBAKE_EXE, args, with_encoder);
+  // MATBAKE_TEST_EXE: another build's matbake (an earlier commit's), to show a new test failing on it.
+  const char* other = std::getenv("MATBAKE_TEST_EXE");
+  return run(other && *other ? other : MATBAKE_EXE, args, with_encoder);
 }
 
 }  // namespace matbake::test

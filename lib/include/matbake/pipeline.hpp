@@ -24,6 +24,8 @@
 #include "matbake/enum_names.hpp"
 #include "matbake/export.hpp"
 #include "matbake/image.hpp"
+#include "matbake/output_check.hpp"
+#include "matbake/output_gate.hpp"
 #include "matbake/pack.hpp"
 #include "matbake/result.hpp"
 #include "matbake/validate.hpp"
@@ -177,6 +179,10 @@ struct StaleOutputs {
   std::vector<std::filesystem::path> removed;  // at the end of a full run with no failure
   std::vector<std::filesystem::path> kept;     // --keep-stale, --only, a failed job or a dry run: removed later
   std::vector<std::filesystem::path> changed;  // changed since matbake wrote them: left alone, forgotten
+  // Entries of the log that do not provably name a file matbake made in the output folder (a path
+  // out of it, through a link, an alias of a live output, an input): each with why; left alone,
+  // forgotten.
+  std::vector<std::string> refused;
 };
 
 struct RunOptions {
@@ -220,6 +226,15 @@ Result<std::vector<JobStatus>> job_statuses(const Manifest& manifest, const Plan
 // the output folder, each job (name, outcome, inputs, outputs, seconds, warnings, reason, error,
 // details), the counts by outcome, images decoded and the plan's warnings.
 nlohmann::json json_report(const Manifest& manifest, const Plan& plan, const Report& report);
+
+// The gate of the plan's output folder: it protects the manifest and every input and output of
+// every job (docs/reliability.md).
+OutputGate output_gate(const Manifest& manifest, const Plan& plan);
+
+// Files written on request beside a build (--depfile, --stamp, plan -o, a Slurm folder's scripts),
+// checked before any work: none may be a file the build reads or writes, lie in the output
+// folder's state folder, or be another of them. A usage error naming the option and the file.
+Status check_side_outputs(const Manifest& manifest, const Plan& plan, std::span<const NamedOutput> outputs);
 
 // What a build step leaves for the build tool that runs it (CMake, Ninja): a Make depfile of the
 // manifest and every input the jobs read, whose targets are the jobs' outputs or, when given,

@@ -10,7 +10,6 @@
 #include <set>
 
 #include "matbake/atomic_file.hpp"
-#include "matbake/read_file.hpp"
 
 namespace matbake::pipeline {
 namespace fs = std::filesystem;
@@ -20,19 +19,50 @@ constexpr int kLogForm = 1;
 
 fs::path log_path(const StampRoots& roots) { return roots.state_folder / "made.json"; }
 
-MadeLog::Files files_in(const nlohmann::json& j) {
+bool is_hash(const nlohmann::json& h) {
+  if (!h.is_string()) return false;
+  const std::string& text = h.get_ref<const std::string&>();
+  return text.size() == 16 && text.find_first_not_of("0123456789abcdef") == std::string::npos;
+}
+
+// Files by path, each with a hash; empty (and `problem` said) when `j` is not that.
+MadeLog::Files files_in(const nlohmann::json& j, std::string& problem) {
   MadeLog::Files files;
-  if (!j.is_object()) return files;
+  if (!j.is_object()) {
+    problem = "a list of files that is not an object";
+    return files;
+  }
   for (const auto& [path, hash] : j.items()) {
-    if (hash.is_string()) files[path] = hash.get<std::string>();
+    if (!is_hash(hash)) {
+      problem = "a file without its hash";
+      return {};
+    }
+    files[path] = hash.get<std::string>();
   }
   return files;
+}
+
+// The log in `j`, or why it is not one matbake wrote.
+std::string parse_log(const nlohmann::json& j, MadeLog& log) {
+  if (j.is_discarded()) return "is not JSON";
+  if (!j.is_object() || !j.contains("form") || j["form"] != kLogForm) return "is not a log of this matbake (form " + std::to_string(kLogForm) + ")";
+  if (!j.contains("jobs") || !j["jobs"].is_object() || !j.contains("stale")) return "has no jobs or stale files";
+  std::string problem;
+  for (const auto& [name, files] : j["jobs"].items()) {
+    log.jobs[name] = files_in(files, problem);
+    if (!problem.empty()) return "has " + problem;
+  }
+  log.stale = files_in(j["stale"], problem);
+  return problem.empty() ? problem : "has " + problem;
 }
 
 }  // namespace
 
 MadeLogLock::MadeLogLock(const StampRoots& roots) {
-  fd_ = ::open((roots.state_folder / "made.lock").c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  // O_NOFOLLOW: a link planted as the lock would otherwise make its target, wherever it points.
+  const fs::path file = roots.state_folder / "made.lock";
+  fd_ = ::open(file.c_str(), O_RDWR | O_CREAT | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC, 0644);
+  if (fd_ < 0 && errno == ELOOP) problem_ = file.string() + " is a link (matbake's state files never are); the log of files made is not updated";
   while (fd_ >= 0 && ::flock(fd_, LOCK_EX) != 0 && errno == EINTR) {
   }
 }
@@ -41,16 +71,13 @@ MadeLogLock::~MadeLogLock() {
   if (fd_ >= 0) ::close(fd_);
 }
 
-MadeLog read_made_log(const StampRoots& roots) {
+MadeLog read_made_log(const StampRoots& roots, std::string& problem) {
+  const StateText read = read_state_file(log_path(roots), kMadeLogLimit);
+  problem = read.problem;
   MadeLog log;
-  std::string text;
-  if (!read_whole_file(log_path(roots), text)) return log;
-  const nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
-  if (j.is_discarded() || !j.is_object() || j.value("form", 0) != kLogForm) return log;
-  if (j.contains("jobs") && j["jobs"].is_object()) {
-    for (const auto& [name, files] : j["jobs"].items()) log.jobs[name] = files_in(files);
-  }
-  if (j.contains("stale")) log.stale = files_in(j["stale"]);
+  if (read.absent || !problem.empty()) return log;
+  problem = parse_log(nlohmann::json::parse(read.text, nullptr, false), log);
+  if (!problem.empty()) log = {};
   return log;
 }
 
@@ -91,22 +118,20 @@ std::vector<std::string> record_run(MadeLog& log, const Plan& plan, const Report
   return gone;
 }
 
-StaleOutputs clean_stale(MadeLog& log, const StampRoots& roots, bool remove) {
+StaleOutputs clean_stale(MadeLog& log, const OutputGate& gate, const StampRoots& roots, bool remove) {
   StaleOutputs result;
   for (auto it = log.stale.begin(); it != log.stale.end();) {
+    const RemoveResult r = gate.remove_made(it->first, it->second, !remove);
     const fs::path file = resolved_path(it->first, roots.outputs);
-    std::error_code ec;
-    const std::optional<FileIdentity> now = fs::is_regular_file(file, ec) ? identify(file) : std::nullopt;
-    if (!now || now->hash != it->second) {
-      if (now) result.changed.push_back(file);
-      it = log.stale.erase(it);
-    } else if (remove && fs::remove(file, ec)) {
-      result.removed.push_back(file);
-      it = log.stale.erase(it);
-    } else {
+    if (r.outcome == RemoveOutcome::removed && !remove) {
       result.kept.push_back(file);
       ++it;
+      continue;
     }
+    if (r.outcome == RemoveOutcome::removed) result.removed.push_back(file);
+    if (r.outcome == RemoveOutcome::changed) result.changed.push_back(file);
+    if (r.outcome == RemoveOutcome::refused) result.refused.push_back("'" + it->first + "': " + r.why);
+    it = log.stale.erase(it);
   }
   return result;
 }

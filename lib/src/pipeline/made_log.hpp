@@ -6,6 +6,7 @@
 #include <map>
 #include <string>
 
+#include "matbake/output_gate.hpp"
 #include "matbake/pipeline.hpp"
 #include "state.hpp"
 
@@ -28,12 +29,16 @@ class MadeLogLock {
   MadeLogLock(const MadeLogLock&) = delete;
   MadeLogLock& operator=(const MadeLogLock&) = delete;
   ~MadeLogLock();
+  const std::string& problem() const { return problem_; }  // the lock is a link: nothing held
 
  private:
   int fd_ = -1;
+  std::string problem_;
 };
 
-MadeLog read_made_log(const StampRoots& roots);  // empty when there is none or it is unreadable
+// Empty when there is none, or when it is not a log matbake wrote (too large, a link, a field of
+// the wrong type): then `problem` says why, and the run warns and starts a new log.
+MadeLog read_made_log(const StampRoots& roots, std::string& problem);
 Status write_made_log(const MadeLog& log, const StampRoots& roots);
 
 // The log after this run: a built job's entry becomes what it wrote; the files it no longer writes,
@@ -41,8 +46,9 @@ Status write_made_log(const MadeLog& log, const StampRoots& roots);
 // Returns the names of the jobs the plan no longer has.
 std::vector<std::string> record_run(MadeLog& log, const Plan& plan, const Report& report, const StampRoots& roots);
 
-// The stale files: removed when `remove` and still as written, else kept in the log; a file changed
-// since it was written (or gone) leaves the log untouched on disk.
-StaleOutputs clean_stale(MadeLog& log, const StampRoots& roots, bool remove);
+// The stale files, through the gate: removed when `remove` and provably as matbake wrote them, else
+// kept in the log; one changed since it was written, gone, or refused by the gate leaves the log
+// (and the disk untouched).
+StaleOutputs clean_stale(MadeLog& log, const OutputGate& gate, const StampRoots& roots, bool remove);
 
 }  // namespace matbake::pipeline

@@ -346,6 +346,24 @@ Result<Plan> make_plan(const Manifest& manifest) {
   });
 }
 
+OutputGate output_gate(const Manifest& manifest, const Plan& plan) {
+  std::vector<fs::path> protect{manifest.file};
+  for (const Job& job : plan.jobs) {
+    protect.insert(protect.end(), job.inputs.begin(), job.inputs.end());
+    for (fs::path& out : job.outputs.all()) protect.push_back(std::move(out));
+  }
+  return OutputGate(manifest.output, protect);
+}
+
+Status check_side_outputs(const Manifest& manifest, const Plan& plan, std::span<const NamedOutput> outputs) {
+  const OutputGate gate = output_gate(manifest, plan);
+  for (const NamedOutput& out : outputs) {
+    if (out.path.empty()) continue;
+    if (Status s = gate.check_side_output(out.path, out.role); !s) return s;
+  }
+  return check_outputs(outputs, {});  // no two are one file
+}
+
 std::string depfile_text(const std::vector<fs::path>& targets, const std::vector<fs::path>& inputs) {
   std::string text;
   for (const fs::path& t : targets) text += (text.empty() ? "" : " ") + make_escape(t.string());

@@ -43,7 +43,8 @@ nlohmann::json json_report(const Manifest& manifest, const Plan& plan, const Rep
                       {"images_decoded", report.images_decoded},
                       {"stale", {{"removed", strings(report.stale.removed)},
                                  {"kept", strings(report.stale.kept)},
-                                 {"changed", strings(report.stale.changed)}}},
+                                 {"changed", strings(report.stale.changed)},
+                                 {"refused", report.stale.refused}}},
                       {"warnings", plan.warnings}};
   for (const std::string& w : report.warnings) j["warnings"].push_back(w);
   for (const auto& [outcome, name] : kOutcomeNames) j[std::string(name)] = report.count(outcome);

@@ -305,18 +305,29 @@ void run_job(const Job& job, const JobContext& ctx, const RunOptions& run_option
   report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
+MadeLog read_log(const StampRoots& roots, Report& report) {
+  std::string problem;
+  MadeLog log = read_made_log(roots, problem);
+  if (!problem.empty()) {
+    report.warnings.push_back((roots.state_folder / "made.json").string() + " " + problem +
+                              "; ignored (a new log is started, no file it lists is removed)");
+  }
+  return log;
+}
+
 // The log of files made, brought up to date, the stamps of jobs the manifest no longer has removed,
 // and after a full run with no failure the stale files too (unless kept).
-Status finish_run(const Plan& plan, const RunOptions& options, const StampRoots& roots, Report& report) {
+Status finish_run(const Manifest& manifest, const Plan& plan, const RunOptions& options, const StampRoots& roots, Report& report) {
   const MadeLogLock lock(roots);
-  const MadeLog before = read_made_log(roots);
+  if (!lock.problem().empty()) return Error{"", lock.problem()};
+  const MadeLog before = read_log(roots, report);
   MadeLog log = before;
   for (const std::string& name : record_run(log, plan, report, roots)) {
     remove_stamp(name, roots);
     remove_failure(name, roots);
   }
   const bool full = options.only.empty() && report.count(Outcome::failed) == 0;
-  report.stale = clean_stale(log, roots, full && !options.keep_stale);
+  report.stale = clean_stale(log, output_gate(manifest, plan), roots, full && !options.keep_stale);
   return log == before ? success() : write_made_log(log, roots);  // a no-op run writes nothing
 }
 
@@ -362,10 +373,13 @@ Result<Report> run(const Manifest& manifest, const Plan& plan, const RunOptions&
     }
     report.jobs.push_back(std::move(r));
   }
+  for (const JobReport& r : report.jobs) {
+    if (r.reason.rfind(kBadStamp, 0) == 0) report.warnings.push_back(r.reason.substr(std::string_view(kBadStamp).size()) + "; " + r.job->name + " rebuilds");
+  }
   if (options.dry_run) {
-    MadeLog log = read_made_log(roots);
+    MadeLog log = read_log(roots, report);
     record_run(log, plan, report, roots);
-    report.stale = clean_stale(log, roots, false);
+    report.stale = clean_stale(log, output_gate(manifest, plan), roots, false);
     return report;
   }
   if (Status s = ensure_folder(plan.state_folder); !s) return s.error();
@@ -416,7 +430,7 @@ Result<Report> run(const Manifest& manifest, const Plan& plan, const RunOptions&
   report.images_decoded = cache.decoded();
   // The log is a convenience (stale files found later), not an output: a full disk or a read-only
   // folder that lets no job write has already failed the jobs, each with its error line.
-  if (Status s = finish_run(plan, options, roots, report); !s) {
+  if (Status s = finish_run(manifest, plan, options, roots, report); !s) {
     report.warnings.push_back("the log of files made was not updated: " + s.error().to_string());
   }
   return report;

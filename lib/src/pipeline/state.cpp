@@ -1,11 +1,15 @@
 #include "state.hpp"
 
+#include <fcntl.h>
 #include <nlohmann/json.hpp>
 #include <sys/stat.h>
-#include <xxhash.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
 
 #include "matbake/atomic_file.hpp"
-#include "matbake/read_file.hpp"
+#include "matbake/output_gate.hpp"
 #include "matbake/version.hpp"
 
 namespace matbake::pipeline {
@@ -26,7 +30,40 @@ nlohmann::json stamped_file_json(const FileIdentity& f, const std::string& path)
 }
 
 FileIdentity identity_in(const nlohmann::json& f) {
-  return {f.value("size", std::uintmax_t(0)), f.value("mtime", std::int64_t(0)), f.value("hash", "")};
+  return {f["size"].get<std::uintmax_t>(), f["mtime"].get<std::int64_t>(), f["hash"].get<std::string>()};
+}
+
+// Why a file entry of a stamp is not one matbake wrote, or empty.
+std::string file_entry_problem(const nlohmann::json& f, bool output) {
+  if (!f.is_object() || !f.contains("path") || !f["path"].is_string()) return "a file without a path";
+  if (!f.contains("size") || !f["size"].is_number_unsigned() || !f.contains("mtime") || !f["mtime"].is_number_integer() ||
+      !f.contains("hash") || !f["hash"].is_string()) {
+    return "a file without its size, time or hash";
+  }
+  const std::string path = f["path"].get<std::string>();
+  if (path.empty() || path.find('\0') != std::string::npos) return "an empty path";
+  if (output) {
+    if (const std::string problem = recorded_path_problem(path); !problem.empty()) return "an output path with " + problem;
+  }
+  return {};
+}
+
+// Why a stamp's JSON is not one matbake wrote (every field of the right type), or empty.
+std::string stamp_problem(const nlohmann::json& stamp) {
+  if (!stamp.is_object()) return "not a JSON object";
+  if (!stamp.contains("form")) return {};  // the first form had none: said as older
+  if (!stamp["form"].is_number_integer()) return "a form that is not a number";
+  if (stamp["form"].get<std::int64_t>() != kStampForm) return {};  // an older form: said as such
+  for (const char* key : {"matbake", "options", "job"}) {
+    if (!stamp.contains(key) || !stamp[key].is_string()) return std::string("no '") + key + "' text";
+  }
+  for (const char* key : {"inputs", "outputs"}) {
+    if (!stamp.contains(key) || !stamp[key].is_array()) return std::string("no '") + key + "' list";
+    for (const nlohmann::json& f : stamp[key]) {
+      if (std::string why = file_entry_problem(f, key[0] == 'o'); !why.empty()) return why;
+    }
+  }
+  return {};
 }
 
 // Empty when the recorded file is as it was (its time refreshed in `f` when only that moved),
@@ -71,10 +108,38 @@ Result<std::vector<StampedFile>> identify_all(const std::vector<fs::path>& files
   return identified;
 }
 
-std::string content_hash(std::span<const unsigned char> bytes) {
-  char hex[17];
-  std::snprintf(hex, sizeof hex, "%016llx", (unsigned long long)XXH64(bytes.data(), bytes.size(), 0));
-  return hex;
+std::string content_hash(std::span<const unsigned char> bytes) { return hash_bytes(bytes); }
+
+StateText read_state_file(const fs::path& file, std::size_t limit) {
+  StateText out;
+  const int fd = ::open(file.c_str(), O_RDONLY | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) {
+    out.absent = errno == ENOENT;
+    if (!out.absent) out.problem = errno == ELOOP ? "is a link (matbake's state files never are)" : std::strerror(errno);
+    return out;
+  }
+  struct stat s;
+  if (::fstat(fd, &s) != 0 || !S_ISREG(s.st_mode)) {
+    out.problem = "is not a regular file";
+  } else if (std::size_t(s.st_size) > limit) {
+    out.problem = "is " + std::to_string(s.st_size) + " bytes, over the " + std::to_string(limit >> 20) + " MiB a state file may hold";
+  } else {
+    out.text.resize(std::size_t(s.st_size));
+    std::size_t done = 0;
+    while (done < out.text.size()) {
+      const ssize_t n = ::read(fd, out.text.data() + done, out.text.size() - done);
+      if (n == 0) break;
+      if (n < 0 && errno == EINTR) continue;
+      if (n < 0) {
+        out.problem = std::strerror(errno);
+        break;
+      }
+      done += std::size_t(n);
+    }
+    out.text.resize(done);
+  }
+  ::close(fd);
+  return out;
 }
 
 std::optional<FileStat> stat_file(const fs::path& file) {
@@ -90,10 +155,18 @@ std::optional<std::int64_t> modification_time(const fs::path& file) {
 }
 
 std::optional<FileIdentity> identify(const fs::path& file) {
-  const std::optional<std::int64_t> mtime = modification_time(file);
-  std::vector<unsigned char> bytes;
-  if (!mtime || !read_whole_file(file, bytes)) return std::nullopt;
-  return FileIdentity{bytes.size(), *mtime, content_hash(bytes)};
+  const int fd = ::open(file.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) return std::nullopt;
+  struct stat s;
+  std::optional<FileIdentity> identity;
+  if (::fstat(fd, &s) == 0 && S_ISREG(s.st_mode)) {
+    // The time first, then the bytes (streamed: constant memory whatever the size).
+    const std::int64_t mtime = std::int64_t(s.st_mtim.tv_sec) * 1000000000 + s.st_mtim.tv_nsec;
+    std::string hash = hash_file_descriptor(fd);
+    if (!hash.empty()) identity = FileIdentity{std::uintmax_t(s.st_size), mtime, std::move(hash)};
+  }
+  ::close(fd);
+  return identity;
 }
 
 bool changed_since(const fs::path& file, const FileIdentity& read) {
@@ -104,16 +177,18 @@ bool changed_since(const fs::path& file, const FileIdentity& read) {
 }
 
 std::string out_of_date_reason(const Job& job, const StampRoots& roots, bool refresh, std::map<fs::path, std::string>* recorded_outputs) {
-  std::string text;
-  if (!read_whole_file(stamp_path(job.name, roots), text)) return "no earlier build";
-  nlohmann::json stamp = nlohmann::json::parse(text, nullptr, false);
-  if (stamp.is_discarded() || !stamp.is_object()) return "its stamp is unreadable";
+  const fs::path file = stamp_path(job.name, roots);
+  const StateText read = read_state_file(file, kStampLimit);
+  if (read.absent) return "no earlier build";
+  nlohmann::json stamp = nlohmann::json::parse(read.text, nullptr, false);
+  std::string problem = read.problem;
+  if (problem.empty()) problem = stamp.is_discarded() ? "is not JSON" : stamp_problem(stamp);
+  if (!problem.empty()) return std::string(kBadStamp) + file.string() + " " + (read.problem.empty() ? "is not one matbake wrote: " : "") + problem;
   if (stamp.value("form", 1) != kStampForm) return "its stamp is from an older matbake (recorded anew)";
-  if (stamp.value("matbake", "") != version) return "matbake's version changed";
-  if (stamp.value("options", "") != job.options) return "its options changed";
-  if (!stamp["inputs"].is_array() || !stamp["outputs"].is_array()) return "its stamp is unreadable";
+  if (stamp["matbake"] != version) return "matbake's version changed";
+  if (stamp["options"] != job.options) return "its options changed";
   std::vector<fs::path> recorded;
-  for (const nlohmann::json& f : stamp["inputs"]) recorded.push_back(resolved_path(f.value("path", ""), roots.inputs));
+  for (const nlohmann::json& f : stamp["inputs"]) recorded.push_back(resolved_path(f["path"].get<std::string>(), roots.inputs));
   for (const fs::path& p : job.inputs) {
     if (std::find(recorded.begin(), recorded.end(), p) == recorded.end()) return "new input: " + p.string();
   }
@@ -123,7 +198,7 @@ std::string out_of_date_reason(const Job& job, const StampRoots& roots, bool ref
     if (!why.empty()) return why;
   }
   for (nlohmann::json& f : stamp["outputs"]) {
-    const fs::path p = resolved_path(f.value("path", ""), roots.outputs);
+    const fs::path p = resolved_path(f["path"].get<std::string>(), roots.outputs);
     std::string why = check_recorded(f, p, "output missing: ", "output changed since it was built: ", touched);
     if (!why.empty()) return why;
   }
@@ -131,7 +206,7 @@ std::string out_of_date_reason(const Job& job, const StampRoots& roots, bool ref
   if (touched && refresh) (void)write_file_atomically(stamp_path(job.name, roots), stamp.dump(1) + "\n");
   if (recorded_outputs) {
     for (const nlohmann::json& f : stamp["outputs"]) {
-      (*recorded_outputs)[resolved_path(f.value("path", ""), roots.outputs)] = f.value("hash", "");
+      (*recorded_outputs)[resolved_path(f["path"].get<std::string>(), roots.outputs)] = f["hash"].get<std::string>();
     }
   }
   return {};
@@ -173,9 +248,9 @@ void remove_failure(const std::string& job_name, const StampRoots& roots) {
 }
 
 std::optional<std::string> recorded_failure(const std::string& job_name, const StampRoots& roots) {
-  std::string text;
-  if (!read_whole_file(failure_path(job_name, roots), text)) return std::nullopt;
-  const nlohmann::json record = nlohmann::json::parse(text, nullptr, false);
+  const StateText read = read_state_file(failure_path(job_name, roots), kStampLimit);
+  if (!read.problem.empty() || read.absent) return std::nullopt;  // a bad record is as none: "not built"
+  const nlohmann::json record = nlohmann::json::parse(read.text, nullptr, false);
   if (!record.is_object() || !record.contains("error") || !record["error"].is_string()) return std::nullopt;
   return record["error"].get<std::string>();
 }

@@ -39,6 +39,17 @@ std::optional<FileIdentity> identify(const std::filesystem::path& file);
 // Whether the file is no longer what `read` says (the size or time differ and so do the bytes).
 bool changed_since(const std::filesystem::path& file, const FileIdentity& read);
 
+// matbake's state files (stamps, made.json, failure records) are read as hostile input: a link, a
+// file that is not regular or one over `limit` bytes is refused before it is read.
+struct StateText {
+  std::string text;     // the bytes, when read
+  std::string problem;  // why it was refused or could not be read (empty: read, or absent)
+  bool absent = false;  // no such file: not a problem
+};
+StateText read_state_file(const std::filesystem::path& file, std::size_t limit);
+inline constexpr std::size_t kStampLimit = 16u << 20;    // a scene with thousands of images: ~1 MB
+inline constexpr std::size_t kMadeLogLimit = 64u << 20;  // 100,000 files: ~10 MB
+
 struct StampedFile {
   std::filesystem::path path;  // absolute
   FileIdentity identity;
@@ -55,6 +66,8 @@ struct StampRoots {
 // checkout or a copied tree does not rebuild). With `refresh`, the stamp of an up-to-date job takes
 // the new times, so that the next run need not hash those files again.
 // `recorded` (when given) receives the stamp's outputs with their hashes when the job is up to date.
+// A reason that begins so says the stamp was refused (named, with why): the run warns of it.
+inline constexpr const char* kBadStamp = "stamp refused: ";
 std::string out_of_date_reason(const Job& job, const StampRoots& roots, bool refresh,
                                std::map<std::filesystem::path, std::string>* recorded = nullptr);
 

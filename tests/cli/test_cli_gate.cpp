@@ -1,0 +1,167 @@
+// Issue "Safe by construction": what a build writes, deletes and runs goes through one gate. Each
+// case plants what an attacker or a careless user would (a tampered output folder, an option naming
+// an input, a hostile path in a generated script) and checks every file outside the output folder
+// byte for byte before and after.
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <map>
+
+#include "matbake/output_gate.hpp"
+#include "support/expect_error.hpp"
+#include "support/files.hpp"
+#include "support/run.hpp"
+#include "support/temp_dir.hpp"
+
+namespace matbake::test {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+// Every regular file under `root` outside `skip` (the output folder), with its bytes.
+std::map<std::string, std::string> files_outside(const fs::path& root, const fs::path& skip) {
+  std::map<std::string, std::string> files;
+  for (auto it = fs::recursive_directory_iterator(root); it != fs::recursive_directory_iterator(); ++it) {
+    if (it->path() == skip) {
+      it.disable_recursion_pending();
+      continue;
+    }
+    if (it->is_regular_file() && !it->is_symlink()) files[it->path().string()] = read_bytes(it->path());
+  }
+  return files;
+}
+
+// A manifest of one material from a 2×2 PNG into the glTF ORM layout; the user's own files beside it.
+struct Library {
+  TempDir dir;
+  fs::path manifest = dir / "m.toml";
+  fs::path out = dir / "out";
+  Library() {
+    write_raw(dir / "kd.png", 2, 2, 3, "uint8", {100, 110, 120, 130, 140, 150, 160, 170, 180, 190, 200, 210});
+    write_bytes(manifest, "output = \"out\"\n[materials.m0]\nsources = { base_color = \"kd.png\", metallic = 0.0, roughness = 0.5 }\n"
+                          "layout = \"gltf-orm\"\n");
+    fs::create_directories(dir / "u");
+    write_bytes(dir / "u/notes.txt", "the user's notes");
+  }
+  RunResult build(std::vector<std::string> more = {}) const {
+    std::vector<std::string> args{"build", manifest.string()};
+    args.insert(args.end(), more.begin(), more.end());
+    return matbake(args);
+  }
+};
+
+// What made.json records of a file (the XXH64 of its bytes): public, so anyone can forge an entry.
+std::string xxh64_of(const fs::path& file) {
+  const std::string bytes = read_bytes(file);
+  return hash_bytes({reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size()});
+}
+
+// made.json entries that name files outside the output folder (`..`, absolute, a job the manifest no
+// longer has, through a link inside OUT) or a live output another way, each with the file's true
+// hash: no file is removed, each entry is one warning, and the live output stays.
+TEST(Gate, TheCleanerRemovesOnlyWhatItProvablyMade) {
+  Library lib;
+  ASSERT_EQ(lib.build().exit_code, 0);
+  const std::string notes_hash = xxh64_of(lib.dir / "u/notes.txt");
+  const std::string orm_hash = xxh64_of(lib.out / "materials/m0_orm.png");
+  fs::create_directory_symlink(lib.dir / "u", lib.out / "linked");
+  json log = json::parse(read_bytes(lib.out / ".matbake/made.json"));
+  log["stale"] = {{"../u/notes.txt", notes_hash},
+                  {(lib.dir / "u/notes.txt").string(), notes_hash},
+                  {"linked/notes.txt", notes_hash},
+                  {"materials/./m0_orm.png", orm_hash},
+                  {"../m.toml", xxh64_of(lib.manifest)},
+                  {"../kd.png", xxh64_of(lib.dir / "kd.png")}};
+  log["jobs"]["material:gone"] = {{"../../" + lib.dir.path().filename().string() + "/u/notes.txt", notes_hash}};
+  write_bytes(lib.out / ".matbake/made.json", log.dump());
+  const auto before = files_outside(lib.dir.path(), lib.out);
+  const RunResult r = lib.build();
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(files_outside(lib.dir.path(), lib.out), before);
+  EXPECT_TRUE(fs::exists(lib.out / "materials/m0_orm.png"));
+  EXPECT_EQ(read_bytes(lib.dir / "u/notes.txt"), "the user's notes");
+  EXPECT_EQ(r.out.find("removed "), std::string::npos) << r.out;
+  for (const char* entry : {"'../u/notes.txt'", "'linked/notes.txt'", "'materials/./m0_orm.png'", "'../m.toml'"}) {
+    EXPECT_NE(r.err.find(std::string("matbake: warning: made.json lists ") + entry), std::string::npos) << entry << "\n" << r.err;
+  }
+  // Each refusal is said once: the entries are forgotten.
+  const RunResult again = lib.build();
+  EXPECT_EQ(again.err.find("made.json lists"), std::string::npos) << again.err;
+  EXPECT_NE(again.out.find("nothing to do"), std::string::npos) << again.out;
+}
+
+// --depfile, --stamp and plan -o never overwrite a file the build reads or writes, nor matbake's
+// state: a usage error naming the option, and every file as it was.
+TEST(Gate, SideOutputsNeverOverwriteInputsOutputsOrState) {
+  Library lib;
+  ASSERT_EQ(lib.build().exit_code, 0);
+  const std::string manifest = lib.manifest.string(), source = (lib.dir / "kd.png").string(),
+                    output = (lib.out / "materials/m0_orm.png").string(), log = (lib.out / ".matbake/made.json").string();
+  const std::vector<std::vector<std::string>> cases = {
+      {"build", manifest, "--depfile", manifest},
+      {"build", manifest, "--stamp", source},
+      {"build", manifest, "--depfile", output},
+      {"build", manifest, "--stamp", log},
+      {"build", manifest, "--depfile", (lib.dir / "d").string(), "--stamp", (lib.dir / "d").string()},
+      {"plan", manifest, "-o", manifest},
+      {"plan", manifest, "-o", output},
+      {"plan", manifest, "-o", source},
+  };
+  for (const auto& args : cases) {
+    const auto before = files_outside(lib.dir.path(), lib.dir / "none");
+    const RunResult r = matbake(args);
+    EXPECT_EQ(r.exit_code, 2) << args[2] << " " << args[3] << ": " << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_EQ(r.err.rfind("matbake: error: ", 0), 0u) << r.err;
+    EXPECT_NE(r.err.find(args.back() + ": is "), std::string::npos) << r.err;
+    EXPECT_EQ(files_outside(lib.dir.path(), lib.dir / "none"), before) << args[2] << " " << args[3];
+  }
+}
+
+// Stamps, made.json and failure records are read as hostile input: a wrong type, a huge file or a
+// link is one warning naming the file; the job rebuilds and the build succeeds; --status works.
+TEST(Gate, StateFilesAreReadAsHostileInput) {
+  Library lib;
+  ASSERT_EQ(lib.build().exit_code, 0);
+  const fs::path stamp = lib.out / ".matbake/material-m0.json", made = lib.out / ".matbake/made.json";
+  json s = json::parse(read_bytes(stamp));
+  s["outputs"][0]["size"] = "big";
+  write_bytes(stamp, s.dump());
+  write_bytes(made, R"({"form": 1, "jobs": {"material:m0": {"materials/m0_orm.png": 7}}, "stale": {}})");
+  const RunResult status = matbake({"build", lib.manifest.string(), "--status"});
+  EXPECT_EQ(status.exit_code, 0) << status.err;
+  EXPECT_NE(status.out.find("not built material:m0: stamp refused: " + stamp.string() + " is not one matbake wrote"),
+            std::string::npos) << status.out;
+  const RunResult r = lib.build();
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("matbake: warning: " + stamp.string() + " is not one matbake wrote"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("matbake: warning: " + made.string() + " has a file without its hash"), std::string::npos) << r.err;
+  EXPECT_NE(r.out.find("built 1"), std::string::npos) << r.out;
+  EXPECT_NE(lib.build().out.find("nothing to do"), std::string::npos);
+
+  // 100 MB of made.json (sparse, so the test costs nothing): refused by its size, not read.
+  {
+    const int fd = ::open(made.c_str(), O_WRONLY | O_TRUNC);
+    ASSERT_GE(fd, 0);
+    ASSERT_EQ(::ftruncate(fd, 100 << 20), 0);
+    ::close(fd);
+  }
+  const RunResult huge = lib.build({"--force"});
+  EXPECT_EQ(huge.exit_code, 0) << huge.err;
+  EXPECT_NE(huge.err.find(made.string() + " is 104857600 bytes, over the 64 MiB"), std::string::npos) << huge.err;
+
+  // A lock that is a dangling link: its target is never made.
+  fs::remove(lib.out / ".matbake/made.lock");
+  fs::create_symlink(lib.dir / "u/planted", lib.out / ".matbake/made.lock");
+  const RunResult linked = lib.build({"--force"});
+  EXPECT_EQ(linked.exit_code, 0) << linked.err;
+  EXPECT_FALSE(fs::exists(lib.dir / "u/planted"));
+  EXPECT_NE(linked.err.find("made.lock is a link"), std::string::npos) << linked.err;
+}
+
+}  // namespace
+}  // namespace matbake::test
