@@ -107,20 +107,20 @@ int run_slurm_plan(const PlanSettings& s, const GlobalOptions& global, pipeline:
   const auto submission = pipeline::slurm_submission(
       plan, *report, manifest.cluster, [](const pipeline::Job& job) { return pipeline::largest_image_pixels(job.inputs); });
   const pipeline::SlurmTarget target{fs::absolute(s.output).lexically_normal(), self};
-  const std::vector<std::string> lines = pipeline::sbatch_lines(submission, manifest.cluster, target);
+  auto lines = pipeline::sbatch_lines(submission, manifest.cluster, target);
+  auto scripts = pipeline::slurm_scripts(manifest, submission, manifest.cluster, target);
+  if (!lines || !scripts) return report_error(!lines ? lines.error() : scripts.error());
   if (s.dry_run) {
     if (!global.json) {
-      for (const std::string& line : lines) std::printf("%s\n", line.c_str());
+      for (const std::string& line : *lines) std::printf("%s\n", line.c_str());
     }
-  } else if (Status st = write_slurm_scripts(manifest, plan, pipeline::slurm_scripts(manifest, submission, manifest.cluster, target),
-                                             target.folder);
-             !st) {
+  } else if (Status st = write_slurm_scripts(manifest, plan, *scripts, target.folder); !st) {
     return report_error(st.error());
   }
   if (global.json) {
     nlohmann::json doc = {{"command", "plan"}, {"format", "slurm"}, {"folder", target.folder}, {"dry_run", s.dry_run},
                           {"up_to_date", submission.up_to_date}, {"cluster", params::to_json(pipeline::cluster_params(), manifest.cluster)},
-                          {"sbatch", lines}};
+                          {"sbatch", *lines}};
     doc["array"] = {{"memory_mb", submission.array_memory_mb}, {"jobs", nlohmann::json::array()}};
     for (const pipeline::SlurmJob& j : submission.array) doc["array"]["jobs"].push_back(j.job->name);
     doc["scenes"] = nlohmann::json::array();
@@ -186,11 +186,11 @@ int run_plan(const PlanSettings& s, const GlobalOptions& global) {
   std::error_code ec;
   const fs::path self = s.matbake.empty() ? fs::read_symlink("/proc/self/exe", ec) : fs::absolute(s.matbake);
   if (s.format == "slurm") return run_slurm_plan(s, global, manifest, *plan, self);
-  const NamedOutput ninja_file[] = {{s.output, "-o"}};
+  const NamedOutput ninja_file[] = {{fs::absolute(s.output).lexically_normal(), "-o"}};
   if (Status st = pipeline::check_side_outputs(manifest, *plan, ninja_file); !st) return report_error(st.error());
-  if (Status st = write_file_atomically(s.output, pipeline::ninja_text(manifest, *plan, self, s.output)); !st) {
-    return report_error(st.error());
-  }
+  auto text = pipeline::ninja_text(manifest, *plan, self, ninja_file[0].path);
+  if (!text) return report_error(text.error());
+  if (Status st = write_file_atomically(ninja_file[0].path, *text); !st) return report_error(st.error());
   if (global.json) {
     nlohmann::json jobs = nlohmann::json::array();
     for (const pipeline::Job& j : plan->jobs) jobs.push_back(j.name);
@@ -210,6 +210,9 @@ int run_build(const BuildSettings& s, const GlobalOptions& global) {
   if (s.status) return run_status(s, global, manifest, *plan);
   const NamedOutput side_outputs[] = {{s.depfile, "--depfile"}, {s.stamp, "--stamp"}};
   if (Status st = pipeline::check_side_outputs(manifest, *plan, side_outputs); !st) return report_error(st.error());
+  if (!s.depfile.empty()) {
+    if (Status st = pipeline::check_depfile_paths(manifest, *plan); !st) return report_error(st.error());
+  }
   if (!global.quiet) {
     for (const std::string& w : plan->warnings) std::cerr << "matbake: warning: " << w << "\n";
   }

@@ -14,6 +14,7 @@
 #include "support/expect_error.hpp"
 #include "support/files.hpp"
 #include "support/run.hpp"
+#include "support/sbatch.hpp"
 #include "support/temp_dir.hpp"
 
 namespace matbake::test {
@@ -161,6 +162,78 @@ TEST(Gate, StateFilesAreReadAsHostileInput) {
   EXPECT_EQ(linked.exit_code, 0) << linked.err;
   EXPECT_FALSE(fs::exists(lib.dir / "u/planted"));
   EXPECT_NE(linked.err.find("made.lock is a link"), std::string::npos) << linked.err;
+}
+
+std::string program_on_path(const std::string& name) {
+  const RunResult which = run("/bin/sh", {"-c", "command -v " + name});
+  return which.exit_code == 0 ? which.out.substr(0, which.out.find('\n')) : std::string();
+}
+
+// A manifest in a folder whose name is shell or Ninja syntax: the Ninja plan builds it (or, where a
+// depfile as Ninja reads it cannot hold the name, refuses it: exit 2, nothing written) and the Slurm
+// scripts submit it (through a stand-in sbatch); nothing the name smuggles in runs.
+TEST(Gate, GeneratedScriptsHoldHostilePathsAsData) {
+  const std::string ninja = program_on_path("ninja");
+  if (ninja.empty()) GTEST_SKIP() << "ninja is not installed";
+  TempDir dir;
+  const fs::path sbatch = stand_in_sbatch(dir.path());
+  const std::vector<std::string> names = {"assets $(touch PWNED)", "assets `touch PWNED`", "q\"uote;semi&amp",
+                                          "-dash", "dollar$array $(id)", "colon:a b", "non-utf8 \xff\xfe", "it's"};
+  for (const std::string& name : names) {
+    const fs::path folder = dir / name;
+    fs::create_directories(folder);
+    write_raw(folder / "kd.png", 2, 2, 3, "uint8", {100, 110, 120, 130, 140, 150, 160, 170, 180, 190, 200, 210});
+    write_bytes(folder / "m.toml", "output = \"out\"\n[materials.m0]\nsources = { base_color = \"kd.png\", metallic = 0.0, roughness = 0.5 }\n"
+                                   "layout = \"gltf-orm\"\n");
+    const RunResult plan = matbake({"plan", (folder / "m.toml").string(), "-o", (folder / "build.ninja").string()});
+    if (name.find_first_of("`\";'") != std::string::npos) {
+      EXPECT_EQ(plan.exit_code, 2) << name;
+      EXPECT_NE(plan.err.find("which a depfile (as Ninja reads it) cannot hold"), std::string::npos) << plan.err;
+      EXPECT_FALSE(fs::exists(folder / "build.ninja"));
+    } else {
+      ASSERT_EQ(plan.exit_code, 0) << name << ": " << plan.err;
+      const RunResult built = run(ninja, {"-C", folder.string()});
+      EXPECT_EQ(built.exit_code, 0) << name << ": " << built.out << built.err;
+      EXPECT_TRUE(fs::exists(folder / "out/materials/m0_orm.png")) << name;
+      EXPECT_NE(run(ninja, {"-C", folder.string()}).out.find("no work to do"), std::string::npos) << name;
+      fs::remove_all(folder / "out");
+    }
+
+    const fs::path slurm = folder / ("slurm " + name);
+    const RunResult planned = matbake({"plan", (folder / "m.toml").string(), "--format", "slurm", "-o", slurm.string()});
+    ASSERT_EQ(planned.exit_code, 0) << name << ": " << planned.err;
+    EXPECT_EQ(run("/bin/bash", {"-n", (slurm / "submit.sh").string()}).exit_code, 0) << name;
+    const RunResult submitted = run("/bin/bash", {(slurm / "submit.sh").string()}, {"SBATCH=" + sbatch.string()});
+    EXPECT_EQ(submitted.exit_code, 0) << name << ": " << submitted.err;
+    EXPECT_TRUE(fs::exists(folder / "out/materials/m0_orm.png")) << name;
+  }
+  for (const auto& e : fs::recursive_directory_iterator(dir.path())) EXPECT_NE(e.path().filename(), "PWNED") << e.path();
+  EXPECT_FALSE(fs::exists("PWNED"));
+}
+
+// What a generated file cannot hold (a line break anywhere, '|' in a Ninja path) is one error line,
+// exit 2, and nothing written.
+TEST(Gate, UnrepresentablePathsAreRefusedBeforeAnythingIsWritten) {
+  TempDir dir;
+  for (const std::string& name : {std::string("new\nline"), std::string("pipe|name")}) {
+    const fs::path folder = dir / name;
+    fs::create_directories(folder);
+    write_bytes(folder / "m.toml", "output = \"out\"\n[materials.m0]\nsources = { base_color = 0.5, metallic = 0.0, roughness = 0.5 }\n"
+                                   "layout = \"gltf-orm\"\n");
+    const auto before = list_folder(folder);
+    const RunResult ninja = matbake({"plan", (folder / "m.toml").string(), "-o", (folder / "build.ninja").string()});
+    EXPECT_EQ(ninja.exit_code, 2) << ninja.err;
+    EXPECT_EQ(std::count(ninja.err.begin(), ninja.err.end(), '\n'), 1) << ninja.err;
+    EXPECT_NE(ninja.err.find(name.find('|') != std::string::npos ? "holds '|'" : "holds a line break"), std::string::npos) << ninja.err;
+    const RunResult slurm = matbake({"plan", (folder / "m.toml").string(), "--format", "slurm", "-o", (folder / "s").string()});
+    if (name.find('\n') != std::string::npos) {
+      EXPECT_EQ(slurm.exit_code, 2) << slurm.err;
+      EXPECT_NE(slurm.err.find("holds a line break; a shell script cannot hold it"), std::string::npos) << slurm.err;
+      EXPECT_EQ(list_folder(folder), before);
+    } else {
+      EXPECT_EQ(slurm.exit_code, 0) << slurm.err;  // the shell holds '|' in quotes
+    }
+  }
 }
 
 }  // namespace

@@ -12,6 +12,7 @@
 #include "cli/progress_bar.hpp"
 #include "matbake/cluster.hpp"
 #include "matbake/pipeline.hpp"
+#include "matbake/script_text.hpp"
 #include "support/files.hpp"
 #include "support/gltf_files.hpp"
 #include "support/run.hpp"
@@ -279,8 +280,8 @@ materials = { "other" = "scene_only" }
   EXPECT_EQ(plan->state_folder, out / ".matbake");
 
   // Ninja: one edge per job with its outputs, inputs and depfile, and the regenerate edge.
-  const std::string ninja = pipeline::ninja_text(*m, *plan, "/usr/bin/matbake", "build.ninja");
-  EXPECT_NE(ninja.find("build " + (out / "room.glb").string() + ": matbake $manifest | " + (dir.path() / "room.gltf").string() +
+  const std::string ninja = pipeline::ninja_text(*m, *plan, "/usr/bin/matbake", "build.ninja").value();
+  EXPECT_NE(ninja.find("build " + (out / "room.glb").string() + ": matbake " + m->file.string() + " | " + (dir.path() / "room.gltf").string() +
                        " " + (dir.path() / "tex$ a.png").string()),
             std::string::npos)
       << ninja;
@@ -292,7 +293,7 @@ materials = { "other" = "scene_only" }
                        "\n  job = scene:room"),
             std::string::npos)
       << ninja;
-  EXPECT_NE(ninja.find("build build.ninja: matbake_plan $manifest\n"), std::string::npos);
+  EXPECT_NE(ninja.find("build build.ninja: matbake_plan " + m->file.string() + "\n"), std::string::npos);
 }
 
 TEST(BuildPlan, RefusesToWriteAnInputOrOneFileTwice) {
@@ -371,7 +372,7 @@ TEST(BuildRun, ASourceRewrittenDuringTheRunRebuildsTheJobsThatReadTheOldBytes) {
 }
 
 TEST(BuildDepfile, MakeSyntaxWithEscapes) {
-  EXPECT_EQ(pipeline::depfile_text({"/o/a b.png", "/o/c.json"}, {"/in/x#1.png", "/in/$y.png", "/in/z.png"}),
+  EXPECT_EQ(pipeline::depfile_text({"/o/a b.png", "/o/c.json"}, {"/in/x#1.png", "/in/$y.png", "/in/z.png"}).value(),
             "/o/a\\ b.png /o/c.json: \\\n  /in/x\\#1.png \\\n  /in/$$y.png \\\n  /in/z.png\n");
 }
 
@@ -418,17 +419,17 @@ TEST(ClusterMemory, IsTheModelsClosedForm) {
 }
 
 // Quoted words come back from bash unchanged, whatever they hold.
-TEST(ShellQuoted, WordsReadBackUnchanged) {
+TEST(ShellWord, WordsReadBackUnchanged) {
   const std::vector<std::string> words = {"plain",  "with space", "it's",       "$HOME",     "`id`",  "back\\slash",
                                           "new\nline", "ünïcode",   "*",          "a;b|c&d", "'", "--dependency=afterok:1_0",
                                           "%a",     "\"quoted\"",  "tab\there", ""};
   for (const std::string& w : words) {
-    const RunResult r = run("/bin/bash", {"-c", "printf '%s' " + pipeline::shell_quoted(w)});
+    const RunResult r = run("/bin/bash", {"-c", "printf '%s' " + shell_word(w)});
     EXPECT_EQ(r.exit_code, 0) << w;
-    EXPECT_EQ(r.out, w) << pipeline::shell_quoted(w);
+    EXPECT_EQ(r.out, w) << shell_word(w);
   }
-  EXPECT_EQ(pipeline::shell_quoted("/abs/path-1.2_x:y=z%a@b+c,d"), "/abs/path-1.2_x:y=z%a@b+c,d");
-  EXPECT_EQ(pipeline::shell_quoted("it's"), "'it'\\''s'");
+  EXPECT_EQ(shell_word("/abs/path-1.2_x:y=z%a@b+c,d"), "/abs/path-1.2_x:y=z%a@b+c,d");
+  EXPECT_EQ(shell_word("it's"), "'it'\\''s'");
 }
 
 }  // namespace

@@ -56,8 +56,10 @@ struct SlurmTarget {
 // The sbatch command of each submission as a shell line, in order (the array first, then the
 // scenes); a scene's dependency names the array by "$array" (its job id, known when the script runs).
 // `program` starts each line: sbatch, or submit.sh's "$sbatch" (a stand-in the tests set).
-std::vector<std::string> sbatch_lines(const SlurmSubmission& submission, const ClusterOptions& options,
-                                      const SlurmTarget& target, const std::string& program = "sbatch");
+// Every word is quoted by shell_word (script_text.hpp); an error (usage) for a path or name the
+// shell script cannot hold (a line break).
+Result<std::vector<std::string>> sbatch_lines(const SlurmSubmission& submission, const ClusterOptions& options,
+                                              const SlurmTarget& target, const std::string& program = "sbatch");
 
 // "5 material jobs (one array), 1 scene job; 0 up to date"
 std::string submission_counts(const SlurmSubmission& submission);
@@ -68,11 +70,7 @@ struct SlurmScripts {
   std::string submit;
   std::string job;
 };
-SlurmScripts slurm_scripts(const Manifest& manifest, const SlurmSubmission& submission, const ClusterOptions& options,
-                           const SlurmTarget& target);
-
-// A word as the shell reads it back unchanged: single-quoted where it holds anything but
-// [A-Za-z0-9_./:=%@+,-], with ' written as '\''.
-std::string shell_quoted(const std::string& word);
+Result<SlurmScripts> slurm_scripts(const Manifest& manifest, const SlurmSubmission& submission, const ClusterOptions& options,
+                                   const SlurmTarget& target);
 
 }  // namespace matbake::pipeline

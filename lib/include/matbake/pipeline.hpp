@@ -85,6 +85,7 @@ struct MaterialRule {
   std::string name;
   std::string origin;  // "assets.toml:12:1"
   std::vector<std::string> materials;
+  std::filesystem::path folder;  // the folder its match scans (a new file there is a new material)
 };
 
 // The manifest's [cluster] table: what `plan --format slurm` asks sbatch for (matbake/cluster.hpp).
@@ -243,14 +244,20 @@ Status check_side_outputs(const Manifest& manifest, const Plan& plan, std::span<
 Status write_build_tool_files(const Manifest& manifest, const Report& report, const std::filesystem::path& depfile,
                               const std::filesystem::path& stamp);
 
-// Make syntax: `targets: inputs`, spaces escaped, one prerequisite per line.
-std::string depfile_text(const std::vector<std::filesystem::path>& targets,
-                         const std::vector<std::filesystem::path>& inputs);
+// Make syntax: `targets: inputs`, spaces escaped, one prerequisite per line; an error (usage) for
+// a path no depfile can hold (a line break).
+Result<std::string> depfile_text(const std::vector<std::filesystem::path>& targets,
+                                 const std::vector<std::filesystem::path>& inputs);
+
+// Whether a depfile can list every file of the plan (the manifest, each job's inputs and outputs):
+// checked before a build with --depfile runs, and by ninja_text.
+Status check_depfile_paths(const Manifest& manifest, const Plan& plan);
 
 // A Ninja file with one edge per job, each running `matbake build MANIFEST --only JOB`, with the
 // job's depfile so Ninja also learns what it read, and an edge that writes `ninja_file` again
-// (named as Ninja will be given it) when the manifest changes.
-std::string ninja_text(const Manifest& manifest, const Plan& plan, const std::filesystem::path& matbake,
-                       const std::filesystem::path& ninja_file);
+// when the manifest changes or a folder a material rule scans does (a new texture set). Every path
+// and name goes through script_text.hpp: an error (usage) for one Ninja or the shell cannot hold.
+Result<std::string> ninja_text(const Manifest& manifest, const Plan& plan, const std::filesystem::path& matbake,
+                               const std::filesystem::path& ninja_file);
 
 }  // namespace matbake::pipeline

@@ -341,7 +341,8 @@ Result<std::vector<std::string>> rule_matches(const Reader& r, const toml::node&
   }
   if (ec) return r.at(match, where + ".match: " + pattern.parent_path().string() + ": " + ec.message());
   std::sort(names.begin(), names.end());
-  if (names.empty()) notes.push_back(r.origin(match.source()) + ": " + where + ": '" + *text + "' matches no file");
+  // A typo would otherwise drop every material the rule made, and the cleaner their outputs.
+  if (names.empty()) return r.at(match, where + ".match: '" + *text + "' matches no file in " + pattern.parent_path().string());
   return names;
 }
 
@@ -369,7 +370,7 @@ Status read_material_rule(const Reader& r, const std::string& rule, const toml::
       }
     }
   }
-  MaterialRule expanded{rule, r.origin(node.source()), {}};
+  MaterialRule expanded{rule, r.origin(node.source()), {}, (m.folder / *match->value<std::string>()).parent_path()};
   for (const std::string& name : *names) {
     MaterialSpec spec = *shared;
     spec.name = name;

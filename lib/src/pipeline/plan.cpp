@@ -19,6 +19,7 @@
 #include "matbake/output_check.hpp"
 #include "matbake/pipeline.hpp"
 #include "matbake/report_json.hpp"
+#include "matbake/script_text.hpp"
 #include "matbake/version.hpp"
 
 namespace matbake::pipeline {
@@ -147,26 +148,6 @@ void add_unique(std::vector<fs::path>& to, const std::vector<fs::path>& from) {
     if (std::find(to.begin(), to.end(), p) == to.end()) to.push_back(p);
   }
 }
-
-std::string ninja_escape(const std::string& path) {
-  std::string out;
-  for (char c : path) {
-    if (c == '$' || c == ' ' || c == ':' || c == '\n') out += '$';
-    out += c;
-  }
-  return out;
-}
-
-std::string make_escape(const std::string& path) {
-  std::string out;
-  for (char c : path) {
-    if (c == ' ' || c == '#' || c == '\\') out += '\\';
-    if (c == '$') out += '$';
-    out += c;
-  }
-  return out;
-}
-
 
 // A material's job: what it reads and writes, its options, and what makes it fail before it starts.
 Result<Job> material_job(const Manifest& manifest, std::size_t i, const Result<std::vector<material_table::Material>>& table) {
@@ -364,24 +345,93 @@ Status check_side_outputs(const Manifest& manifest, const Plan& plan, std::span<
   return check_outputs(outputs, {});  // no two are one file
 }
 
-std::string depfile_text(const std::vector<fs::path>& targets, const std::vector<fs::path>& inputs) {
+Result<std::string> depfile_text(const std::vector<fs::path>& targets, const std::vector<fs::path>& inputs) {
   std::string text;
-  for (const fs::path& t : targets) text += (text.empty() ? "" : " ") + make_escape(t.string());
+  for (const fs::path& t : targets) {
+    auto path = depfile_path(t.native());
+    if (!path) return path.error();
+    text += (text.empty() ? "" : " ") + *path;
+  }
   text += ":";
-  for (const fs::path& in : inputs) text += " \\\n  " + make_escape(in.string());
+  for (const fs::path& in : inputs) {
+    auto path = depfile_path(in.native());
+    if (!path) return path.error();
+    text += " \\\n  " + *path;
+  }
   return text + "\n";
 }
 
-std::string ninja_text(const Manifest& manifest, const Plan& plan, const fs::path& matbake, const fs::path& ninja_file) {
-  std::string text = "# Written by `matbake plan` (matbake " + std::string(version) + ") from " + manifest.file.string() +
+Status check_depfile_paths(const Manifest& manifest, const Plan& plan) {
+  std::vector<fs::path> files{manifest.file};
+  for (const Job& job : plan.jobs) {
+    files.insert(files.end(), job.inputs.begin(), job.inputs.end());
+    for (fs::path& out : job.outputs.all()) files.push_back(std::move(out));
+  }
+  auto text = depfile_text({}, files);
+  if (!text) return text.error();
+  return success();
+}
+
+namespace {
+
+// A list of paths for a build statement, each after a space.
+Result<std::string> ninja_paths(const std::vector<fs::path>& paths) {
+  std::string text;
+  for (const fs::path& p : paths) {
+    auto escaped = ninja_path(p.native());
+    if (!escaped) return escaped.error();
+    text += " " + *escaped;
+  }
+  return text;
+}
+
+// "name = value" for a word the edge's command passes to the shell.
+Result<std::string> shell_variable(const std::string& name, const std::string& word) {
+  if (std::string problem = unscriptable(word); !problem.empty()) return Error{word, problem + "; a Ninja file cannot hold it", true};
+  return "  " + name + " = " + ninja_value(shell_word(word)) + "\n";
+}
+
+Result<std::string> job_edge(const Job& job, const Plan& plan, const std::map<std::string, const Job*>& by_name,
+                             const std::string& manifest_path) {
+  auto outputs = ninja_paths(job.outputs.all());
+  if (!outputs) return outputs.error();
+  // Implicit inputs: what it reads, and the outputs of the jobs it depends on (so a failed
+  // material stops the scenes that use it, as a build does).
+  std::vector<fs::path> implicit = job.inputs;
+  for (const std::string& name : job.depends_on) add_unique(implicit, by_name.at(name)->outputs.all());
+  auto inputs = ninja_paths(implicit);
+  if (!inputs) return inputs.error();
+  const fs::path depfile = plan.state_folder / (job_file_stem(job.name) + ".d");
+  auto depfile_ninja = ninja_path(depfile.native());
+  auto job_word = shell_variable("job", job.name);
+  auto depfile_word = shell_variable("depfile_word", depfile.native());
+  if (!depfile_ninja || !job_word || !depfile_word) return !depfile_ninja ? depfile_ninja.error() : !job_word ? job_word.error() : depfile_word.error();
+  return "build" + *outputs + ": matbake " + manifest_path + (implicit.empty() ? "" : " |" + *inputs) + "\n" + *job_word +
+         "  depfile_path = " + *depfile_ninja + "\n" + *depfile_word + "\n";
+}
+
+}  // namespace
+
+Result<std::string> ninja_text(const Manifest& manifest, const Plan& plan, const fs::path& matbake, const fs::path& ninja_file) {
+  if (Status s = check_depfile_paths(manifest, plan); !s) return s.error();  // each edge writes one
+  auto manifest_path = ninja_path(manifest.file.native());
+  auto file_path = ninja_path(ninja_file.native());
+  if (!manifest_path || !file_path) return !manifest_path ? manifest_path.error() : file_path.error();
+  std::string variables;
+  for (const auto& [name, word] : {std::pair{"matbake", matbake.native()}, {"manifest", manifest.file.native()},
+                                   {"output", manifest.output.native()}}) {
+    auto line = shell_variable(name, word);
+    if (!line) return line.error();
+    variables += line->substr(2);  // top level: not indented
+  }
+  // The manifest's path in a comment, as the shell would quote it (a line break was refused above).
+  std::string text = "# Written by `matbake plan` (matbake " + std::string(version) + ") from " + shell_word(manifest.file.native()) +
                      ".\n# One edge per job; each edge's depfile adds what the job read. Written again by\n"
-                     "# `matbake plan` when the manifest changes (the last edge).\n"
-                     "ninja_required_version = 1.10\n\n";
-  text += "matbake = " + ninja_escape(matbake.string()) + "\n";
-  text += "manifest = " + ninja_escape(manifest.file.string()) + "\n";
-  text += "output = " + ninja_escape(manifest.output.string()) + "\n\n";
+                     "# `matbake plan` when the manifest, or a folder a material rule scans, changes (the last edge).\n"
+                     "ninja_required_version = 1.10\n\n" + variables + "\n";
+  // Variables hold shell words ($matbake, $manifest, $job, ...): the command uses them unquoted.
   text += "rule matbake\n"
-          "  command = \"$matbake\" build \"$manifest\" --output-dir \"$output\" --only $job --quiet --depfile \"$depfile_path\"\n"
+          "  command = $matbake build $manifest --output-dir $output --only $job --quiet --depfile $depfile_word\n"
           "  description = matbake $job\n"
           "  depfile = $depfile_path\n"
           "  deps = gcc\n"
@@ -389,25 +439,20 @@ std::string ninja_text(const Manifest& manifest, const Plan& plan, const fs::pat
   std::map<std::string, const Job*> by_name;
   for (const Job& job : plan.jobs) by_name[job.name] = &job;
   for (const Job& job : plan.jobs) {
-    text += "build";
-    for (const fs::path& out : job.outputs.all()) text += " " + ninja_escape(out.string());
-    text += ": matbake $manifest";
-    // Implicit inputs: what it reads, and the outputs of the jobs it depends on (so a failed
-    // material stops the scenes that use it, as a build does).
-    std::vector<fs::path> implicit = job.inputs;
-    for (const std::string& name : job.depends_on) add_unique(implicit, by_name.at(name)->outputs.all());
-    if (!implicit.empty()) {
-      text += " |";
-      for (const fs::path& in : implicit) text += " " + ninja_escape(in.string());
-    }
-    text += "\n  job = " + job.name + "\n";
-    text += "  depfile_path = " + ninja_escape((plan.state_folder / (job_file_stem(job.name) + ".d")).string()) + "\n\n";
+    auto edge = job_edge(job, plan, by_name, *manifest_path);
+    if (!edge) return edge.error();
+    text += *edge;
   }
+  std::vector<fs::path> scanned;
+  for (const MaterialRule& rule : manifest.rules) add_unique(scanned, {rule.folder});
+  auto folders = ninja_paths(scanned);
+  if (!folders) return folders.error();
+  // Ninja quotes $out itself; the file is absolute, so it never reads as an option.
   text += "rule matbake_plan\n"
-          "  command = \"$matbake\" plan \"$manifest\" --output-dir \"$output\" -o \"$out\" --quiet\n"
+          "  command = $matbake plan $manifest --output-dir $output -o $out --quiet\n"
           "  description = matbake plan $manifest\n"
           "  generator = 1\n\n"
-          "build " + ninja_escape(ninja_file.string()) + ": matbake_plan $manifest\n";
+          "build " + *file_path + ": matbake_plan " + *manifest_path + (scanned.empty() ? "" : " |" + *folders) + "\n";
   return text;
 }
 

@@ -64,7 +64,9 @@ Status write_build_tool_files(const Manifest& manifest, const Report& report, co
       }
     }
     if (!stamp.empty()) targets = {fs::absolute(stamp).lexically_normal()};
-    if (Status s = write_file_atomically(depfile, depfile_text(targets, inputs)); !s) return s;
+    auto text = depfile_text(targets, inputs);
+    if (!text) return text.error();
+    if (Status s = write_file_atomically(depfile, *text); !s) return s;
   }
   if (!stamp.empty() && report.count(Outcome::failed) == 0 && report.moved() == 0) {
     const std::string text = "matbake build " + manifest.file.string() + ": " + std::to_string(report.jobs.size()) + " jobs\n";

@@ -5,6 +5,7 @@
 
 #include "matbake/cluster.hpp"
 #include "matbake/image.hpp"
+#include "matbake/script_text.hpp"
 #include "matbake/version.hpp"
 #include "state.hpp"
 
@@ -26,64 +27,79 @@ bool may_be_image(const fs::path& file) {
   return ext != ".gltf" && ext != ".glb" && ext != ".bin" && ext != ".json" && ext != ".toml";
 }
 
-std::string mem_argument(std::int64_t mb) { return "--mem=" + std::to_string(mb) + "M"; }
+// An argument of an sbatch line: literal text, or the array's job id that the script learns when it
+// runs ("$array"). Never a literal text read for a variable: a path holding "$array" stays a path.
+struct Part {
+  std::string text;
+  bool array_id = false;
+};
+using Word = std::vector<Part>;
+
+Word literal(std::string text) { return {Part{std::move(text)}}; }
+
+Word mem_argument(std::int64_t mb) { return literal("--mem=" + std::to_string(mb) + "M"); }
 
 // --output's file in `folder`: Slurm expands %-patterns, so the folder's own % are written %%.
-std::string log_pattern(const fs::path& folder, const std::string& file_pattern) {
-  std::string out;
+Word log_pattern(const fs::path& folder, const std::string& file_pattern) {
+  std::string out = "--output=";
   for (char c : (folder / "logs").string() + "/") out += c == '%' ? std::string("%%") : std::string(1, c);
-  return out + file_pattern;
+  return literal(out + file_pattern);
 }
 
 // What every sbatch call asks for besides its own job: cores, the options' partition, account, time.
-std::vector<std::string> common_arguments(const ClusterOptions& options) {
-  std::vector<std::string> args{"--cpus-per-task=" + std::to_string(options.cpus)};
-  if (!options.partition.empty()) args.push_back("--partition=" + options.partition);
-  if (!options.account.empty()) args.push_back("--account=" + options.account);
-  if (!options.time_limit.empty()) args.push_back("--time=" + options.time_limit);
-  return args;
+void add_common_arguments(std::vector<Word>& args, const ClusterOptions& options) {
+  args.push_back(literal("--cpus-per-task=" + std::to_string(options.cpus)));
+  if (!options.partition.empty()) args.push_back(literal("--partition=" + options.partition));
+  if (!options.account.empty()) args.push_back(literal("--account=" + options.account));
+  if (!options.time_limit.empty()) args.push_back(literal("--time=" + options.time_limit));
 }
 
-std::vector<std::string> array_command(const SlurmSubmission& s, const ClusterOptions& options, const SlurmTarget& target) {
+std::vector<Word> array_command(const SlurmSubmission& s, const ClusterOptions& options, const SlurmTarget& target) {
   std::string range = "0-" + std::to_string(s.array.size() - 1);
   if (options.array_throttle > 0) range += "%" + std::to_string(options.array_throttle);
-  std::vector<std::string> args{"--parsable", "--job-name=matbake-materials", "--array=" + range,
-                                mem_argument(s.array_memory_mb)};
-  for (std::string& a : common_arguments(options)) args.push_back(std::move(a));
-  args.push_back("--output=" + log_pattern(target.folder, "material-%a.log"));
-  args.push_back((target.folder / "job.sh").string());
+  std::vector<Word> args{literal("--parsable"), literal("--job-name=matbake-materials"), literal("--array=" + range),
+                         mem_argument(s.array_memory_mb)};
+  add_common_arguments(args, options);
+  args.push_back(log_pattern(target.folder, "material-%a.log"));
+  args.push_back(literal((target.folder / "job.sh").string()));
   return args;
 }
 
-std::vector<std::string> scene_command(const SlurmJob& scene, const ClusterOptions& options, const SlurmTarget& target) {
-  std::vector<std::string> args{"--parsable", "--job-name=matbake-" + scene.job->name};
+std::vector<Word> scene_command(const SlurmJob& scene, const ClusterOptions& options, const SlurmTarget& target) {
+  std::vector<Word> args{literal("--parsable"), literal("--job-name=matbake-" + scene.job->name)};
   if (!scene.after.empty()) {
-    std::string dependency = "--dependency=afterok";
-    for (std::size_t task : scene.after) dependency += ":$array_" + std::to_string(task);
-    args.push_back(dependency);
+    Word dependency = literal("--dependency=afterok");
+    for (std::size_t task : scene.after) {
+      dependency.push_back({":"});
+      dependency.push_back({"", true});
+      dependency.push_back({"_" + std::to_string(task)});
+    }
+    args.push_back(std::move(dependency));
     // A failed material cancels the scenes that wait for it (else they would wait for ever).
-    args.push_back("--kill-on-invalid-dep=yes");
+    args.push_back(literal("--kill-on-invalid-dep=yes"));
   }
   args.push_back(mem_argument(scene.memory_mb));
-  for (std::string& a : common_arguments(options)) args.push_back(std::move(a));
-  args.push_back("--output=" + log_pattern(target.folder, job_file_stem(scene.job->name) + ".log"));
-  args.push_back((target.folder / "job.sh").string());
-  args.push_back(scene.job->name);
+  add_common_arguments(args, options);
+  args.push_back(log_pattern(target.folder, job_file_stem(scene.job->name) + ".log"));
+  args.push_back(literal((target.folder / "job.sh").string()));
+  args.push_back(literal(scene.job->name));
   return args;
 }
 
-// An argument for the script: quoted, with "$array" left for the shell to expand.
-std::string script_word(const std::string& arg) {
+// The word as the script holds it: literal parts quoted, the array id as "$array".
+Result<std::string> script_word(const Word& word) {
   std::string out;
-  std::size_t from = 0;
-  for (std::size_t at; (at = arg.find("$array", from)) != std::string::npos; from = at + 6) {
-    if (at > from) out += shell_quoted(arg.substr(from, at - from));
-    out += "\"$array\"";
+  for (const Part& part : word) {
+    if (part.array_id) {
+      out += "\"$array\"";
+    } else if (std::string problem = unscriptable(part.text); !problem.empty()) {
+      return Error{part.text, problem + "; a shell script cannot hold it", true};
+    } else if (!part.text.empty()) {
+      out += shell_word(part.text);
+    }
   }
-  if (from < arg.size() || out.empty()) out += shell_quoted(arg.substr(from));
   return out;
 }
-
 
 }  // namespace
 
@@ -131,15 +147,19 @@ SlurmSubmission slurm_submission(const Plan& plan, const Report& dry_run, const 
   return s;
 }
 
-std::vector<std::string> sbatch_lines(const SlurmSubmission& submission, const ClusterOptions& options,
-                                      const SlurmTarget& target, const std::string& program) {
-  std::vector<std::vector<std::string>> commands;
+Result<std::vector<std::string>> sbatch_lines(const SlurmSubmission& submission, const ClusterOptions& options,
+                                              const SlurmTarget& target, const std::string& program) {
+  std::vector<std::vector<Word>> commands;
   if (!submission.array.empty()) commands.push_back(array_command(submission, options, target));
   for (const SlurmJob& scene : submission.scenes) commands.push_back(scene_command(scene, options, target));
   std::vector<std::string> lines;
   for (const auto& args : commands) {
     std::string line = program;
-    for (const std::string& a : args) line += " " + script_word(a);
+    for (const Word& a : args) {
+      auto word = script_word(a);
+      if (!word) return word.error();
+      line += " " + *word;
+    }
     lines.push_back(std::move(line));
   }
   return lines;
@@ -151,49 +171,47 @@ std::string submission_counts(const SlurmSubmission& submission) {
          " up to date";
 }
 
-std::string shell_quoted(const std::string& word) {
-  const bool plain = !word.empty() && std::all_of(word.begin(), word.end(), [](char c) {
-    return std::isalnum(static_cast<unsigned char>(c)) || std::string_view("_./:=%@+,-").find(c) != std::string_view::npos;
-  });
-  if (plain) return word;
-  std::string out = "'";
-  for (char c : word) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return out + "'";
-}
-
-SlurmScripts slurm_scripts(const Manifest& manifest, const SlurmSubmission& submission, const ClusterOptions& options,
-                           const SlurmTarget& target) {
+Result<SlurmScripts> slurm_scripts(const Manifest& manifest, const SlurmSubmission& submission, const ClusterOptions& options,
+                                   const SlurmTarget& target) {
+  // Every path and name the scripts hold, refused before anything is written when a line break
+  // would end a comment or a command.
+  std::vector<std::string> words{manifest.file.native(), manifest.output.native(), target.folder.native(), target.matbake.native()};
+  for (const SlurmJob& j : submission.array) words.push_back(j.job->name);
+  for (const std::string& w : words) {
+    if (std::string problem = unscriptable(w); !problem.empty()) return Error{w, problem + "; a shell script cannot hold it", true};
+  }
+  auto lines = sbatch_lines(submission, options, target, "\"$sbatch\"");
+  if (!lines) return lines.error();
   const std::string header = "#!/usr/bin/env bash\n# Written by `matbake plan --format slurm` (matbake " +
-                             std::string(version) + ") from " + manifest.file.string() + ".\n";
+                             std::string(version) + ") from " + shell_word(manifest.file.native()) + ".\n";
   SlurmScripts out;
   out.job = header +
             "# One job on a Slurm node: the material of this array task, or the job named as the argument\n"
             "# (a scene). It builds and stamps as `matbake build --only JOB` does on any machine.\n"
             "set -euo pipefail\nmaterials=(";
-  for (const SlurmJob& j : submission.array) out.job += (&j == submission.array.data() ? "" : " ") + shell_quoted(j.job->name);
-  out.job += ")\njob=${1:-${materials[$SLURM_ARRAY_TASK_ID]}}\nexec " + shell_quoted(target.matbake.string()) +
-             " --jobs " + std::to_string(options.cpus) + " build " + shell_quoted(manifest.file.string()) +
-             " --output-dir " + shell_quoted(manifest.output.string()) + " --only \"$job\"\n";
+  for (const SlurmJob& j : submission.array) out.job += (&j == submission.array.data() ? "" : " ") + shell_word(j.job->name);
+  out.job += ")\njob=${1:-${materials[$SLURM_ARRAY_TASK_ID]}}\nexec " + shell_word(target.matbake.string()) +
+             " --jobs " + std::to_string(options.cpus) + " build " + shell_word(manifest.file.string()) +
+             " --output-dir " + shell_word(manifest.output.string()) + " --only \"$job\"\n";
 
   const std::string counts = submission_counts(submission);
   out.submit = header + "# " + counts +
                ".\n# Run it where sbatch works; every path is absolute (a filesystem every node shares). Then\n"
-               "# `matbake build " + shell_quoted(manifest.file.string()) + " --status` tells how the jobs went.\n"
+               "# `matbake build " + shell_word(manifest.file.string()) + " --status` tells how the jobs went.\n"
                "set -euo pipefail\n";
   if (submission.array.empty() && submission.scenes.empty()) {
-    out.submit += "echo " + shell_quoted("matbake: nothing to submit: " + counts) + "\n";
+    out.submit += "echo " + shell_word("matbake: nothing to submit: " + counts) + "\n";
     return out;
   }
-  out.submit += "sbatch=${SBATCH:-sbatch}\nmkdir -p " + shell_quoted((target.folder / "logs").string()) + "\n";
-  const std::vector<std::string> lines = sbatch_lines(submission, options, target, "\"$sbatch\"");
+  out.submit += "sbatch=${SBATCH:-sbatch}\nmkdir -p " + shell_word((target.folder / "logs").string()) + "\n";
   std::size_t next = 0;
   if (!submission.array.empty()) {
-    out.submit += "array=$(" + lines[next++] + ")\narray=${array%%;*}  # --parsable: id[;cluster]\n";
+    out.submit += "array=$(" + (*lines)[next++] + ")\narray=${array%%;*}  # --parsable: id[;cluster]\n";
   }
   std::string ids;
-  for (; next < lines.size(); ++next) {
+  for (; next < lines->size(); ++next) {
     const std::string var = "scene_" + std::to_string(next);
-    out.submit += var + "=$(" + lines[next] + ")\n";
+    out.submit += var + "=$(" + (*lines)[next] + ")\n";
     ids += " $" + var;
   }
   out.submit += "echo \"matbake: submitted " + counts + ":" + (submission.array.empty() ? "" : " array $array") +
