@@ -8,7 +8,9 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <map>
+#include <thread>
 
 #include "matbake/output_gate.hpp"
 #include "support/expect_error.hpp"
@@ -234,6 +236,28 @@ TEST(Gate, UnrepresentablePathsAreRefusedBeforeAnythingIsWritten) {
       EXPECT_EQ(slurm.exit_code, 0) << slurm.err;  // the shell holds '|' in quotes
     }
   }
+}
+
+// A texture set that a material rule now matches is built by Ninja: the plan's own edge depends on
+// the folders rules scan, so a new file there writes the plan again and the new edge runs.
+TEST(Gate, NinjaBuildsANewTextureSetARuleMatches) {
+  const std::string ninja = program_on_path("ninja");
+  if (ninja.empty()) GTEST_SKIP() << "ninja is not installed";
+  TempDir dir;
+  fs::create_directories(dir / "t");
+  write_raw(dir / "t/a_BaseColor.png", 2, 2, 3, "uint8", {100, 110, 120, 130, 140, 150, 160, 170, 180, 190, 200, 210});
+  write_bytes(dir / "m.toml", "output = \"out\"\n[material_rules.lib]\nmatch = \"t/{name}_BaseColor.png\"\n"
+                              "sources = { base_color = \"t/{name}_BaseColor.png\", metallic = 0.0, roughness = 0.5 }\nlayout = \"gltf-orm\"\n");
+  ASSERT_EQ(matbake({"plan", (dir / "m.toml").string(), "-o", (dir / "build.ninja").string()}).exit_code, 0);
+  ASSERT_EQ(run(ninja, {"-C", dir.path().string()}).exit_code, 0);
+  EXPECT_TRUE(fs::exists(dir / "out/materials/a_orm.png"));
+  // Folder times have a granularity: the new entry must change the folder's time.
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  fs::copy_file(dir / "t/a_BaseColor.png", dir / "t/b_BaseColor.png");
+  const RunResult again = run(ninja, {"-C", dir.path().string()});
+  EXPECT_EQ(again.exit_code, 0) << again.out << again.err;
+  EXPECT_TRUE(fs::exists(dir / "out/materials/b_orm.png")) << again.out;
+  EXPECT_NE(run(ninja, {"-C", dir.path().string()}).out.find("no work to do"), std::string::npos);
 }
 
 }  // namespace

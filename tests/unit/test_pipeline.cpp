@@ -226,6 +226,11 @@ layout = "gltf-metal-rough"
                 .find("material_rules.lib.overrides.bb: no such match; did you mean b or a?"),
             std::string::npos)
       << error_of(rule + "[material_rules.lib.overrides.bb]\nlayout = \"schuler\"\n");
+  // A typo in the pattern (_OMR for _ORM) is an error at its line: it would drop every material the
+  // rule made, and the cleaner their outputs.
+  EXPECT_EQ(error_of("[material_rules.x]\nmatch = \"t/{name}_OMR.png\"\nsources = { kd = 0.5 }\n"),
+            (dir / "m.toml").string() + ":2:9: material_rules.x.match: 't/{name}_OMR.png' matches no file in " + (dir / "t").string());
+  EXPECT_EQ(m->rules[0].folder, dir / "t");
   EXPECT_NE(error_of("[material_rules.x]\nmatch = \"t/{name}/BaseColor.png\"\nsources = { kd = 0.5 }\n").find("m.toml:2:9: material_rules.x.match: a file pattern with {name} once"),
             std::string::npos);
   EXPECT_NE(error_of("[material_rules.x]\nmatch = \"t/{name}.png\"\nsources = { kd = 0.5 }\nlayot = 1\n").find("unknown key 'layot' in material_rules.x"),
@@ -280,7 +285,7 @@ materials = { "other" = "scene_only" }
   EXPECT_EQ(plan->state_folder, out / ".matbake");
 
   // Ninja: one edge per job with its outputs, inputs and depfile, and the regenerate edge.
-  const std::string ninja = pipeline::ninja_text(*m, *plan, "/usr/bin/matbake", "build.ninja").value();
+  const std::string ninja = pipeline::ninja_text(*m, *plan, "/usr/bin/matbake", dir / "build.ninja").value();
   EXPECT_NE(ninja.find("build " + (out / "room.glb").string() + ": matbake " + m->file.string() + " | " + (dir.path() / "room.gltf").string() +
                        " " + (dir.path() / "tex$ a.png").string()),
             std::string::npos)

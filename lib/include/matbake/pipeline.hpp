@@ -254,8 +254,9 @@ Result<std::string> depfile_text(const std::vector<std::filesystem::path>& targe
 Status check_depfile_paths(const Manifest& manifest, const Plan& plan);
 
 // A Ninja file with one edge per job, each running `matbake build MANIFEST --only JOB`, with the
-// job's depfile so Ninja also learns what it read, and an edge that writes `ninja_file` again
-// when the manifest changes or a folder a material rule scans does (a new texture set). Every path
+// job's depfile so Ninja also learns what it read, and an edge that writes `ninja_file` (absolute;
+// named by its file name, as Ninja run in its folder names it) again when the manifest changes or
+// a folder a material rule scans does (a new texture set). Every path
 // and name goes through script_text.hpp: an error (usage) for one Ninja or the shell cannot hold.
 Result<std::string> ninja_text(const Manifest& manifest, const Plan& plan, const std::filesystem::path& matbake,
                                const std::filesystem::path& ninja_file);

@@ -415,11 +415,13 @@ Result<std::string> job_edge(const Job& job, const Plan& plan, const std::map<st
 Result<std::string> ninja_text(const Manifest& manifest, const Plan& plan, const fs::path& matbake, const fs::path& ninja_file) {
   if (Status s = check_depfile_paths(manifest, plan); !s) return s.error();  // each edge writes one
   auto manifest_path = ninja_path(manifest.file.native());
-  auto file_path = ninja_path(ninja_file.native());
+  // Named as Ninja names its manifest (the file in the folder it runs in), so that Ninja knows this
+  // edge remakes it and reloads it before building.
+  auto file_path = ninja_path(ninja_file.filename().native());
   if (!manifest_path || !file_path) return !manifest_path ? manifest_path.error() : file_path.error();
   std::string variables;
   for (const auto& [name, word] : {std::pair{"matbake", matbake.native()}, {"manifest", manifest.file.native()},
-                                   {"output", manifest.output.native()}}) {
+                                   {"output", manifest.output.native()}, {"plan_file", ninja_file.native()}}) {
     auto line = shell_variable(name, word);
     if (!line) return line.error();
     variables += line->substr(2);  // top level: not indented
@@ -447,9 +449,9 @@ Result<std::string> ninja_text(const Manifest& manifest, const Plan& plan, const
   for (const MaterialRule& rule : manifest.rules) add_unique(scanned, {rule.folder});
   auto folders = ninja_paths(scanned);
   if (!folders) return folders.error();
-  // Ninja quotes $out itself; the file is absolute, so it never reads as an option.
+  // The file by its absolute path: never read as an option, wherever Ninja runs.
   text += "rule matbake_plan\n"
-          "  command = $matbake plan $manifest --output-dir $output -o $out --quiet\n"
+          "  command = $matbake plan $manifest --output-dir $output -o $plan_file --quiet\n"
           "  description = matbake plan $manifest\n"
           "  generator = 1\n\n"
           "build " + *file_path + ": matbake_plan " + *manifest_path + (scanned.empty() ? "" : " |" + *folders) + "\n";

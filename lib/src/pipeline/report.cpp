@@ -63,6 +63,11 @@ Status write_build_tool_files(const Manifest& manifest, const Report& report, co
         if (std::find(inputs.begin(), inputs.end(), p) == inputs.end()) inputs.push_back(p);
       }
     }
+    // The folders material rules scan too: a new texture set there is a new material (CMake and
+    // Ninja compare a folder's time like a file's).
+    for (const MaterialRule& rule : manifest.rules) {
+      if (std::find(inputs.begin(), inputs.end(), rule.folder) == inputs.end()) inputs.push_back(rule.folder);
+    }
     if (!stamp.empty()) targets = {fs::absolute(stamp).lexically_normal()};
     auto text = depfile_text(targets, inputs);
     if (!text) return text.error();
