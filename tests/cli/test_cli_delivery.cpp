@@ -5,7 +5,9 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <chrono>
 #include <cmath>
+#include <thread>
 #include <fstream>
 
 #include "lib/src/gltf/document.hpp"
@@ -346,6 +348,91 @@ TEST(CliDelivery, BadSettingsAndAMissingEncoderAreOneErrorLineAndNothingIsWritte
   const RunResult unknown = matbake({"build", (dir / "assets.toml").string(), "-n"});
   EXPECT_NE(unknown.exit_code, 0);
   EXPECT_NE(unknown.err.find("colour_codec"), std::string::npos) << unknown.err;
+}
+
+// A stand-in encoder that answers -version as basisu does, then misbehaves as MODE says: hang
+// (ignoring SIGTERM, SIGINT and SIGHUP), flood (50 MB of output, then an error), huge (a 1 GB output
+// file). HANG_VERSION=1 makes -version hang. It writes its process id to PIDFILE.
+fs::path misbehaving_encoder(const fs::path& dir) {
+  const fs::path script = dir / "basisu";
+  write_bytes(script, "#!/bin/bash\n"
+                      "if [ \"$1\" = -version ]; then\n"
+                      "  [ -n \"$HANG_VERSION\" ] && exec sleep 1000\n"
+                      "  echo 'Basis Universal GPU Texture Compressor v1.16.4'; exit 0\n"
+                      "fi\n"
+                      "echo $$ > \"$PIDFILE\"\n"
+                      "trap '' TERM INT HUP\n"
+                      "case $MODE in\n"
+                      "  hang) while :; do sleep 1; done ;;\n"
+                      "  flood) head -c 50000000 /dev/zero | tr '\\0' x; echo; echo 'ERROR: flooded'; exit 1 ;;\n"
+                      "  huge) while [ $# -gt 0 ]; do [ \"$1\" = -output_path ] && { out=$2; shift; }; last=$1; shift; done\n"
+                      "        truncate -s 1G \"$out/$(basename \"$last\" .png).ktx2\" ;;\n"
+                      "esac\n");
+  fs::permissions(script, fs::perms::owner_exec, fs::perm_options::add);
+  return script;
+}
+
+// Whether process `pid` still runs (a zombie does not).
+bool still_runs(const std::string& pid) {
+  const std::string stat = fs::exists("/proc/" + pid + "/stat") ? read_bytes("/proc/" + pid + "/stat") : "";
+  const std::size_t paren = stat.rfind(')');
+  return paren != std::string::npos && stat.size() > paren + 2 && stat[paren + 2] != 'Z' && stat[paren + 2] != 'X';
+}
+
+// The encoder is supervised: a hung -version or encode is killed at its time limit, a flood of
+// output costs its last lines, a 1 GB output is refused by its size before it is read.
+TEST(CliDelivery, TheEncoderIsSupervised) {
+  TempDir dir;
+  write_textured_quad(dir.path());
+  const fs::path encoder = misbehaving_encoder(dir.path());
+  const std::string in = (dir / "quad.gltf").string(), out = (dir / "out" / "quad.glb").string(), pidfile = (dir / "pid").string();
+  const std::vector<std::string> args = {"export", in, "-o", out, "--texture-format", "ktx2"};
+  const std::vector<std::string> base = {"MATBAKE_BASISU=" + encoder.string(), "PIDFILE=" + pidfile, "MATBAKE_ENCODER_TIME_LIMIT=1"};
+  const auto with = [&](const std::string& setting) {
+    std::vector<std::string> env = base;
+    env.push_back(setting);
+    return env;
+  };
+  const RunResult probe = matbake(args, with("HANG_VERSION=1"));
+  EXPECT_EQ(probe.exit_code, 1);
+  expect_one_error_line(probe, encoder.string(), "the KTX2 encoder (MATBAKE_BASISU) does not run as basisu: it did not answer -version within 1 s");
+  const RunResult hang = matbake(args, with("MODE=hang"));
+  EXPECT_EQ(hang.exit_code, 1);
+  EXPECT_NE(hang.err.find("did not finish within its time limit of 1 s (killed"), std::string::npos) << hang.err;
+  EXPECT_FALSE(still_runs(read_bytes(pidfile).substr(0, read_bytes(pidfile).find('\n'))));
+  const RunResult flood = matbake(args, with("MODE=flood"));
+  EXPECT_EQ(flood.exit_code, 1);
+  EXPECT_EQ(std::count(flood.err.begin(), flood.err.end(), '\n'), 1) << flood.err.size();
+  EXPECT_NE(flood.err.find("failed (exit 1): ERROR: flooded"), std::string::npos) << flood.err.substr(0, 500);
+  const RunResult huge = matbake(args, with("MODE=huge"));
+  EXPECT_EQ(huge.exit_code, 1);
+  EXPECT_NE(huge.err.find("the encoder wrote 1073741824 bytes, more than the"), std::string::npos) << huge.err;
+  EXPECT_TRUE(!fs::exists(dir / "out") || list_folder(dir / "out").empty());
+}
+
+// SIGTERM to matbake while the encoder runs (and ignores SIGTERM itself): matbake exits at once
+// and takes the encoder's whole group with it; nothing keeps its stderr open.
+TEST(CliDelivery, AnInterruptKillsTheEncoder) {
+  TempDir dir;
+  write_textured_quad(dir.path());
+  const fs::path encoder = misbehaving_encoder(dir.path());
+  const std::string pidfile = (dir / "pid").string();
+  // matbake's output through a pipe (as `matbake ... | tee` has it): the reader ends only when
+  // every writer, the encoder included, has closed it.
+  const std::string command = "(MATBAKE_BASISU='" + encoder.string() + "' PIDFILE='" + pidfile + "' MODE=hang '" + matbake_exe() +
+                              "' export '" + (dir / "quad.gltf").string() + "' -o '" + (dir / "out/q.glb").string() +
+                              "' --texture-format ktx2 2>&1 & echo $! > '" + (dir / "mpid").string() + "'; wait) | cat & reader=$!; "
+                              "for i in $(seq 100); do [ -s '" + pidfile + "' ] && break; sleep 0.1; done; "
+                              "kill -TERM $(cat '" + (dir / "mpid").string() + "'); "
+                              "{ sleep 15; kill -9 $reader; } >/dev/null 2>&1 & dog=$!; wait $reader; kill $dog";
+  const auto start = std::chrono::steady_clock::now();
+  const RunResult r = run("/bin/bash", {"-c", command});
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 10.0);  // not the 15 s timeout
+  EXPECT_NE(r.out.find("matbake: interrupted"), std::string::npos) << r.out << r.err;
+  ASSERT_TRUE(fs::exists(pidfile));
+  const std::string pid = read_bytes(pidfile).substr(0, read_bytes(pidfile).find('\n'));
+  for (int i = 0; i < 50 && still_runs(pid); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  EXPECT_FALSE(still_runs(pid)) << pid;
 }
 
 }  // namespace

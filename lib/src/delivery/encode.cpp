@@ -4,9 +4,9 @@
 #include <unistd.h>
 
 #include <fstream>
-#include <iterator>
 
 #include "matbake/atomic_file.hpp"
+#include "matbake/read_file.hpp"
 #include "matbake/ktx2.hpp"
 
 namespace matbake::delivery {
@@ -36,11 +36,21 @@ Result<std::string> png_bytes(const image::Image& level, const EncodeRequest& re
   return image::encode_image(rgb, "level.png", options);
 }
 
-Result<std::vector<unsigned char>> read_all(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return Error{path.string(), "the encoder wrote no file"};
-  return std::vector<unsigned char>((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+// The encoder's output, its size checked before it is read: at most `limit` bytes.
+Result<std::vector<unsigned char>> read_output(const fs::path& path, std::uintmax_t limit, const std::string& what) {
+  std::error_code ec;
+  const std::uintmax_t size = fs::file_size(path, ec);
+  if (ec || !fs::is_regular_file(fs::symlink_status(path, ec))) return Error{what, "the encoder wrote no file"};
+  if (size > limit) {
+    return Error{what, "the encoder wrote " + std::to_string(size) + " bytes, more than the " + std::to_string(limit) +
+                           " its levels can take; not read"};
+  }
+  std::vector<unsigned char> bytes;
+  if (!read_whole_file(path, bytes) || bytes.size() > limit) return Error{what, "the encoder's output cannot be read"};
+  return bytes;
 }
+
+std::uint64_t texels_of(const image::Image& level) { return std::uint64_t(level.width) * std::uint64_t(level.height); }
 
 // Files basisu names itself (after its inputs), removed when the run's scratch files go.
 struct EncoderOutputs {
@@ -55,9 +65,9 @@ struct EncoderOutputs {
 Result<std::vector<std::vector<unsigned char>>> run_on(const Encoder& encoder, const std::vector<const image::Image*>& levels,
                                                        const EncodeRequest& request, std::vector<std::string> args) {
   std::vector<AtomicFile> inputs;
-  auto log = AtomicFile::create(fs::path(request.scratch).replace_extension(".basisu.log"));
-  if (!log) return log.error();
+  std::uint64_t texels = 0;
   for (const image::Image* level : levels) {
+    texels += texels_of(*level);
     auto png = png_bytes(*level, request);
     if (!png) return png.error();
     auto input = AtomicFile::create(fs::path(request.scratch).replace_extension(".basisu-in.png"));
@@ -68,15 +78,17 @@ Result<std::vector<std::vector<unsigned char>>> run_on(const Encoder& encoder, c
     inputs.push_back(std::move(*input));
   }
   EncoderOutputs outputs;  // declared after the inputs: removed first, so their folder can go with them
-  args.insert(args.end(), {"-max_threads", std::to_string(request.threads), "-output_path", log->temp_path().parent_path().string()});
+  args.insert(args.end(), {"-max_threads", std::to_string(request.threads), "-output_path", inputs[0].temp_path().parent_path().string()});
   for (const AtomicFile& input : inputs) {
     args.push_back(input.temp_path().string());
     outputs.paths.push_back(fs::path(input.temp_path()).replace_extension(".ktx2"));
   }
-  if (Status s = run_encoder(encoder, args, log->temp_path(), request.scratch.string()); !s) return s.error();
+  const std::string what = request.scratch.string();
+  if (Status s = run_encoder(encoder, args, what, texels); !s) return s.error();
   std::vector<std::vector<unsigned char>> files;
-  for (const fs::path& p : outputs.paths) {
-    auto bytes = read_all(p);
+  for (std::size_t i = 0; i < outputs.paths.size(); ++i) {
+    // UASTC is a byte a texel; ETC1S less; a whole mip chain under 4/3 of that; plus the header.
+    auto bytes = read_output(outputs.paths[i], 2 * texels_of(*levels[i]) + (1u << 20), what);
     if (!bytes) return bytes.error();
     files.push_back(std::move(*bytes));
   }
@@ -182,8 +194,17 @@ Result<Encoded> encode_texture(const Encoder& encoder, const image::Image& sourc
     work.wait();
     if (!file) return file.error();
     out.file = std::move((*file)[0]);
-    auto read = ktx2::read(out.file, request.scratch.string());  // basisu's own chain: its level count
+    auto read = ktx2::read(out.file, request.scratch.string());  // basisu's own chain
     if (!read) return read.error();
+    const std::size_t expected = request.mipmaps ? mip_sizes(base).size() : 1;
+    if (read->descriptor.model != ktx2::kModelETC1S || read->width != unsigned(base.width) || read->height != unsigned(base.height) ||
+        read->levels.size() != expected) {
+      return Error{request.scratch.string(), "basisu " + encoder.version + " wrote an unexpected KTX2 file (" +
+                                                 std::to_string(read->width) + "x" + std::to_string(read->height) + ", " +
+                                                 std::to_string(read->levels.size()) + " levels; asked for ETC1S " +
+                                                 std::to_string(base.width) + "x" + std::to_string(base.height) + ", " +
+                                                 std::to_string(expected) + " levels)"};
+    }
     out.levels = int(read->levels.size());
   } else {
     auto levels = uastc_levels(encoder, level0, work, rest, request);

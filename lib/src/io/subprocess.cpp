@@ -1,0 +1,181 @@
+#include "matbake/subprocess.hpp"
+
+#include <fcntl.h>
+#include <poll.h>
+#include <signal.h>
+#include <sys/prctl.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstring>
+#include <mutex>
+#include <set>
+
+#include "matbake/result.hpp"
+
+extern char** environ;
+
+namespace matbake {
+namespace {
+
+// The process groups running now, for the interrupt handler.
+struct Running {
+  std::mutex mutex;
+  std::set<pid_t> groups;
+  bool closed = false;
+};
+Running& running() {
+  static Running r;
+  return r;
+}
+
+// In the child, between fork and exec: async-signal-safe calls only.
+[[noreturn]] void exec_child(const char* program, char* const* argv, int output_fd, pid_t parent) {
+  ::setpgid(0, 0);
+  ::prctl(PR_SET_PDEATHSIG, SIGKILL);
+  if (::getppid() != parent) ::_exit(127);  // the parent died before prctl took effect
+  for (int s : {SIGINT, SIGTERM, SIGHUP, SIGPIPE, SIGQUIT}) ::signal(s, SIG_DFL);
+  sigset_t none;
+  sigemptyset(&none);
+  ::sigprocmask(SIG_SETMASK, &none, nullptr);
+  const int null = ::open("/dev/null", O_RDONLY);
+  if (null < 0 || ::dup2(null, 0) < 0 || ::dup2(output_fd, 1) < 0 || ::dup2(output_fd, 2) < 0) ::_exit(127);
+  // Nothing else of matbake's (a copy of its stderr kept for messages, a lock): a program that
+  // outlived matbake would keep a pipe reading matbake's stderr waiting.
+  ::close_range(3, ~0u, 0);
+  ::execve(program, argv, environ);
+  ::_exit(127);
+}
+
+// Appends `bytes` to `tail`, keeping its last `limit` bytes.
+void keep_tail(std::string& tail, const char* bytes, std::size_t n, std::size_t limit) {
+  tail.append(bytes, n);
+  if (tail.size() > 2 * limit) tail.erase(0, tail.size() - limit);
+}
+
+// Whether the child ended (not reaped: its group's id stays reserved until wait_for).
+bool has_ended(pid_t pid) {
+  siginfo_t info{};
+  return ::waitid(P_PID, id_t(pid), &info, WEXITED | WNOHANG | WNOWAIT) == 0 && info.si_pid == pid;
+}
+
+// Whether the child ends before the deadline (it may close its output and go on).
+bool ended_by(pid_t pid, std::chrono::steady_clock::time_point deadline) {
+  while (!has_ended(pid)) {
+    if (std::chrono::steady_clock::now() >= deadline) return false;
+    ::usleep(2000);
+  }
+  return true;
+}
+
+// Reads the child's output until the child has ended and the pipe is drained or closed (a process
+// it left behind may hold the pipe open), or the deadline passes: false then.
+bool read_until_ended(int fd, pid_t pid, std::chrono::steady_clock::time_point deadline, std::string& tail, std::size_t limit) {
+  char buffer[16384];
+  for (;;) {
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+    if (left.count() <= 0) return false;
+    pollfd p{fd, POLLIN, 0};
+    const int ready = ::poll(&p, 1, int(std::min<long long>(left.count(), 50)));
+    if (ready < 0 && errno != EINTR) return true;
+    if (ready == 0) {
+      if (has_ended(pid)) return true;
+      continue;
+    }
+    if (ready < 0) continue;
+    const ssize_t n = ::read(fd, buffer, sizeof buffer);
+    if (n == 0 || (n < 0 && errno != EINTR && errno != EAGAIN)) return ended_by(pid, deadline);  // closed: wait for its end
+    if (n > 0) keep_tail(tail, buffer, std::size_t(n), limit);
+  }
+}
+
+int exit_code(int status) { return WIFSIGNALED(status) ? 128 + WTERMSIG(status) : WEXITSTATUS(status); }
+
+int wait_for(pid_t pid) {
+  int status = 0;
+  while (::waitpid(pid, &status, 0) < 0) {
+    if (errno != EINTR) return -1;
+  }
+  return exit_code(status);
+}
+
+}  // namespace
+
+std::string SubprocessResult::error_line() const {
+  std::string last, found;
+  std::size_t start = 0;
+  while (start < output_tail.size()) {
+    std::size_t end = output_tail.find('\n', start);
+    if (end == std::string::npos) end = output_tail.size();
+    const std::string line = output_tail.substr(start, end - start);
+    if (line.find_first_not_of(" \t\r") != std::string::npos) {
+      last = line;
+      if (found.empty() && (line.find("ERROR") != std::string::npos || line.find("Error") != std::string::npos)) found = line;
+    }
+    start = end + 1;
+  }
+  std::string line = escape_control(found.empty() ? last : found);
+  if (line.size() > 300) line = line.substr(0, 297) + "...";
+  return line;
+}
+
+SubprocessResult run_supervised(const SubprocessRequest& request) {
+  SubprocessResult result;
+  std::vector<std::string> argv_text{request.program.string()};
+  argv_text.insert(argv_text.end(), request.args.begin(), request.args.end());
+  std::vector<char*> argv;
+  for (std::string& a : argv_text) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  int pipe_fds[2];
+  if (::pipe2(pipe_fds, O_CLOEXEC) != 0) {
+    result.start_error = std::strerror(errno);
+    return result;
+  }
+  const pid_t parent = ::getpid();
+  pid_t pid = -1;
+  {
+    // Under the lock: an interrupt sees either no child or a child in the set (its group made by
+    // setpgid below as well as in the child, so a kill never misses it).
+    std::lock_guard lock(running().mutex);
+    if (!running().closed) pid = ::fork();
+    if (pid == 0) exec_child(argv_text[0].c_str(), argv.data(), pipe_fds[1], parent);
+    if (pid > 0) {
+      ::setpgid(pid, pid);
+      running().groups.insert(pid);
+    }
+  }
+  const int fork_errno = errno;
+  ::close(pipe_fds[1]);
+  if (pid < 0) {
+    ::close(pipe_fds[0]);
+    result.start_error = running().closed ? "interrupted" : std::strerror(fork_errno);
+    return result;
+  }
+  const auto deadline = std::chrono::steady_clock::now() + request.time_limit;
+  result.timed_out = !read_until_ended(pipe_fds[0], pid, deadline, result.output_tail, request.output_limit);
+  ::close(pipe_fds[0]);
+  // The whole group goes: at the time limit, and after a normal exit any child it left behind
+  // (the leader, a zombie until reaped, keeps the group's id from being reused).
+  ::kill(-pid, SIGKILL);
+  result.status = wait_for(pid);
+  {
+    std::lock_guard lock(running().mutex);
+    running().groups.erase(pid);
+  }
+  if (result.output_tail.size() > request.output_limit) {
+    result.output_tail.erase(0, result.output_tail.size() - request.output_limit);
+  }
+  if (result.status == 127 && result.output_tail.empty()) result.start_error = "cannot be run";
+  return result;
+}
+
+void kill_subprocesses_for_exit() {
+  Running& r = running();
+  r.mutex.lock();  // held until the process exits: no program starts after this
+  r.closed = true;
+  for (pid_t group : r.groups) ::kill(-group, SIGKILL);
+}
+
+}  // namespace matbake
