@@ -1,5 +1,8 @@
 // Outputs through a temporary file and a rename; an interrupt leaves finished files and no temporary ones.
 #include <gtest/gtest.h>
+#include <fcntl.h>
+#include <sys/file.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -82,17 +85,43 @@ TEST(AtomicFile, CommitRenamesAndAnAbandonedFileLeavesNothing) {
   EXPECT_EQ(std::distance(fs::directory_iterator(dir.path()), fs::directory_iterator()), 1);
 }
 
-TEST(AtomicFile, APlantedLinkInPlaceOfTheTemporaryFolderIsRefused) {
+// A run killed with SIGKILL leaves its temporary folder: the next run in that folder removes it
+// when its owner is provably gone (this host and a PID that runs nothing, or another host's after
+// a day), and never a live process's (it holds the folder's lock), whatever its PID says.
+TEST(AtomicFile, LeftoverTemporaryFoldersGoWhenTheirOwnerProvablyHas) {
   test::TempDir dir;
-  fs::create_directories(dir / "out");
-  fs::create_directory(dir / "elsewhere");
-  fs::create_directory_symlink(dir / "elsewhere", dir / "out" / (".matbake-" + std::to_string(getpid())));
-  const Status written = write_file_atomically(dir / "out/x.txt", "bytes");
-  ASSERT_FALSE(written);
-  EXPECT_EQ(written.error().path, (dir / "out/x.txt").string());
-  EXPECT_NE(written.error().message.find("is not a folder"), std::string::npos) << written.error().message;
-  EXPECT_TRUE(fs::is_empty(dir / "elsewhere"));
-  EXPECT_FALSE(fs::exists(dir / "out/x.txt"));
+  char host_text[256] = {};
+  ASSERT_EQ(gethostname(host_text, sizeof host_text - 1), 0);
+  std::string host = host_text;  // as the folder names it: '-' is its separator
+  for (char& c : host) c = std::isalnum(static_cast<unsigned char>(c)) || c == '.' ? c : '_';
+  const auto leftover = [&](const std::string& name) {
+    fs::create_directories(dir / name);
+    std::ofstream(dir / name / "scratch.png") << "partial";
+    return dir / name;
+  };
+  pid_t dead = 1 << 22;  // above Linux's pid_max
+  const fs::path gone = leftover(".matbake-tmp-" + host + "-" + std::to_string(dead) + "-00");
+  const fs::path live = leftover(".matbake-tmp-" + host + "-" + std::to_string(dead) + "-11");  // same PID, other namespace
+  const fs::path other_fresh = leftover(".matbake-tmp-elsewhere-1-22");
+  const fs::path other_old = leftover(".matbake-tmp-elsewhere-1-33");
+  const fs::path not_ours = leftover(".matbake-tmpfoo");
+  const int held = ::open(live.c_str(), O_RDONLY | O_DIRECTORY);
+  ASSERT_EQ(::flock(held, LOCK_EX), 0);
+  const timespec two_days_ago[2] = {{time(nullptr) - 2 * 86400, 0}, {time(nullptr) - 2 * 86400, 0}};
+  ASSERT_EQ(::utimensat(AT_FDCWD, other_old.c_str(), two_days_ago, 0), 0);
+  ASSERT_TRUE(write_file_atomically(dir / "x.txt", "bytes"));
+  EXPECT_FALSE(fs::exists(gone));
+  EXPECT_FALSE(fs::exists(other_old));
+  EXPECT_TRUE(fs::exists(live / "scratch.png"));
+  EXPECT_TRUE(fs::exists(other_fresh / "scratch.png"));
+  EXPECT_TRUE(fs::exists(not_ours / "scratch.png"));
+  ::close(held);
+  // This run's own folder: host, PID and a random token; gone once its last file is.
+  auto file = AtomicFile::create(dir / "y.txt");
+  ASSERT_TRUE(file);
+  const std::string own = file->temp_path().parent_path().filename().string();
+  EXPECT_EQ(own.rfind(".matbake-tmp-" + host + "-" + std::to_string(getpid()) + "-", 0), 0u) << own;
+  EXPECT_EQ(own.size(), (".matbake-tmp-" + host + "-" + std::to_string(getpid()) + "-").size() + 16);
 }
 
 }  // namespace

@@ -1,14 +1,21 @@
 #include "matbake/atomic_file.hpp"
 
 #include <fcntl.h>
+#include <signal.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include <atomic>
+#include <cctype>
 #include <cerrno>
+#include <chrono>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <map>
 #include <mutex>
+#include <random>
 #include <set>
 #include <string>
 
@@ -21,13 +28,17 @@ namespace {
 // The temporary files that exist now, for remove_temporary_files_for_exit(). A name is added before
 // the file is made and taken out after it is renamed or removed, under one lock.
 //
-// They live in a hidden folder of this process's own in the target's folder (.matbake-PID), so that
-// an interrupt can close them off for good: writers (ours, OIIO's) open their temporary file by
-// name, and one that does so after the file was removed would make it again; once the folder is
-// gone, no open can.
+// They live in a hidden folder of this process's own in the target's folder, so that an interrupt
+// can close them off for good: writers (ours, OIIO's) open their temporary file by name, and one
+// that does so after the file was removed would make it again; once the folder is gone, no open
+// can. The folder is named .matbake-tmp-HOST-PID-TOKEN (a random token: two processes with one PID
+// on a shared filesystem, from two containers or nodes, never share one), made exclusively, and
+// held under an flock while it exists, so that a later run can prove its owner gone.
 struct TemporaryFiles {
   std::mutex mutex;
   std::set<fs::path> paths;
+  std::map<fs::path, int> folders;  // made by this process, each with its locked descriptor
+  std::set<fs::path> swept;         // target folders whose leftovers were looked at
   bool closed = false;
 };
 TemporaryFiles& temporary_files() {
@@ -35,12 +46,74 @@ TemporaryFiles& temporary_files() {
   return files;
 }
 
-fs::path temporary_folder_in(const fs::path& folder) { return folder / (".matbake-" + std::to_string(getpid())); }
+constexpr const char* kPrefix = ".matbake-tmp-";
+// A leftover folder of another host is removed only this long after its last change.
+constexpr auto kLeftoverAge = std::chrono::hours(24);
+
+std::string host_name() {
+  char name[256] = {};
+  if (::gethostname(name, sizeof name - 1) != 0) return "host";
+  std::string out;
+  for (char c : std::string(name)) out += std::isalnum(static_cast<unsigned char>(c)) || c == '.' ? c : '_';
+  return out;
+}
+
+const std::string& folder_name() {
+  static const std::string name = [] {
+    std::random_device random;
+    char token[17];
+    std::snprintf(token, sizeof token, "%08x%08x", random(), random());
+    return kPrefix + host_name() + "-" + std::to_string(getpid()) + "-" + token;
+  }();
+  return name;
+}
+
+fs::path temporary_folder_in(const fs::path& folder) { return folder / folder_name(); }
+
+// Whether a leftover folder's owner is provably gone: nobody holds its lock, and it is this host's
+// with a PID that runs no process here, or it has not changed for kLeftoverAge.
+bool owner_gone(int folder_fd, const std::string& name) {
+  if (::flock(folder_fd, LOCK_EX | LOCK_NB) != 0) return false;
+  const std::string host = kPrefix + host_name() + "-";
+  if (name.rfind(host, 0) == 0) {
+    const long pid = std::strtol(name.c_str() + host.size(), nullptr, 10);
+    if (pid > 0 && ::kill(pid_t(pid), 0) != 0 && errno == ESRCH) return true;
+  }
+  struct stat s;
+  if (::fstat(folder_fd, &s) != 0) return false;
+  const auto changed = std::chrono::system_clock::from_time_t(s.st_mtim.tv_sec);
+  return std::chrono::system_clock::now() - changed > kLeftoverAge;
+}
+
+// Removes the leftover temporary folders in `folder` whose owners are provably gone (a run killed
+// with SIGKILL leaves one): their files, then the folder. Nothing is followed (a link is removed as
+// a link); a folder inside one is left.
+void sweep_leftovers(const fs::path& folder) {
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(folder, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (name.rfind(kPrefix, 0) != 0 || name == folder_name()) continue;
+    const int fd = ::open(entry.path().c_str(), O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC);
+    if (fd < 0) continue;
+    if (owner_gone(fd, name)) {
+      std::error_code inner;
+      for (const auto& file : fs::directory_iterator(entry.path(), inner)) ::unlinkat(fd, file.path().filename().c_str(), 0);
+      ::rmdir(entry.path().c_str());
+    }
+    ::close(fd);
+  }
+}
 
 // Under the lock: the folder goes when its last file does (another of ours may still be in it).
 void forget_temporary(TemporaryFiles& files, const fs::path& temp) {
   files.paths.erase(temp);
-  (void)::rmdir(temp.parent_path().c_str());
+  const fs::path folder = temp.parent_path();
+  if (::rmdir(folder.c_str()) == 0) {
+    if (const auto found = files.folders.find(folder); found != files.folders.end()) {
+      ::close(found->second);
+      files.folders.erase(found);
+    }
+  }
 }
 
 // Removes the folder even while writers make files in it: each pass removes what is there.
@@ -52,14 +125,19 @@ void remove_temporary_folder(const fs::path& folder) {
   }
 }
 
-// An existing name must be our folder, not a link planted to send outputs elsewhere.
-Status make_temporary_folder(const fs::path& temp_folder, const fs::path& target) {
-  if (::mkdir(temp_folder.c_str(), 0755) == 0) return success();
-  const int mkdir_errno = errno;
-  std::error_code ec;
-  if (mkdir_errno == EEXIST && fs::symlink_status(temp_folder, ec).type() == fs::file_type::directory) return success();
-  const std::string reason = mkdir_errno == EEXIST ? temp_folder.filename().string() + " is not a folder" : std::strerror(mkdir_errno);
-  return Error{target.string(), "cannot write in the output folder: " + reason};
+// Under the lock: this process's folder in `target`'s folder, made exclusively (an existing name is
+// never taken for ours: it may be a link planted to send outputs elsewhere) and locked.
+Status make_temporary_folder(TemporaryFiles& files, const fs::path& temp_folder, const fs::path& target) {
+  if (files.folders.count(temp_folder)) return success();
+  if (files.swept.insert(temp_folder.parent_path()).second) sweep_leftovers(temp_folder.parent_path());
+  if (::mkdir(temp_folder.c_str(), 0700) != 0) {
+    const std::string reason = errno == EEXIST ? temp_folder.filename().string() + " exists and is not this run's" : std::strerror(errno);
+    return Error{target.string(), "cannot write in the output folder: " + reason};
+  }
+  const int fd = ::open(temp_folder.c_str(), O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC);
+  if (fd >= 0) ::flock(fd, LOCK_EX | LOCK_NB);
+  files.folders[temp_folder] = fd;
+  return success();
 }
 
 }  // namespace
@@ -113,7 +191,7 @@ Result<AtomicFile> AtomicFile::create(const fs::path& target) {
     TemporaryFiles& files = temporary_files();
     std::unique_lock lock(files.mutex);
     if (files.closed) return Error{target.string(), "interrupted"};
-    if (Status made = make_temporary_folder(temp_folder, target); !made) return made.error();
+    if (Status made = make_temporary_folder(files, temp_folder, target); !made) return made.error();
     const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
     const int open_errno = errno;
     if (fd >= 0) {
@@ -121,7 +199,7 @@ Result<AtomicFile> AtomicFile::create(const fs::path& target) {
       files.paths.insert(temp);
       return AtomicFile(target, temp);
     }
-    (void)::rmdir(temp_folder.c_str());  // when empty
+    forget_temporary(files, temp);  // the folder, when empty
     lock.unlock();
     if (open_errno != EEXIST) {
       return Error{target.string(), std::string("cannot write in the output folder: ") + std::strerror(open_errno)};
