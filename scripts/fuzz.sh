@@ -4,7 +4,8 @@
 #   scripts/fuzz.sh --smoke SECONDS                        every target for SECONDS each (the test
 #                                                          command's smoke run)
 # Targets: image (our reader over OIIO), gltf and glb (document + flattened scene), manifest,
-# layout, materials. Seeds: the repository's presets and examples, plus ../shared/testdata when it
+# layout, materials, ktx2, state (stamps and made.json through the output gate), scripts (hostile
+# words through the Ninja and Slurm writers). Seeds: the repository's presets and examples, plus ../shared/testdata when it
 # is there (pngsuite, libpng-testpngs, openexr, the Khronos models), and tests/fuzz/regressions/ (inputs
 # that once failed, and seeds made by other tools; replayed first by every run). The growing corpus stays in
 # build-fuzz/corpus/TARGET; a crash is written to build-fuzz/artifacts/TARGET/ and fails the run.
@@ -12,7 +13,7 @@ set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 testdata=$root/../shared/testdata
 build=$root/build-fuzz
-targets=(image gltf glb manifest layout materials ktx2)
+targets=(image gltf glb manifest layout materials ktx2 state scripts)
 
 if [ $# -lt 2 ]; then
   echo "usage: scripts/fuzz.sh TARGET|--smoke SECONDS [libFuzzer flags...]  (targets: ${targets[*]})" >&2
@@ -67,6 +68,9 @@ run() {  # target, seconds, extra flags
     layout) seeds=$(seed layout -path '*layouts*' -name '*.json') ;;
     materials) seeds=$(seed materials -name 'materials*.toml') ;;
     ktx2) seeds=$(seed ktx2 -name '*.ktx2') ;;
+    # State files as a build writes them (tests/fuzz/regressions/state: a stamp and a made.json).
+    state) seeds=$(seed state -name '*.json' -path '*regressions*') ;;
+    scripts) seeds=$(seed scripts -name '*.txt' -path '*regressions*') ;;
     *) echo "scripts/fuzz.sh: unknown target '$target' (${targets[*]})" >&2; exit 2 ;;
   esac
   mkdir -p "$build/corpus/$target" "$build/artifacts/$target"

@@ -712,11 +712,13 @@ TEST(CliBuild, InterruptKeepsFinishedOutputsAndNoTemporaryFiles) {
                                const_cast<char*>("--quiet"), nullptr};
     pid_t pid = 0;
     ASSERT_EQ(posix_spawn(&pid, exe.c_str(), nullptr, nullptr, argv.data(), environ), 0);
-    // Wait for the first finished job's stamp (not the temporary file it is written through), then interrupt.
+    // Wait for the first finished job's stamp (not the temporary file it is written through, nor the
+    // folder's owner record), then interrupt.
+    const auto is_stamp = [](const fs::path& p) { return p.filename().string().rfind("material-", 0) == 0; };
     const auto stamps = [&] {
       std::size_t n = 0;
       std::error_code ec;
-      for (const auto& e : fs::directory_iterator(state_folder, ec)) n += e.path().filename().string()[0] != '.';
+      for (const auto& e : fs::directory_iterator(state_folder, ec)) n += is_stamp(e.path());
       return n;
     };
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(300);
@@ -732,6 +734,7 @@ TEST(CliBuild, InterruptKeepsFinishedOutputsAndNoTemporaryFiles) {
     std::size_t finished = 0;
     for (const auto& e : fs::directory_iterator(state_folder)) {
       ASSERT_NE(e.path().filename().string()[0], '.') << e.path();
+      if (!is_stamp(e.path())) continue;
       ++finished;
       const json stamp = json::parse(read_bytes(e.path()));
       for (const json& out : stamp["outputs"]) {

@@ -260,5 +260,40 @@ TEST(Gate, NinjaBuildsANewTextureSetARuleMatches) {
   EXPECT_NE(run(ninja, {"-C", dir.path().string()}).out.find("no work to do"), std::string::npos);
 }
 
+// Two manifests with one output folder (two CMake targets with one OUTPUT_DIR, the default out/):
+// the second is refused, naming the first, and the first's outputs stay byte for byte. When both
+// say shared_output = true, each keeps its own state and cleans only its own files.
+TEST(Gate, AnOutputFolderBelongsToOneManifestUnlessShared) {
+  Library lib;
+  write_bytes(lib.dir / "b.toml", "output = \"out\"\n[materials.b0]\nsources = { base_color = \"kd.png\", metallic = 0.0, roughness = 0.2 }\n"
+                                  "layout = \"gltf-orm\"\n");
+  ASSERT_EQ(lib.build().exit_code, 0);
+  const auto before = files_outside(lib.dir.path(), lib.dir / "none");
+  const RunResult second = matbake({"build", (lib.dir / "b.toml").string()});
+  EXPECT_EQ(second.exit_code, 1);
+  expect_one_error_line(second, (lib.dir / "b.toml").string(), "its output folder " + lib.out.string() + " belongs to " +
+                                                                   lib.manifest.string());
+  EXPECT_EQ(files_outside(lib.dir.path(), lib.dir / "none"), before);
+  EXPECT_EQ(matbake({"build", (lib.dir / "b.toml").string(), "-n"}).exit_code, 1);
+  EXPECT_NE(lib.build().out.find("nothing to do"), std::string::npos);
+
+  // Shared: each builds and stays up to date after the other; dropping a material removes only its files.
+  fs::remove_all(lib.out);
+  for (const fs::path& m : {lib.manifest, lib.dir / "b.toml"}) write_bytes(m, "shared_output = true\n" + read_bytes(m));
+  ASSERT_EQ(lib.build().exit_code, 0);
+  ASSERT_EQ(matbake({"build", (lib.dir / "b.toml").string()}).exit_code, 0);
+  EXPECT_NE(lib.build().out.find("nothing to do"), std::string::npos);
+  EXPECT_NE(matbake({"build", (lib.dir / "b.toml").string()}).out.find("nothing to do"), std::string::npos);
+  std::string text = read_bytes(lib.dir / "b.toml");
+  text.replace(text.find("[materials.b0]"), 14, "[materials.b1]");
+  write_bytes(lib.dir / "b.toml", text);
+  const RunResult renamed = matbake({"build", (lib.dir / "b.toml").string()});
+  EXPECT_EQ(renamed.exit_code, 0) << renamed.err;
+  EXPECT_FALSE(fs::exists(lib.out / "materials/b0_orm.png"));
+  EXPECT_TRUE(fs::exists(lib.out / "materials/b1_orm.png"));
+  EXPECT_TRUE(fs::exists(lib.out / "materials/m0_orm.png"));
+  EXPECT_NE(lib.build().out.find("nothing to do"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace matbake::test

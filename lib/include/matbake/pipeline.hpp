@@ -109,6 +109,10 @@ struct Manifest {
   std::vector<MaterialRule> rules;
   std::vector<SceneSpec> scenes;
   ClusterOptions cluster;
+  // `shared_output = true`: other manifests (that say so too) build into the same output folder;
+  // each keeps its own stamps and log (OUT/.matbake/shared/<its id>/) and cleans apart. Without
+  // it the folder belongs to the manifest that built it first (OUT/.matbake/owner.json).
+  bool shared_output = false;
 };
 
 // Errors name the manifest with line and column, and the key.
@@ -143,7 +147,8 @@ struct Job {
 struct Plan {
   std::vector<Job> jobs;
   std::vector<std::string> warnings;  // e.g. a material nothing uses
-  std::filesystem::path state_folder;  // the stamps: <output>/.matbake
+  std::filesystem::path state_folder;  // the stamps: <output>/.matbake (shared: .matbake/shared/<id>)
+  std::string owner;                   // the manifest as the output folder records it (owner.json)
 };
 
 // Which jobs the manifest makes and what each reads and writes (a scene's buffers and images are

@@ -200,7 +200,13 @@ Result<Plan> make_plan(const Manifest& manifest) {
   return guarded(manifest.file.string(), [&]() -> Result<Plan> {
     Plan plan;
     plan.warnings = manifest.notes;
+    // The manifest as its output folder knows it: its path from there (a moved or copied tree keeps it).
+    plan.owner = stamped_path(manifest.file, manifest.output);
     plan.state_folder = manifest.output / ".matbake";
+    if (manifest.shared_output) {
+      const std::string id = content_hash({reinterpret_cast<const unsigned char*>(plan.owner.data()), plan.owner.size()});
+      plan.state_folder = plan.state_folder / "shared" / (manifest.file.stem().string() + "-" + id);
+    }
     std::vector<bool> used(manifest.materials.size(), false);
     const auto material_index = [&](const std::string& name) -> std::optional<std::size_t> {
       for (std::size_t i = 0; i < manifest.materials.size(); ++i) {

@@ -343,6 +343,7 @@ Result<Report> run(const Manifest& manifest, const Plan& plan, const RunOptions&
   }
   const StampRoots roots{plan.state_folder, manifest.folder, manifest.output};
   Report report;
+  if (Status s = claim_output_folder(manifest, plan, !options.dry_run, report.warnings); !s) return s.error();
   std::vector<const Job*> selected;
   for (const Job& job : plan.jobs) {
     if (options.only.empty() || std::find(options.only.begin(), options.only.end(), job.name) != options.only.end()) {

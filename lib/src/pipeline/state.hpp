@@ -88,6 +88,10 @@ void record_failure(const std::string& job_name, const Error& error, const Stamp
 void remove_failure(const std::string& job_name, const StampRoots& roots);
 std::optional<std::string> recorded_failure(const std::string& job_name, const StampRoots& roots);
 
+// Checks, and unless the folder is someone else's records (`record`), that the output folder belongs
+// to this manifest (OUT/.matbake/owner.json; owner.cpp). An error names both manifests.
+Status claim_output_folder(const Manifest& manifest, const Plan& plan, bool record, std::vector<std::string>& warnings);
+
 // A path as a stamp or the state folder's logs hold it: relative to `root` where it lies below or
 // beside it; and back.
 std::string stamped_path(const std::filesystem::path& p, const std::filesystem::path& root);
