@@ -148,6 +148,9 @@ CLI::App* setup_build(CLI::App& app, BuildSettings& s) {
   cmd->add_flag("-n,--dry-run", s.dry_run, "List what would be built, and why, without building it");
   cmd->add_flag("--keep-stale", s.keep_stale,
                 "Keep the files an earlier build made that no job makes now (by default a full run with no failure removes them)");
+  cmd->add_flag("--prune", s.prune,
+                "Allow what a lost input looks like: removing more than half of the files the build made, or a scene\n"
+                "losing a manifest material it was built with (without it, the files are kept and the scene refused)");
   cmd->add_flag("--status", s.status,
                 "Build nothing; say how each job stands after runs elsewhere (a cluster, docs/cluster.md): up to date,\n"
                 "failed (its error line) or not built. Exit 1 when any failed");
@@ -226,6 +229,7 @@ int run_build(const BuildSettings& s, const GlobalOptions& global) {
   options.dry_run = s.dry_run;
   options.only = s.only;
   options.keep_stale = s.keep_stale;
+  options.prune = s.prune;
   options.progress = [&](const pipeline::JobReport& r, std::size_t done, std::size_t total) {
     if (r.outcome == pipeline::Outcome::failed) {
       bar.print_above("matbake: error: " + job_error(r));
@@ -299,10 +303,12 @@ int run_build(const BuildSettings& s, const GlobalOptions& global) {
                                          " read it; its outputs are from the earlier bytes (as its stamp records): build again"});
     }
   }
+  if (!report->stale.held_back.empty()) std::cerr << "matbake: error: " << s.manifest << ": " << report->stale.held_back << "\n";
   if (failed) {
     std::cerr << "matbake: error: " << s.manifest << ": " << failed << " of " << report->jobs.size() << " jobs failed\n";
     return kFailed;
   }
+  if (!report->stale.held_back.empty()) return kFailed;
   return report->moved() ? kFailed : kOk;
 }
 

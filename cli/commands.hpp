@@ -129,6 +129,7 @@ struct BuildSettings {
   bool force = false;
   bool dry_run = false;
   bool keep_stale = false;
+  bool prune = false;
   bool status = false;  // report how the jobs stand (after a cluster run); build nothing
   std::vector<std::string> only;
   std::string depfile;

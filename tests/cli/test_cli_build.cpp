@@ -260,7 +260,13 @@ TEST(CliBuild, StaleOutputsAreRemovedAndOnlyThose) {
   edit("decode = \"srgb\"", "decode = \"srgb\"\nvalidate = { enabled = false }");
   edit("[materials.gold_trim]", "[materials.old_gold_trim]");
   write_bytes(dir / "out/materials/gold_trim_orm.png", "changed by hand");
-  const json cleaned = run_json({"build", manifest});
+  // The scene was built with the manifest's gold_trim: losing it is refused unless pruned.
+  const RunResult refused = matbake({"build", manifest});
+  EXPECT_EQ(refused.exit_code, 1);
+  EXPECT_NE(refused.err.find("scenes.showroom: its glTF material 'gold_trim' was built with a manifest material"), std::string::npos)
+      << refused.err;
+  EXPECT_TRUE(fs::exists(dir / "out/materials/gold_trim_base_color.png"));
+  const json cleaned = run_json({"build", manifest, "--prune"});
   std::vector<std::string> gone = cleaned["stale"]["removed"];
   std::sort(gone.begin(), gone.end());
   EXPECT_EQ(gone, (std::vector<std::string>{(dir / "out/materials/gold_trim.validation.json").string(),

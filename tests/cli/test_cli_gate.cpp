@@ -295,5 +295,28 @@ TEST(Gate, AnOutputFolderBelongsToOneManifestUnlessShared) {
   EXPECT_NE(lib.build().out.find("nothing to do"), std::string::npos);
 }
 
+// A run that would remove more than half of what the build made (a renamed folder, a lost input)
+// keeps the files and says why, exit 1; --prune removes them.
+TEST(Gate, RemovingMostOutputsAtOnceNeedsPrune) {
+  Library lib;
+  std::string manifest = "output = \"out\"\n";
+  for (int m = 0; m < 4; ++m) {
+    manifest += "[materials.m" + std::to_string(m) + "]\nsources = { base_color = \"kd.png\", metallic = 0.0, roughness = 0.5 }\n"
+                "layout = \"gltf-orm\"\n";
+  }
+  write_bytes(lib.manifest, manifest);
+  ASSERT_EQ(lib.build().exit_code, 0);
+  write_bytes(lib.manifest, "output = \"out\"\n[materials.m0]\nsources = { base_color = \"kd.png\", metallic = 0.0, roughness = 0.5 }\n"
+                            "layout = \"gltf-orm\"\n");
+  const RunResult held = lib.build();
+  EXPECT_EQ(held.exit_code, 1);
+  EXPECT_NE(held.err.find("this run would remove 9 of the 12 files the build made"), std::string::npos) << held.err;
+  EXPECT_TRUE(fs::exists(lib.out / "materials/m3_orm.png"));
+  const RunResult pruned = lib.build({"--prune"});
+  EXPECT_EQ(pruned.exit_code, 0) << pruned.err;
+  EXPECT_FALSE(fs::exists(lib.out / "materials/m3_orm.png"));
+  EXPECT_TRUE(fs::exists(lib.out / "materials/m0_orm.png"));
+}
+
 }  // namespace
 }  // namespace matbake::test

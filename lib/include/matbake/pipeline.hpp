@@ -113,6 +113,7 @@ struct Manifest {
   // each keeps its own stamps and log (OUT/.matbake/shared/<its id>/) and cleans apart. Without
   // it the folder belongs to the manifest that built it first (OUT/.matbake/owner.json).
   bool shared_output = false;
+  bool prune = false;  // `prune = true`: as --prune on every run (RunOptions::prune)
 };
 
 // Errors name the manifest with line and column, and the key.
@@ -185,17 +186,26 @@ struct StaleOutputs {
   std::vector<std::filesystem::path> removed;  // at the end of a full run with no failure
   std::vector<std::filesystem::path> kept;     // --keep-stale, --only, a failed job or a dry run: removed later
   std::vector<std::filesystem::path> changed;  // changed since matbake wrote them: left alone, forgotten
+  // Why nothing was removed although files are stale (too many at once without --prune), or empty.
+  std::string held_back;
   // Entries of the log that do not provably name a file matbake made in the output folder (a path
   // out of it, through a link, an alias of a live output, an input): each with why; left alone,
   // forgotten.
   std::vector<std::string> refused;
 };
 
+inline constexpr double kPruneShare = 0.5;
+inline constexpr std::size_t kPruneMinimum = 8;
+
 struct RunOptions {
   bool force = false;
   bool dry_run = false;
   std::vector<std::string> only;  // job names; empty: all
   bool keep_stale = false;        // keep the files no job makes now (else removed after a full run)
+  // Allow what a lost input looks like: removing more than kPruneShare of the files made (and more
+  // than kPruneMinimum), or a scene losing a manifest material it was built with. Without it
+  // the run stops before building (a scene) or keeps the files (the share) and says why.
+  bool prune = false;
   // Called as each job finishes (from worker threads, one call at a time).
   std::function<void(const JobReport&, std::size_t done, std::size_t total)> progress;
   // Called when a job has written its outputs and before its stamp is (tests change a source here).

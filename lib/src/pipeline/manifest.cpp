@@ -483,7 +483,7 @@ Result<Manifest> parse_manifest(std::string_view toml_text, const fs::path& file
                                              with_keys_of(image::encoding_params(),
                                                           with_keys_of(image::gltf_texture_params(),
                                                                        {"output", "table", "validate", "materials", "material_rules",
-                                                                        "scenes", "cluster", "shared_output"}))));
+                                                                        "scenes", "cluster", "shared_output", "prune"}))));
         !s) {
       return s.error();
     }
@@ -495,6 +495,7 @@ Result<Manifest> parse_manifest(std::string_view toml_text, const fs::path& file
     if (Status s = r.get(doc, "output", "manifest", output); !s) return s.error();
     if (Status s = r.get(doc, "table", "manifest", table); !s) return s.error();
     if (Status s = r.get(doc, "shared_output", "manifest", m.shared_output); !s) return s.error();
+    if (Status s = r.get(doc, "prune", "manifest", m.prune); !s) return s.error();
     m.output = (m.folder / output).lexically_normal();
     if (!table.empty()) m.table = m.folder / table;
     // The top level's material options, encoding and validation are every material's defaults (the

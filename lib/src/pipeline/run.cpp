@@ -305,6 +305,27 @@ void run_job(const Job& job, const JobContext& ctx, const RunOptions& run_option
   report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
+// A scene whose last build gave a glTF material a manifest material that the manifest no longer
+// has would silently fall back to the glTF's own material: the run stops and says so.
+Status check_scene_materials(const Manifest& manifest, const Plan& plan, const StampRoots& roots) {
+  for (const Job& job : plan.jobs) {
+    if (job.kind != JobKind::scene) continue;
+    const StateText read = read_state_file(roots.state_folder / (job_file_stem(job.name) + ".json"), kStampLimit);
+    const nlohmann::json stamp = nlohmann::json::parse(read.text, nullptr, false);
+    if (!read.problem.empty() || !stamp.is_object() || !stamp.contains("options") || !stamp["options"].is_string()) continue;
+    const nlohmann::json options = nlohmann::json::parse(stamp["options"].get<std::string>(), nullptr, false);
+    if (!options.is_object() || !options.contains("materials") || !options["materials"].is_object()) continue;
+    for (const auto& [gltf_name, material] : options["materials"].items()) {
+      if (job.materials.count(gltf_name)) continue;
+      const SceneSpec& s = manifest.scenes[job.spec];
+      return Error{s.origins.of(""), "scenes." + s.name + ": its glTF material '" + gltf_name +
+                                         "' was built with a manifest material the manifest no longer gives it; the scene would "
+                                         "fall back to the glTF's own material: restore it, or pass --prune (or set prune = true)"};
+    }
+  }
+  return success();
+}
+
 MadeLog read_log(const StampRoots& roots, Report& report) {
   std::string problem;
   MadeLog log = read_made_log(roots, problem);
@@ -327,7 +348,16 @@ Status finish_run(const Manifest& manifest, const Plan& plan, const RunOptions& 
     remove_failure(name, roots);
   }
   const bool full = options.only.empty() && report.count(Outcome::failed) == 0;
-  report.stale = clean_stale(log, output_gate(manifest, plan), roots, full && !options.keep_stale);
+  std::size_t made = log.stale.size();
+  for (const auto& [name, files] : log.jobs) made += files.size();
+  const bool prune = options.prune || manifest.prune;
+  const bool too_many = log.stale.size() > kPruneMinimum && double(log.stale.size()) > kPruneShare * double(made);
+  report.stale = clean_stale(log, output_gate(manifest, plan), roots, full && !options.keep_stale && (prune || !too_many));
+  if (full && !options.keep_stale && !prune && too_many && !report.stale.kept.empty()) {
+    report.stale.held_back = "this run would remove " + std::to_string(report.stale.kept.size()) + " of the " + std::to_string(made) +
+                             " files the build made (more than half: a renamed folder or a lost input looks like this); "
+                             "they are kept: pass --prune (or set prune = true) to remove them";
+  }
   return log == before ? success() : write_made_log(log, roots);  // a no-op run writes nothing
 }
 
@@ -344,6 +374,9 @@ Result<Report> run(const Manifest& manifest, const Plan& plan, const RunOptions&
   const StampRoots roots{plan.state_folder, manifest.folder, manifest.output};
   Report report;
   if (Status s = claim_output_folder(manifest, plan, !options.dry_run, report.warnings); !s) return s.error();
+  if (!options.prune && !manifest.prune) {
+    if (Status s = check_scene_materials(manifest, plan, roots); !s) return s.error();
+  }
   std::vector<const Job*> selected;
   for (const Job& job : plan.jobs) {
     if (options.only.empty() || std::find(options.only.begin(), options.only.end(), job.name) != options.only.end()) {
