@@ -435,5 +435,52 @@ TEST(CliDelivery, AnInterruptKillsTheEncoder) {
   EXPECT_FALSE(still_runs(pid)) << pid;
 }
 
+// kill -9 of matbake mid-encode: the encoder dies with it (PR_SET_PDEATHSIG), and the scratch it
+// leaves in the output's folder is removed by the next run there (its owner is provably gone).
+TEST(CliDelivery, KillNineMidEncodeLeavesNothingRunningAndTheNextRunSweeps) {
+  TempDir dir;
+  write_textured_quad(dir.path());
+  const fs::path encoder = misbehaving_encoder(dir.path());
+  const std::string pidfile = (dir / "pid").string(), out = (dir / "out/q.glb").string();
+  const std::string command = "MATBAKE_BASISU='" + encoder.string() + "' PIDFILE='" + pidfile + "' MODE=hang '" + matbake_exe() +
+                              "' export '" + (dir / "quad.gltf").string() + "' -o '" + out + "' --texture-format ktx2 "
+                              ">/dev/null 2>&1 & m=$!; for i in $(seq 100); do [ -s '" + pidfile + "' ] && break; sleep 0.1; done; "
+                              "kill -KILL $m; wait $m; echo $?";
+  const RunResult r = run("/bin/bash", {"-c", command});
+  EXPECT_EQ(r.out, "137\n") << r.err;
+  const std::string pid = read_bytes(pidfile).substr(0, read_bytes(pidfile).find('\n'));
+  for (int i = 0; i < 100 && still_runs(pid); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  EXPECT_FALSE(still_runs(pid)) << pid;
+  const auto leftovers = [&] {
+    std::vector<std::string> found;
+    for (const auto& e : fs::directory_iterator(dir / "out")) {
+      if (e.path().filename().string().rfind(".matbake-tmp-", 0) == 0) found.push_back(e.path().string());
+    }
+    return found;
+  };
+  ASSERT_EQ(leftovers().size(), 1u);  // the killed run's scratch
+  EXPECT_EQ(matbake({"export", (dir / "quad.gltf").string(), "-o", out}).exit_code, 0);
+  EXPECT_EQ(leftovers(), std::vector<std::string>{});
+}
+
+// An ETC1S file of another size or level count than asked for is refused, not delivered.
+TEST(CliDelivery, AnEncoderOutputOfTheWrongSizeIsRefused) {
+  MATBAKE_BASISU_OR_SKIP(basisu);
+  TempDir dir;
+  write_textured_quad(dir.path());
+  for (const std::string& extra : {std::string("-resample 8 8"), std::string("-mip_smallest 8")}) {
+    const fs::path wrapper = dir / "basisu-wrong";
+    write_bytes(wrapper, "#!/bin/bash\ncase \" $* \" in *\" -uastc \"*|*\" -version \"*) exec '" + basisu + "' \"$@\" ;; esac\n"
+                         "exec '" + basisu + "' \"$@\" " + extra + "\n");
+    fs::permissions(wrapper, fs::perms::owner_exec, fs::perm_options::add);
+    const RunResult r = matbake({"export", (dir / "quad.gltf").string(), "-o", (dir / "out/q.glb").string(), "--texture-format", "ktx2"},
+                                {"MATBAKE_BASISU=" + wrapper.string()});
+    EXPECT_EQ(r.exit_code, 1) << extra;
+    EXPECT_NE(r.err.find("wrote an unexpected KTX2 file"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("asked for ETC1S 32x32, 6 levels"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(dir / "out/q.glb"));
+  }
+}
+
 }  // namespace
 }  // namespace matbake::test

@@ -157,6 +157,19 @@ TEST(Gate, StateFilesAreReadAsHostileInput) {
   EXPECT_EQ(huge.exit_code, 0) << huge.err;
   EXPECT_NE(huge.err.find(made.string() + " is 104857600 bytes, over the 64 MiB"), std::string::npos) << huge.err;
 
+  // A truncated stamp, and a stamp that is a link to a file elsewhere: refused, rebuilt.
+  const std::string whole = read_bytes(stamp);
+  write_bytes(stamp, whole.substr(0, whole.size() / 2));
+  const RunResult truncated = lib.build();
+  EXPECT_EQ(truncated.exit_code, 0) << truncated.err;
+  EXPECT_NE(truncated.err.find(stamp.string() + " is not one matbake wrote: is not JSON"), std::string::npos) << truncated.err;
+  write_bytes(lib.dir / "u/stamp.json", read_bytes(stamp));
+  fs::remove(stamp);
+  fs::create_symlink(lib.dir / "u/stamp.json", stamp);
+  const RunResult linked_stamp = lib.build();
+  EXPECT_NE(linked_stamp.err.find(stamp.string() + " is a link"), std::string::npos) << linked_stamp.err;
+  EXPECT_NE(linked_stamp.out.find("built 1"), std::string::npos) << linked_stamp.out;
+
   // A lock that is a dangling link: its target is never made.
   fs::remove(lib.out / ".matbake/made.lock");
   fs::create_symlink(lib.dir / "u/planted", lib.out / ".matbake/made.lock");
