@@ -188,5 +188,48 @@ TEST(CliWorkflow, ReportsBothConversionsAndConvertsBack) {
   EXPECT_EQ(none.exit_code, 2);
 }
 
+// A spec-gloss material written in gltf-pbr keeps its normal and emissive maps, through the
+// workflow command and a manifest material alike; without an emissive map no emissive texture.
+TEST(CliWorkflow, SpecGlossMaterialKeepsItsNormalAndEmissiveMaps) {
+  TempDir dir;
+  std::vector<double> normal, emissive, kd;
+  for (int i = 0; i < 16; ++i) {
+    const double angle = 0.3 * i, x = 0.5 * std::sin(angle), y = 0.5 * std::cos(angle), z = std::sqrt(1 - x * x - y * y);
+    normal.insert(normal.end(), {std::round((0.5 * x + 0.5) * 255), std::round((0.5 * y + 0.5) * 255),
+                                 std::round((0.5 * z + 0.5) * 255)});
+    emissive.insert(emissive.end(), {double(i * 16), double(255 - i * 16), 77});
+    kd.insert(kd.end(), {double(40 + i), 90, 120});
+  }
+  write_raw(dir / "n.png", 4, 4, 3, "uint8", normal);
+  write_raw(dir / "e.png", 4, 4, 3, "uint8", emissive);
+  write_raw(dir / "d.png", 4, 4, 3, "uint8", kd);
+  const auto expect_maps = [&](const fs::path& normal_file, const fs::path& emissive_file) {
+    const RawImage n = read_raw(normal_file), e = read_raw(emissive_file);
+    ASSERT_EQ(n.samples.size(), normal.size());
+    for (std::size_t i = 0; i < normal.size(); ++i) EXPECT_NEAR(n.samples[i], normal[i], 1) << i;
+    EXPECT_EQ(e.samples, emissive);
+  };
+  const RunResult run = matbake({"workflow", "--kd", (dir / "d.png").string(), "--ks", "0.04", "--gloss", "0.6",
+                                 "--normal", (dir / "n.png").string(), "--emissive", (dir / "e.png").string(),
+                                 "--layout", "gltf-pbr", "-o", (dir / "wf_{texture}.png").string()});
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  expect_maps(dir / "wf_normal.png", dir / "wf_emissive.png");
+
+  write_bytes(dir / "lib.toml", "output = \"out\"\n"
+                                "[materials.sg]\nsources = { kd = \"d.png\", ks = 0.04, gloss = 0.6, normal = \"n.png\", "
+                                "emissive = \"e.png\" }\nlayout = \"gltf-pbr\"\n"
+                                "[materials.plain]\nsources = { kd = \"d.png\", ks = 0.04, gloss = 0.6 }\nlayout = \"gltf-pbr\"\n");
+  const RunResult built = matbake({"build", (dir / "lib.toml").string()});
+  ASSERT_EQ(built.exit_code, 0) << built.err;
+  expect_maps(dir / "out/materials/sg_normal.png", dir / "out/materials/sg_emissive.png");
+  EXPECT_FALSE(fs::exists(dir / "out/materials/plain_emissive.png"));
+  EXPECT_FALSE(fs::exists(dir / "out/materials/plain_normal.png"));
+  EXPECT_TRUE(fs::exists(dir / "out/materials/plain_orm.png"));
+  // Up to date afterwards: the plan expects the textures the run wrote, no more.
+  const RunResult again = matbake({"build", (dir / "lib.toml").string(), "-n"});
+  EXPECT_EQ(again.exit_code, 0) << again.err;
+  EXPECT_EQ(again.out.find("material:"), std::string::npos) << again.out;
+}
+
 }  // namespace
 }  // namespace matbake::test

@@ -2,6 +2,7 @@
 // The in-memory material: named source maps (linear float, colour maps with 3 channels, scalar ones
 // with 1, all one size) — what pack, workflow, validate, preview and export hand each other.
 #include <map>
+#include <set>
 #include <span>
 #include <string>
 #include <string_view>
@@ -38,12 +39,15 @@ inline int component_count(SourceKind kind) { return kind == SourceKind::scalar 
 // A source given as a number holds a texel value: finite and in [0, 1] (NaN fails both).
 inline bool is_valid_constant(double value) { return value >= 0.0 && value <= 1.0; }
 
+using MapNames = std::set<std::string, std::less<>>;
+
 struct Maps {
   int width = 0;
   int height = 0;
   std::map<std::string, image::Image, std::less<>> maps;
   const image::Image* find(std::string_view name) const;
   bool has_any(std::initializer_list<std::string_view> names) const;
+  MapNames names() const;
   // Which workflow the maps are in: any of kd, ks, gloss / any of base_color, metallic, roughness.
   bool spec_gloss() const { return has_any({kKd, kKs, kGloss}); }
   bool metal_rough() const { return has_any({kBaseColor, kMetallic, kRoughness}); }

@@ -126,6 +126,10 @@ Result<material::Maps> load_material(const std::vector<SourceInput>& sources, co
 
 // The sources a layout reads, and which of them it cannot do without (no fallback).
 std::vector<std::string> layout_sources(const Layout& layout);
+// Whether a texture is written for a material with maps of these names: not when it reads maps
+// and the material has none of them (gltf-pbr's emissive texture of a material without emission
+// would be all default values); a texture of constants only is.
+bool texture_written(const Texture& texture, const material::MapNames& given);
 Result<std::vector<image::Image>> pack(const Layout& layout, const material::Maps& sources);
 // The inverse: source maps from decoded textures (one per layout texture, same size).
 Result<material::Maps> unpack(const Layout& layout, std::span<const image::Image> textures,
@@ -151,8 +155,9 @@ struct WriteRequest {
   std::vector<NamedOutput> also;                     // the run's other outputs (a report): checked with the textures
   image::Encoding encoding;
 };
-// Packs `sources` into the layout's textures and writes them (each atomically). An output that is
-// an input, or two outputs that are one file, are refused before anything is written.
+// Packs `sources` into the layout's textures and writes those texture_written() keeps (each
+// atomically), returning their paths. An output that is an input, or two outputs that are one
+// file, are refused before anything is written.
 Result<std::vector<std::filesystem::path>> write_textures(const Layout& layout, const material::Maps& sources,
                                                           const WriteRequest& request);
 

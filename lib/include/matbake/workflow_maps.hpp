@@ -46,8 +46,8 @@ struct ConversionReport {
   DielectricF0 dielectric;          // spec-gloss → metal-rough only
 };
 
-// Needs kd, ks, gloss; writes base_color, metallic, roughness (and passes mask, occlusion and
-// detail_mask through).
+// Needs kd, ks, gloss; writes base_color, metallic, roughness (and passes every other map through:
+// mask, occlusion, detail_mask, normal, emissive).
 Result<material::Maps> metal_rough_from_spec_gloss(const material::Maps& in, RoughnessMapping mapping,
                                                      ConversionReport& report);
 // Needs base_color, metallic, roughness; writes kd, ks, gloss (the same pass-through).
@@ -64,7 +64,11 @@ struct LayoutMaps {
   ConversionReport report;  // when converted
 };
 Result<LayoutMaps> in_layout_workflow(material::Maps maps, const pack::Layout& layout, RoughnessMapping mapping);
-// The conversion in_layout_workflow makes, if any.
+// The conversion in_layout_workflow makes, if any: of maps, or of maps with these names.
 std::optional<Direction> layout_direction(const material::Maps& maps, const pack::Layout& layout);
+std::optional<Direction> layout_direction(const material::MapNames& names, const pack::Layout& layout);
+// The names of the maps in_layout_workflow returns for maps of these names (what a plan knows
+// before any file is read).
+material::MapNames names_in_layout_workflow(material::MapNames names, const pack::Layout& layout);
 
 }  // namespace matbake::workflow

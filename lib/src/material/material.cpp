@@ -36,6 +36,12 @@ const image::Image* Maps::find(std::string_view name) const {
   return it == maps.end() ? nullptr : &it->second;
 }
 
+MapNames Maps::names() const {
+  MapNames names;
+  for (const auto& entry : maps) names.insert(entry.first);
+  return names;
+}
+
 bool Maps::has_any(std::initializer_list<std::string_view> names) const {
   return std::any_of(names.begin(), names.end(), [&](std::string_view n) { return find(n) != nullptr; });
 }

@@ -422,6 +422,16 @@ std::vector<std::string> layout_sources(const Layout& layout) {
   return names;
 }
 
+bool texture_written(const Texture& texture, const material::MapNames& given) {
+  bool reads = false;
+  for (const Channel& c : texture.channels) {
+    if (c.source.empty()) continue;
+    if (given.contains(c.source)) return true;
+    reads = true;
+  }
+  return !reads;
+}
+
 Result<std::vector<image::Image>> pack(const Layout& layout, const material::Maps& sources) {
   return guarded("", [&]() -> Result<std::vector<image::Image>> {
     std::vector<image::Image> textures;
@@ -531,12 +541,16 @@ Result<std::vector<fs::path>> write_textures(const Layout& layout, const materia
     if (Status s = check_outputs(outputs, request.inputs); !s) return s.error();
     auto images = pack(layout, sources);
     if (!images) return images.error();
+    const material::MapNames given = sources.names();
+    std::vector<fs::path> written;
     for (std::size_t t = 0; t < paths->size(); ++t) {
+      if (!texture_written(layout.textures[t], given)) continue;
       const image::SampleType type = request.type.value_or(default_sample_type((*paths)[t]));
       const image::WriteOptions options = write_options(layout.textures[t].color, {type, request.transfer, request.encoding});
       if (Status s = image::write_image((*images)[t], (*paths)[t], options); !s) return s.error();
+      written.push_back((*paths)[t]);
     }
-    return paths;
+    return written;
   });
 }
 

@@ -21,6 +21,7 @@
 #include "matbake/report_json.hpp"
 #include "matbake/script_text.hpp"
 #include "matbake/version.hpp"
+#include "matbake/workflow_maps.hpp"
 
 namespace matbake::pipeline {
 namespace fs = std::filesystem;
@@ -149,6 +150,17 @@ void add_unique(std::vector<fs::path>& to, const std::vector<fs::path>& from) {
   }
 }
 
+// The maps a material's layout is written from (its sources, or its packed layout's, in the
+// layout's workflow): what decides which of the layout's textures it writes.
+material::MapNames layout_map_names(const MaterialSpec& m) {
+  material::MapNames names;
+  for (const pack::SourceInput& s : m.sources) names.insert(s.name);
+  if (m.packed) {
+    for (std::string& n : pack::layout_sources(m.packed->layout)) names.insert(std::move(n));
+  }
+  return workflow::names_in_layout_workflow(std::move(names), m.layout->layout);
+}
+
 // A material's job: what it reads and writes, its options, and what makes it fail before it starts.
 Result<Job> material_job(const Manifest& manifest, std::size_t i, const Result<std::vector<material_table::Material>>& table) {
   const MaterialSpec& m = manifest.materials[i];
@@ -161,9 +173,12 @@ Result<Job> material_job(const Manifest& manifest, std::size_t i, const Result<s
   job.options = material_options(m, manifest).dump();
   job.problem = material_problem(m, table, manifest.origins);
   if (m.layout) {
-    auto paths = pack::output_paths(m.layout->layout, {(materials_folder / (m.name + "_{texture}." + m.options.format)).string()});
+    auto paths = pack::output_paths(m.layout->layout, {material_texture_pattern(manifest, m).string()});
     if (!paths) return Error{m.origins.of("layout"), "materials." + m.name + ".layout: " + paths.error().to_string()};
-    job.outputs.textures = *paths;
+    const material::MapNames given = layout_map_names(m);
+    for (std::size_t t = 0; t < paths->size(); ++t) {
+      if (pack::texture_written(m.layout->layout.textures[t], given)) job.outputs.textures.push_back((*paths)[t]);
+    }
   }
   if (m.validation.enabled) {
     job.outputs.validation_report = materials_folder / (m.name + ".validation.json");
@@ -173,6 +188,10 @@ Result<Job> material_job(const Manifest& manifest, std::size_t i, const Result<s
 }
 
 }  // namespace
+
+fs::path material_texture_pattern(const Manifest& manifest, const MaterialSpec& m) {
+  return manifest.output / "materials" / (m.name + "_{texture}." + m.options.format);
+}
 
 std::vector<fs::path> JobOutputs::all() const {
   std::vector<fs::path> files = textures;

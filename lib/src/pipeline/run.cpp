@@ -194,7 +194,7 @@ Status validate_material(const MaterialSpec& m, const material::Maps& maps, cons
 }
 
 // The material's textures in its layout's workflow (converted when the layout needs the other one).
-Status write_layout(const Job& job, const MaterialSpec& m, material::Maps maps, JobReport& report) {
+Status write_layout(const Job& job, const JobContext& ctx, const MaterialSpec& m, material::Maps maps, JobReport& report) {
   const pack::Layout& layout = m.layout->layout;
   const bool converts = workflow::layout_direction(maps, layout).has_value();
   auto in_workflow = workflow::in_layout_workflow(std::move(maps), layout, m.options.mapping);
@@ -202,10 +202,13 @@ Status write_layout(const Job& job, const MaterialSpec& m, material::Maps maps, 
     return Error{m.origins.of("layout"), "materials." + m.name + ".layout: " + in_workflow.error().to_string()};
   }
   if (converts) report.details["conversion"] = to_json(*in_workflow, m.options.mapping);
-  const std::vector<std::string> outputs(job.outputs.textures.begin(), job.outputs.textures.end());
+  const std::vector<std::string> outputs{material_texture_pattern(ctx.manifest, m).string()};
   auto written = pack::write_textures(layout, in_workflow->maps,
                                       {outputs, m.options.bits, m.options.transfer, decoded_files(m), {}, m.encoding});
   if (!written) return written.error();
+  // The plan chose the textures from the maps' names, the writer from the maps: one rule, so a
+  // difference is a bug (a written file the build does not know, or a planned one never written).
+  if (*written != job.outputs.textures) return Error{m.name, "internal error: the textures written are not the planned ones"};
   return success();
 }
 
@@ -220,7 +223,7 @@ Status run_material(const Job& job, const JobContext& ctx, JobReport& report) {
     if (m.validation.enabled) {
       if (Status s = validate_material(m, *maps, ctx, job.outputs, report); !s) return s;
     }
-    if (m.layout) return write_layout(job, m, std::move(*maps), report);
+    if (m.layout) return write_layout(job, ctx, m, std::move(*maps), report);
     return success();
   });
 }

@@ -16,7 +16,9 @@
 
 namespace matbake::pipeline {
 
-std::string job_file_stem(const std::string& job_name);  // "material-wood": the stamp's and the depfile's name
+std::string job_file_stem(const std::string& job_name);
+// Where a material's layout textures go: OUT/materials/NAME_{texture}.FORMAT.
+std::filesystem::path material_texture_pattern(const Manifest& manifest, const MaterialSpec& m);  // "material-wood": the stamp's and the depfile's name
 
 // A file as a job read it: its size and modification time (nanoseconds) and the XXH64 of the bytes.
 struct FileIdentity {

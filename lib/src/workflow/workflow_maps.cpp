@@ -3,6 +3,8 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
+#include <span>
 #include <cmath>
 
 namespace matbake::workflow {
@@ -52,9 +54,15 @@ Result<const image::Image*> need(const material::Maps& in, std::string_view name
   return map;
 }
 
-void pass_through(const material::Maps& in, material::Maps& out) {
-  for (const char* name : {"mask", "occlusion", "detail_mask"}) {
-    if (const image::Image* m = in.find(name)) out.maps[name] = *m;
+// Every map the conversion does not read (mask, occlusion, normal, emissive, ...) reaches the
+// result as it is: a material's maps are the same whichever workflow its layout is in.
+// The maps each conversion reads (and the other one writes).
+constexpr std::array<std::string_view, 3> kSpecGlossMaps{material::kKd, material::kKs, material::kGloss};
+constexpr std::array<std::string_view, 3> kMetalRoughMaps{material::kBaseColor, material::kMetallic, material::kRoughness};
+
+void pass_through(const material::Maps& in, std::span<const std::string_view> converted, material::Maps& out) {
+  for (const auto& [name, map] : in.maps) {
+    if (std::find(converted.begin(), converted.end(), name) == converted.end()) out.maps.emplace(name, map);
   }
 }
 
@@ -167,7 +175,7 @@ Result<material::Maps> metal_rough_from_spec_gloss(const material::Maps& in, Rou
     out.maps["base_color"] = std::move(base);
     out.maps["metallic"] = std::move(metallic);
     out.maps["roughness"] = std::move(roughness);
-    pass_through(in, out);
+    pass_through(in, kSpecGlossMaps, out);
     return out;
   });
 }
@@ -199,7 +207,7 @@ Result<material::Maps> spec_gloss_from_metal_rough(const material::Maps& in, Rou
     out.maps["kd"] = std::move(kd);
     out.maps["ks"] = std::move(ks);
     out.maps["gloss"] = std::move(gloss);
-    pass_through(in, out);
+    pass_through(in, kMetalRoughMaps, out);
     return out;
   });
 }
@@ -208,13 +216,16 @@ std::string_view direction_name(Direction d) {
   return d == Direction::metal_rough_from_spec_gloss ? "spec-gloss to metal-rough" : "metal-rough to spec-gloss";
 }
 
-std::optional<Direction> layout_direction(const material::Maps& maps, const pack::Layout& layout) {
+std::optional<Direction> layout_direction(const material::MapNames& names, const pack::Layout& layout) {
   const std::vector<std::string> read = pack::layout_sources(layout);
-  const auto reads = [&](std::initializer_list<std::string_view> names) {
-    return std::any_of(names.begin(), names.end(),
+  const auto reads = [&](std::initializer_list<std::string_view> wanted) {
+    return std::any_of(wanted.begin(), wanted.end(),
                        [&](std::string_view n) { return std::find(read.begin(), read.end(), n) != read.end(); });
   };
-  const bool spec_gloss = maps.spec_gloss(), metal_rough = maps.metal_rough();
+  const auto has_any = [&](std::span<const std::string_view> wanted) {
+    return std::any_of(wanted.begin(), wanted.end(), [&](std::string_view n) { return names.contains(n); });
+  };
+  const bool spec_gloss = has_any(kSpecGlossMaps), metal_rough = has_any(kMetalRoughMaps);
   if (reads({material::kBaseColor, material::kMetallic, material::kRoughness}) && spec_gloss && !metal_rough) {
     return Direction::metal_rough_from_spec_gloss;
   }
@@ -222,6 +233,21 @@ std::optional<Direction> layout_direction(const material::Maps& maps, const pack
     return Direction::spec_gloss_from_metal_rough;
   }
   return std::nullopt;
+}
+
+std::optional<Direction> layout_direction(const material::Maps& maps, const pack::Layout& layout) {
+  return layout_direction(maps.names(), layout);
+}
+
+material::MapNames names_in_layout_workflow(material::MapNames names, const pack::Layout& layout) {
+  const std::optional<Direction> direction = layout_direction(names, layout);
+  if (!direction) return names;
+  const bool to_metal_rough = *direction == Direction::metal_rough_from_spec_gloss;
+  for (std::string_view n : to_metal_rough ? kSpecGlossMaps : kMetalRoughMaps) {
+    if (auto it = names.find(n); it != names.end()) names.erase(it);
+  }
+  for (std::string_view n : to_metal_rough ? kMetalRoughMaps : kSpecGlossMaps) names.emplace(n);
+  return names;
 }
 
 Result<LayoutMaps> in_layout_workflow(material::Maps maps, const pack::Layout& layout, RoughnessMapping mapping) {

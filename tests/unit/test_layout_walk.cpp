@@ -1,0 +1,96 @@
+// Every (layout × workflow × source map) combination: a map the material has reaches every texture
+// channel that reads it, whichever workflow the sources are in and whichever the layout needs; a
+// texture whose maps the material does not have is not written.
+#include <gtest/gtest.h>
+
+#include "matbake/pack.hpp"
+#include "matbake/workflow_maps.hpp"
+
+namespace matbake::pack {
+namespace {
+
+constexpr int kSide = 2;
+
+// A 2×2 map whose texels differ from each other and from every layout default (0, 0.5, 1).
+image::Image distinct_map(int channels, float offset) {
+  image::Image m;
+  m.width = m.height = kSide;
+  m.channels = channels;
+  for (int i = 0; i < kSide * kSide * channels; ++i) m.pixels.push_back(offset + 0.07f * float(i));
+  return m;
+}
+
+// A valid stored normal map: unit vectors n, stored 0.5 n + 0.5.
+image::Image normal_map() {
+  image::Image m = distinct_map(3, 0);
+  const float n[4][3] = {{0.6f, 0, 0.8f}, {0, 0.6f, 0.8f}, {-0.28f, 0.96f * 0.6f, 0.96f * 0.8f}, {0, 0, 1}};
+  for (int t = 0; t < 4; ++t) {
+    for (int c = 0; c < 3; ++c) m.pixels[std::size_t(t * 3 + c)] = 0.5f * n[t][c] + 0.5f;
+  }
+  return m;
+}
+
+image::Image source_map(std::string_view name) {
+  if (name == material::kNormal) return normal_map();
+  const material::Source* source = material::find_source(name);
+  return distinct_map(material::component_count(source->kind), 0.11f);
+}
+
+material::Maps material_with(const std::vector<std::string_view>& workflow_maps, std::string_view extra) {
+  material::Maps m;
+  m.width = m.height = kSide;
+  for (std::string_view name : workflow_maps) m.maps.emplace(std::string(name), source_map(name));
+  if (!extra.empty()) m.maps.emplace(std::string(extra), source_map(extra));
+  return m;
+}
+
+double stored(const Channel& c, double x) { return c.transform == Transform::one_minus ? 1 - x : x; }
+
+TEST(LayoutWalk, EveryGivenMapReachesEveryLayoutThatReadsIt) {
+  const std::vector<std::vector<std::string_view>> workflows = {
+      {material::kKd, material::kKs, material::kGloss}, {material::kBaseColor, material::kMetallic, material::kRoughness}};
+  const std::vector<std::string_view> extras = {"", material::kMask, material::kOcclusion, material::kDetailMask,
+                                                material::kNormal, material::kEmissive};
+  int checked_channels = 0, skipped_textures = 0;
+  for (const std::string& layout_name : builtin_layout_names()) {
+    auto layout = find_layout(layout_name);
+    ASSERT_TRUE(layout) << layout.error().to_string();
+    for (const auto& workflow : workflows) {
+      for (std::string_view extra : extras) {
+        SCOPED_TRACE(layout_name + " with " + std::string(workflow[0]) + "… + " + std::string(extra));
+        const material::Maps given = material_with(workflow, extra);
+        auto in_layout = workflow::in_layout_workflow(given, *layout, workflow::kDefaultRoughnessMapping);
+        ASSERT_TRUE(in_layout) << in_layout.error().to_string();
+        const material::MapNames names = in_layout->maps.names();
+        // The plan's rule, from names alone, agrees with the maps the conversion returned.
+        EXPECT_EQ(workflow::names_in_layout_workflow(given.names(), *layout), names);
+        auto textures = pack(*layout, in_layout->maps);
+        ASSERT_TRUE(textures) << textures.error().to_string();
+        for (std::size_t t = 0; t < layout->textures.size(); ++t) {
+          const Texture& texture = layout->textures[t];
+          bool reads_a_given_map = false;
+          for (std::size_t c = 0; c < texture.channels.size(); ++c) {
+            const Channel& channel = texture.channels[c];
+            if (!names.contains(channel.source)) continue;
+            reads_a_given_map = true;
+            if (channel.source != extra) continue;  // the converted maps have their own tests
+            const image::Image& map = given.maps.at(std::string(extra));
+            for (std::size_t i = 0; i < kSide * kSide; ++i) {
+              const double expected = stored(channel, map.pixels[i * std::size_t(map.channels) + std::size_t(channel.component)]);
+              EXPECT_NEAR((*textures)[t].pixels[i * texture.channels.size() + c], expected, 1e-6)
+                  << texture.name << " channel " << c << " texel " << i;
+            }
+            ++checked_channels;
+          }
+          EXPECT_EQ(texture_written(texture, names), reads_a_given_map) << texture.name;
+          skipped_textures += !reads_a_given_map;
+        }
+      }
+    }
+  }
+  EXPECT_GE(checked_channels, 34);  // each layout channel reading mask, occlusion, detail mask, normal or emissive, twice
+  EXPECT_GT(skipped_textures, 0);   // gltf-pbr's emissive and normal without those maps
+}
+
+}  // namespace
+}  // namespace matbake::pack
