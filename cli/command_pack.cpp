@@ -68,6 +68,9 @@ int run_unpack(const UnpackSettings& s, const GlobalOptions& global) {
   in.from = s.layout;
   in.inputs = s.inputs;
   in.options = s.options;
+  if (auto problem = s.options.bits ? image::sample_type_problem("map." + s.options.format, *s.options.bits) : std::nullopt) {
+    return report_error(Error{"--bits", *problem + " (--format " + s.options.format + ")", true});
+  }
   auto sources = gather_sources(in);
   if (!sources) return report_error(sources.error());
   const pack::UnpackRequest request{s.out_dir,         s.options.format, s.options.bits, s.options.transfer,

@@ -80,6 +80,11 @@ std::vector<std::filesystem::path> input_files(const SourceSettings& inputs) {
 Result<std::vector<std::string>> write_textures(const pack::Layout& layout, const material::Maps& sources,
                                                 const OutputSettings& o, const SourceSettings& inputs,
                                                 std::vector<NamedOutput> also) {
+  for (const std::string& output : o.outputs) {
+    if (auto problem = inputs.options.bits ? image::sample_type_problem(output, *inputs.options.bits) : std::nullopt) {
+      return Error{"--bits", *problem + " (" + output + ")", true};
+    }
+  }
   const pack::WriteRequest request{o.outputs,           inputs.options.bits, inputs.options.transfer,
                                    input_files(inputs), std::move(also),     o.encoding};
   SilencedStderr quiet;

@@ -231,5 +231,35 @@ TEST(CliWorkflow, SpecGlossMaterialKeepsItsNormalAndEmissiveMaps) {
   EXPECT_EQ(again.out.find("material:"), std::string::npos) << again.out;
 }
 
+// Half samples into PNG (8 or 16-bit only) are refused through every door before anything is
+// written: pack's --bits (naming the flag), unpack's --bits with --format, a manifest material's
+// bits with its format (at the key's line and column).
+TEST(CliPack, SampleTypesTheFormatCannotStoreAreRefusedAtEveryDoor) {
+  TempDir dir;
+  const auto before = list_folder(dir.path());
+  const RunResult pack = matbake({"pack", "--bits", "half", "--layout", "gltf-orm", "--base-color", "1,0.766,0.336",
+                                  "--metallic", "1", "--roughness", "0.3", "-o", (dir / "x_{texture}.png").string()});
+  EXPECT_EQ(pack.exit_code, 2);
+  expect_one_error_line(pack, "--bits", "PNG stores 8 or 16-bit samples, not half");
+  const RunResult unpack = matbake({"unpack", "--bits", "float", "--format", "png", "-o", (dir / "maps").string(),
+                                    (dir / "a.png").string(), (dir / "b.png").string()});
+  EXPECT_EQ(unpack.exit_code, 2);
+  expect_one_error_line(unpack, "--bits", "PNG stores 8 or 16-bit samples, not float");
+  EXPECT_EQ(list_folder(dir.path()), before);
+
+  write_bytes(dir / "lib.toml", "output = \"out\"\n[materials.gold]\nsources = { base_color = \"1,0.766,0.336\", "
+                                "metallic = 1, roughness = 0.3 }\nlayout = \"gltf-orm\"\nbits = \"half\"\n");
+  const RunResult built = matbake({"build", (dir / "lib.toml").string()});
+  EXPECT_EQ(built.exit_code, 1);  // as every manifest error
+  expect_one_error_line(built, (dir / "lib.toml").string() + ":5:8",
+                        "materials.gold: bits = \"half\" with format = \"png\": PNG stores 8 or 16-bit samples, not half");
+  EXPECT_FALSE(fs::exists(dir / "out"));
+  // With EXR the same material is written, as half.
+  write_bytes(dir / "lib.toml", read_bytes(dir / "lib.toml") + "format = \"exr\"\n");
+  const RunResult exr = matbake({"build", (dir / "lib.toml").string()});
+  ASSERT_EQ(exr.exit_code, 0) << exr.err;
+  EXPECT_EQ(read_raw(dir / "out/materials/gold_base_color.exr").format, "half");
+}
+
 }  // namespace
 }  // namespace matbake::test

@@ -27,6 +27,10 @@ inline std::string_view sample_type_name(SampleType type) { return name_in(kSamp
 // judges the range.
 std::optional<std::pair<int, int>> size_from_text(std::string_view text);
 bool is_integer(SampleType type);
+// Why a file of `path`'s format cannot hold `type` samples ("PNG stores 8 or 16-bit samples, not
+// half"), or nothing: PNG 8 or 16, EXR half or float, JPEG and WebP 8, TIFF any. Every writer
+// refuses what this refuses, so no door can write half samples into an 8-bit file.
+std::optional<std::string> sample_type_problem(const std::filesystem::path& path, SampleType type);
 
 // The largest image matbake holds, in pixels (width × height), for every image it reads or makes:
 // a size beyond it is refused before anything is allocated, so a 100-byte file that declares

@@ -16,14 +16,6 @@ std::string lower_extension(const fs::path& path) {
 }
 
 bool is_exr(const fs::path& path) { return lower_extension(path) == ".exr"; }
-bool is_png(const fs::path& path) { return lower_extension(path) == ".png"; }
-
-// EXR stores half or float; PNG 8 or 16 bits; TIFF all four.
-bool format_stores(const fs::path& output, image::SampleType type) {
-  if (is_exr(output)) return !image::is_integer(type);
-  if (is_png(output)) return image::is_integer(type);
-  return true;
-}
 
 // The tag OIIO writes into the file (PNG sRGB/gAMA chunks, an EXR/TIFF attribute).
 std::string colorspace_tag(const Plan& plan, const Options& options) {
@@ -88,11 +80,8 @@ Result<Report> convert_file(const Plan& plan, const fs::path& input, const fs::p
     if (!is_supported_output_extension(output)) {
       return Error{output.string(), "unsupported output format (matbake writes .exr, .png, .tif)", true};
     }
-    if (options.bits && !format_stores(output, *options.bits)) {
-      return Error{output.string(),
-                   "this format cannot store " + std::string(image::sample_type_name(*options.bits)) +
-                       " samples (EXR: half or float; PNG: 8 or 16)",
-                   true};
+    if (auto problem = options.bits ? image::sample_type_problem(output, *options.bits) : std::nullopt) {
+      return Error{output.string(), *problem, true};
     }
     const NamedOutput outputs[] = {{output, "output"}};
     if (Status s = check_outputs(outputs, std::span(&input, 1)); !s) return s.error();

@@ -197,6 +197,7 @@ struct EncodedBand {
 class RowWriter {
  public:
   static Result<RowWriter> open(const fs::path& path, const ImageLayout& layout, const WriteOptions& options) {
+    if (auto problem = sample_type_problem(path, options.type)) return Error{path.string(), *problem, true};
     auto file = AtomicFile::create(path);
     if (!file) return file.error();
     const fs::path temp = file->temp_path();  // copied: the file is moved in the same call
@@ -206,6 +207,7 @@ class RowWriter {
   // Into `bytes`: `name`'s extension picks the writer.
   static Result<RowWriter> open_memory(std::vector<unsigned char>& bytes, const fs::path& name, const ImageLayout& layout,
                                        const WriteOptions& options) {
+    if (auto problem = sample_type_problem(name, options.type)) return Error{name.string(), *problem, true};
     return open(name, name, std::nullopt, &bytes, layout, options);
   }
 
@@ -501,6 +503,28 @@ std::optional<int> png_level_from_name(std::string_view name) {
 }
 
 bool is_integer(SampleType type) { return type == SampleType::u8 || type == SampleType::u16; }
+
+std::optional<std::string> sample_type_problem(const fs::path& path, SampleType type) {
+  struct Stores {
+    std::string_view extension, format;
+    std::initializer_list<SampleType> types;
+    std::string_view types_text;
+  };
+  static const Stores kFormats[] = {
+      {".png", "PNG", {SampleType::u8, SampleType::u16}, "8 or 16-bit"},
+      {".exr", "EXR", {SampleType::half, SampleType::f32}, "half or float"},
+      {".jpg", "JPEG", {SampleType::u8}, "8-bit"},
+      {".jpeg", "JPEG", {SampleType::u8}, "8-bit"},
+      {".webp", "WebP", {SampleType::u8}, "8-bit"},
+  };
+  for (const Stores& f : kFormats) {
+    if (!has_extension(path, f.extension)) continue;
+    if (std::find(f.types.begin(), f.types.end(), type) != f.types.end()) return std::nullopt;
+    return std::string(f.format) + " stores " + std::string(f.types_text) + " samples, not " +
+           std::string(sample_type_name(type));
+  }
+  return std::nullopt;
+}
 
 std::vector<color::Transfer> channel_transfers(const ImageLayout& layout, color::Transfer colour) {
   std::vector<color::Transfer> transfers(std::size_t(layout.channels), colour);

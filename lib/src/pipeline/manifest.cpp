@@ -266,6 +266,19 @@ Status read_packed_entry(const Reader& r, const toml::node& packed, const std::s
 
 // A material entry over `defaults` (the manifest's top level, or for a rule's override the rule's
 // material); `structure` are further keys the entry may hold (a rule's `match` and `overrides`).
+// `bits` the format of the material's textures cannot store (half into PNG), wherever either was
+// set (the material, a rule, the defaults): an error at the key this table gives.
+Status check_bits_and_format(const Reader& r, const toml::table& t, const std::string& where,
+                             const pack::MaterialOptions& options) {
+  if (!options.bits) return success();
+  auto problem = image::sample_type_problem("texture." + options.format, *options.bits);
+  if (!problem) return success();
+  const toml::node* at = t.get("bits") ? t.get("bits") : t.get("format");
+  return r.at(at ? *at : static_cast<const toml::node&>(t),
+              where + ": bits = \"" + std::string(image::sample_type_name(*options.bits)) + "\" with format = \"" +
+                  options.format + "\": " + *problem);
+}
+
 Result<MaterialSpec> read_material(const Reader& r, const std::string& name, const std::string& where,
                                    const toml::node& node, const Manifest& m, const MaterialSpec& defaults,
                                    std::vector<std::string>& notes, std::vector<std::string> structure = {}) {
@@ -288,6 +301,7 @@ Result<MaterialSpec> read_material(const Reader& r, const std::string& name, con
                    r.get(*t, "reference", where, spec.reference)}) {
     if (!s) return s.error();
   }
+  if (Status s = check_bits_and_format(r, *t, where, spec.options); !s) return s.error();
   auto layout = read_layout(r, *t, "layout", where, m.folder);
   if (!layout) return layout.error();
   if (*layout) spec.layout = std::move(*layout);  // else the defaults' (a rule's, for its overrides)

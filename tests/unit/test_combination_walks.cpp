@@ -1,10 +1,18 @@
-// Every (layout × workflow × source map) combination: a map the material has reaches every texture
-// channel that reads it, whichever workflow the sources are in and whichever the layout needs; a
-// texture whose maps the material does not have is not written.
+// Combinations of features, walked whole:
+// - every (layout × workflow × source map): a map the material has reaches every texture channel
+//   that reads it, whichever workflow the sources are in and whichever the layout needs; a texture
+//   whose maps the material does not have is not written;
+// - every (format × bits × transfer) of a written texture: read back as the build reads it, the
+//   same values within the encoding's step, or refused before anything is written.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
+#include "matbake/color.hpp"
 #include "matbake/pack.hpp"
 #include "matbake/workflow_maps.hpp"
+#include "support/files.hpp"
+#include "support/temp_dir.hpp"
 
 namespace matbake::pack {
 namespace {
@@ -90,6 +98,78 @@ TEST(LayoutWalk, EveryGivenMapReachesEveryLayoutThatReadsIt) {
   }
   EXPECT_GE(checked_channels, 34);  // each layout channel reading mask, occlusion, detail mask, normal or emissive, twice
   EXPECT_GT(skipped_textures, 0);   // gltf-pbr's emissive and normal without those maps
+}
+
+// The largest difference a write then read may make to a value in [0, 1]: half a code of the
+// curve it is stored with (8-bit colour: the transfer's), or half's and float's rounding.
+double encoding_step(image::SampleType type, color::Transfer stored_with, double value) {
+  switch (type) {
+    case image::SampleType::u8: {
+      // Half a code in the encoded domain, as a linear difference (the curve's slope at value).
+      const double encoded = color::encoded_from_linear(stored_with, value);
+      return std::abs(color::linear_from_encoded(stored_with, std::min(1.0, encoded + 0.5 / 255)) - value) + 1e-6;
+    }
+    case image::SampleType::u16: return 0.5 / 65535 + 1e-7;
+    case image::SampleType::half: return std::max(value, 6.1e-5) * std::ldexp(1.0, -11);
+    case image::SampleType::f32: return 0;
+  }
+  return 0;
+}
+
+TEST(EncodingWalk, EveryFormatBitsAndTransferRoundTripsOrIsRefused) {
+  const Layout layout{"walk", "", {{"colour", true, {{"base_color", 0}, {"base_color", 1}, {"base_color", 2}, {"mask", 0}}}}};
+  material::Maps maps;
+  maps.width = 16;
+  maps.height = 4;
+  image::Image colour = distinct_map(3, 0), mask = distinct_map(1, 0);
+  colour.width = mask.width = 16;
+  colour.height = mask.height = 4;
+  colour.pixels.resize(16 * 4 * 3);
+  mask.pixels.resize(16 * 4);
+  for (std::size_t i = 0; i < colour.pixels.size(); ++i) colour.pixels[i] = float((i * 37) % 192) / 191.0f;
+  for (std::size_t i = 0; i < mask.pixels.size(); ++i) mask.pixels[i] = float(i) / 63.0f;
+  maps.maps.emplace("base_color", colour);
+  maps.maps.emplace("mask", mask);
+  test::TempDir dir;
+  int written = 0, refused = 0;
+  for (const char* format : {"png", "exr", "tif"}) {
+    for (image::SampleType type : {image::SampleType::u8, image::SampleType::u16, image::SampleType::half, image::SampleType::f32}) {
+      for (color::Transfer transfer : {color::Transfer::linear, color::Transfer::srgb, color::Transfer::gamma22}) {
+        const std::string name = std::string(image::sample_type_name(type)) + "_" +
+                                 std::string(color::transfer_name(transfer)) + "." + format;
+        SCOPED_TRACE(name);
+        const std::filesystem::path path = dir / name;
+        auto result = write_textures(layout, maps, {{path.string()}, type, transfer, {}, {}, {}});
+        const bool storable = !image::sample_type_problem(path, type);
+        if (!storable) {
+          ASSERT_FALSE(result);
+          EXPECT_TRUE(result.error().usage);
+          EXPECT_FALSE(std::filesystem::exists(path));
+          EXPECT_EQ(test::list_folder(dir.path()).size(), std::size_t(written));  // no temporary left either
+          ++refused;
+          continue;
+        }
+        ASSERT_TRUE(result) << result.error().to_string();
+        ++written;
+        // Read back as a material source is: the file's own tag, else the depth rule.
+        auto decode = decode_transfer(path, transfer);
+        ASSERT_TRUE(decode) << decode.error().to_string();
+        auto back = image::read_image(path, *decode);
+        ASSERT_TRUE(back) << back.error().to_string();
+        ASSERT_EQ(back->channels, 4);
+        const color::Transfer stored_with = type == image::SampleType::u8 ? transfer : color::Transfer::linear;
+        for (std::size_t t = 0; t < 64; ++t) {
+          for (std::size_t c = 0; c < 4; ++c) {
+            const double expected = c < 3 ? colour.pixels[t * 3 + c] : mask.pixels[t];
+            const color::Transfer curve = c < 3 ? stored_with : color::Transfer::linear;
+            ASSERT_NEAR(back->pixels[t * 4 + c], expected, encoding_step(type, curve, expected)) << t << " " << c;
+          }
+        }
+      }
+    }
+  }
+  EXPECT_EQ(written, 3 * 2 + 3 * 2 + 3 * 4);  // PNG 8/16, EXR half/float, TIFF all four; × 3 transfers
+  EXPECT_EQ(refused, 3 * 2 + 3 * 2);
 }
 
 }  // namespace
