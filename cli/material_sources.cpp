@@ -1,6 +1,7 @@
 #include "material_sources.hpp"
 
 #include <filesystem>
+#include <iostream>
 
 #include "commands.hpp"
 #include "matbake/encoding_params.hpp"
@@ -54,6 +55,9 @@ Result<material::Maps> gather_sources(const SourceSettings& s) {
     auto layout = pack::find_layout(s.from);
     if (!layout) return layout.error();
     packed = std::move(*layout);
+  }
+  for (const std::string& note : pack::decode_overrides(inputs, s.options)) {
+    std::cerr << "matbake: warning: " << escape_control(note) << "\n";
   }
   SilencedStderr quiet;
   return pack::load_material(inputs, packed ? &*packed : nullptr, {s.inputs.begin(), s.inputs.end()}, s.options);

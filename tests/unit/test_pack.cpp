@@ -2,8 +2,11 @@
 // source loading (sizes, resize, constants).
 #include <gtest/gtest.h>
 
+#include <zlib.h>
+
 #include <cmath>
 
+#include "matbake/color.hpp"
 #include "matbake/pack.hpp"
 #include "support/files.hpp"
 #include "support/temp_dir.hpp"
@@ -159,6 +162,69 @@ TEST(Sources, ColourFilesDecodeBy8BitRuleGreyRepeats) {
   const float grey = float(std::pow(188 / 255.0, 2.2));
   EXPECT_EQ(maps->find("kd")->pixels, std::vector<float>(3, grey));
   EXPECT_FLOAT_EQ(maps->find("ks")->pixels[1], 32768 / 65535.0f);  // 16-bit: linear
+}
+
+// A PNG chunk `type` with `data` inserted after IHDR (a tag matbake's writer does not make).
+std::string with_chunk_after_header(const std::string& png, const std::string& type, const std::string& data) {
+  std::string chunk;
+  for (int shift = 24; shift >= 0; shift -= 8) chunk += char((data.size() >> shift) & 0xff);
+  const std::string body = type + data;
+  chunk += body;
+  const unsigned long crc = crc32(0, reinterpret_cast<const Bytef*>(body.data()), uInt(body.size()));
+  for (int shift = 24; shift >= 0; shift -= 8) chunk += char((crc >> shift) & 0xff);
+  return png.substr(0, 33) + chunk + png.substr(33);
+}
+
+// A colour file's own tag decides how it is decoded (the depth rule only for untagged files):
+// a 16-bit PNG written sRGB-encoded and tagged by `convert --to srgb --bits 16` is read as sRGB,
+// an 8-bit one tagged linear as linear, a cICP chunk outranks the rest; `decode` overrides the
+// tag, with a note naming the file.
+TEST(Sources, ColourFilesDecodeByTheirOwnTag) {
+  TempDir dir;
+  image::Image colour;
+  colour.width = 3;
+  colour.height = 1;
+  colour.channels = 3;
+  colour.pixels = {0.0f, 0.2f, 0.9f, 0.05f, 0.5f, 1.0f, 0.3f, 0.01f, 0.7f};
+  struct Case {
+    const char* file;
+    image::SampleType type;
+    color::Transfer encoded;
+    const char* tag;
+  };
+  const Case cases[] = {{"srgb16.png", image::SampleType::u16, color::Transfer::srgb, "sRGB"},
+                        {"gamma16.png", image::SampleType::u16, color::Transfer::gamma22, "Gamma2.2"},
+                        {"linear8.png", image::SampleType::u8, color::Transfer::linear, "Linear"},
+                        {"srgb8.png", image::SampleType::u8, color::Transfer::srgb, "sRGB"}};
+  for (const Case& c : cases) {
+    image::WriteOptions options{.colour = c.encoded, .type = c.type, .colorspace = c.tag};
+    ASSERT_TRUE(image::write_image(colour, dir / c.file, options));
+    // `transfer` (gamma 2.2) is for untagged 8-bit files: the tag wins over it and over the depth.
+    auto maps = load_sources({{"kd", dir / c.file, {}}}, {.transfer = color::Transfer::gamma22});
+    ASSERT_TRUE(maps) << maps.error().to_string();
+    const double step = c.type == image::SampleType::u8 ? 0.02 : 2e-4;
+    for (std::size_t i = 0; i < colour.pixels.size(); ++i) {
+      EXPECT_NEAR(maps->find("kd")->pixels[i], colour.pixels[i], step) << c.file << " " << i;
+    }
+    auto tagged = decode_transfer(dir / c.file, color::Transfer::gamma22);
+    ASSERT_TRUE(tagged);
+    EXPECT_EQ(*tagged, c.encoded) << c.file;
+  }
+  // cICP transfer 8 (linear) outranks the sRGB chunk beside it.
+  test::write_bytes(dir / "cicp.png", with_chunk_after_header(test::read_bytes(dir / "srgb16.png"), "cICP",
+                                                               std::string("\x01\x08\x00\x01", 4)));
+  EXPECT_EQ(*decode_transfer(dir / "cicp.png", color::Transfer::srgb), color::Transfer::linear);
+  // Untagged: the depth rule.
+  test::write_raw(dir / "plain16.png", 1, 1, 3, "uint16", {0, 32768, 65535});
+  EXPECT_EQ(*decode_transfer(dir / "plain16.png", color::Transfer::srgb), color::Transfer::linear);
+  // An explicit decode wins, and says so naming the file; agreeing files say nothing.
+  const std::vector<SourceInput> inputs = {{"kd", dir / "srgb16.png", {}}, {"ks", dir / "linear8.png", {}}};
+  const auto notes = decode_overrides(inputs, {.decode = color::Transfer::linear});
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_EQ(notes[0], (dir / "srgb16.png").string() + ": decoded as linear as asked, though its sRGB chunk says srgb");
+  auto decoded = load_sources(inputs, {.decode = color::Transfer::linear});
+  ASSERT_TRUE(decoded);
+  EXPECT_NEAR(decoded->find("kd")->pixels[1], color::encoded_from_linear(color::Transfer::srgb, 0.2), 2e-4);
 }
 
 // One channel of a file (gloss from the alpha of a spec-gloss texture, roughness from G of an ORM),

@@ -173,8 +173,12 @@ struct UnpackRequest {
 };
 Result<std::vector<std::filesystem::path>> write_maps(const material::Maps& maps, const UnpackRequest& request);
 
-// How to decode a file holding colour: `authored` for 8-bit files, linear for 16-bit and float
-// ones (the rule write_options follows).
+// How to decode a file holding colour when `decode` does not say: as the file's own tag says
+// (image::ReadInfo::tagged: PNG cICP/iCCP/sRGB/gAMA, EXR, TIFF), else by its depth: `authored`
+// for 8-bit files, linear for 16-bit and float ones (the rule write_options follows).
 Result<color::Transfer> decode_transfer(const std::filesystem::path& path, color::Transfer authored);
+// The colour sources whose tag disagrees with an explicit `options.decode`, one note each naming
+// the file (decode wins; the note says so).
+std::vector<std::string> decode_overrides(const std::vector<SourceInput>& inputs, const MaterialOptions& options);
 
 }  // namespace matbake::pack

@@ -100,7 +100,8 @@ class RowReader {
  public:
   const ImageLayout& layout() const { return stored_->format().layout; }
   ReadInfo info() const {
-    return {stored_->format().stored, stored_->format().format_name, layout().width, layout().height};
+    const StoredFormat& f = stored_->format();
+    return {f.stored, f.format_name, layout().width, layout().height, f.tagged, f.tag};
   }
 
   // Rows [y, y + rows) into `out`, decoded.

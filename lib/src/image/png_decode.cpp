@@ -2,6 +2,8 @@
 
 #include <spng.h>
 
+#include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cstring>
 #include <vector>
@@ -75,6 +77,7 @@ class PngDecoder final : public StoredReader {
     // As libpng: a damaged critical chunk is an error, a damaged ancillary one is dropped.
     spng_set_crc_action(c, SPNG_CRC_ERROR, SPNG_CRC_DISCARD);
     spng_set_chunk_limits(c, kChunkLimit, kChunkCacheLimit);
+    spng_set_option(c, SPNG_KEEP_UNKNOWN_CHUNKS, 1);  // cICP is one to libspng 0.7
     if (!memory.empty()) {
       if (int e = spng_set_png_buffer(c, memory.data(), memory.size())) return problem(e);
     } else {
@@ -119,6 +122,7 @@ class PngDecoder final : public StoredReader {
     layout.alpha_channel = layout.channels == 2 || layout.channels == 4 ? layout.channels - 1 : -1;
     format_.stored = deep && header.color_type != kPalette ? SampleType::u16 : SampleType::u8;
     format_.format_name = "png";
+    read_colour_tag();
     row_bytes_ = std::size_t(layout.width) * std::size_t(layout.channels) * (format_.stored == SampleType::u16 ? 2 : 1);
     interlaced_ = header.interlace_method != 0;
     if (!interlaced_) {
@@ -128,6 +132,47 @@ class PngDecoder final : public StoredReader {
       }
     }
     return success();
+  }
+
+  // The PNG's own colour declaration, in the order PNG's third edition ranks them: cICP, iCCP,
+  // sRGB, gAMA. These chunks come before the pixels, so they are read by now.
+  void read_colour_tag() {
+    spng_ctx* c = context_.get();
+    std::uint32_t count = 0;
+    if (spng_get_unknown_chunks(c, nullptr, &count) == 0 && count > 0) {
+      std::vector<spng_unknown_chunk> chunks(count);
+      if (spng_get_unknown_chunks(c, chunks.data(), &count) == 0) {
+        for (const spng_unknown_chunk& chunk : chunks) {
+          if (std::memcmp(chunk.type, "cICP", 4) != 0 || chunk.length < 4) continue;
+          const int transfer = static_cast<const unsigned char*>(chunk.data)[1];
+          if (transfer == 13) format_.tagged = color::Transfer::srgb;
+          else if (transfer == 8) format_.tagged = color::Transfer::linear;
+          else if (transfer == 4) format_.tagged = color::Transfer::gamma22;
+          format_.tag = "cICP transfer " + std::to_string(transfer);
+          return;  // a cICP matbake cannot interpret still outranks the rest
+        }
+      }
+    }
+    spng_iccp profile{};
+    if (spng_get_iccp(c, &profile) == 0) {
+      std::string name(profile.profile_name, strnlen(profile.profile_name, sizeof profile.profile_name));
+      format_.tag = "iCCP profile '" + name + "'";
+      std::transform(name.begin(), name.end(), name.begin(), [](unsigned char ch) { return char(std::tolower(ch)); });
+      if (name.find("srgb") != std::string::npos) format_.tagged = color::Transfer::srgb;
+      return;
+    }
+    std::uint8_t intent = 0;
+    if (spng_get_srgb(c, &intent) == 0) {
+      format_.tagged = color::Transfer::srgb;
+      format_.tag = "sRGB chunk";
+      return;
+    }
+    std::uint32_t gamma = 0;  // the file's gamma × 100000: 45455 is 1/2.2, 100000 is 1 (linear)
+    if (spng_get_gama_int(c, &gamma) == 0) {
+      if (gamma >= 45400 && gamma <= 45500) format_.tagged = color::Transfer::gamma22;
+      else if (gamma >= 99900 && gamma <= 100100) format_.tagged = color::Transfer::linear;
+      format_.tag = "gAMA " + std::to_string(gamma / 100000.0);
+    }
   }
 
   std::string name_;

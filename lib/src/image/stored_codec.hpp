@@ -3,6 +3,7 @@
 // png_encode.cpp, exr_encode.cpp) or OpenImageIO's, behind the module in oiio_module.hpp.
 #pragma once
 
+#include <optional>
 #include <string>
 
 #include "matbake/image.hpp"
@@ -14,6 +15,8 @@ struct StoredFormat {
   ImageLayout layout;
   SampleType stored = SampleType::u8;
   std::string format_name;  // OIIO's names: "png", "openexr", "jpeg", ...
+  std::optional<color::Transfer> tagged;  // the colour encoding the file itself declares, if any
+  std::string tag;                        // that declaration as the file has it ("sRGB chunk")
 };
 
 class StoredReader {

@@ -285,7 +285,22 @@ Result<Layout> find_layout(const std::string& name_or_path) {
 Result<color::Transfer> decode_transfer(const fs::path& path, color::Transfer authored) {
   auto info = image::probe_image(path);
   if (!info) return info.error();
+  if (info->tagged) return *info->tagged;
   return info->stored_type == image::SampleType::u8 ? authored : color::Transfer::linear;
+}
+
+std::vector<std::string> decode_overrides(const std::vector<SourceInput>& inputs, const MaterialOptions& options) {
+  std::vector<std::string> notes;
+  if (!options.decode) return notes;
+  for (const SourceInput& input : inputs) {
+    const Source* source = find_source(input.name);
+    if (input.file.empty() || !source || source->kind != SourceKind::color) continue;
+    auto info = image::probe_image(input.file);
+    if (!info || !info->tagged || *info->tagged == *options.decode) continue;
+    notes.push_back(input.file.string() + ": decoded as " + std::string(color::transfer_name(*options.decode)) +
+                    " as asked, though its " + info->tag + " says " + std::string(color::transfer_name(*info->tagged)));
+  }
+  return notes;
 }
 
 Result<material::Maps> load_sources(const std::vector<SourceInput>& inputs, const MaterialOptions& options,

@@ -38,8 +38,8 @@ const params::Group<MaterialOptions>& material_params() {
                                            .example = "gamma2.2"},
                                       [](auto& o) -> auto& { return o.transfer; }, color::kTransferNames),
       params::choice<MaterialOptions>(Spec{.name = "decode",
-                                           .help = "Curve of every colour input whatever its depth, overriding the "
-                                                   "rule (8-bit: transfer; 16-bit, half, float: linear)",
+                                           .help = "Curve of every colour input, overriding its own tag and the "
+                                                   "rule for untagged files (8-bit: transfer; deeper: linear)",
                                            .example = "linear",
                                            .aliases = {"input_transfer"}},
                                       [](auto& o) -> auto& { return o.decode; }, color::kTransferNames),

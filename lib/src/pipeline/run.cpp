@@ -218,6 +218,7 @@ Status run_material(const Job& job, const JobContext& ctx, JobReport& report) {
     const MaterialSpec& m = ctx.manifest.materials[job.spec];
     auto maps = load_material(m, ctx.cache);
     if (!maps) return maps.error();
+    for (std::string& note : pack::decode_overrides(m.sources, m.options)) report.warnings.push_back(std::move(note));
     report.details["size"] = {maps->width, maps->height};
     if (Status s = ensure_folder(ctx.manifest.output / "materials"); !s) return s;
     if (m.validation.enabled) {

@@ -33,6 +33,22 @@ SampleType stored_type_of(const ImageSpec& spec) {
   }
 }
 
+// EXR holds linear light by definition; a TIFF's colour space as OIIO reads it from the file.
+// Other formats' oiio:ColorSpace is OIIO's default, not the file's word (JPEG is always "sRGB").
+void declared_transfer(const ImageSpec& spec, StoredFormat& format) {
+  if (format.format_name == "openexr") {
+    format.tagged = color::Transfer::linear;
+    format.tag = "OpenEXR (linear)";
+    return;
+  }
+  if (format.format_name != "tiff") return;
+  const std::string space = spec.get_string_attribute("oiio:ColorSpace");
+  if (space == "sRGB") format.tagged = color::Transfer::srgb;
+  else if (space == "Linear" || space == "linear") format.tagged = color::Transfer::linear;
+  else if (space == "Gamma2.2") format.tagged = color::Transfer::gamma22;
+  if (format.tagged) format.tag = "TIFF colour space " + space;
+}
+
 TypeDesc type_desc(SampleType type) {
   switch (type) {
     case SampleType::u8: return TypeDesc::UINT8;
@@ -80,6 +96,7 @@ class OiioReader final : public StoredReader {
     format.layout.alpha_channel = spec.alpha_channel;
     format.stored = stored_type_of(spec);
     format.format_name = reader->in_->format_name();
+    declared_transfer(spec, format);
     return std::unique_ptr<StoredReader>(std::move(reader));
   }
 
