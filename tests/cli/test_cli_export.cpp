@@ -389,5 +389,50 @@ TEST(CliExport, BadInputIsRefusedAndNothingIsWritten) {
   EXPECT_EQ(over.exit_code, 2) << over.err;
 }
 
+// Emission above 1 (an EXR emissive source) is carried by KHR_materials_emissive_strength, the
+// factor or texture divided by the maximum; negative emission is refused naming the file; every
+// result passes the validator (a factor of 2 did not: VALUE_NOT_IN_RANGE).
+TEST(CliExport, EmissionAboveOneBecomesEmissiveStrength) {
+  TempDir dir;
+  GltfBuilder b = quad_scene(json::array({{{"name", "glow"}}, {{"name", "other"}}}));
+  b.write(dir / "in.gltf", {0});
+  const auto build_with = [&](const std::vector<double>& emissive, int width) {
+    write_raw(dir / "e.exr", width, 1, 3, "float", emissive);
+    write_bytes(dir / "m.toml", "output = \"out\"\n[materials.glow]\nsources = { base_color = \"0.5\", metallic = 0, "
+                                "roughness = 0.5, emissive = \"e.exr\" }\n[scenes.s]\ninput = \"in.gltf\"\n");
+    return matbake({"build", (dir / "m.toml").string()});
+  };
+  for (double value : {2.0, 1e30, 0.25}) {
+    SCOPED_TRACE(value);
+    const RunResult r = build_with({value, value, value, value, value, value}, 2);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const gltf::Document out = read_output(dir / "out/s.glb");
+    const json& material = out.json["materials"][0];
+    const double strength = value > 1 ? value : 1;
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(material["emissiveFactor"][c].get<double>(), value / strength, 1e-6);
+    if (value > 1) {
+      EXPECT_NEAR(material["extensions"]["KHR_materials_emissive_strength"]["emissiveStrength"].get<double>() / value, 1, 1e-6);
+    } else {
+      EXPECT_FALSE(material.contains("extensions"));
+    }
+    expect_validator_clean(dir / "out/s.glb");
+  }
+  // A textured one: the texture holds emission / 4 (sRGB-encoded), the strength 4.
+  const RunResult textured = build_with({4, 2, 1, 0, 0.5, 0.04}, 2);
+  ASSERT_EQ(textured.exit_code, 0) << textured.err;
+  const gltf::Document out = read_output(dir / "out/s.glb");
+  const json& material = out.json["materials"][0];
+  EXPECT_EQ(material["extensions"]["KHR_materials_emissive_strength"]["emissiveStrength"].get<double>(), 4.0);
+  const RawImage texels = texture_pixels(out, material["emissiveTexture"]["index"], dir / "e.png");
+  const double expected[] = {1, 0.5, 0.25, 0, 0.125, 0.01};
+  for (int i = 0; i < 6; ++i) EXPECT_NEAR(code_to_linear(texels.samples[std::size_t(i)]), expected[i], 0.004) << i;
+  expect_validator_clean(dir / "out/s.glb");
+  // Negative emission: one error line naming the file.
+  const RunResult negative = build_with({-5, -5, -5, 1, 1, 1}, 2);
+  EXPECT_EQ(negative.exit_code, 1);
+  EXPECT_NE(negative.err.find((dir / "e.exr").string() + ": emissive values below 0 (-5.000000 at x 0, y 0)"),
+            std::string::npos) << negative.err;
+}
+
 }  // namespace
 }  // namespace matbake::test

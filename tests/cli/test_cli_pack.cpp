@@ -261,5 +261,24 @@ TEST(CliPack, SampleTypesTheFormatCannotStoreAreRefusedAtEveryDoor) {
   EXPECT_EQ(read_raw(dir / "out/materials/gold_base_color.exr").format, "half");
 }
 
+// HDR emission (an EXR of 3.0) into an 8-bit gltf-pbr emissive texture is refused, naming the
+// file and the source, before any texture is written (it was clipped to 1 without a word); into
+// EXR it is written as it is.
+TEST(CliPack, ValuesAnIntegerFileCannotHoldAreRefusedNotClipped) {
+  TempDir dir;
+  write_raw(dir / "e.exr", 2, 1, 3, "float", {3, 0.5, 0.25, 0, 0, 0});
+  const std::vector<std::string> sources = {"--base-color", "0.5", "--metallic", "0", "--roughness", "0.5",
+                                            "--emissive", (dir / "e.exr").string()};
+  const auto before = list_folder(dir.path());
+  const RunResult clipped = matbake(concat({"pack", "--layout", "gltf-pbr", "-o", (dir / "x_{texture}.png").string()}, sources));
+  EXPECT_EQ(clipped.exit_code, 1);
+  expect_one_error_line(clipped, (dir / "x_emissive.png").string(),
+                        "texture emissive holds 3.000000 (from emissive), outside the [0, 1] an 8-bit file stores");
+  EXPECT_EQ(list_folder(dir.path()), before);
+  const RunResult exr = matbake(concat({"pack", "--layout", "gltf-pbr", "-o", (dir / "x_{texture}.exr").string()}, sources));
+  ASSERT_EQ(exr.exit_code, 0) << exr.err;
+  EXPECT_EQ(read_raw(dir / "x_emissive.exr").samples[0], 3.0);
+}
+
 }  // namespace
 }  // namespace matbake::test

@@ -29,6 +29,7 @@ int int_in(const gltf::Json& object, const char* key, int fallback) {
 constexpr const char* kSpecGloss = "KHR_materials_pbrSpecularGlossiness";
 constexpr const char* kSpecular = "KHR_materials_specular";
 constexpr const char* kIor = "KHR_materials_ior";
+constexpr const char* kEmissiveStrength = "KHR_materials_emissive_strength";
 constexpr double kF0Tolerance = 0.001;  // below an 8-bit sRGB step at F0 0.04 (0.0014)
 
 // A factor of `object` (as many numbers as `fallback` has; `fallback` when absent).
@@ -45,6 +46,14 @@ Result<std::vector<double>> numbers(const Json& object, const char* key, std::ve
   std::vector<double> out;
   for (const Json& v : value) out.push_back(v.get<double>());
   return out;
+}
+
+// Whether every texel of a 3-channel map is `value`.
+bool uniform(const image::Image& map, std::initializer_list<float> value) {
+  for (std::size_t i = 0; i < map.pixels.size(); ++i) {
+    if (map.pixels[i] != value.begin()[i % 3]) return false;
+  }
+  return true;
 }
 
 void add_extension_used(Json& json, const char* name) {
@@ -112,12 +121,6 @@ struct Exporter {
   // the material's own.
   Status write_normal_and_emissive(Json& material, const material::Maps& given, const std::string& name, Json texture_info,
                                    int sampler_of, MaterialReport& out) {
-    const auto uniform = [](const image::Image& map, std::initializer_list<float> value) {
-      for (std::size_t i = 0; i < map.pixels.size(); ++i) {
-        if (map.pixels[i] != value.begin()[i % 3]) return false;
-      }
-      return true;
-    };
     if (const image::Image* normal = given.find(material::kNormal)) {
       material.erase("normalTexture");
       if (!uniform(*normal, {0.5f, 0.5f, 1.0f})) {
@@ -130,18 +133,39 @@ struct Exporter {
       }
     }
     if (const image::Image* emissive = given.find(material::kEmissive)) {
-      material.erase("emissiveTexture");
-      material.erase("emissiveFactor");
-      if (uniform(*emissive, {emissive->pixels[0], emissive->pixels[1], emissive->pixels[2]})) {
-        if (!uniform(*emissive, {0.0f, 0.0f, 0.0f})) material["emissiveFactor"] = {emissive->pixels[0], emissive->pixels[1], emissive->pixels[2]};
-      } else {
-        auto texture = add_texture(*emissive, color::Transfer::srgb, name + "_emissive", sampler_of);
-        if (!texture) return texture.error();
-        texture_info["index"] = *texture;
-        material["emissiveTexture"] = texture_info;
-        material["emissiveFactor"] = {1.0, 1.0, 1.0};
-        out.action += "; emissive map";
-      }
+      if (Status s = write_emissive(material, *emissive, name, texture_info, sampler_of, out); !s) return s;
+    }
+    return success();
+  }
+
+  // A given emissive map replaces the material's emission: emissiveFactor for a constant (none when
+  // black), else emissiveTexture. Emission above 1 (HDR, from EXR sources) is divided by its
+  // maximum m, which KHR_materials_emissive_strength carries (strength m): nothing is clipped, and
+  // the texture's 8 bits span the map's own range.
+  Status write_emissive(Json& material, const image::Image& emissive, const std::string& name, Json texture_info,
+                        int sampler_of, MaterialReport& out) {
+    material.erase("emissiveTexture");
+    material.erase("emissiveFactor");
+    if (material.contains("extensions")) material["extensions"].erase(kEmissiveStrength);
+    const float peak = *std::max_element(emissive.pixels.begin(), emissive.pixels.end());
+    const float strength = std::max(peak, 1.0f);
+    image::Image scaled = emissive;
+    for (float& v : scaled.pixels) v /= strength;
+    if (uniform(scaled, {scaled.pixels[0], scaled.pixels[1], scaled.pixels[2]})) {
+      if (peak == 0) return success();
+      material["emissiveFactor"] = {scaled.pixels[0], scaled.pixels[1], scaled.pixels[2]};
+    } else {
+      auto texture = add_texture(scaled, color::Transfer::srgb, name + "_emissive", sampler_of);
+      if (!texture) return texture.error();
+      texture_info["index"] = *texture;
+      material["emissiveTexture"] = texture_info;
+      material["emissiveFactor"] = {1.0, 1.0, 1.0};
+      out.action += "; emissive map";
+    }
+    if (strength > 1) {
+      material["extensions"][kEmissiveStrength] = {{"emissiveStrength", strength}};
+      add_extension_used(doc.json, kEmissiveStrength);
+      out.action += " (emissive strength " + std::to_string(strength) + ")";
     }
     return success();
   }

@@ -177,6 +177,18 @@ Result<std::shared_ptr<const image::Image>> read_shared(const std::filesystem::p
   return std::make_shared<const image::Image>(std::move(*file));
 }
 
+// Emission is light given off: an emissive map below 0 has no meaning in any renderer (above 1 is
+// HDR emission, which export carries with KHR_materials_emissive_strength).
+Status check_emission(const image::Image& map, const SourceInput& input) {
+  if (input.name != material::kEmissive) return success();
+  const auto lowest = std::min_element(map.pixels.begin(), map.pixels.end());
+  if (lowest == map.pixels.end() || *lowest >= 0) return success();
+  const std::size_t texel = std::size_t(lowest - map.pixels.begin()) / std::size_t(map.channels);
+  return Error{input.file.string(), "emissive values below 0 (" + std::to_string(*lowest) + " at x " +
+                                        std::to_string(texel % std::size_t(map.width)) + ", y " +
+                                        std::to_string(texel / std::size_t(map.width)) + "): emission cannot be negative"};
+}
+
 // How a colour file is decoded: as `decode` says, else by decode_transfer's rule.
 Result<color::Transfer> colour_decode(const fs::path& file, const MaterialOptions& options) {
   return options.decode ? Result<color::Transfer>(*options.decode) : decode_transfer(file, options.transfer);
@@ -322,6 +334,7 @@ Result<material::Maps> load_sources(const std::vector<SourceInput>& inputs, cons
       if (!file) return file.error();
       auto map = source_from_file(**file, source->kind, input.channels, input.file, input.name);
       if (!map) return map.error();
+      if (Status s = check_emission(*map, input); !s) return s.error();
       result.maps[input.name] = std::move(*map);
       origin[input.name] = input.file.string();
     }
@@ -546,6 +559,22 @@ image::SampleType default_sample_type(const fs::path& path) {
   return path.extension() == ".exr" ? image::SampleType::half : image::SampleType::u8;
 }
 
+// 8 and 16-bit files hold [0, 1]: a texture with values outside it (HDR emission from an EXR
+// source) is refused rather than clipped. Float rounding of a conversion stays within the slack.
+Status check_storable_range(const image::Image& texture, const Texture& spec, const fs::path& path, image::SampleType type) {
+  constexpr float kSlack = 1e-5f;
+  if (!image::is_integer(type)) return success();
+  const auto [low, high] = std::minmax_element(texture.pixels.begin(), texture.pixels.end());
+  if (low == texture.pixels.end() || (*low >= -kSlack && *high <= 1 + kSlack)) return success();
+  const float worst = *high > 1 + kSlack ? *high : *low;
+  const std::size_t at = std::size_t((*high > 1 + kSlack ? high : low) - texture.pixels.begin());
+  const Channel& channel = spec.channels[at % spec.channels.size()];
+  return Error{path.string(), "texture " + spec.name + " holds " + std::to_string(worst) + " (from " +
+                                  (channel.source.empty() ? "a constant" : channel.source) +
+                                  "), outside the [0, 1] an " + std::string(image::sample_type_name(type)) +
+                                  "-bit file stores: write it as half or float (EXR), or scale the source"};
+}
+
 Result<std::vector<fs::path>> write_textures(const Layout& layout, const material::Maps& sources, const WriteRequest& request) {
   return guarded("", [&]() -> Result<std::vector<fs::path>> {
     auto paths = output_paths(layout, request.outputs);
@@ -556,11 +585,17 @@ Result<std::vector<fs::path>> write_textures(const Layout& layout, const materia
     if (Status s = check_outputs(outputs, request.inputs); !s) return s.error();
     auto images = pack(layout, sources);
     if (!images) return images.error();
+    // Which textures, as what: every one checked before the first is written.
     const material::MapNames given = sources.names();
-    std::vector<fs::path> written;
+    std::vector<std::pair<std::size_t, image::SampleType>> planned;
     for (std::size_t t = 0; t < paths->size(); ++t) {
       if (!texture_written(layout.textures[t], given)) continue;
       const image::SampleType type = request.type.value_or(default_sample_type((*paths)[t]));
+      if (Status s = check_storable_range((*images)[t], layout.textures[t], (*paths)[t], type); !s) return s.error();
+      planned.emplace_back(t, type);
+    }
+    std::vector<fs::path> written;
+    for (const auto& [t, type] : planned) {
       const image::WriteOptions options = write_options(layout.textures[t].color, {type, request.transfer, request.encoding});
       if (Status s = image::write_image((*images)[t], (*paths)[t], options); !s) return s.error();
       written.push_back((*paths)[t]);
