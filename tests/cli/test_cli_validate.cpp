@@ -34,7 +34,7 @@ TEST(CliValidate, ExitCodesReportAndHeatmap) {
   // Pair B, 8-bit sRGB: 3 dielectric texels (F0 0.04: code 57), one in the semiconductor gap (code 150).
   write_raw(dir / "b.png", 4, 1, 4, "uint8", {57, 57, 57, 128, 57, 57, 57, 128, 57, 57, 57, 128, 150, 150, 150, 128});
   const std::string b = (dir / "b.png").string();
-  const auto strict = matbake({"--json", "validate", "--ks", b, "--heatmap", (dir / "map.png").string()});
+  const auto strict = matbake({"--json", "validate", "--gate", "--ks", b, "--heatmap", (dir / "map.png").string()});
   EXPECT_EQ(strict.exit_code, 3) << strict.err;
   const auto doc = nlohmann::json::parse(strict.out);
   EXPECT_EQ(doc["classes"]["dielectric"], 3);
@@ -45,13 +45,13 @@ TEST(CliValidate, ExitCodesReportAndHeatmap) {
   EXPECT_EQ(doc["passed"], false);
   const RawImage map = read_raw(dir / "map.png");
   EXPECT_EQ(map.samples, std::vector<double>({40, 170, 70, 40, 170, 70, 40, 170, 70, 255, 150, 0}));
-  // Allowed share: passes. Over it with the gate off: advisory (exit 0, said, not passed).
-  EXPECT_EQ(matbake({"validate", "--ks", b, "--max-violations", "0.25"}).exit_code, 0);
-  const auto advisory = matbake({"--json", "validate", "--ks", b, "--no-gate"});
+  // Allowed share: passes. Over it without --gate (the default): advisory (exit 0, said, not passed).
+  EXPECT_EQ(matbake({"validate", "--gate", "--ks", b, "--max-violations", "0.25"}).exit_code, 0);
+  const auto advisory = matbake({"--json", "validate", "--ks", b});
   EXPECT_EQ(advisory.exit_code, 0) << advisory.err;
   EXPECT_EQ(nlohmann::json::parse(advisory.out)["passed"], false);
   EXPECT_EQ(nlohmann::json::parse(advisory.out)["gate"], false);
-  EXPECT_NE(matbake({"validate", "--ks", b, "--no-gate"}).out.find("over the limit (advisory: gate off)"), std::string::npos);
+  EXPECT_NE(matbake({"validate", "--ks", b}).out.find("over the limit (advisory: gate off)"), std::string::npos);
   // The curve moves the class: code 57 under gamma 2.2 is 0.0443 (still dielectric), 150 is 0.311.
   const auto g22 = matbake({"--json", "validate", "--ks", b, "--transfer", "gamma2.2"});
   EXPECT_NEAR(nlohmann::json::parse(g22.out)["f0_stats"][0]["min"].get<double>(), std::pow(57 / 255.0, 2.2), 1e-6);
@@ -65,7 +65,7 @@ TEST(CliValidate, WholePairMetalRoughAndMaterial) {
                 .exit_code,
             0);
   const auto r = matbake({"--json", "validate", "--from", "schuler", (dir / "g_a.png").string(),
-                          (dir / "g_b.png").string(), "--material", "gold"});
+                          (dir / "g_b.png").string(), "--material", "gold", "--gate"});
   EXPECT_EQ(r.exit_code, 3);
   const auto doc = nlohmann::json::parse(r.out);
   EXPECT_EQ(doc["flags"]["metal_with_diffuse"], 4);

@@ -17,8 +17,9 @@ const params::Group<Options>& options_params() {
       params::flag<Options>(Spec{.name = "gate",
                                  .help = "Whether more flagged texels than max_violations fail (validate: exit 3; a "
                                          "build: the job fails and writes no textures, and the scenes using the "
-                                         "material are skipped); off: advisory, reported and counted only",
-                                 .example = "false"},
+                                         "material are skipped); off (the default): advisory, reported and "
+                                         "counted only",
+                                 .example = "true"},
                             [](auto& o) -> auto& { return o.gate; }),
       params::integer<Options>(Spec{.name = "worst", .help = "How many of the worst texels the report lists", .min = 0,
                                     .max = 1e6, .example = "3"},
