@@ -245,6 +245,35 @@ TEST(CliDelivery, TexelDensitySizesTexturesFromTheScene) {
   }
 }
 
+// KHR_texture_transform scales the UV area a texture is read over: tiled 3× (scale 3) the quad
+// needs 8 / 3 texels per texture side, at scale 0.5 twice 8, at scale (1, 2) rotated 8 / √2; each
+// texture of the one material gets its own size (they all got 8).
+TEST(CliDelivery, TexelDensityFollowsEachTexturesTransform) {
+  TempDir dir;
+  write_textured_quad(dir.path(), "OPAQUE");
+  json doc = json::parse(read_bytes(dir / "quad.gltf"));
+  json& material = doc["materials"][0];
+  const auto transform = [](json scale, double rotation) {
+    return json{{"KHR_texture_transform", {{"scale", scale}, {"rotation", rotation}}}};
+  };
+  material["pbrMetallicRoughness"]["baseColorTexture"]["extensions"] = transform({3, 3}, 0);
+  material["pbrMetallicRoughness"]["metallicRoughnessTexture"]["extensions"] = transform({1, 2}, 0.7);
+  material["normalTexture"]["extensions"] = transform({0.5, 0.5}, 0);
+  doc["extensionsUsed"] = {"KHR_texture_transform"};
+  write_bytes(dir / "quad.gltf", doc.dump());
+  const json report = run_json({"export", (dir / "quad.gltf").string(), "-o", (dir / "out" / "quad.glb").string(),
+                                "--texel-density", "8"},
+                               {});
+  ASSERT_EQ(report["textures"].size(), 3u);
+  EXPECT_EQ(report["textures"][0]["needed_side"], 3);   // ceil(8 / 3)
+  EXPECT_EQ(report["textures"][1]["needed_side"], 6);   // ceil(8 / √2)
+  EXPECT_EQ(report["textures"][2]["needed_side"], 16);  // 8 / 0.5
+  // Rounded to the nearest power of two in ratio (3 → 4, 6 → 8).
+  EXPECT_EQ(report["textures"][0]["size"], json::array({4, 4}));
+  EXPECT_EQ(report["textures"][1]["size"], json::array({8, 8}));
+  EXPECT_EQ(report["textures"][2]["size"], json::array({16, 16}));
+}
+
 // README command 1's KTX2 variant: the example's scene, built, then exported with KTX2 textures.
 TEST(CliDelivery, TheExampleSceneAsKtx2HasNoValidatorErrors) {
   MATBAKE_BASISU_OR_SKIP(basisu);

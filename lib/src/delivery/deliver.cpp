@@ -14,6 +14,7 @@
 #include <set>
 
 #include "../scene/from_document.hpp"
+#include "../gltf/texture_transform.hpp"
 #include "encode.hpp"
 #include "matbake/ktx2.hpp"
 #include "matbake/version.hpp"
@@ -26,11 +27,21 @@ namespace {
 constexpr const char* kBasisu = "KHR_texture_basisu";
 constexpr const char* kWebp = "EXT_texture_webp";
 
+// A material slot reading a texture: through which texCoord set, and how much its
+// KHR_texture_transform scales UV area (|scale.x · scale.y|; rotation and offset keep area), so
+// that a texture tiled 3× needs a third of the side per direction.
+struct Placement {
+  int material = -1;
+  int texcoord = 0;
+  double uv_area_scale = 1;
+  auto operator<=>(const Placement&) const = default;
+};
+
 struct Use {
   TextureClass texture_class = TextureClass::colour;
   std::optional<float> alpha_cutoff;
   std::string conflict;  // "used as colour and data": kept as it is
-  std::set<std::pair<int, int>> placements;  // (material, texCoord) pairs that read it
+  std::set<Placement> placements;  // every slot that reads it
 };
 
 // The class of a material slot, by its name, for core and extension slots alike: normal maps
@@ -42,7 +53,7 @@ TextureClass class_of_slot(const std::string& key) {
   return TextureClass::data;
 }
 
-void record(std::map<int, Use>& uses, int texture, TextureClass c, std::optional<float> cutoff, std::pair<int, int> placement) {
+void record(std::map<int, Use>& uses, int texture, TextureClass c, std::optional<float> cutoff, Placement placement) {
   auto [it, fresh] = uses.try_emplace(texture, Use{c, cutoff, "", {}});
   Use& use = it->second;
   use.placements.insert(placement);
@@ -54,6 +65,17 @@ void record(std::map<int, Use>& uses, int texture, TextureClass c, std::optional
   if (!use.alpha_cutoff) use.alpha_cutoff = cutoff;
 }
 
+// How a textureInfo reads its texture. A malformed transform counts as none here (the export
+// reports it where it resamples through it).
+Placement placement_of(const Json& info, int material) {
+  Placement p{material, gltf::integer_in<int>(info, "texCoord", 0, -1), 1};
+  if (auto transform = gltf::uv_transform_of(info, "", "")) {
+    if (transform->texcoord >= 0) p.texcoord = transform->texcoord;
+    p.uv_area_scale = std::abs(transform->scale.x * transform->scale.y);
+  }
+  return p;
+}
+
 // Every textureInfo under `node` (a material, its extensions): {"index": n} under a key "...Texture".
 void collect(const Json& node, int material, std::optional<float> cutoff, std::map<int, Use>& uses) {
   if (!node.is_object()) return;
@@ -62,8 +84,7 @@ void collect(const Json& node, int material, std::optional<float> cutoff, std::m
     if (key.ends_with("Texture") && value.contains("index")) {
       const int index = gltf::integer_in<int>(value, "index", -1, -1);
       const bool mask_alpha = key == "baseColorTexture";
-      const int texcoord = gltf::integer_in<int>(value, "texCoord", 0, -1);
-      if (index >= 0) record(uses, index, class_of_slot(key), mask_alpha ? cutoff : std::nullopt, {material, texcoord});
+      if (index >= 0) record(uses, index, class_of_slot(key), mask_alpha ? cutoff : std::nullopt, placement_of(value, material));
     } else {
       collect(value, material, cutoff, uses);
     }
@@ -144,7 +165,7 @@ Result<std::map<int, std::vector<MappedTriangle>>> mapped_triangles(const gltf::
   std::map<int, std::vector<MappedTriangle>> out;
   for (const scene::Instance& instance : scene->instances) {
     for (const auto& [texture, use] : uses) {
-      for (const auto& [material, texcoord] : use.placements) {
+      for (const auto& [material, texcoord, uv_area_scale] : use.placements) {
         if (material != instance.material || texcoord < 0 || std::size_t(texcoord) >= instance.texcoords.size()) continue;
         const std::vector<glm::vec2>& uv = instance.texcoords[std::size_t(texcoord)];
         if (uv.size() != instance.positions.size()) continue;
@@ -153,7 +174,7 @@ Result<std::map<int, std::vector<MappedTriangle>>> mapped_triangles(const gltf::
           const double uv_area =
               0.5 * std::abs(double(uv[t[1]].x - uv[t[0]].x) * double(uv[t[2]].y - uv[t[0]].y) -
                              double(uv[t[2]].x - uv[t[0]].x) * double(uv[t[1]].y - uv[t[0]].y));
-          out[texture].push_back({triangle_area(p[t[0]], p[t[1]], p[t[2]]), uv_area});
+          out[texture].push_back({triangle_area(p[t[0]], p[t[1]], p[t[2]]), uv_area * uv_area_scale});
         }
       }
     }
@@ -234,8 +255,8 @@ void drop_unused_webp(gltf::Document& doc) {
 
 std::vector<int> materials_of(const Use& use) {
   std::vector<int> out;
-  for (const auto& [material, texcoord] : use.placements) {
-    if (out.empty() || out.back() != material) out.push_back(material);
+  for (const Placement& p : use.placements) {
+    if (out.empty() || out.back() != p.material) out.push_back(p.material);
   }
   return out;
 }

@@ -85,8 +85,8 @@ const params::Group<Options>& options_params() {
                                                   .example = "true"},
                                              [](auto& o) -> auto& { return o.png_fallback; }));
     g.params.push_back(params::number<Options>(Spec{.name = "texel_density",
-                                                    .help = "Size each material's textures for this many texels per scene "
-                                                            "unit, from its UV mapping in the scene; 0 off",
+                                                    .help = "Size each texture for this many texels per scene unit, from the "
+                                                            "UVs (and texture transforms) that read it; 0 off",
                                                     .min = 0, .max = 1e9, .example = "256"},
                                                [](auto& o) -> auto& { return o.texel_density; }));
     return g;
