@@ -105,7 +105,8 @@ int run_slurm_plan(const PlanSettings& s, const GlobalOptions& global, pipeline:
   auto report = pipeline::run(manifest, plan, dry);
   if (!report) return report_error(report.error());
   const auto submission = pipeline::slurm_submission(
-      plan, *report, manifest.cluster, [](const pipeline::Job& job) { return pipeline::largest_image_pixels(job.inputs); });
+      plan, *report, manifest.cluster,
+      [&](const pipeline::Job& job) { return pipeline::job_footprint(job, manifest, int(manifest.cluster.cpus)); });
   const pipeline::SlurmTarget target{fs::absolute(s.output).lexically_normal(), self};
   auto lines = pipeline::sbatch_lines(submission, manifest.cluster, target);
   auto scripts = pipeline::slurm_scripts(manifest, submission, manifest.cluster, target);
@@ -122,7 +123,11 @@ int run_slurm_plan(const PlanSettings& s, const GlobalOptions& global, pipeline:
                           {"up_to_date", submission.up_to_date}, {"cluster", params::to_json(pipeline::cluster_params(), manifest.cluster)},
                           {"sbatch", *lines}};
     doc["array"] = {{"memory_mb", submission.array_memory_mb}, {"jobs", nlohmann::json::array()}};
-    for (const pipeline::SlurmJob& j : submission.array) doc["array"]["jobs"].push_back(j.job->name);
+    doc["array"]["task_memory_mb"] = nlohmann::json::array();  // each task's own estimate (or setting)
+    for (const pipeline::SlurmJob& j : submission.array) {
+      doc["array"]["jobs"].push_back(j.job->name);
+      doc["array"]["task_memory_mb"].push_back(j.memory_mb);
+    }
     doc["scenes"] = nlohmann::json::array();
     for (const pipeline::SlurmJob& j : submission.scenes) {
       doc["scenes"].push_back({{"job", j.job->name}, {"memory_mb", j.memory_mb}, {"after_tasks", j.after}});

@@ -1,62 +1,127 @@
 #!/usr/bin/env bash
-# The cluster cost model's per-job figures (docs/cluster.md, "Cost model"): one material job
-# (`matbake build --only`, as a Slurm array task runs it) at 512² to 4096², with 1 and 2 cores:
-# wall time and peak memory (best of 3), the bytes it reads and writes; and the example's scene
-# job. Then the expected wall time for 10,000 2048² materials on 1, 8, 64 and 256 nodes.
-#   scripts/bench-cluster.sh [BUILD_DIR]     (about 3 minutes on 2 cores)
+# The cluster cost model's figures (docs/cluster.md, "Memory model" and "Cost model"): every job
+# as a Slurm task runs it (`matbake --jobs 1 build --only JOB`), its peak memory (its processes'
+# resident memory summed, as a cgroup counts the job and the basisu it starts) against the memory
+# `plan --format slurm` asks for it; material jobs of 1 to 6 maps and a spec-gloss conversion at
+# 1024² to 4096², scenes using them (PNG, AO textures, KTX2); then one-map material times with 1
+# and 2 cores and the expected wall time for 10,000 2048² materials on 1, 8, 64 and 256 nodes.
+#   scripts/bench-cluster.sh [BUILD_DIR]     (about 8 minutes on 2 cores)
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 matbake=$(cd "${1:-$root/build}" && pwd)/cli/matbake
+export MATBAKE_BASISU=${MATBAKE_BASISU:-$root/scripts/basisu/bin/basisu}
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 
-# One material of the size: an sRGB noise base colour (validation off: noise is no material),
-# constant metallic and roughness, the glTF ORM layout. Prints "seconds peak_MB read_MB written_MB".
-measure() {  # size, cores
-  local dir=$work/m$1 best=
-  if [ ! -f "$dir/m.toml" ]; then
-    mkdir -p "$dir"
-    oiiotool --pattern noise:type=uniform "$1x$1" 3 -d uint8 -o "$dir/noise.png"
-    printf '[materials.m]\nsources = { base_color = "noise.png", metallic = 0.0, roughness = 0.5 }\nlayout = "gltf-orm"\nvalidate = { enabled = false }\n' >"$dir/m.toml"
-  fi
-  for _ in 1 2 3; do
-    /usr/bin/time -f "%e %M" -o "$work/time" "$matbake" --jobs "$2" build "$dir/m.toml" --only material:m --force --quiet
-    read -r seconds kb <"$work/time"
-    if [ -z "$best" ] || awk -v a="$seconds" -v b="${best%% *}" 'BEGIN {exit !(a < b)}'; then best="$seconds $kb"; fi
+# Runs a command in a session of its own; prints "seconds peak_MB": the largest sum of its
+# processes' resident memory, sampled every 10 ms, or the largest single process's own peak.
+measure() {
+  local peak=0 now start end
+  start=$(date +%s.%N)
+  setsid /usr/bin/time -f %M -o "$work/own_peak" "$@" >/dev/null &
+  local pid=$!  # the session's id: setsid starts it in place (a background job leads no group)
+  while kill -0 "$pid" 2>/dev/null; do
+    now=$(ps -o rss= -s "$pid" 2>/dev/null | awk '{s += $1} END {print s + 0}')
+    [ "$now" -gt "$peak" ] && peak=$now
+    sleep 0.01
   done
-  local read_mb written_mb
-  read_mb=$(du -k "$dir/noise.png" | awk '{printf "%.1f", $1 / 1024}')
-  written_mb=$(du -sk "$dir/out/materials" | awk '{printf "%.1f", $1 / 1024}')
-  echo "$best" | awk -v r="$read_mb" -v w="$written_mb" '{printf "%s %.0f %s %s\n", $1, $2 / 1024, r, w}'
+  wait "$pid"
+  end=$(date +%s.%N)
+  now=$(cat "$work/own_peak")
+  [ "$now" -gt "$peak" ] && peak=$now
+  awk -v a="$start" -v b="$end" -v p="$peak" 'BEGIN {printf "%.2f %.0f\n", b - a, p / 1024}'
 }
 
-echo "| texture | cores | time (s) | peak memory (MB) | model's request (MB) | read (MB) | written (MB) |"
-echo "|---|---|---|---|---|---|---|"
-for size in 512 1024 2048 4096; do
-  for cores in 1 2; do
-    read -r seconds peak read_mb written_mb < <(measure "$size" "$cores")
-    model=$(awk -v p=$((size * size)) 'BEGIN {m = (32 + 64 * p / 1048576) * 1.25; printf "%d", int((m + 63.999) / 64) * 64}')
-    echo "| ${size}² | $cores | $seconds | $peak | $model | $read_mb | $written_mb |"
-    if [ "$size" = 2048 ] && [ "$cores" = 1 ]; then job_2048=$seconds written_2048=$written_mb; fi
+# The sources of a side: noise (PNG compresses it poorly, as painted textures), normals near +Z.
+make_sources() {
+  local dir=$work/s$1
+  mkdir -p "$dir"
+  oiiotool --pattern noise:type=uniform:min=0.15:max=0.8 "$1x$1" 3 -d uint8 -o "$dir/base.png"
+  oiiotool --pattern noise:type=uniform:min=0.1:max=0.3 "$1x$1" 3 -d uint8 -o "$dir/emissive.png"
+  oiiotool --pattern noise:type=uniform:min=0.2:max=0.9 "$1x$1" 3 -d uint8 -o "$dir/orm.png"
+  oiiotool --pattern noise:type=uniform:min=0.3:max=0.8 "$1x$1" 1 -d uint8 -o "$dir/rough.png"
+  oiiotool --pattern noise:type=uniform:min=0:max=0.1 "$1x$1" 1 -d uint8 -o "$dir/metal.png"
+  oiiotool --pattern noise:type=uniform:min=0.42:max=0.58 "$1x$1" 3 --ch R,G,B=1.0 -d uint8 -o "$dir/normal.png"
+  cp "$root"/examples/showroom.{gltf,bin} "$dir/"
+  cat >"$dir/lib.toml" <<EOF
+output = "out"
+validate = { max_violations = 1.0 }
+[materials.one]
+sources = { base_color = "base.png", metallic = 0.0, roughness = 0.5 }
+layout = "gltf-orm"
+[materials.three]
+sources = { base_color = "base.png", metallic = "metal.png", roughness = "rough.png" }
+layout = "gltf-orm"
+[materials.five]
+sources = { base_color = "base.png", metallic = "metal.png", roughness = "rough.png", normal = "normal.png", emissive = "emissive.png" }
+layout = "gltf-pbr"
+[materials.six]
+sources = { base_color = "base.png", occlusion = "orm.png:r", roughness = "orm.png:g", metallic = "orm.png:b", normal = "normal.png", emissive = "emissive.png" }
+layout = "gltf-pbr"
+[materials.spec_gloss]
+sources = { kd = "base.png", ks = "emissive.png", gloss = "rough.png", normal = "normal.png" }
+layout = "gltf-pbr"
+[scenes.png]
+input = "showroom.gltf"
+output = "png.glb"
+materials = { painted_metal = "five", wood = "six", rubber = "spec_gloss" }
+[scenes.ao]
+input = "showroom.gltf"
+output = "ao.glb"
+materials = { painted_metal = "five", wood = "six", rubber = "spec_gloss" }
+ao = { samples = 8, texture = 1024 }
+[scenes.ktx2]
+input = "showroom.gltf"
+output = "ktx2.glb"
+materials = { painted_metal = "five", wood = "six", rubber = "spec_gloss" }
+texture_format = "ktx2"
+EOF
+}
+
+# The request of each job as plan --format slurm makes it, "job MB" a line.
+requests() {
+  "$matbake" --json plan "$1" --format slurm --dry-run -o "$work/slurm" | python3 -c '
+import json, sys
+d = json.load(sys.stdin)
+for job, mb in zip(d["array"]["jobs"], d["array"]["task_memory_mb"]): print(job, mb)
+for s in d["scenes"]: print(s["job"], s["memory_mb"])'
+}
+
+echo "| job | sources | time (s) | peak memory (MB) | request (MB) | peak / request |"
+echo "|---|---|---|---|---|---|"
+for side in 1024 2048 4096; do
+  make_sources "$side"
+  manifest=$work/s$side/lib.toml
+  jobs="material:one material:three material:five material:six material:spec_gloss"
+  if [ "$side" = 4096 ]; then jobs="material:one material:five"; fi
+  if [ "$side" != 4096 ]; then jobs="$jobs scene:png scene:ao"; fi
+  if [ "$side" = 1024 ] && [ -x "$MATBAKE_BASISU" ]; then jobs="$jobs scene:ktx2"; fi
+  requests "$manifest" >"$work/requests"
+  "$matbake" --jobs 2 build "$manifest" --quiet --only material:five --only material:six --only material:spec_gloss >/dev/null
+  for job in $jobs; do
+    read -r seconds peak < <(measure "$matbake" --jobs 1 build "$manifest" --only "$job" --force --quiet)
+    request=$(awk -v j="$job" '$1 == j {print $2}' "$work/requests")
+    awk -v j="$job" -v s="$side" -v t="$seconds" -v p="$peak" -v r="$request" \
+      'BEGIN {printf "| %s | %d² | %s | %d | %d | %.2f |\n", j, s, t, p, r, p / r}'
+    if [ "$side" = 2048 ] && [ "$job" = material:one ]; then job_2048=$seconds request_2048=$request; fi
   done
 done
 
-mkdir -p "$work/example" && cp "$root"/examples/showroom.{toml,gltf,bin} "$work/example/" && cp -r "$root/examples/textures" "$work/example/"
-"$matbake" build "$work/example/showroom.toml" --quiet
-/usr/bin/time -f "%e %M" -o "$work/time" "$matbake" --jobs 2 build "$work/example/showroom.toml" --only scene:showroom --force --quiet
-read -r scene_seconds scene_kb <"$work/time"
+one_core=$(measure "$matbake" --jobs 1 build "$work/s2048/lib.toml" --only material:one --force --quiet)
+two_cores=$(measure "$matbake" --jobs 2 build "$work/s2048/lib.toml" --only material:one --force --quiet)
+written_2048=$(du -ck "$work"/s2048/out/materials/one_* | tail -1 | awk '{printf "%.1f", $1 / 1024}')
 echo
-echo "scene job (the example, AO textures baked, 2 cores): $scene_seconds s, $((scene_kb / 1024)) MB peak"
+echo "one-map 2048² material: 1 core ${one_core% *} s, 2 cores ${two_cores% *} s; writes $written_2048 MB"
 
-# The model: nodes of 32 cores and 128 GB, one core per job (32 jobs a node, memory permitting), the
-# 2048² one-core job time above; the scene jobs after the last material (Amdahl); the shared
-# filesystem writing at most 1 GB/s in all.
+# Nodes of 32 cores and 128 GB, one core per job (32 jobs a node, memory permitting), the 2048²
+# one-core job time above; the scene jobs after the last material (Amdahl; the example's 4.3 s);
+# the shared filesystem writing at most 1 GB/s in all.
 echo
 echo "| nodes (32 cores) | materials at once | material phase | filesystem floor | expected wall time |"
 echo "|---|---|---|---|---|"
 for nodes in 1 8 64 256; do
-  awk -v n="$nodes" -v t="$job_2048" -v w="$written_2048" -v s="$scene_seconds" 'BEGIN {
-    jobs = 10000; per_node = 32; mem_jobs = int(128 * 1024 / 384); if (mem_jobs < per_node) per_node = mem_jobs
+  awk -v n="$nodes" -v t="$job_2048" -v w="$written_2048" -v m="$request_2048" -v s=4.3 'BEGIN {
+    jobs = 10000; per_node = 32; mem_jobs = int(128 * 1024 / m); if (mem_jobs < per_node) per_node = mem_jobs
     at_once = n * per_node; waves = int((jobs + at_once - 1) / at_once)
     phase = waves * t; floor_s = jobs * w / 1024
     wall = (phase > floor_s ? phase : floor_s) + s

@@ -1,9 +1,11 @@
 #include "support/run.hpp"
 
 #include <fcntl.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
@@ -34,9 +36,38 @@ std::vector<std::string> merged_environment(const std::vector<std::string>& chan
   return env;
 }
 
-}  // namespace
+// The resident memory (bytes) of every process in process group `group`.
+double group_resident_bytes(pid_t group) {
+  double bytes = 0;
+  const double page = double(sysconf(_SC_PAGESIZE));
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator("/proc", ec)) {
+    const std::string pid = entry.path().filename().string();
+    if (pid.empty() || pid.find_first_not_of("0123456789") != std::string::npos) continue;
+    // read(2), not a stream: a process that ends meanwhile fails the read (ESRCH), not the test.
+    const int fd = open((entry.path() / "stat").c_str(), O_RDONLY);
+    if (fd < 0) continue;
+    std::string text(1024, '\0');
+    const ssize_t got = read(fd, text.data(), text.size());
+    close(fd);
+    if (got <= 0) continue;
+    text.resize(std::size_t(got));
+    const std::size_t close = text.rfind(')');  // the command name may hold spaces
+    if (close == std::string::npos) continue;
+    std::istringstream fields(text.substr(close + 2));
+    std::string field;
+    long pgrp = 0, rss = 0;
+    for (int i = 3; i <= 24 && fields >> field; ++i) {
+      if (i == 5) pgrp = std::atol(field.c_str());
+      if (i == 24) rss = std::atol(field.c_str());
+    }
+    if (pgrp == group) bytes += double(rss) * page;
+  }
+  return bytes;
+}
 
-RunResult run(const std::string& program, const std::vector<std::string>& args, const std::vector<std::string>& env) {
+RunResult run_program(const std::string& program, const std::vector<std::string>& args, const std::vector<std::string>& env,
+                      bool measure) {
   TempDir dir;
   const auto out_path = dir / "stdout", err_path = dir / "stderr";
   std::vector<std::string> argv_strings{program};
@@ -51,6 +82,7 @@ RunResult run(const std::string& program, const std::vector<std::string>& args, 
 
   const pid_t pid = fork();
   if (pid == 0) {
+    if (measure) setpgid(0, 0);
     const int in = open("/dev/null", O_RDONLY);
     const int out = open(out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
     const int err = open(err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
@@ -60,13 +92,33 @@ RunResult run(const std::string& program, const std::vector<std::string>& args, 
     execve(program.c_str(), argv.data(), envp.data());
     _exit(127);
   }
-  int status = 0;
-  waitpid(pid, &status, 0);
   RunResult result;
+  int status = 0;
+  if (measure) {
+    setpgid(pid, pid);  // as the child does: whichever runs first
+    struct rusage usage {};
+    while (wait4(pid, &status, WNOHANG, &usage) == 0) {
+      result.peak_mb = std::max(result.peak_mb, group_resident_bytes(pid) / (1024.0 * 1024.0));
+      usleep(1000);
+    }
+    result.peak_mb = std::max(result.peak_mb, double(usage.ru_maxrss) / 1024.0);
+  } else {
+    waitpid(pid, &status, 0);
+  }
   result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
   result.out = slurp(out_path);
   result.err = slurp(err_path);
   return result;
+}
+
+}  // namespace
+
+RunResult run(const std::string& program, const std::vector<std::string>& args, const std::vector<std::string>& env) {
+  return run_program(program, args, env, false);
+}
+
+RunResult run_measured(const std::string& program, const std::vector<std::string>& args, const std::vector<std::string>& env) {
+  return run_program(program, args, env, true);
 }
 
 std::string matbake_exe() {
@@ -75,14 +127,18 @@ std::string matbake_exe() {
   return other && *other ? other : MATBAKE_EXE;
 }
 
-RunResult matbake(const std::vector<std::string>& args, const std::vector<std::string>& env) {
+std::vector<std::string> matbake_environment(const std::vector<std::string>& env) {
   // The KTX2 encoder scripts/install-basisu.sh installs, unless the environment or `env` names one.
   std::vector<std::string> with_encoder = env;
   const std::filesystem::path installed = std::filesystem::path(MATBAKE_SOURCE_DIR) / "scripts" / "basisu" / "bin" / "basisu";
   if (!std::getenv("MATBAKE_BASISU") && ::access(installed.c_str(), X_OK) == 0) {
     with_encoder.insert(with_encoder.begin(), "MATBAKE_BASISU=" + installed.string());
   }
-  return run(matbake_exe(), args, with_encoder);
+  return with_encoder;
+}
+
+RunResult matbake(const std::vector<std::string>& args, const std::vector<std::string>& env) {
+  return run(matbake_exe(), args, matbake_environment(env));
 }
 
 }  // namespace matbake::test

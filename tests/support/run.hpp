@@ -8,6 +8,7 @@ struct RunResult {
   int exit_code = -1;  // 128 + signal when killed by one
   std::string out;
   std::string err;
+  double peak_mb = 0;  // run_measured: the most memory its processes held at once (RSS, MiB)
 };
 
 // Runs `program args...` with stdout and stderr captured; `env` entries ("NAME=value") are added
@@ -15,9 +16,17 @@ struct RunResult {
 RunResult run(const std::string& program, const std::vector<std::string>& args,
               const std::vector<std::string>& env = {});
 
+// run, in a process group of its own whose resident memory is summed every millisecond, as a
+// cluster's cgroup counts a job and the encoders it starts: the peak of the sums, or the largest
+// single process's own peak (the kernel's, between samples) when that is higher.
+RunResult run_measured(const std::string& program, const std::vector<std::string>& args,
+                       const std::vector<std::string>& env = {});
+
 // The matbake binary built with these tests (or MATBAKE_TEST_EXE, an earlier build's).
 std::string matbake_exe();
 
 RunResult matbake(const std::vector<std::string>& args, const std::vector<std::string>& env = {});
+// The environment matbake() runs it with: `env` and the installed KTX2 encoder.
+std::vector<std::string> matbake_environment(const std::vector<std::string>& env = {});
 
 }  // namespace matbake::test

@@ -408,19 +408,55 @@ TEST(ProgressBar, DrawsAfterAMomentAndClears) {
   EXPECT_EQ(text.substr(text.size() - 14), "still printed\n");
 }
 
-// The memory model's closed form: (32 MB + 64 bytes a texel) x 1.25, up to a multiple of 64 MB.
-TEST(ClusterMemory, IsTheModelsClosedForm) {
-  EXPECT_EQ(pipeline::job_memory_mb(0), 64);                      // 40 → 64
-  EXPECT_EQ(pipeline::job_memory_mb(2048ull * 2048), 384);        // 360 → 384
-  EXPECT_EQ(pipeline::job_memory_mb(4096ull * 4096), 1344);       // 1320 → 1344
-  EXPECT_EQ(pipeline::job_memory_mb(16384ull * 16384), 20544);    // 20520 → 20544
-  for (std::uint64_t pixels : {0ull, 1ull, 1000ull, 1ull << 22, 1ull << 26, 1ull << 30}) {
-    const double exact = (32.0 + 64.0 * double(pixels) / (1024.0 * 1024.0)) * 1.25;
-    const std::int64_t mb = pipeline::job_memory_mb(pixels);
-    EXPECT_EQ(mb % 64, 0) << pixels;
-    EXPECT_GE(double(mb), exact) << pixels;
-    EXPECT_LT(double(mb), exact + 64) << pixels;
-  }
+// The memory model's closed form (docs/cluster.md): 4 bytes a channel a texel of the largest
+// source, over the channels a job decodes, makes and writes, 16 bytes a texel of working buffers,
+// 32 MiB of program; a scene adds its AO textures, geometry and KTX2 encoders; the request is the
+// footprint with a quarter on top, rounded up to 64 MB.
+TEST(ClusterMemory, FootprintIsTheModelsClosedForm) {
+  TempDir dir;
+  write_raw(dir / "base.png", 64, 32, 3, "uint8", std::vector<double>(64 * 32 * 3, 100));
+  write_raw(dir / "rough.png", 32, 16, 1, "uint8", std::vector<double>(32 * 16, 100));
+  write_bytes(dir / "b.bin", std::string(1000, '\0'));
+  write_bytes(dir / "s.gltf", R"({"asset": {"version": "2.0"}, "buffers": [{"byteLength": 1000, "uri": "b.bin"}],
+    "materials": [{"name": "mr"}], "nodes": [{}, {}]})");
+  auto m = pipeline::parse_manifest(R"(
+[materials.mr]                     # files 3 + 1 channels, maps 3 + 1 + 1, textures 4 + 3
+sources = { base_color = "base.png", roughness = "rough.png", metallic = 0.0 }
+layout = "gltf-orm"
+[materials.sg]                     # files 3, maps 3 + 3 + 1, textures 4 + 3, a conversion's 7
+sources = { kd = "base.png", ks = 0.04, gloss = 0.5 }
+layout = "gltf-orm"
+[scenes.s]                         # mr with a glTF material's 13 texture channels
+input = "s.gltf"
+texture_format = "ktx2"
+ao = { samples = 8, texture = 64, per_instance = true }
+)", dir / "m.toml");
+  ASSERT_TRUE(m) << m.error().to_string();
+  auto plan = pipeline::make_plan(*m);
+  ASSERT_TRUE(plan) << plan.error().to_string();
+  const double texels = 64 * 32, mib = 1024.0 * 1024.0;
+  const auto footprint = [&](const std::string& name, int cpus) {
+    for (const pipeline::Job& j : plan->jobs) {
+      if (j.name == name) return pipeline::job_footprint(j, *m, cpus);
+    }
+    ADD_FAILURE() << name;
+    return pipeline::JobFootprint{};
+  };
+  const pipeline::JobFootprint mr = footprint("material:mr", 1), sg = footprint("material:sg", 1);
+  EXPECT_EQ(mr.program, 32 * mib);
+  EXPECT_EQ(mr.images, texels * (4 * (4 + 5 + 7) + 16));
+  EXPECT_EQ(sg.images, texels * (4 * (3 + 7 + 7 + 7) + 16));
+  EXPECT_EQ(mr.geometry + mr.ao + mr.encoder, 0);
+  const pipeline::JobFootprint scene = footprint("scene:s", 2);
+  EXPECT_EQ(scene.images, texels * (4 * (4 + 5 + 13) + 16));
+  EXPECT_EQ(scene.geometry, 8 * 1000);
+  EXPECT_EQ(scene.ao, (1 + 2) * 64 * 64 * 24);          // a material and two placements
+  EXPECT_EQ(scene.encoder, 2 * texels * (80 + 72));     // two at once: the job's cores
+  EXPECT_EQ(footprint("scene:s", 1).encoder, texels * (80 + 72));
+
+  EXPECT_EQ(pipeline::memory_request_mb({.program = 32 * mib, .images = 200 * mib}), 320);  // 290 → 320
+  EXPECT_EQ(pipeline::memory_request_mb({.program = 32 * mib}), 64);                        // 40 → 64
+  EXPECT_EQ(pipeline::memory_request_mb({.program = 32 * mib, .encoder = 19.2 * mib}), 64);  // 64 → 64
 }
 
 // Quoted words come back from bash unchanged, whatever they hold.

@@ -18,16 +18,26 @@ namespace matbake::pipeline {
 // [cluster] table) and cpus (the manifest's; `plan --jobs` sets it too).
 const params::Group<ClusterOptions>& cluster_params();
 
-// The memory (MB) to ask for a job whose largest image has `pixels` texels: 32 MB for the program
-// and 64 bytes a texel, as material jobs were measured to peak (docs/cluster.md), with a quarter on
-// top (Slurm ends a job that passes its request), rounded up to a multiple of 64 MB.
-std::int64_t job_memory_mb(std::uint64_t pixels);
+// What a job holds at its peak, in bytes, by part (docs/cluster.md, "Memory model"): counted from
+// what it decodes, makes and writes, as scripts/bench-cluster.sh measured those to cost.
+struct JobFootprint {
+  double program = 0;   // the program and its libraries
+  double images = 0;    // decoded sources, a material's maps, the textures it makes (float samples)
+  double geometry = 0;  // a scene's buffers, meshes and ray-tracing structure
+  double ao = 0;        // a scene's AO textures being baked
+  double encoder = 0;   // KTX2: the textures encoded at once, basisu's own memory included
+  double total() const { return program + images + geometry + ao + encoder; }
+};
+// `cpus`: the cores the job runs with (a KTX2 scene encodes that many textures at once).
+JobFootprint job_footprint(const Job& job, const Manifest& manifest, int cpus);
+// The request for a footprint: a quarter on top (Slurm ends a job that passes its request),
+// rounded up to a multiple of 64 MB.
+std::int64_t memory_request_mb(const JobFootprint& footprint);
 
 // One job as it is submitted.
 struct SlurmJob {
   const Job* job = nullptr;
-  std::uint64_t pixels = 0;          // of the largest image it holds (for a scene: its materials' too)
-  std::int64_t memory_mb = 0;        // asked for: the options' memory_mb, else job_memory_mb(pixels)
+  std::int64_t memory_mb = 0;        // asked for: the options' (its kind's, else every job's), else the model's
   std::vector<std::size_t> after;    // a scene: the array tasks (indices) whose outputs it reads
 };
 
@@ -39,13 +49,10 @@ struct SlurmSubmission {
 };
 
 // The jobs a dry run found out of date (or failing: they run and fail where the status shows
-// them), and every scene that reads a material submitted with them. `pixels_of` gives a job's
-// largest image (largest_image_pixels of its inputs, in practice).
+// them), and every scene that reads a material submitted with them. `footprint_of` gives a job's
+// footprint (job_footprint, in practice), used where the options set no memory for its kind.
 SlurmSubmission slurm_submission(const Plan& plan, const Report& dry_run, const ClusterOptions& options,
-                                 const std::function<std::uint64_t(const Job&)>& pixels_of);
-
-// The largest width x height among `files` that are images (others, and unreadable ones, count 0).
-std::uint64_t largest_image_pixels(const std::vector<std::filesystem::path>& files);
+                                 const std::function<JobFootprint(const Job&)>& footprint_of);
 
 // Where the submission runs and what it runs.
 struct SlurmTarget {

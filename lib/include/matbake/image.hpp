@@ -70,6 +70,7 @@ struct ReadInfo {
   SampleType stored_type = SampleType::u8;  // the closest of ours to what the file holds
   std::string format_name;                  // OIIO's names: "png", "openexr", "tiff", "jpeg", ...
   int width = 0, height = 0;                // as the header declares them
+  int channels = 0;
   // The colour encoding the file declares: PNG cICP (transfer 13 sRGB, 8 linear, 4 gamma 2.2),
   // else an sRGB chunk or an iCCP profile named sRGB, else gAMA 1/2.2 or 1.0; EXR linear; TIFF
   // as OIIO reports it. Unset: untagged (or a tag matbake cannot interpret, e.g. another ICC profile).

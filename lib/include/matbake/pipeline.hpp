@@ -94,7 +94,9 @@ struct ClusterOptions {
   std::string account;              // sbatch --account; empty: the user's default
   std::string time_limit;           // sbatch --time of each job ("30:00", "2:00:00"); empty: the partition's
   std::int64_t array_throttle = 0;  // at most this many material jobs at once (--array=...%N); 0: no limit
-  std::int64_t memory_mb = 0;       // each job's memory; 0: estimated from the largest image it holds
+  std::int64_t memory_mb = 0;       // each job's memory; 0: the memory model's (job_footprint)
+  std::int64_t material_memory_mb = 0;  // a material job's, over memory_mb; 0: memory_mb's
+  std::int64_t scene_memory_mb = 0;     // a scene job's, over memory_mb; 0: memory_mb's
   std::int64_t cpus = 1;            // cores per job (--cpus-per-task); the job runs with --jobs this
 };
 

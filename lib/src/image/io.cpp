@@ -101,7 +101,7 @@ class RowReader {
   const ImageLayout& layout() const { return stored_->format().layout; }
   ReadInfo info() const {
     const StoredFormat& f = stored_->format();
-    return {f.stored, f.format_name, layout().width, layout().height, f.tagged, f.tag};
+    return {f.stored, f.format_name, layout().width, layout().height, layout().channels, f.tagged, f.tag};
   }
 
   // Rows [y, y + rows) into `out`, decoded.

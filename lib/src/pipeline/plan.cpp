@@ -150,17 +150,6 @@ void add_unique(std::vector<fs::path>& to, const std::vector<fs::path>& from) {
   }
 }
 
-// The maps a material's layout is written from (its sources, or its packed layout's, in the
-// layout's workflow): what decides which of the layout's textures it writes.
-material::MapNames layout_map_names(const MaterialSpec& m) {
-  material::MapNames names;
-  for (const pack::SourceInput& s : m.sources) names.insert(s.name);
-  if (m.packed) {
-    for (std::string& n : pack::layout_sources(m.packed->layout)) names.insert(std::move(n));
-  }
-  return workflow::names_in_layout_workflow(std::move(names), m.layout->layout);
-}
-
 // A material's job: what it reads and writes, its options, and what makes it fail before it starts.
 Result<Job> material_job(const Manifest& manifest, std::size_t i, const Result<std::vector<material_table::Material>>& table) {
   const MaterialSpec& m = manifest.materials[i];
@@ -175,7 +164,8 @@ Result<Job> material_job(const Manifest& manifest, std::size_t i, const Result<s
   if (m.layout) {
     auto paths = pack::output_paths(m.layout->layout, {material_texture_pattern(manifest, m).string()});
     if (!paths) return Error{m.origins.of("layout"), "materials." + m.name + ".layout: " + paths.error().to_string()};
-    const material::MapNames given = layout_map_names(m);
+    // The maps it is written from, in the layout's workflow: what decides which textures it writes.
+    const material::MapNames given = workflow::names_in_layout_workflow(source_map_names(m), m.layout->layout);
     for (std::size_t t = 0; t < paths->size(); ++t) {
       if (pack::texture_written(m.layout->layout.textures[t], given)) job.outputs.textures.push_back((*paths)[t]);
     }
@@ -188,6 +178,26 @@ Result<Job> material_job(const Manifest& manifest, std::size_t i, const Result<s
 }
 
 }  // namespace
+
+material::MapNames source_map_names(const MaterialSpec& m) {
+  material::MapNames names;
+  for (const pack::SourceInput& s : m.sources) names.insert(s.name);
+  if (m.packed) {
+    for (std::string& n : pack::layout_sources(m.packed->layout)) names.insert(std::move(n));
+  }
+  return names;
+}
+
+std::vector<fs::path> decoded_files(const MaterialSpec& m) {
+  std::vector<fs::path> files;
+  for (const pack::SourceInput& s : m.sources) {
+    if (!s.file.empty()) files.push_back(fs::absolute(s.file).lexically_normal());
+  }
+  for (const fs::path& f : m.packed_files) files.push_back(fs::absolute(f).lexically_normal());
+  std::sort(files.begin(), files.end());
+  files.erase(std::unique(files.begin(), files.end()), files.end());
+  return files;
+}
 
 fs::path material_texture_pattern(const Manifest& manifest, const MaterialSpec& m) {
   return manifest.output / "materials" / (m.name + "_{texture}." + m.options.format);

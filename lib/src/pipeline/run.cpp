@@ -96,18 +96,6 @@ class DecodeCache {
   std::atomic<std::size_t> decoded_{0};
 };
 
-// The image files a material decodes.
-std::vector<fs::path> decoded_files(const MaterialSpec& m) {
-  std::vector<fs::path> files;
-  for (const pack::SourceInput& s : m.sources) {
-    if (!s.file.empty()) files.push_back(fs::absolute(s.file).lexically_normal());
-  }
-  for (const fs::path& f : m.packed_files) files.push_back(fs::absolute(f).lexically_normal());
-  std::sort(files.begin(), files.end());
-  files.erase(std::unique(files.begin(), files.end()), files.end());
-  return files;
-}
-
 std::vector<fs::path> decoded_files(const Job& job, const Manifest& manifest) {
   if (job.kind == JobKind::material) return decoded_files(manifest.materials[job.spec]);
   std::set<fs::path> files;

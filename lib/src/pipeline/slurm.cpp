@@ -1,6 +1,5 @@
 #include <algorithm>
 #include <cctype>
-#include <cmath>
 #include <map>
 
 #include "matbake/cluster.hpp"
@@ -12,20 +11,6 @@
 namespace matbake::pipeline {
 namespace fs = std::filesystem;
 namespace {
-
-// The memory model, fitted to scripts/bench-cluster.sh's peak memory of material jobs from 512² to
-// 4096² (docs/cluster.md, "Cost model"): the program and its libraries, then 64 bytes a texel (the
-// decoded sources, maps and packed textures of the largest image held at once).
-constexpr double kBaseMb = 32.0;
-constexpr double kMbPerTexel = 64.0 / (1024.0 * 1024.0);
-constexpr double kHeadroom = 1.25;
-constexpr std::int64_t kMemoryStepMb = 64;
-
-// Inputs that are never images: the scene files, the layout and table files.
-bool may_be_image(const fs::path& file) {
-  const std::string ext = file.extension().string();
-  return ext != ".gltf" && ext != ".glb" && ext != ".bin" && ext != ".json" && ext != ".toml";
-}
 
 // An argument of an sbatch line: literal text, or the array's job id that the script learns when it
 // runs ("$array"). Never a literal text read for a variable: a path holding "$array" stays a path.
@@ -103,45 +88,30 @@ Result<std::string> script_word(const Word& word) {
 
 }  // namespace
 
-std::int64_t job_memory_mb(std::uint64_t pixels) {
-  const double mb = (kBaseMb + kMbPerTexel * double(pixels)) * kHeadroom;
-  return std::int64_t(std::ceil(mb / double(kMemoryStepMb))) * kMemoryStepMb;
-}
-
-std::uint64_t largest_image_pixels(const std::vector<fs::path>& files) {
-  std::uint64_t largest = 0;
-  for (const fs::path& f : files) {
-    if (!may_be_image(f)) continue;
-    if (auto info = image::probe_image(f)) largest = std::max(largest, std::uint64_t(info->width) * std::uint64_t(info->height));
-  }
-  return largest;
-}
-
 SlurmSubmission slurm_submission(const Plan& plan, const Report& dry_run, const ClusterOptions& options,
-                                 const std::function<std::uint64_t(const Job&)>& pixels_of) {
-  const auto memory_for = [&](std::uint64_t pixels) {
-    return options.memory_mb > 0 ? options.memory_mb : job_memory_mb(pixels);
+                                 const std::function<JobFootprint(const Job&)>& footprint_of) {
+  const auto memory_for = [&](const Job& job) {
+    const std::int64_t of_kind = job.kind == JobKind::material ? options.material_memory_mb : options.scene_memory_mb;
+    if (of_kind > 0) return of_kind;
+    return options.memory_mb > 0 ? options.memory_mb : memory_request_mb(footprint_of(job));
   };
   SlurmSubmission s;
   std::map<std::string, std::size_t> task_of;  // material job name → array index
-  std::map<std::string, std::uint64_t> pixels_by_name;
   for (const JobReport& r : dry_run.jobs) {
-    if (r.job->kind != JobKind::material) continue;
-    pixels_by_name[r.job->name] = pixels_of(*r.job);
-    if (r.outcome == Outcome::up_to_date) continue;
+    if (r.job->kind != JobKind::material || r.outcome == Outcome::up_to_date) continue;
     task_of[r.job->name] = s.array.size();
-    s.array.push_back({r.job, pixels_by_name[r.job->name], memory_for(pixels_by_name[r.job->name]), {}});
+    s.array.push_back({r.job, memory_for(*r.job), {}});
     s.array_memory_mb = std::max(s.array_memory_mb, s.array.back().memory_mb);
   }
   for (const JobReport& r : dry_run.jobs) {
     if (r.job->kind != JobKind::scene) continue;
-    SlurmJob scene{r.job, pixels_of(*r.job), 0, {}};
+    SlurmJob scene{r.job, 0, {}};
     for (const std::string& name : r.job->depends_on) {
       if (const auto t = task_of.find(name); t != task_of.end()) scene.after.push_back(t->second);
-      if (const auto p = pixels_by_name.find(name); p != pixels_by_name.end()) scene.pixels = std::max(scene.pixels, p->second);
     }
-    scene.memory_mb = memory_for(scene.pixels);
-    if (r.outcome != Outcome::up_to_date || !scene.after.empty()) s.scenes.push_back(std::move(scene));
+    if (r.outcome == Outcome::up_to_date && scene.after.empty()) continue;
+    scene.memory_mb = memory_for(*r.job);
+    s.scenes.push_back(std::move(scene));
   }
   s.up_to_date = plan.jobs.size() - s.array.size() - s.scenes.size();
   return s;

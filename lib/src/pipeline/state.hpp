@@ -16,9 +16,13 @@
 
 namespace matbake::pipeline {
 
-std::string job_file_stem(const std::string& job_name);
+std::string job_file_stem(const std::string& job_name);  // "material-wood": the stamp's and the depfile's name
 // Where a material's layout textures go: OUT/materials/NAME_{texture}.FORMAT.
-std::filesystem::path material_texture_pattern(const Manifest& manifest, const MaterialSpec& m);  // "material-wood": the stamp's and the depfile's name
+std::filesystem::path material_texture_pattern(const Manifest& manifest, const MaterialSpec& m);
+// The image files a material decodes (absolute, sorted, each once).
+std::vector<std::filesystem::path> decoded_files(const MaterialSpec& m);
+// The maps a material has: its sources, or its packed layout's.
+material::MapNames source_map_names(const MaterialSpec& m);
 
 // A file as a job read it: its size and modification time (nanoseconds) and the XXH64 of the bytes.
 struct FileIdentity {

@@ -1,0 +1,176 @@
+// The memory a job asks a cluster for, from what it holds at its peak: every image is float
+// samples, so a job's images cost 4 bytes a channel a texel, counted by what the job decodes, makes
+// and writes (docs/cluster.md, "Memory model"; scripts/bench-cluster.sh measures it against peaks).
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+#include "../gltf/document.hpp"
+#include "matbake/cluster.hpp"
+#include "matbake/image.hpp"
+#include "matbake/workflow_maps.hpp"
+#include "state.hpp"
+
+namespace matbake::pipeline {
+namespace fs = std::filesystem;
+namespace {
+
+constexpr double kMiB = 1024.0 * 1024.0;
+constexpr double kProgramBytes = 32 * kMiB;  // the program and its libraries, nothing loaded
+constexpr double kSampleBytes = 4;           // a float
+// Per texel of a material: row buffers of the PNG writer, validation's classes.
+constexpr double kWorkingBytesPerTexel = 16;
+// A workflow conversion's new maps: the larger direction (kd, ks, gloss: 7 channels).
+constexpr int kConversionChannels = 7;
+// What a scene writes for a material with no layout: base colour + alpha, ORM, normal, emissive.
+constexpr int kGltfMaterialChannels = 13;
+// A glTF's own image: decoded RGBA, converted (workflow, ORM) and written.
+constexpr double kOwnImageBytesPerTexel = 3 * 4 * kSampleBytes;
+// An AO texture being baked: its value, coverage and samples' sums (bake_ao/textures.cpp).
+constexpr double kAoBytesPerTexel = 24;
+// A scene's geometry: each buffer as read, the meshes as triangles and Embree's BVH over them.
+constexpr double kGeometryPerBufferByte = 8;
+constexpr double kCompressedGeometryPerBufferByte = 32;  // Draco or meshopt: decoded first
+// KTX2 per texture encoded at once: matbake's level 0, mip chain and the PNG it hands over, then
+// basisu's own (ETC1S at 2048² peaked at 64.5 bytes a texel, UASTC with RDO at 21).
+constexpr double kKtx2ParentBytesPerTexel = 80;
+constexpr double kBasisuBytesPerTexel = 72;
+
+constexpr double kHeadroom = 1.25;
+constexpr std::int64_t kMemoryStepMb = 64;
+
+// Inputs that are never images: the scene files, the layout and table files.
+bool may_be_image(const fs::path& file) {
+  const std::string ext = file.extension().string();
+  return ext != ".gltf" && ext != ".glb" && ext != ".bin" && ext != ".json" && ext != ".toml";
+}
+
+struct ImageSize {
+  double texels = 0;
+  int channels = 0;
+};
+
+ImageSize probe(const fs::path& file) {
+  if (!may_be_image(file)) return {};
+  auto info = image::probe_image(file);
+  if (!info) return {};
+  return {double(info->width) * double(info->height), info->channels};
+}
+
+// The texels a material's maps have (its largest source, or its size when every source is a
+// constant) and the channels of its decoded files and of its maps.
+struct MaterialShape {
+  double texels = 1;
+  int file_channels = 0;
+  int map_channels = 0;
+};
+
+MaterialShape material_shape(const MaterialSpec& m) {
+  MaterialShape shape;
+  for (const fs::path& f : decoded_files(m)) {
+    const ImageSize size = probe(f);
+    shape.texels = std::max(shape.texels, size.texels);
+    shape.file_channels += size.channels;
+  }
+  shape.texels = std::max(shape.texels, double(std::max(1, m.options.width)) * double(std::max(1, m.options.height)));
+  for (const pack::SourceInput& s : m.sources) {
+    if (const material::Source* source = material::find_source(s.name)) shape.map_channels += material::component_count(source->kind);
+  }
+  if (m.packed) shape.map_channels += shape.file_channels;  // a packed file's channels are its maps'
+  return shape;
+}
+
+int texture_channels(const pack::Layout& layout) {
+  int channels = 0;
+  for (const pack::Texture& t : layout.textures) channels += int(t.channels.size());
+  return channels;
+}
+
+// A material's images at their peak: files, maps, a conversion's maps, the textures it writes.
+double material_bytes(const MaterialSpec& m, int written_channels) {
+  const MaterialShape shape = material_shape(m);
+  int channels = shape.file_channels + shape.map_channels + written_channels;
+  if (m.layout && workflow::layout_direction(source_map_names(m), m.layout->layout)) channels += kConversionChannels;
+  return shape.texels * (kSampleBytes * channels + kWorkingBytesPerTexel);
+}
+
+std::size_t array_size(const gltf::Json& json, const char* key) {
+  return json.contains(key) && json[key].is_array() ? json[key].size() : 0;
+}
+
+bool uses_extension(const gltf::Json& json, const std::string& name) {
+  if (!json.contains("extensionsUsed") || !json["extensionsUsed"].is_array()) return false;
+  for (const auto& e : json["extensionsUsed"]) {
+    if (e.is_string() && e.get<std::string>() == name) return true;
+  }
+  return false;
+}
+
+double geometry_bytes(const gltf::Json& json) {
+  double bytes = 0;
+  if (json.contains("buffers") && json["buffers"].is_array()) {
+    for (const auto& b : json["buffers"]) {
+      if (b.is_object() && b.contains("byteLength") && b["byteLength"].is_number()) bytes += std::max(0.0, b["byteLength"].get<double>());
+    }
+  }
+  const bool compressed = uses_extension(json, "KHR_draco_mesh_compression") || uses_extension(json, "EXT_meshopt_compression");
+  return bytes * (compressed ? kCompressedGeometryPerBufferByte : kGeometryPerBufferByte);
+}
+
+JobFootprint material_footprint(const MaterialSpec& m) {
+  JobFootprint f;
+  f.program = kProgramBytes;
+  f.images = material_bytes(m, m.layout ? texture_channels(m.layout->layout) : 0);
+  return f;
+}
+
+JobFootprint scene_footprint(const Job& job, const Manifest& manifest, int cpus) {
+  const SceneSpec& s = manifest.scenes[job.spec];
+  JobFootprint f;
+  f.program = kProgramBytes;
+  double largest_texture = 0;
+  std::set<std::size_t> materials;
+  std::set<fs::path> material_files;
+  for (const auto& [gltf_name, m] : job.materials) materials.insert(m);
+  for (std::size_t m : materials) {
+    const MaterialSpec& spec = manifest.materials[m];
+    const int written = spec.layout ? std::max(kGltfMaterialChannels, texture_channels(spec.layout->layout)) : kGltfMaterialChannels;
+    f.images += material_bytes(spec, written);
+    largest_texture = std::max(largest_texture, material_shape(spec).texels);
+    for (const fs::path& file : decoded_files(spec)) material_files.insert(file);
+  }
+  for (const fs::path& in : job.inputs) {
+    if (material_files.count(fs::absolute(in).lexically_normal())) continue;
+    const ImageSize size = probe(in);
+    f.images += size.texels * kOwnImageBytesPerTexel;
+    largest_texture = std::max(largest_texture, size.texels);
+  }
+  auto json = gltf::read_json(s.input);
+  if (json) f.geometry = geometry_bytes(*json);
+  if (s.options.ao && s.options.ao->texture) {
+    const ao::TextureRequest& t = *s.options.ao->texture;
+    // One texture per material, and per placement of a mesh when each gets its own.
+    double textures = double(std::max<std::size_t>(1, json ? array_size(*json, "materials") : 1));
+    if (t.per_instance && json) textures += double(array_size(*json, "nodes"));
+    f.ao = textures * double(t.size.width) * double(t.size.height) * kAoBytesPerTexel;
+  }
+  if (s.options.encoding.texture_format == image::TextureFormat::ktx2) {
+    // Textures are encoded in parallel, one per core: the largest, that many times at once.
+    f.encoder = double(std::max(1, cpus)) * largest_texture * (kKtx2ParentBytesPerTexel + kBasisuBytesPerTexel);
+  }
+  return f;
+}
+
+}  // namespace
+
+JobFootprint job_footprint(const Job& job, const Manifest& manifest, int cpus) {
+  if (job.kind == JobKind::material) return material_footprint(manifest.materials[job.spec]);
+  return scene_footprint(job, manifest, cpus);
+}
+
+std::int64_t memory_request_mb(const JobFootprint& footprint) {
+  const double mb = footprint.total() / kMiB * kHeadroom;
+  return std::int64_t(std::ceil(mb / double(kMemoryStepMb))) * kMemoryStepMb;
+}
+
+}  // namespace matbake::pipeline
