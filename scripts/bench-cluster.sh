@@ -18,14 +18,14 @@ trap 'rm -rf "$work"' EXIT
 measure() {
   local peak=0 now start end
   start=$(date +%s.%N)
-  setsid /usr/bin/time -f %M -o "$work/own_peak" "$@" >/dev/null &
+  setsid /usr/bin/time -f %M -o "$work/own_peak" "$@" >"$work/job.log" 2>&1 &
   local pid=$!  # the session's id: setsid starts it in place (a background job leads no group)
   while kill -0 "$pid" 2>/dev/null; do
-    now=$(ps -o rss= -s "$pid" 2>/dev/null | awk '{s += $1} END {print s + 0}')
+    now=$(ps -o rss= -s "$pid" | awk '{s += $1} END {print s + 0}') || now=0  # ps fails once it has ended
     [ "$now" -gt "$peak" ] && peak=$now
     sleep 0.01
   done
-  wait "$pid"
+  wait "$pid" || { cat "$work/job.log" >&2; return 1; }
   end=$(date +%s.%N)
   now=$(cat "$work/own_peak")
   [ "$now" -gt "$peak" ] && peak=$now
@@ -97,7 +97,7 @@ for side in 1024 2048 4096; do
   if [ "$side" != 4096 ]; then jobs="$jobs scene:png scene:ao"; fi
   if [ "$side" = 1024 ] && [ -x "$MATBAKE_BASISU" ]; then jobs="$jobs scene:ktx2"; fi
   requests "$manifest" >"$work/requests"
-  "$matbake" --jobs 2 build "$manifest" --quiet --only material:five --only material:six --only material:spec_gloss >/dev/null
+  "$matbake" --jobs 2 build "$manifest" --quiet --only material:five --only material:six --only material:spec_gloss
   for job in $jobs; do
     read -r seconds peak < <(measure "$matbake" --jobs 1 build "$manifest" --only "$job" --force --quiet)
     request=$(awk -v j="$job" '$1 == j {print $2}' "$work/requests")

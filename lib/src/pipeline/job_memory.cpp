@@ -31,6 +31,10 @@ constexpr double kAoBytesPerTexel = 24;
 // A scene's geometry: each buffer as read, the meshes as triangles and Embree's BVH over them.
 constexpr double kGeometryPerBufferByte = 8;
 constexpr double kCompressedGeometryPerBufferByte = 32;  // Draco or meshopt: decoded first
+// KTX2 delivery first decodes every texture the scene uses (RGBA float); a manifest material gives
+// the glTF at most 4 (base colour, ORM, normal, emissive).
+constexpr double kDecodedTextureBytesPerTexel = 4 * kSampleBytes;
+constexpr int kGltfMaterialTextures = 4;
 // KTX2 per texture encoded at once: matbake's level 0, mip chain and the PNG it hands over, then
 // basisu's own (ETC1S at 2048² peaked at 64.5 bytes a texel, UASTC with RDO at 21).
 constexpr double kKtx2ParentBytesPerTexel = 80;
@@ -128,7 +132,7 @@ JobFootprint scene_footprint(const Job& job, const Manifest& manifest, int cpus)
   const SceneSpec& s = manifest.scenes[job.spec];
   JobFootprint f;
   f.program = kProgramBytes;
-  double largest_texture = 0;
+  double largest_texture = 0, delivered_texels = 0;
   std::set<std::size_t> materials;
   std::set<fs::path> material_files;
   for (const auto& [gltf_name, m] : job.materials) materials.insert(m);
@@ -137,6 +141,7 @@ JobFootprint scene_footprint(const Job& job, const Manifest& manifest, int cpus)
     const int written = spec.layout ? std::max(kGltfMaterialChannels, texture_channels(spec.layout->layout)) : kGltfMaterialChannels;
     f.images += material_bytes(spec, written);
     largest_texture = std::max(largest_texture, material_shape(spec).texels);
+    delivered_texels += kGltfMaterialTextures * material_shape(spec).texels;
     for (const fs::path& file : decoded_files(spec)) material_files.insert(file);
   }
   for (const fs::path& in : job.inputs) {
@@ -144,6 +149,7 @@ JobFootprint scene_footprint(const Job& job, const Manifest& manifest, int cpus)
     const ImageSize size = probe(in);
     f.images += size.texels * kOwnImageBytesPerTexel;
     largest_texture = std::max(largest_texture, size.texels);
+    delivered_texels += size.texels;
   }
   auto json = gltf::read_json(s.input);
   if (json) f.geometry = geometry_bytes(*json);
@@ -155,8 +161,9 @@ JobFootprint scene_footprint(const Job& job, const Manifest& manifest, int cpus)
     f.ao = textures * double(t.size.width) * double(t.size.height) * kAoBytesPerTexel;
   }
   if (s.options.encoding.texture_format == image::TextureFormat::ktx2) {
-    // Textures are encoded in parallel, one per core: the largest, that many times at once.
-    f.encoder = double(std::max(1, cpus)) * largest_texture * (kKtx2ParentBytesPerTexel + kBasisuBytesPerTexel);
+    // Every texture decoded, then encoded in parallel, one per core: the largest, that many at once.
+    f.encoder = delivered_texels * kDecodedTextureBytesPerTexel +
+                double(std::max(1, cpus)) * largest_texture * (kKtx2ParentBytesPerTexel + kBasisuBytesPerTexel);
   }
   return f;
 }
