@@ -154,7 +154,8 @@ int run_validate(const ValidateSettings& s, const GlobalOptions& global) {
                 failed ? (options.gate ? ": FAILED" : ": over the limit (advisory: gate off)") : "");
     for (int b = 0; b < validate::kFlagCount; ++b) {
       if (report->flag_counts[std::size_t(b)]) {
-        std::printf("    %-22s %zu\n", std::string(validate::flag_name(b)).c_str(), report->flag_counts[std::size_t(b)]);
+        std::printf("    %-22s %zu: %s\n", std::string(validate::flag_name(b)).c_str(), report->flag_counts[std::size_t(b)],
+                    std::string(validate::flag_meaning(b, report->vocabulary)).c_str());
       }
     }
     for (const validate::Texel& t : report->worst) {

@@ -81,6 +81,38 @@ TEST(CliValidate, WholePairMetalRoughAndMaterial) {
             0);
 }
 
+// A metal-rough material is told what is wrong in base colour and metallic terms, a spec-gloss one in
+// F0 and diffuse terms: the same texels, the same flags, each in its own workflow's words (the
+// summary, --json and a build's warning).
+TEST(CliValidate, FlagsSpeakTheInputsWorkflow) {
+  TempDir dir;
+  // A dark metal (base 0.3, metallic 1: F0 0.3) and a non-metal darker than charcoal (base 0.01).
+  ASSERT_EQ(matbake({"pack", "--layout", "gltf-metal-rough", "--base-color", "0.3", "--metallic", "1", "--roughness", "0.5",
+                     "--size", "2x1", "-o", (dir / "metal_{texture}.png").string()}).exit_code, 0);
+  ASSERT_EQ(matbake({"pack", "--layout", "gltf-metal-rough", "--base-color", "0.01", "--metallic", "0", "--roughness", "0.5",
+                     "--size", "2x1", "-o", (dir / "coal_{texture}.png").string()}).exit_code, 0);
+  const auto metal = matbake({"validate", "--from", "gltf-metal-rough", (dir / "metal_base_color.png").string(),
+                              (dir / "metal_metallic_roughness.png").string()});
+  EXPECT_NE(metal.out.find("semiconductor_gap      2: metal base colour darker than any real metal"), std::string::npos)
+      << metal.out;
+  const auto coal = matbake({"--json", "validate", "--from", "gltf-metal-rough", (dir / "coal_base_color.png").string(),
+                             (dir / "coal_metallic_roughness.png").string()});
+  const auto doc = nlohmann::json::parse(coal.out);
+  EXPECT_EQ(doc["vocabulary"], "metal-rough");
+  EXPECT_EQ(doc["flags"]["albedo_out_of_range"], 2);
+  EXPECT_EQ(doc["flag_meanings"]["albedo_out_of_range"],
+            "non-metal base colour darker than charcoal (0.02) or brighter than toothpaste (0.94)");
+  // The same F0 given as spec-gloss speaks of F0.
+  const auto ks = matbake({"validate", "--ks", "0.3"});
+  EXPECT_NE(ks.out.find("semiconductor_gap      1: F0 in the semiconductor gap"), std::string::npos) << ks.out << ks.err;
+  // A build's warning names the most common flag in the material's terms.
+  write_bytes(dir / "m.toml", "[materials.coal]\nsources = { base_color = \"coal_base_color.png\", metallic = 0.0, roughness = 0.5 }\n");
+  const auto built = matbake({"build", (dir / "m.toml").string()});
+  EXPECT_EQ(built.exit_code, 0) << built.err;
+  EXPECT_NE(built.err.find("most: non-metal base colour darker than charcoal (0.02) or brighter than toothpaste (0.94) (2 texels)"),
+            std::string::npos) << built.err;
+}
+
 TEST(CliValidate, BadInputs) {
   TempDir dir;
   write_raw(dir / "a.png", 2, 2, 4, "uint8", std::vector<double>(16, 100));

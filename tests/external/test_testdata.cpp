@@ -2,6 +2,7 @@
 // OpenEXR test images including damaged files. Skipped, with a message, where the folder is absent.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 
@@ -15,6 +16,7 @@
 #include "matbake/image.hpp"
 #include "matbake/material_table.hpp"
 #include "matbake/scene.hpp"
+#include "matbake/validate.hpp"
 #include "support/files.hpp"
 #include "support/gltf_validator.hpp"
 #include "support/run.hpp"
@@ -217,6 +219,52 @@ TEST(PhysicallyBased, TableEntriesMatchTheDatabase) {
   // The database's gold base colour is above 1 in linear red (a colour, not F0).
   const auto gold = std::find_if(db.begin(), db.end(), [](const auto& e) { return e["name"] == "Gold"; });
   EXPECT_GT((*gold)["color"][0]["color"][0].get<double>(), 1.0);
+}
+
+// Validation against every measured material of physicallybased.info, as glTF would carry it
+// (base colour = its linear colour clamped to [0, 1], metallic = its metalness): nothing flagged
+// but the cases docs/validate.md lists, each for the reason given there.
+TEST(PhysicallyBased, ValidationFlagsOnlyTheDocumentedMaterials) {
+  REQUIRE_TESTDATA("materials/physicallybased");
+  std::ifstream in(kTestdata / "materials/physicallybased/materials.json");
+  const auto db = nlohmann::json::parse(in)["data"];
+  // Metals whose mean F0 falls in the semiconductor gap (silicon is one; anodized colours are thin
+  // films); engineered extremes of diffuse albedo; transmissive materials, whose colour is a tint.
+  const std::set<std::string> gap_metals = {"Silicon", "Titanium", "Titanium (Anodized)", "Aluminum (Anodized Red)"};
+  const std::set<std::string> engineered = {"MIT Black", "Musou Black", "Spectralon"};
+  int flagged = 0, transmissive_flagged = 0;
+  for (const auto& entry : db) {
+    const std::string name = entry["name"];
+    material::Maps maps;
+    maps.width = maps.height = 1;
+    image::Image base{{1, 1, 3, {"R", "G", "B"}}, {}}, metallic{{1, 1, 1, {"Y"}}, {}};
+    for (const auto& colour : entry["color"]) {
+      if (colour["colorSpace"] != "srgb-linear") continue;
+      for (int c = 0; c < 3; ++c) base.pixels.push_back(std::clamp(colour["color"][c].get<float>(), 0.0f, 1.0f));
+    }
+    metallic.pixels = {entry.value("metalness", 0.0f)};
+    maps.maps.emplace(material::kBaseColor, base);
+    maps.maps.emplace(material::kMetallic, metallic);
+    auto report = validate::validate_maps(maps, {});
+    ASSERT_TRUE(report) << name;
+    std::uint8_t bits = 0;
+    for (int b = 0; b < validate::kFlagCount; ++b) bits = std::uint8_t(bits | (report->flag_counts[std::size_t(b)] ? 1 << b : 0));
+    const std::string flags = validate::flag_names(bits);
+    flagged += !flags.empty();
+    if (gap_metals.count(name)) {
+      EXPECT_EQ(flags, "semiconductor_gap") << name;
+    } else if (engineered.count(name)) {
+      EXPECT_EQ(flags, "albedo_out_of_range") << name;
+    } else if (entry.value("transmission", 0.0) > 0) {
+      EXPECT_TRUE(flags.empty() || flags == "albedo_out_of_range") << name << ": " << flags;
+      transmissive_flagged += !flags.empty();
+    } else {
+      EXPECT_EQ(flags, "") << name;
+    }
+  }
+  EXPECT_EQ(db.size(), 110u);
+  EXPECT_EQ(flagged, 4 + 3 + transmissive_flagged);
+  std::printf("  %d of %zu flagged: 4 gap metals, 3 engineered, %d transmissive\n", flagged, db.size(), transmissive_flagged);
 }
 
 // Every Khronos sample model loads; counts checked where the model's README states them.

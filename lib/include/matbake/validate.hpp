@@ -24,13 +24,20 @@ enum Flag : std::uint8_t {
   kSemiconductorGap = 1 << 1,    // 0.2 ≤ F0 < 0.45: only semiconductors (silicon) live here
   kMetalWithDiffuse = 1 << 2,    // metal F0 but a diffuse colour (Schüler: metals have none)
   kColouredDielectric = 1 << 3,  // dielectric or gem with a coloured F0 (max − min > 20% of max)
-  kAlbedoOutOfRange = 1 << 4,    // a non-metal's diffuse luminance outside [0.02, 0.94]
+  kAlbedoOutOfRange = 1 << 4,    // a dielectric's or gem's diffuse luminance outside [0.02, 0.94]
   kNotReflectance = 1 << 5,      // an F0 or diffuse channel outside [0, 1]
   kMaterialMismatch = 1 << 6,    // outside the tolerance of the --material entry
 };
 inline constexpr int kFlagCount = 7;
 std::string_view flag_name(int bit);  // "below_real", ...
 std::string flag_names(std::uint8_t flags);  // "below_real,metal_with_diffuse"
+
+// The workflow a material was given in, whose words a report uses: the flags are F0 and diffuse
+// tests, but an artist with metal-rough maps is told about base colour and metallic.
+enum class Vocabulary { spec_gloss, metal_rough };
+std::string_view vocabulary_name(Vocabulary vocabulary);  // "spec-gloss", "metal-rough"
+// What flag `bit` means in that workflow's terms.
+std::string_view flag_meaning(int bit, Vocabulary vocabulary);
 
 // Bounds of a plausible diffuse albedo (luminance, linear): the darkest and brightest opaque
 // non-engineered materials of physicallybased.info, charcoal 0.02 and toothpaste 0.935
@@ -81,6 +88,7 @@ struct Report {
   std::vector<Texel> worst;          // the most severe, most severe first
   std::vector<std::uint8_t> class_map;
   bool has_diffuse = false;          // a diffuse map was checked too
+  Vocabulary vocabulary = Vocabulary::spec_gloss;  // of the maps validate_maps was given
   double violation_fraction() const { return checked ? double(violations) / double(checked) : 0.0; }
 };
 

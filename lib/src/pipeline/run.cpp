@@ -139,6 +139,14 @@ Status ensure_folder(const fs::path& folder) {
   return success();
 }
 
+// The flag most texels have, in the words of the material's own workflow: "; most: ... (N texels)".
+std::string most_flagged(const validate::Report& report) {
+  const auto most = std::max_element(report.flag_counts.begin(), report.flag_counts.end());
+  if (*most == 0) return "";
+  const int bit = int(most - report.flag_counts.begin());
+  return "; most: " + std::string(validate::flag_meaning(bit, report.vocabulary)) + " (" + std::to_string(*most) + " texels)";
+}
+
 // Validation of the material as authored; a job error when more texels are flagged than allowed
 // and the check is a gate, else a warning (the report's `validation.passed` says so).
 Status validate_material(const MaterialSpec& m, const material::Maps& maps, const JobContext& ctx,
@@ -177,7 +185,7 @@ Status validate_material(const MaterialSpec& m, const material::Maps& maps, cons
     return Error{m.origins.of("validate.max_violations"),
                  "materials." + m.name + ": " + line + "; the texels are in " + json_file.string()};
   }
-  if (result->violations) report.warnings.push_back(line);
+  if (result->violations) report.warnings.push_back(line + most_flagged(*result));
   return success();
 }
 

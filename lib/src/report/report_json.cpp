@@ -56,7 +56,11 @@ nlohmann::json to_json(const validate::Report& r, const validate::Options& optio
   const bool has_diffuse = r.has_diffuse;
   nlohmann::json classes, flags, worst = nlohmann::json::array();
   for (std::size_t c = 0; c < 5; ++c) classes[std::string(material_table::f0_class_name(material_table::F0Class(c)))] = r.class_counts[c];
-  for (int b = 0; b < validate::kFlagCount; ++b) flags[std::string(validate::flag_name(b))] = r.flag_counts[std::size_t(b)];
+  nlohmann::json meanings;
+  for (int b = 0; b < validate::kFlagCount; ++b) {
+    flags[std::string(validate::flag_name(b))] = r.flag_counts[std::size_t(b)];
+    meanings[std::string(validate::flag_name(b))] = validate::flag_meaning(b, r.vocabulary);
+  }
   for (const validate::Texel& t : r.worst) {
     worst.push_back({{"x", t.x}, {"y", t.y}, {"class", material_table::f0_class_name(t.f0_class)},
                      {"flags", validate::flag_names(t.flags)}, {"severity", t.severity}, {"f0", rgb(t.f0)},
@@ -66,6 +70,8 @@ nlohmann::json to_json(const validate::Report& r, const validate::Options& optio
                         {"texels", r.texels},       {"masked", r.masked},
                         {"checked", r.checked},     {"classes", classes},
                         {"flags", flags},           {"violations", r.violations},
+                        {"vocabulary", validate::vocabulary_name(r.vocabulary)},
+                        {"flag_meanings", meanings},
                         {"violation_fraction", r.violation_fraction()},
                         {"worst", worst},           {"f0_stats", stats_json(r.f0_stats)}};
   if (has_diffuse) doc["diffuse_stats"] = stats_json(r.diffuse_stats);

@@ -171,7 +171,7 @@ void first_pass(const RowSetup& r, std::size_t row, int width, std::uint8_t* cla
       flagged = _mm_or_ps(flagged, _mm_and_ps(g3, _mm_cmpge_ps(luminance, splat(float(kMetalDiffuseMax)))));
       const V implausible = _mm_or_ps(_mm_cmplt_ps(luminance, splat(float(kAlbedoMin))),
                                       _mm_cmpgt_ps(luminance, splat(float(kAlbedoMax))));
-      flagged = _mm_or_ps(flagged, _mm_andnot_ps(g3, implausible));
+      flagged = _mm_or_ps(flagged, _mm_and_ps(_mm_andnot_ps(g2, g0), implausible));  // dielectric or gem
       diffuse.add(c, live);
     }
     if constexpr (kMaterial) {
@@ -252,9 +252,12 @@ std::uint8_t check_texel(const RowSetup& r, std::size_t i, F0Class cls, double& 
     const float luminance = 0.2126f * d[0] + 0.7152f * d[1] + 0.0722f * d[2];
     const float d_lo = min3(d), d_hi = max3(d);
     if (d_lo < 0 || d_hi > 1) flag(kNotReflectance, std::max(-d_lo, d_hi - 1.0f));
+    // The albedo bounds are a dielectric's (or gem's): a texel below any real F0 or in the
+    // semiconductor gap is flagged for that already, its diffuse colour no second cause.
     if (cls == F0Class::metal) {
       if (luminance >= float(kMetalDiffuseMax)) flag(kMetalWithDiffuse, luminance);
-    } else if (luminance < float(kAlbedoMin) || luminance > float(kAlbedoMax)) {
+    } else if ((cls == F0Class::dielectric || cls == F0Class::gem) &&
+               (luminance < float(kAlbedoMin) || luminance > float(kAlbedoMax))) {
       flag(kAlbedoOutOfRange, luminance < float(kAlbedoMin) ? kAlbedoMin - luminance : luminance - kAlbedoMax);
     }
   }
@@ -339,6 +342,33 @@ std::string_view flag_name(int bit) {
       "below_real", "semiconductor_gap", "metal_with_diffuse", "coloured_dielectric",
       "albedo_out_of_range", "not_a_reflectance", "material_mismatch"};
   return bit >= 0 && bit < kFlagCount ? kNames[bit] : "";
+}
+
+std::string_view vocabulary_name(Vocabulary vocabulary) {
+  return vocabulary == Vocabulary::metal_rough ? "metal-rough" : "spec-gloss";
+}
+
+// Metal-rough maps are checked through F0 = lerp(0.04, base colour, metallic) and diffuse = base
+// colour × (1 − metallic): each flag said again in the maps' own terms.
+std::string_view flag_meaning(int bit, Vocabulary vocabulary) {
+  static constexpr std::string_view kSpecGloss[kFlagCount] = {
+      "F0 below any real material's (< 0.02)",
+      "F0 in the semiconductor gap (0.2-0.45): no dielectric, no metal",
+      "a metal's F0 with a diffuse colour (metals have none)",
+      "a dielectric's F0 that is coloured (max - min > 20% of max)",
+      "a non-metal's diffuse albedo darker than charcoal (0.02) or brighter than toothpaste (0.94)",
+      "an F0 or diffuse channel outside [0, 1]",
+      "F0 outside the reference material's tolerance"};
+  static constexpr std::string_view kMetalRough[kFlagCount] = {
+      "metallic with a base colour darker than any real material reflects (F0 < 0.02)",
+      "metal base colour darker than any real metal, or metallic between 0 and 1 (F0 0.2-0.45)",
+      "partly metallic: metallic between 0 and 1 leaves a metal with a diffuse colour",
+      "partly metallic with a coloured base colour: a non-metal's reflection tinted",
+      "non-metal base colour darker than charcoal (0.02) or brighter than toothpaste (0.94)",
+      "a base colour or metallic value outside [0, 1]",
+      "metal base colour outside the reference material's tolerance"};
+  if (bit < 0 || bit >= kFlagCount) return "";
+  return vocabulary == Vocabulary::metal_rough ? kMetalRough[bit] : kSpecGloss[bit];
 }
 
 std::string flag_names(std::uint8_t flags) {
@@ -484,7 +514,9 @@ Result<Report> validate_maps(const material::Maps& maps, const Options& options)
     return Error{"", "validation needs a specular map (ks, e.g. a Schüler pair) or metal-rough maps (base_color and "
                      "metallic)", true};
   }
-  return validate(inputs, options);
+  auto report = validate(inputs, options);
+  if (report && !maps.find(material::kKs)) report->vocabulary = Vocabulary::metal_rough;
+  return report;
 }
 
 Status write_heatmap(const Report& report, const std::filesystem::path& png) {
