@@ -26,6 +26,12 @@ void write_noise(const fs::path& file, int side, int channels, std::uint32_t see
   write_raw(file, side, side, channels, "uint8", samples);
 }
 
+#ifdef MATBAKE_SANITIZED
+#define SKIP_UNLESS_RELEASE() GTEST_SKIP() << "peaks are measured in the release build: AddressSanitizer's shadow memory is no job's"
+#else
+#define SKIP_UNLESS_RELEASE() static_cast<void>(0)
+#endif
+
 // Runs every job the plan submits and checks its peak against its request (a material's own, as
 // `task_memory_mb` lists it; the array asks for the largest of them).
 void expect_requests_cover_peaks(const fs::path& manifest) {
@@ -67,6 +73,7 @@ TEST(ClusterMemory, EachKindsSettingWinsOverEveryJobs) {
 }
 
 TEST(ClusterMemory, RequestsCoverTheExamplesPeaks) {
+  SKIP_UNLESS_RELEASE();
   TempDir dir;
   copy_example(dir.path(), true);
   expect_requests_cover_peaks(dir / "showroom.toml");
@@ -75,6 +82,7 @@ TEST(ClusterMemory, RequestsCoverTheExamplesPeaks) {
 // A studio's library at 1024²: five and six maps (one file's channels picked), a spec-gloss material
 // converted, and a scene using all three with AO textures, delivered as KTX2 when basisu is here.
 TEST(ClusterMemory, RequestsCoverAFiveMapLibrarysPeaks) {
+  SKIP_UNLESS_RELEASE();
   TempDir dir;
   constexpr int kSide = 1024;
   write_noise(dir / "base.png", kSide, 3, 1);

@@ -1,13 +1,22 @@
 // The README's and docs/'s examples are what a new user copies first: every ```toml block is
 // valid TOML and every ```json block valid JSON (docs/build.md's rule example was an inline table
-// over several lines, which TOML forbids), and every relative link resolves.
+// over several lines, which TOML forbids), every relative link resolves, and every matbake command
+// of a ```sh block runs (exit 0) in a folder holding the files it names.
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 #include <toml++/toml.h>
 
+#include <algorithm>
+#include <chrono>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+
+#include "support/files.hpp"
+#include "support/gltf_files.hpp"
+#include "support/run.hpp"
+#include "support/temp_dir.hpp"
 
 namespace matbake::test {
 namespace {
@@ -92,6 +101,113 @@ TEST(DocsExamples, EveryRelativeLinkResolves) {
       EXPECT_TRUE(fs::exists(file.parent_path() / target)) << file.filename().string() << " links to " << target;
     }
   }
+}
+
+// The examples' scene.gltf: three quads on a floor, materials Brick, Steel and Rubber, each quad's
+// UVs over a 0.1 × 0.1 corner, so that an AO texture of 1024² bakes 10⁴ texels, not 10⁶.
+void write_small_scene(const fs::path& file) {
+  GltfBuilder b;
+  const int positions = b.add_vec3({-1, 0, -1, 1, 0, -1, 1, 0, 1, -1, 0, 1});
+  const int normals = b.add_vec3({0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0});
+  const int uvs = b.add_floats({0, 0, 0.1f, 0, 0.1f, 0.1f, 0, 0.1f}, "VEC2", 2);
+  const int indices = b.add_indices({0, 2, 1, 0, 3, 2});
+  std::vector<int> nodes;
+  for (const char* name : {"Brick", "Steel", "Rubber"}) {
+    const int mesh = b.add_mesh(positions, indices, 4, normals);
+    const int material = int(b.doc["materials"].size());
+    b.doc["materials"].push_back({{"name", name}, {"pbrMetallicRoughness", {{"metallicFactor", 0.0}}}});
+    b.doc["meshes"][std::size_t(mesh)]["primitives"][0]["attributes"]["TEXCOORD_0"] = uvs;
+    b.doc["meshes"][std::size_t(mesh)]["primitives"][0]["material"] = material;
+    nodes.push_back(b.add_node({{"mesh", mesh}, {"translation", {0.0, 0.5 * double(nodes.size()), 0.0}}}));
+  }
+  b.write(file, nodes);
+}
+
+// The files the examples name, small: 8×8 images (a Schüler pair A/B and brick_a/brick_b of a
+// plausible dielectric), the example as assets.toml and as examples/, its scene as scene.gltf
+// (a material renamed Brick) and scene.glb, the presets.
+void write_example_files(const fs::path& dir) {
+  const auto image = [&](const char* name, int channels, double value) {
+    write_raw(dir / name, 8, 8, channels, "uint8", std::vector<double>(std::size_t(64 * channels), value));
+  };
+  for (const char* f : {"albedo.png", "base.png", "a.png"}) image(f, 3, 140);
+  for (const char* f : {"gloss.png", "m.png", "r.png", "ao.png"}) image(f, 1, 150);
+  image("mr.png", 3, 120);
+  for (const char* f : {"A.png", "brick_a.png"}) image(f, 4, 140);
+  std::vector<double> pair_b;
+  for (int i = 0; i < 64; ++i) pair_b.insert(pair_b.end(), {57, 57, 57, 160});  // F0 0.04, gloss 0.63
+  for (const char* f : {"B.png", "brick_b.png"}) write_raw(dir / f, 8, 8, 4, "uint8", pair_b);
+  write_raw(dir / "lin.exr", 8, 8, 3, "float", std::vector<double>(192, 0.25));
+  copy_example(dir, true);  // the AO of few samples: the commands run, not the bake's quality
+  fs::copy_file(dir / "showroom.toml", dir / "assets.toml");
+  fs::create_directories(dir / "examples");
+  copy_example(dir / "examples", true);
+  write_small_scene(dir / "scene.gltf");
+  fs::create_directory_symlink(fs::path(MATBAKE_SOURCE_DIR) / "presets", dir / "presets");
+  ASSERT_EQ(matbake({"export", (dir / "scene.gltf").string(), "-o", (dir / "scene.glb").string()}).exit_code, 0);
+}
+
+// A shell line's commands (split at &&), comments cut.
+std::vector<std::string> commands_of(std::string line) {
+  if (const std::size_t hash = line.find(" #"); hash != std::string::npos) line.resize(hash);
+  if (line.rfind('#', 0) == 0) return {};
+  std::vector<std::string> commands;
+  for (std::size_t at = 0;;) {
+    const std::size_t next = line.find("&&", at);
+    std::string c = line.substr(at, next == std::string::npos ? std::string::npos : next - at);
+    c.erase(0, c.find_first_not_of(' '));
+    c.erase(c.find_last_not_of(' ') + 1);
+    if (!c.empty()) commands.push_back(c);
+    if (next == std::string::npos) return commands;
+    at = next + 2;
+  }
+}
+
+// Each file's commands in order, in a folder of its own: matbake's, and ninja's after a plan; a
+// line with anything else (the set-up scripts, cmake, Slurm's submit) is not run. KTX2 lines need
+// basisu (skipped, said, without it).
+TEST(DocsExamples, EveryMatbakeCommandRuns) {
+#ifdef MATBAKE_SANITIZED
+  GTEST_SKIP() << "the docs' commands run in the release build (each command has its own tests under the sanitizers)";
+#endif
+  const std::vector<std::string> env = matbake_environment();
+  const bool has_basisu = std::any_of(env.begin(), env.end(), [](const std::string& e) { return e.rfind("MATBAKE_BASISU=", 0) == 0; }) ||
+                          std::getenv("MATBAKE_BASISU");
+  const std::string path = "PATH=" + fs::path(matbake_exe()).parent_path().string() + ":" + std::getenv("PATH");
+  int ran = 0, not_run = 0;
+  for (const fs::path& file : markdown_files()) {
+    TempDir dir;
+    bool files_written = false;
+    for (const Block& block : fenced_blocks(file)) {
+      if (block.language != "sh") continue;
+      std::istringstream lines(block.text);
+      std::string line;
+      for (int n = 1; std::getline(lines, line); ++n) {
+        const std::vector<std::string> commands = commands_of(line);
+        const bool runnable = !commands.empty() && std::all_of(commands.begin(), commands.end(), [](const std::string& c) {
+          return c.rfind("matbake ", 0) == 0 || c == "ninja";
+        });
+        if (!runnable || (!has_basisu && line.find("ktx2") != std::string::npos)) {
+          not_run += !commands.empty();
+          continue;
+        }
+        if (!files_written) {
+          write_example_files(dir.path());
+          files_written = true;
+        }
+        const auto start = std::chrono::steady_clock::now();
+        const RunResult r = run("/bin/bash", {"-c", "cd \"$0\" && " + line.substr(0, line.find(" #")), dir.path().string()},
+                                [&] { auto e = env; e.push_back(path); return e; }());
+        EXPECT_EQ(r.exit_code, 0) << file.filename().string() << ":" << block.line + n << ": " << line << "\n" << r.err;
+        ++ran;
+        const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        if (seconds > 5) std::printf("  %.0f s: %s\n", seconds, line.c_str());
+      }
+    }
+  }
+  std::printf("  %d commands ran, %d lines not run (set-up scripts, cmake, sbatch%s)\n", ran, not_run,
+              has_basisu ? "" : ", KTX2 without basisu");
+  EXPECT_GE(ran, 40);
 }
 
 }  // namespace
