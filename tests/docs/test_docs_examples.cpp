@@ -82,6 +82,36 @@ TEST(DocsExamples, EveryTomlAndJsonBlockParses) {
   EXPECT_GE(json_blocks, 1);
 }
 
+// A TOML block with materials or scenes is a manifest (docs/build.md's schema): it loads and plans,
+// every key and value known, in a folder where only the files it names are missing (a rule's
+// match finds one texture); `build -n` then fails for those files alone.
+TEST(DocsExamples, EveryManifestBlockLoads) {
+  int manifests = 0;
+  for (const fs::path& file : markdown_files()) {
+    for (const Block& block : fenced_blocks(file)) {
+      if (block.language != "toml" || (block.text.find("[materials.") == std::string::npos &&
+                                       block.text.find("[scenes.") == std::string::npos)) {
+        continue;
+      }
+      ++manifests;
+      TempDir dir;
+      fs::create_directories(dir / "textures");
+      write_raw(dir / "textures/brick_BaseColor.png", 4, 4, 3, "uint8", std::vector<double>(48, 120));
+      write_bytes(dir / "m.toml", block.text);
+      const RunResult r = matbake({"build", (dir / "m.toml").string(), "-n"});
+      const std::string where = file.filename().string() + ":" + std::to_string(block.line);
+      EXPECT_NE(r.out.find("jobs would be built"), std::string::npos) << where << ": did not load\n" << r.err;
+      std::istringstream errors(r.err);
+      for (std::string line; std::getline(errors, line);) {
+        const bool missing = line.find("no such file") != std::string::npos || line.find("cannot read the glTF") != std::string::npos ||
+                             line.find("jobs failed") != std::string::npos;
+        EXPECT_TRUE(missing) << where << ": " << line;
+      }
+    }
+  }
+  EXPECT_GE(manifests, 1);
+}
+
 // Links such as [build](build.md) or [x](../README.md#anchor): the file they name exists.
 TEST(DocsExamples, EveryRelativeLinkResolves) {
   for (const fs::path& file : markdown_files()) {
