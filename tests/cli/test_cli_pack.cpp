@@ -280,5 +280,21 @@ TEST(CliPack, ValuesAnIntegerFileCannotHoldAreRefusedNotClipped) {
   EXPECT_EQ(read_raw(dir / "x_emissive.exr").samples[0], 3.0);
 }
 
+// A layout channel with no default needs its map: refused (usage, exit 2, nothing written) though
+// the texture holding it would have no map at all, while a texture whose channels all have
+// defaults and no map is simply not written.
+TEST(CliPack, ARequiredMapIsRefusedEvenWhereItsTextureWouldBeSkipped) {
+  TempDir dir;
+  const auto r = matbake({"pack", "--layout", "gltf-orm", "--roughness", "0.5", "--metallic", "0", "-o",
+                          (dir / "x_{texture}.png").string()});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_EQ(r.err, "matbake: error: layout gltf-orm needs base_color\n");
+  EXPECT_TRUE(list_folder(dir.path()).empty());
+  ASSERT_EQ(matbake({"pack", "--layout", "gltf-pbr", "--base-color", "0.5", "--roughness", "0.5", "--metallic", "0", "-o",
+                     (dir / "y_{texture}.png").string()}).exit_code, 0);
+  EXPECT_FALSE(fs::exists(dir / "y_normal.png"));
+  EXPECT_FALSE(fs::exists(dir / "y_emissive.png"));
+}
+
 }  // namespace
 }  // namespace matbake::test

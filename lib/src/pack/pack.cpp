@@ -460,25 +460,44 @@ bool texture_written(const Texture& texture, const material::MapNames& given) {
   return !reads;
 }
 
+namespace {
+
+// A channel with no default needs its map, whether or not the texture is written.
+Status check_required(const Layout& layout, const Texture& t, const material::Maps& sources) {
+  for (const Channel& channel : t.channels) {
+    if (!channel.fallback && (channel.source.empty() || !sources.find(channel.source))) {
+      return Error{"", "layout " + layout.name + " needs " + channel.source, true};
+    }
+  }
+  return success();
+}
+
+// One of the layout's textures, made from the maps.
+Result<image::Image> pack_texture(const Layout& layout, const Texture& t, const material::Maps& sources) {
+  if (Status s = check_required(layout, t, sources); !s) return s.error();
+  image::Image out = blank(sources.width, sources.height, int(t.channels.size()));
+  const std::size_t texels = std::size_t(out.width) * std::size_t(out.height), stride = t.channels.size();
+  for (std::size_t c = 0; c < stride; ++c) {
+    const Channel& channel = t.channels[c];
+    const image::Image* map = channel.source.empty() ? nullptr : sources.find(channel.source);
+    for (std::size_t i = 0; i < texels; ++i) {
+      const double x = map ? map->pixels[i * std::size_t(map->channels) + std::size_t(channel.component)]
+                           : *channel.fallback;
+      out.pixels[i * stride + c] = float(apply(channel.transform, x));
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
 Result<std::vector<image::Image>> pack(const Layout& layout, const material::Maps& sources) {
   return guarded("", [&]() -> Result<std::vector<image::Image>> {
     std::vector<image::Image> textures;
     for (const Texture& t : layout.textures) {
-      image::Image out = blank(sources.width, sources.height, int(t.channels.size()));
-      const std::size_t texels = std::size_t(out.width) * std::size_t(out.height), stride = t.channels.size();
-      for (std::size_t c = 0; c < stride; ++c) {
-        const Channel& channel = t.channels[c];
-        const image::Image* map = channel.source.empty() ? nullptr : sources.find(channel.source);
-        if (!map && !channel.fallback) {
-          return Error{"", "layout " + layout.name + " needs " + channel.source, true};
-        }
-        for (std::size_t i = 0; i < texels; ++i) {
-          const double x = map ? map->pixels[i * std::size_t(map->channels) + std::size_t(channel.component)]
-                               : *channel.fallback;
-          out.pixels[i * stride + c] = float(apply(channel.transform, x));
-        }
-      }
-      textures.push_back(std::move(out));
+      auto texture = pack_texture(layout, t, sources);
+      if (!texture) return texture.error();
+      textures.push_back(std::move(*texture));
     }
     return textures;
   });
@@ -583,22 +602,29 @@ Result<std::vector<fs::path>> write_textures(const Layout& layout, const materia
     for (std::size_t i = 0; i < paths->size(); ++i) outputs.push_back({(*paths)[i], "texture " + layout.textures[i].name});
     outputs.insert(outputs.end(), request.also.begin(), request.also.end());
     if (Status s = check_outputs(outputs, request.inputs); !s) return s.error();
-    auto images = pack(layout, sources);
-    if (!images) return images.error();
-    // Which textures, as what: every one checked before the first is written.
+    // Which textures, as what: only those written are made, every one checked before the first
+    // is written.
     const material::MapNames given = sources.names();
-    std::vector<std::pair<std::size_t, image::SampleType>> planned;
+    struct Planned {
+      std::size_t index;
+      image::SampleType type;
+      image::Image image;
+    };
+    std::vector<Planned> planned;
     for (std::size_t t = 0; t < paths->size(); ++t) {
+      if (Status s = check_required(layout, layout.textures[t], sources); !s) return s.error();
       if (!texture_written(layout.textures[t], given)) continue;
+      auto image = pack_texture(layout, layout.textures[t], sources);
+      if (!image) return image.error();
       const image::SampleType type = request.type.value_or(default_sample_type((*paths)[t]));
-      if (Status s = check_storable_range((*images)[t], layout.textures[t], (*paths)[t], type); !s) return s.error();
-      planned.emplace_back(t, type);
+      if (Status s = check_storable_range(*image, layout.textures[t], (*paths)[t], type); !s) return s.error();
+      planned.push_back({t, type, std::move(*image)});
     }
     std::vector<fs::path> written;
-    for (const auto& [t, type] : planned) {
-      const image::WriteOptions options = write_options(layout.textures[t].color, {type, request.transfer, request.encoding});
-      if (Status s = image::write_image((*images)[t], (*paths)[t], options); !s) return s.error();
-      written.push_back((*paths)[t]);
+    for (const Planned& p : planned) {
+      const image::WriteOptions options = write_options(layout.textures[p.index].color, {p.type, request.transfer, request.encoding});
+      if (Status s = image::write_image(p.image, (*paths)[p.index], options); !s) return s.error();
+      written.push_back((*paths)[p.index]);
     }
     return written;
   });
