@@ -94,7 +94,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
                          "build ", "  job = ", "  depfile_path = ", "  depfile_word = "});
   }
   pipeline::SlurmSubmission submission;
-  submission.array = {{&plan.jobs[0], 0, 64, {}}};
+  submission.array = {{&plan.jobs[0], 64, {}}};
   if (auto scripts = pipeline::slurm_scripts(m, submission, {}, {m.output / "slurm", "/usr/bin/matbake"})) {
     const std::vector<std::string_view> starts = {"#", "set -euo pipefail", "materials=(", "job=${1:-", "exec ", "sbatch=", "mkdir -p ",
                                                   "array=", "echo "};
