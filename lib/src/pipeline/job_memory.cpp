@@ -91,8 +91,7 @@ int texture_channels(const pack::Layout& layout) {
 }
 
 // A material's images at their peak: files, maps, a conversion's maps, the textures it writes.
-double material_bytes(const MaterialSpec& m, int written_channels) {
-  const MaterialShape shape = material_shape(m);
+double material_bytes(const MaterialSpec& m, const MaterialShape& shape, int written_channels) {
   int channels = shape.file_channels + shape.map_channels + written_channels;
   if (m.layout && workflow::layout_direction(source_map_names(m), m.layout->layout)) channels += kConversionChannels;
   return shape.texels * (kSampleBytes * channels + kWorkingBytesPerTexel);
@@ -124,7 +123,7 @@ double geometry_bytes(const gltf::Json& json) {
 JobFootprint material_footprint(const MaterialSpec& m) {
   JobFootprint f;
   f.program = kProgramBytes;
-  f.images = material_bytes(m, m.layout ? texture_channels(m.layout->layout) : 0);
+  f.images = material_bytes(m, material_shape(m), m.layout ? texture_channels(m.layout->layout) : 0);
   return f;
 }
 
@@ -139,9 +138,10 @@ JobFootprint scene_footprint(const Job& job, const Manifest& manifest, int cpus)
   for (std::size_t m : materials) {
     const MaterialSpec& spec = manifest.materials[m];
     const int written = spec.layout ? std::max(kGltfMaterialChannels, texture_channels(spec.layout->layout)) : kGltfMaterialChannels;
-    f.images += material_bytes(spec, written);
-    largest_texture = std::max(largest_texture, material_shape(spec).texels);
-    delivered_texels += kGltfMaterialTextures * material_shape(spec).texels;
+    const MaterialShape shape = material_shape(spec);  // each source's header read once
+    f.images += material_bytes(spec, shape, written);
+    largest_texture = std::max(largest_texture, shape.texels);
+    delivered_texels += kGltfMaterialTextures * shape.texels;
     for (const fs::path& file : decoded_files(spec)) material_files.insert(file);
   }
   for (const fs::path& in : job.inputs) {
