@@ -63,14 +63,19 @@ void add_params(CLI::App& cmd, const params::Group<T>& group, T& target, const s
   }
 }
 
-// The rules across parameters, errors naming the flags.
+// The command line's spelling of a group's parameters: --PREFIXNAME, and "--NAME VALUE".
+inline params::Spelling flag_spelling(std::vector<std::string> prefixes) {
+  return [prefixes = std::move(prefixes)](std::size_t group, const params::Spec& spec, const std::string* value) {
+    const std::string flag = params::flag_name(spec, prefixes.at(group));
+    return value ? flag + " " + *value : flag;
+  };
+}
+
+// The rules within a group, errors naming the flags.
 template <class T>
 Status finish_params(const params::Group<T>& group, const T& target, const std::set<std::string>& given,
                      const std::string& prefix) {
-  return params::finish(group, target, given, [&](const std::string& name) {
-    const params::Param<T>* p = group.find(name);
-    return p ? params::flag_name(p->spec, prefix) : name;
-  });
+  return params::finish(group, target, given, flag_spelling({prefix}));
 }
 
 }  // namespace matbake::cli

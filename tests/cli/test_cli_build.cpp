@@ -125,6 +125,38 @@ TEST(CliBuild, ExampleBuildsOnceAndPassesTheValidator) {
   EXPECT_EQ(second.err, "");
 }
 
+// A stamp holds what its job reads: a validation setting is the material jobs' alone, so changing it
+// rebuilds them and not the scene (whose bytes and stamp stay as they were), and the reason names it.
+TEST(CliBuild, AValidationSettingRebuildsTheMaterialsOnly) {
+  TempDir dir;
+  copy_example(dir.path(), true);
+  const std::string manifest = (dir / "showroom.toml").string();
+  std::string text = read_bytes(dir / "showroom.toml");
+  text.insert(text.find("tolerance = 0.1"), "worst = 5\n");
+  write_bytes(dir / "showroom.toml", text);
+  ASSERT_EQ(matbake({"build", manifest}).exit_code, 0);
+  const std::string scene = read_bytes(dir / "out/showroom.glb"), stamp = read_bytes(dir / "out/.matbake/scene-showroom.json");
+
+  text.replace(text.find("worst = 5"), 9, "worst = 6");
+  write_bytes(dir / "showroom.toml", text);
+  const json dry = run_json({"build", manifest, "-n"});
+  EXPECT_EQ(dry["out_of_date"], 5) << dry.dump();
+  EXPECT_EQ(outcome_of(dry, "scene:showroom"), "up_to_date");
+  for (const json& job : dry["jobs"]) {
+    if (job["name"] == "scene:showroom") continue;
+    EXPECT_EQ(job["reason"], "its options changed: validate.worst 5 → 6");
+    EXPECT_EQ(job["changed"], json::parse(R"([{"parameter": "validate.worst", "old": 5, "new": 6}])")) << job.dump();
+  }
+  const RunResult told = matbake({"build", manifest, "-n"});
+  EXPECT_NE(told.out.find("would build material:wood: its options changed: validate.worst 5 → 6"), std::string::npos) << told.out;
+
+  const json built = run_json({"build", manifest});
+  EXPECT_EQ(built["built"], 5);
+  EXPECT_EQ(outcome_of(built, "scene:showroom"), "up_to_date");
+  EXPECT_EQ(read_bytes(dir / "out/showroom.glb"), scene);
+  EXPECT_EQ(read_bytes(dir / "out/.matbake/scene-showroom.json"), stamp);
+}
+
 TEST(CliBuild, SameBytesWhateverTheJobCount) {
   TempDir dir;
   copy_example(dir.path(), true);
@@ -175,8 +207,9 @@ TEST(CliBuild, RebuildsWhatChangedAndOnlyThat) {
   text.replace(text.find("gloss = 0.45"), 12, "gloss = 0.50");
   write_bytes(dir / "showroom.toml", text);
   dry = run_json({"build", manifest, "--dry-run"});
-  EXPECT_EQ(outcome_of(dry, "material:wood"), "out_of_date: its options changed");
-  EXPECT_EQ(outcome_of(dry, "scene:showroom"), "out_of_date: its options changed");
+  EXPECT_EQ(outcome_of(dry, "material:wood"), "out_of_date: its options changed: sources.gloss [0.45] → [0.5]");
+  EXPECT_EQ(outcome_of(dry, "scene:showroom"),
+            "out_of_date: its options changed: materials.wood.sources.gloss [0.45] → [0.5]");
   EXPECT_EQ(dry["out_of_date"], 2);
   ASSERT_EQ(matbake({"build", manifest}).exit_code, 0);
 

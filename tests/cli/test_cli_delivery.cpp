@@ -312,9 +312,13 @@ TEST(CliDelivery, TheStampHoldsEverySettingAndTheEncodersVersion) {
   fs::permissions(wrapper, fs::perms::owner_all);
   const json other = run_json({"build", manifest, "--dry-run"}, {"MATBAKE_BASISU=" + wrapper.string()});
   EXPECT_EQ(other["out_of_date"], 1) << other.dump();
+  EXPECT_EQ(other["jobs"][0]["changed"][0]["parameter"], "encoder") << other.dump();
+  // No basisu at all: said as such, not as a changed option.
+  const json missing = run_json({"build", manifest, "--dry-run"}, {"MATBAKE_BASISU=" + (dir / "no-basisu").string()});
+  EXPECT_EQ(missing["jobs"][0]["reason"].get<std::string>().rfind("basisu is missing: ", 0), 0u) << missing.dump();
   std::ofstream(manifest, std::ios::app) << "colour_quality = 200\n";
   const json changed = run_json({"build", manifest, "--dry-run"}, env);
-  EXPECT_EQ(changed["jobs"][0]["reason"], "its options changed") << changed.dump();
+  EXPECT_EQ(changed["jobs"][0]["reason"], "its options changed: export.colour_quality 128 → 200") << changed.dump();
 }
 
 // bake-ao's door: the occlusion textures it bakes, and every other texture, delivered as KTX2.

@@ -462,7 +462,7 @@ TEST_F(Parity, ManifestTextureKeysAreChecked) {
         std::pair{"ao = { texture = 64, bits = 12 }", "assets.toml:4:29: scenes.s.ao.bits: 8 or 16"},
         std::pair{"ao = { texture = 64, existing_occlusion = \"add\" }",
                   "assets.toml:4:43: scenes.s.ao.existing_occlusion: use multiply or replace"},
-        std::pair{"ao = { padding = 4 }", "assets.toml:4:18: scenes.s.ao.padding: applies only with scenes.s.ao.texture as well"},
+        std::pair{"ao = { padding = 4 }", "assets.toml:4:18: scenes.s.ao.padding applies only with scenes.s.ao.texture as well"},
         std::pair{"ao = { samplez = 4 }", "assets.toml:4:8: unknown key 'samplez' in scenes.s.ao; did you mean samples or sampler?"},
         std::pair{"ao = { samples = 4.5 }", "assets.toml:4:18: scenes.s.ao.samples: an integer expected"},
         std::pair{"ao = { tau = 0 }", "assets.toml:4:14: scenes.s.ao.tau: above 0"}}) {

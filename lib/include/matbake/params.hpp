@@ -46,8 +46,17 @@ struct Spec {
   bool above_min = false;            // the range excludes min (a distance above 0)
   std::string example;               // a value other than the default, as a flag takes it
   std::vector<std::string> aliases;  // older manifest keys, still read, with a note
-  std::string needs;                 // the parameter this one applies with (texcoord: texture)
+  // Rules across parameters, run at both doors by check_rules with one message each (a door only
+  // spells the names): `needs` is the parameter this one applies with (texcoord: texture), in its
+  // own group or another of the request; with `needs_value`, only where that one has this value
+  // (colour_codec: texture_format = ktx2). `excludes`: parameters it cannot be given with.
+  std::string needs;
+  std::string needs_value;
+  std::vector<std::string> excludes;
   bool manifest_only = false;        // a manifest key with no flag (a build's own setting)
+  // Read only where a material's own textures are written (bits, format), not where its maps are
+  // loaded: a scene's stamp leaves it out.
+  bool written_only = false;
 };
 
 // "--ao-relative-distance" for "relative_distance" with prefix "ao-".
@@ -106,25 +115,48 @@ std::optional<std::string> apply(const Param<T>& p, T& target, const Value& valu
   return p.set(target, *accepted);
 }
 
-// After every given parameter is set: one that applies only with another that was not given, then
-// the group's own rules. `where` names a parameter as its door does (a flag, a file:line:column).
-template <class T>
-Status finish(const Group<T>& group, const T& target, const std::set<std::string>& given,
-              const std::function<std::string(const std::string&)>& where) {
-  for (const Param<T>& p : group.params) {
-    if (!p.spec.needs.empty() && given.count(p.spec.name) && !given.count(p.spec.needs)) {
-      return Error{where(p.spec.name), "applies only with " + where(p.spec.needs) + " as well", true};
-    }
-  }
-  return group.check(target);
-}
-
 // Every parameter's value, by name (sorted, so a reordered manifest stamps the same).
 template <class T>
 nlohmann::json to_json(const Group<T>& group, const T& target) {
   nlohmann::json j = nlohmann::json::object();
   for (const Param<T>& p : group.params) j[p.spec.name] = p.get(target);
   return j;
+}
+
+// A group of a request as the rules see it once a door has read it: its parameters, their values
+// (as to_json shows them) and the names the door was given (after inheritance: a manifest's top level).
+struct GroupState {
+  std::vector<const Spec*> specs;
+  nlohmann::json values;
+  std::set<std::string> given;
+};
+
+// How a door writes a parameter of group `group`, alone (`value` null) or set to a value:
+// "--ao-texture", "--texture-format ktx2"; "scenes.s.ao.texture", "scenes.s.texture_format = \"ktx2\"".
+using Spelling = std::function<std::string(std::size_t group, const Spec& spec, const std::string* value)>;
+
+// A rule a request breaks: the parameter at fault (its group and name) and the message.
+struct RuleBreak {
+  std::size_t group = 0;
+  std::string name;
+  std::string message;  // "--ao-into and --ao-texture cannot be given together"
+};
+
+// Every Spec's needs, needs_value and excludes over a request's groups; the first broken, or none.
+// A name is looked up in the parameter's own group first, then in the others in order.
+std::optional<RuleBreak> check_rules(const std::vector<GroupState>& groups, const Spelling& spell);
+
+template <class T>
+GroupState state_of(const Group<T>& group, const T& target, const std::set<std::string>& given) {
+  return {group.specs(), to_json(group, target), given};
+}
+
+// After every given parameter is set: the rules within the group (check_rules), then the group's
+// own (ao::check's ranges). The error has no path: the door places it (at the manifest's key).
+template <class T>
+Status finish(const Group<T>& group, const T& target, const std::set<std::string>& given, const Spelling& spell) {
+  if (auto broken = check_rules({state_of(group, target, given)}, spell)) return Error{"", broken->message, true};
+  return group.check(target);
 }
 
 // The parameters `given` by a later door (the command line over a manifest) copied from its
@@ -142,6 +174,9 @@ void copy_given(const Group<T>& group, const T& from, const std::set<std::string
     (void)p.set(into, value);  // accepted once already, by the door that gave it
   }
 }
+
+// A manifest's spelling of a value: quoted where TOML writes it as a string.
+std::string toml_value_text(const Spec& spec, const std::string& value);
 
 // The docs' reference table: flag (with `flag_prefix`), manifest key, type, default, help.
 std::string markdown_table(const std::vector<const Spec*>& specs, const nlohmann::json& defaults,

@@ -171,6 +171,7 @@ struct JobReport {
   const Job* job = nullptr;
   Outcome outcome = Outcome::up_to_date;
   std::string reason;  // why it ran: "no earlier build", "input changed: ...", "forced", ...
+  nlohmann::json changed;  // when its options changed: [{"parameter", "old", "new"}], each one
   double seconds = 0;
   std::vector<std::string> warnings;
   std::optional<Error> error;

@@ -57,13 +57,15 @@ const params::Group<MaterialOptions>& material_params() {
       params::choice<MaterialOptions>(Spec{.name = "bits",
                                            .help = "Samples of the written textures (unset: half for .exr, else 8); "
                                                    "colour is encoded with transfer in 8-bit, linear otherwise",
-                                           .example = "16"},
+                                           .example = "16",
+                                           .written_only = true},
                                       [](auto& o) -> auto& { return o.bits; }, image::kSampleTypeNames),
       params::text<MaterialOptions>(Spec{.name = "format",
                                          .help = "Format of the textures where no output path names one (a "
                                                  "manifest material's, unpack's maps)",
                                          .choices = {"png", "exr", "tif"},
-                                         .example = "exr"},
+                                         .example = "exr",
+                                         .written_only = true},
                                     [](auto& o) -> auto& { return o.format; }),
       params::choice<MaterialOptions>(Spec{.name = "mapping",
                                            .help = "Gloss ⇄ roughness of a workflow conversion (fitted: least "

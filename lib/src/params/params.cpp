@@ -49,6 +49,51 @@ std::optional<std::int64_t> integer_from(std::string_view text) {
 
 }  // namespace
 
+std::optional<RuleBreak> check_rules(const std::vector<GroupState>& groups, const Spelling& spell) {
+  struct Found {
+    std::size_t group;
+    const Spec* spec;
+  };
+  const auto find = [&](std::size_t own, const std::string& name) -> std::optional<Found> {
+    for (std::size_t k = 0; k <= groups.size(); ++k) {  // its own group first, then each in order
+      const std::size_t g = k == 0 ? own : k - 1;
+      for (const Spec* s : groups[g].specs) {
+        if (s->name == name) return Found{g, s};
+      }
+    }
+    return std::nullopt;
+  };
+  for (std::size_t g = 0; g < groups.size(); ++g) {
+    for (const Spec* spec : groups[g].specs) {
+      if (!groups[g].given.count(spec->name)) continue;
+      const std::string self = spell(g, *spec, nullptr);
+      for (const std::string& other : spec->excludes) {
+        const auto o = find(g, other);
+        if (o && groups[o->group].given.count(other)) {
+          return RuleBreak{g, spec->name, self + " and " + spell(o->group, *o->spec, nullptr) + " cannot be given together"};
+        }
+      }
+      if (spec->needs.empty()) continue;
+      const auto needed = find(g, spec->needs);
+      if (!needed) continue;
+      if (spec->needs_value.empty()) {
+        if (!groups[needed->group].given.count(spec->needs)) {
+          return RuleBreak{g, spec->name, self + " applies only with " + spell(needed->group, *needed->spec, nullptr) + " as well"};
+        }
+      } else if (value_text(groups[needed->group].values.value(spec->needs, nlohmann::json())) != spec->needs_value) {
+        return RuleBreak{g, spec->name, self + " applies only with " + spell(needed->group, *needed->spec, &spec->needs_value)};
+      }
+    }
+  }
+  return std::nullopt;
+}
+
+std::string toml_value_text(const Spec& spec, const std::string& value) {
+  const bool bare = spec.kind == Kind::flag || spec.kind == Kind::integer || spec.kind == Kind::number ||
+                    (spec.kind == Kind::integer_or_text && integer_from(value));
+  return bare ? value : "\"" + value + "\"";
+}
+
 std::string flag_name(const Spec& spec, std::string_view prefix) {
   std::string name = "--" + std::string(prefix) + spec.name;
   std::replace(name.begin(), name.end(), '_', '-');

@@ -102,6 +102,21 @@ Result<params::Value> toml_value(const toml::node& node) {
   return Error{"", "a number, a string or true/false expected"};
 }
 
+// A manifest's spelling of a request's groups' parameters, each group in its table `wheres[g]`
+// ("scenes.s.ao"): "scenes.s.ao.texture", "scenes.s.texture_format = \"ktx2\"".
+params::Spelling key_spelling(std::vector<std::string> wheres) {
+  return [wheres = std::move(wheres)](std::size_t group, const params::Spec& spec, const std::string* value) {
+    const std::string key = wheres.at(group) + "." + spec.name;
+    return value ? key + " = " + params::toml_value_text(spec, *value) : key;
+  };
+}
+
+// Where an error about `key` of `t` points: its value, or the table when the key is not there.
+const toml::node& node_or_table(const toml::table& t, const std::string& key) {
+  const toml::node* at = t.get(key);
+  return at ? *at : static_cast<const toml::node&>(t);
+}
+
 // The keys of `t` that a parameter group describes (`where` names the table: "scenes.s.ao"), and
 // no others: each value checked and stored by its parameter, an older key read with a note; then
 // the group's rules across its parameters. Errors are at the value's line and column.
@@ -122,12 +137,11 @@ Status read_params_in(const Reader& r, const toml::table& t, const std::string& 
     if (problem) return r.at(node, where + "." + name + ": " + *problem);
     given.insert(p->spec.name);
   }
-  Status s = params::finish(group, target, given, [&](const std::string& name) { return where + "." + name; });
-  if (s) return s;
-  const std::string key = s.error().path.substr(std::min(s.error().path.size(), where.size() + 1));
-  const toml::node* at = key.empty() ? nullptr : t.get(key);
-  return r.at(at ? *at : static_cast<const toml::node&>(t),
-              (s.error().path.empty() ? where : s.error().path) + ": " + s.error().message);
+  if (auto broken = params::check_rules({params::state_of(group, target, given)}, key_spelling({where}))) {
+    return r.at(node_or_table(t, broken->name), broken->message);
+  }
+  if (Status s = group.check(target); !s) return r.at(t, where + ": " + s.error().message);
+  return success();
 }
 
 // The keys a group describes, with their older names: for a table that holds other keys too.

@@ -39,10 +39,14 @@ std::string manifest_relative(const fs::path& file, const Manifest& manifest) {
   return relative.empty() ? normalized(file).generic_string() : relative.generic_string();
 }
 
-// Everything in a material's spec that decides its outputs, for the stamp.
-nlohmann::json material_options(const MaterialSpec& m, const Manifest& manifest) {
-  nlohmann::json options = params::to_json(image::encoding_params(), m.encoding);
-  options.update(params::to_json(pack::material_params(), m.options));
+// What a scene job reads of a material, for its stamp: the maps as loaded (sources, packed
+// textures, the parameters that decode and size them) and the gloss mapping; not how the
+// material's own job writes or validates them, so changing that rebuilds the material only.
+nlohmann::json material_reads(const MaterialSpec& m, const Manifest& manifest) {
+  nlohmann::json options = nlohmann::json::object();
+  for (const params::Param<pack::MaterialOptions>& p : pack::material_params().params) {
+    if (!p.spec.written_only) options[p.spec.name] = p.get(m.options);
+  }
   nlohmann::json sources = nlohmann::json::object();
   for (const pack::SourceInput& s : m.sources) {
     const std::string channels = s.channels == pack::FileChannels::as_stored ? "" : ":" + std::string(name_in(pack::kFileChannelNames, s.channels));
@@ -51,12 +55,27 @@ nlohmann::json material_options(const MaterialSpec& m, const Manifest& manifest)
   std::vector<std::string> packed;
   for (const fs::path& f : m.packed_files) packed.push_back(manifest_relative(f, manifest));
   options.update(nlohmann::json{{"sources", sources},
-          {"packed", {{"layout", m.packed ? m.packed->reference : ""}, {"files", packed}}},
-          {"layout", m.layout ? m.layout->reference : ""},
-          {"reference", m.reference},
-          {"table", manifest.table.empty() ? "" : manifest_relative(manifest.table, manifest)},
-          {"validate", params::to_json(validation_params(), m.validation)}});
-  options["validate"].update(params::to_json(validate::options_params(), m.validation.options));
+                                {"packed", {{"layout", m.packed ? m.packed->reference : ""}, {"files", packed}}}});
+  return options;
+}
+
+// What a material's own job reads, for its stamp: the maps as a scene reads them, and what writes
+// its layout's textures (when it has a layout) and validates them (when validation is on).
+nlohmann::json material_options(const MaterialSpec& m, const Manifest& manifest) {
+  nlohmann::json options = material_reads(m, manifest);
+  if (m.layout) {
+    options.update(params::to_json(image::encoding_params(), m.encoding));
+    options.update(params::to_json(pack::material_params(), m.options));
+    options["layout"] = m.layout->reference;
+  }
+  options["validate"] = params::to_json(validation_params(), m.validation);
+  if (m.validation.enabled) {
+    options["validate"].update(params::to_json(validate::options_params(), m.validation.options));
+    options["reference"] = m.reference;
+    options["table"] = manifest.table.empty() ? "" : manifest_relative(manifest.table, manifest);
+  } else {
+    options["validate"].erase("heatmap");
+  }
   return options;
 }
 
@@ -299,7 +318,7 @@ Result<Plan> make_plan(const Manifest& manifest) {
         job.materials[gltf_name] = m;
         add_unique(job.inputs, material_inputs(manifest.materials[m], manifest));
         if (!job.problem && material_jobs[m]) job.problem = material_jobs[m]->problem;
-        materials[gltf_name] = material_options(manifest.materials[m], manifest);
+        materials[gltf_name] = material_reads(manifest.materials[m], manifest);
       }
       nlohmann::json options = {{"input", manifest_relative(s.input, manifest)},
                                 {"output", s.output.string()},

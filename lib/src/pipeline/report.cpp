@@ -20,6 +20,7 @@ nlohmann::json job_json(const JobReport& r) {
                       {"seconds", r.seconds},
                       {"warnings", r.warnings}};
   if (!r.reason.empty()) j["reason"] = r.reason;
+  if (!r.changed.is_null()) j["changed"] = r.changed;
   if (!r.job->depends_on.empty()) j["depends_on"] = r.job->depends_on;
   if (!r.moved.empty()) j["moved"] = strings(r.moved);
   if (r.error) j["error"] = r.error->to_string();

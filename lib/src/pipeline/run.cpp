@@ -386,9 +386,10 @@ Result<Report> run(const Manifest& manifest, const Plan& plan, const RunOptions&
   // The stamps read in parallel: a no-op run of a large manifest is mostly this.
   std::vector<std::string> reasons(selected.size(), "forced");
   std::vector<std::map<fs::path, std::string>> recorded(selected.size());
+  std::vector<nlohmann::json> changed(selected.size());
   if (!options.force) {
     tbb::parallel_for(std::size_t(0), selected.size(), [&](std::size_t i) {
-      reasons[i] = out_of_date_reason(*selected[i], roots, !options.dry_run, &recorded[i]);
+      reasons[i] = out_of_date_reason(*selected[i], roots, !options.dry_run, &recorded[i], &changed[i]);
     });
   }
   std::vector<std::size_t> to_run;
@@ -397,6 +398,7 @@ Result<Report> run(const Manifest& manifest, const Plan& plan, const RunOptions&
     JobReport r;
     r.job = &job;
     r.reason = std::move(reasons[i]);
+    r.changed = std::move(changed[i]);
     r.written = std::move(recorded[i]);  // up to date: its outputs as its stamp records them
     if (job.problem && options.dry_run) {  // it would fail: said now, not after a "would build"
       r.outcome = Outcome::failed;

@@ -7,6 +7,7 @@
 
 #include <cerrno>
 #include <cstring>
+#include <set>
 
 #include "matbake/atomic_file.hpp"
 #include "matbake/output_gate.hpp"
@@ -18,8 +19,9 @@ namespace {
 
 // The form of a stamp: raised when the same manifest is recorded differently (2: options by their
 // parameter descriptions' names, sorted; 3: paths relative to the manifest's and output folders,
-// outputs hashed), so that an older stamp says why it rebuilds once rather than "its options changed".
-constexpr int kStampForm = 3;
+// outputs hashed; 4: each job's options only those it reads), so that an older stamp says why it
+// rebuilds once rather than "its options changed".
+constexpr int kStampForm = 4;
 
 fs::path stamp_path(const std::string& job_name, const StampRoots& roots) {
   return roots.state_folder / (job_file_stem(job_name) + ".json");
@@ -64,6 +66,42 @@ std::string stamp_problem(const nlohmann::json& stamp) {
     }
   }
   return {};
+}
+
+// Each value that differs between a stamp's options and the job's, by its dotted path (objects
+// walked, anything else compared whole): {"parameter", "old", "new"}, null where one has none.
+void option_changes(const nlohmann::json& was, const nlohmann::json& now, const std::string& path, nlohmann::json& out) {
+  if (was == now) return;
+  if (!was.is_object() || !now.is_object()) {
+    out.push_back({{"parameter", path}, {"old", was}, {"new", now}});
+    return;
+  }
+  std::set<std::string> keys;
+  for (const auto& [key, value] : was.items()) keys.insert(key);
+  for (const auto& [key, value] : now.items()) keys.insert(key);
+  for (const std::string& key : keys) {
+    const nlohmann::json none;
+    option_changes(was.contains(key) ? was[key] : none, now.contains(key) ? now[key] : none,
+                   path.empty() ? key : path + "." + key, out);
+  }
+}
+
+std::string shown(const nlohmann::json& value) { return value.is_null() ? "(unset)" : value.dump(); }
+
+// "its options changed: validate.worst 5 → 6 (and 2 more)"; a KTX2 scene's encoder gone is said as
+// such (the identity holds basisu's version, or "none: " and why it was not found).
+std::string options_reason(const nlohmann::json& changes) {
+  for (const nlohmann::json& c : changes) {
+    if (c["parameter"] == "encoder" && c["new"].is_string() && c["new"].get<std::string>().rfind("none: ", 0) == 0) {
+      return "basisu is missing: " + c["new"].get<std::string>().substr(6);
+    }
+  }
+  if (changes.empty()) return "its options changed";
+  const nlohmann::json& first = changes[0];
+  std::string why = "its options changed: " + first["parameter"].get<std::string>() + " " + shown(first["old"]) +
+                    " → " + shown(first["new"]);
+  if (changes.size() > 1) why += " (and " + std::to_string(changes.size() - 1) + " more)";
+  return why;
 }
 
 // Empty when the recorded file is as it was (its time refreshed in `f` when only that moved),
@@ -176,7 +214,8 @@ bool changed_since(const fs::path& file, const FileIdentity& read) {
   return !now || now->hash != read.hash;
 }
 
-std::string out_of_date_reason(const Job& job, const StampRoots& roots, bool refresh, std::map<fs::path, std::string>* recorded_outputs) {
+std::string out_of_date_reason(const Job& job, const StampRoots& roots, bool refresh, std::map<fs::path, std::string>* recorded_outputs,
+                               nlohmann::json* changed) {
   const fs::path file = stamp_path(job.name, roots);
   const StateText read = read_state_file(file, kStampLimit);
   if (read.absent) return "no earlier build";
@@ -186,7 +225,13 @@ std::string out_of_date_reason(const Job& job, const StampRoots& roots, bool ref
   if (!problem.empty()) return std::string(kBadStamp) + file.string() + " " + (read.problem.empty() ? "is not one matbake wrote: " : "") + problem;
   if (stamp.value("form", 1) != kStampForm) return "its stamp is from an older matbake (recorded anew)";
   if (stamp["matbake"] != version) return "matbake's version changed";
-  if (stamp["options"] != job.options) return "its options changed";
+  if (stamp["options"] != job.options) {
+    nlohmann::json changes = nlohmann::json::array();
+    option_changes(nlohmann::json::parse(stamp["options"].get<std::string>(), nullptr, false),
+                   nlohmann::json::parse(job.options, nullptr, false), "", changes);
+    if (changed) *changed = changes;
+    return options_reason(changes);
+  }
   std::vector<fs::path> recorded;
   for (const nlohmann::json& f : stamp["inputs"]) recorded.push_back(resolved_path(f["path"].get<std::string>(), roots.inputs));
   for (const fs::path& p : job.inputs) {

@@ -4,6 +4,8 @@
 // output is missing or was changed by someone else. Paths in a stamp are relative to the
 // manifest's folder (inputs) and the output folder (outputs), so a moved or copied tree with the
 // same bytes is up to date.
+#include <nlohmann/json.hpp>
+
 #include <cstdint>
 #include <filesystem>
 #include <map>
@@ -73,9 +75,11 @@ struct StampRoots {
 // the new times, so that the next run need not hash those files again.
 // `recorded` (when given) receives the stamp's outputs with their hashes when the job is up to date.
 // A reason that begins so says the stamp was refused (named, with why): the run warns of it.
+// `changed` (when given) receives each option that differs: [{"parameter", "old", "new"}].
 inline constexpr const char* kBadStamp = "stamp refused: ";
 std::string out_of_date_reason(const Job& job, const StampRoots& roots, bool refresh,
-                               std::map<std::filesystem::path, std::string>* recorded = nullptr);
+                               std::map<std::filesystem::path, std::string>* recorded = nullptr,
+                               nlohmann::json* changed = nullptr);
 
 // The files as they are now; an error names the first that cannot be read.
 Result<std::vector<StampedFile>> identify_all(const std::vector<std::filesystem::path>& files);

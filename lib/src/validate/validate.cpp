@@ -374,7 +374,9 @@ std::string_view flag_meaning(int bit, Vocabulary vocabulary) {
 std::string flag_names(std::uint8_t flags) {
   std::string s;
   for (int bit = 0; bit < kFlagCount; ++bit) {
-    if (flags & (1 << bit)) s += (s.empty() ? "" : ",") + std::string(flag_name(bit));
+    if (!(flags & (1 << bit))) continue;
+    if (!s.empty()) s += ',';
+    s += flag_name(bit);
   }
   return s;
 }
