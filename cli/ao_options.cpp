@@ -1,28 +1,21 @@
 #include "ao_options.hpp"
 
-#include "matbake/ao_params.hpp"
-#include "params_cli.hpp"
 
 #include <cstdio>
 
 namespace matbake::cli {
 
-void add_ao_options(CLI::App& cmd, AoSettings& s, const std::string& prefix) {
-  const std::string group = prefix.empty() ? "Options" : "Ambient occlusion";
-  add_params(cmd, ao::request_params(), s.request, prefix, group, &s.given);
-  cmd.add_option("--" + prefix + "dump-texture", s.dump_texture,
+void add_dump_texture(CLI::App& cmd, std::string& folder, const std::string& prefix, const std::string& help_group) {
+  cmd.add_option("--" + prefix + "dump-texture", folder,
                  "Also write each texture as float EXR into this folder (with --" + prefix + "texture)")
-      ->group(group);
+      ->group(help_group);
 }
 
-Result<ao::Request> ao_request(const AoSettings& s, const std::string& prefix) {
-  if (Status st = finish_params(ao::request_params(), s.request, s.given, prefix); !st) return st.error();
-  ao::Request request = s.request;
-  if (!s.dump_texture.empty()) {
-    if (!request.texture) return Error{"--" + prefix + "dump-texture", "applies only with --" + prefix + "texture as well", true};
-    request.texture->dump = s.dump_texture;
-  }
-  return request;
+Status set_dump_texture(ao::Request& request, const std::string& folder, const std::string& prefix) {
+  if (folder.empty()) return success();
+  if (!request.texture) return Error{"--" + prefix + "dump-texture", "applies only with --" + prefix + "texture as well", true};
+  request.texture->dump = folder;
+  return success();
 }
 
 void print_texture_reports(const std::vector<bake_ao::TextureReport>& textures) {

@@ -3,8 +3,8 @@
 #include <cstdio>
 
 #include "commands.hpp"
-#include "matbake/delivery_params.hpp"
-#include "matbake/encoding_params.hpp"
+#include "ao_options.hpp"
+#include "matbake/bake_ao_params.hpp"
 #include "params_cli.hpp"
 #include "matbake/export.hpp"
 #include "matbake/report_json.hpp"
@@ -22,17 +22,19 @@ CLI::App* setup_bake_ao(CLI::App& app, BakeAoSettings& s) {
   cmd->add_option("-o,--output", s.output,
                   "Output .gltf (+ .bin beside it) or .glb; everything but the baked attribute is kept as written");
   cmd->add_option("--dump", s.dump, "Raw values: .csv (node,mesh,primitive,vertex,x,y,z,ao) or .bin (float32)");
-  add_params(*cmd, image::encoding_params(), s.encoding, "", "Options");
-  add_params(*cmd, image::gltf_texture_params(), s.encoding, "", "Options");
-  add_params(*cmd, delivery::options_params(), s.delivery, "", "Texture delivery (docs/delivery.md)");
-  add_ao_options(*cmd, s.ao, "");
+  add_tree(*cmd, bake_ao::request_tree(), s.options, s.given,
+           {"Options", "Options", "Texture delivery (docs/delivery.md)", "Options"});
+  add_dump_texture(*cmd, s.dump_texture, "", "Options");
   return cmd;
 }
 
 int run_bake_ao(const BakeAoSettings& s, const GlobalOptions& global) {
-  auto request = ao_request(s.ao, "");
-  if (!request) return report_error(request.error());
-  auto report = bake_ao::bake_file(s.scene, {*request, s.output, s.dump, s.encoding, s.delivery});
+  bake_ao::Options options = s.options;
+  options.output = s.output;
+  options.dump = s.dump;
+  if (Status st = finish_tree(bake_ao::request_tree(), options, s.given); !st) return report_error(st.error());
+  if (Status st = set_dump_texture(options.ao, s.dump_texture, ""); !st) return report_error(st.error());
+  auto report = bake_ao::bake_file(s.scene, options);
   if (!report) return report_error(report.error());
   nlohmann::json textures = nlohmann::json::array();
   for (const bake_ao::TextureReport& t : report->textures) textures.push_back(to_json(t));

@@ -10,6 +10,7 @@
 
 #include "commands.hpp"
 #include "params_cli.hpp"
+#include "matbake/join.hpp"
 #include "matbake/atomic_file.hpp"
 #include "matbake/cluster.hpp"
 #include "matbake/output_check.hpp"
@@ -149,21 +150,23 @@ CLI::App* setup_build(CLI::App& app, BuildSettings& s) {
       "workflow, packed, validated; scenes are exported with them and AO. Only out-of-date outputs are built.");
   cmd->add_option("manifest", s.manifest, "The manifest (TOML)")->required();
   add_output_dir_option(*cmd, s.output_dir);
-  cmd->add_flag("--force", s.force, "Build every job, up to date or not");
-  cmd->add_flag("-n,--dry-run", s.dry_run, "List what would be built, and why, without building it");
-  cmd->add_flag("--keep-stale", s.keep_stale,
+  CLI::Option* force = cmd->add_flag("--force", s.force, "Build every job, up to date or not");
+  CLI::Option* dry_run = cmd->add_flag("-n,--dry-run", s.dry_run, "List what would be built, and why, without building it");
+  CLI::Option* keep_stale = cmd->add_flag("--keep-stale", s.keep_stale,
                 "Keep the files an earlier build made that no job makes now (by default a full run with no failure removes them)");
-  cmd->add_flag("--prune", s.prune,
+  CLI::Option* prune = cmd->add_flag("--prune", s.prune,
                 "Allow what a lost input looks like: removing more than half of the files the build made, or a scene\n"
                 "losing a manifest material it was built with (without it, the files are kept and the scene refused)");
-  cmd->add_flag("--status", s.status,
+  CLI::Option* status = cmd->add_flag("--status", s.status,
                 "Build nothing; say how each job stands after runs elsewhere (a cluster, docs/cluster.md): up to date,\n"
                 "failed (its error line) or not built. Exit 1 when any failed");
-  cmd->add_option("--only", s.only, "Build only this job (material:NAME or scene:NAME); repeatable");
-  cmd->add_option("--depfile", s.depfile,
+  CLI::Option* only = cmd->add_option("--only", s.only, "Build only this job (material:NAME or scene:NAME); repeatable");
+  CLI::Option* depfile = cmd->add_option("--depfile", s.depfile,
                   "Write a Make depfile of every input read, for CMake add_custom_command(DEPFILE) and Ninja");
-  cmd->add_option("--stamp", s.stamp,
+  CLI::Option* stamp = cmd->add_option("--stamp", s.stamp,
                   "Write this file after a successful run; the depfile's target is then this file rather than the outputs");
+  // --status builds nothing: a flag about building beside it would be silently ignored.
+  for (CLI::Option* building : {force, dry_run, keep_stale, prune, only, depfile, stamp}) status->excludes(building);
   return cmd;
 }
 
@@ -266,10 +269,8 @@ int run_build(const BuildSettings& s, const GlobalOptions& global) {
   } else if (!global.quiet) {
     if (s.dry_run) {
       for (const pipeline::MaterialRule& rule : manifest.rules) {
-        std::string names;
-        for (const std::string& n : rule.materials) names += (names.empty() ? "" : ", ") + n;
         std::printf("material_rules.%s (%s): %zu materials: %s\n", rule.name.c_str(), rule.origin.c_str(),
-                    rule.materials.size(), names.c_str());
+                    rule.materials.size(), join(rule.materials, ", ").c_str());
       }
       for (const pipeline::JobReport& r : report->jobs) {
         if (r.outcome == pipeline::Outcome::out_of_date) std::printf("would build %s: %s\n", r.job->name.c_str(), r.reason.c_str());

@@ -3,8 +3,7 @@
 #include <cstdio>
 
 #include "commands.hpp"
-#include "matbake/delivery_params.hpp"
-#include "matbake/encoding_params.hpp"
+#include "ao_options.hpp"
 #include "matbake/export_params.hpp"
 #include "params_cli.hpp"
 #include "matbake/material_params.hpp"
@@ -65,20 +64,21 @@ CLI::App* setup_export(CLI::App& app, ExportSettings& s) {
                   "NAME=A.png,B.png: material NAME (or its index) from a Schüler pair; NAME=LAYOUT:FILE,... from\n"
                   "any pack layout's textures (e.g. gltf-metal-rough:base.png,mr.png). Repeatable");
   add_params(*cmd, pack::material_params(), s.material_options, "", "Options", nullptr, {"transfer", "decode", "normal_y"});
-  add_params(*cmd, exporter::options_params(), s.options, "", "Options");
-  add_params(*cmd, image::encoding_params(), s.options.encoding, "", "Options");
-  add_params(*cmd, image::gltf_texture_params(), s.options.encoding, "", "Options");
-  add_params(*cmd, delivery::options_params(), s.options.delivery, "", "Texture delivery (docs/delivery.md)");
-  add_ao_options(*cmd, s.ao, "ao-");  // AO is baked when any of them is given, as a manifest's ao = { ... }
+  // AO is baked when any --ao-* is given, as a manifest's ao = { ... }.
+  add_tree(*cmd, exporter::request_tree(), s.options, s.given,
+           {"Options", "Options", "Options", "Texture delivery (docs/delivery.md)", "Ambient occlusion"});
+  add_dump_texture(*cmd, s.dump_texture, "ao-", "Ambient occlusion");
   cmd->add_option("--report", s.report, "Also write the report as JSON to this file");
   return cmd;
 }
 
 int run_export(const ExportSettings& s, const GlobalOptions& global) {
   exporter::Options options = s.options;
-  auto request = ao_request(s.ao, "ao-");
-  if (!request) return report_error(request.error());
-  if (!s.ao.given.empty()) options.ao = *request;
+  if (Status st = finish_tree(exporter::request_tree(), options, s.given); !st) return report_error(st.error());
+  if (!s.dump_texture.empty()) {
+    if (!options.ao) return report_error(Error{"--ao-dump-texture", "applies only with --ao-texture as well", true});
+    if (Status st = set_dump_texture(*options.ao, s.dump_texture, "ao-"); !st) return report_error(st.error());
+  }
   for (const std::string& text : s.materials) {
     auto m = parse_material(text, s.material_options);
     if (!m) return report_error(m.error());

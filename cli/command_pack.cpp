@@ -3,6 +3,7 @@
 #include <filesystem>
 
 #include "commands.hpp"
+#include "matbake/join.hpp"
 #include "matbake/encoding_params.hpp"
 #include "params_cli.hpp"
 #include "matbake/material_params.hpp"
@@ -14,9 +15,7 @@ namespace matbake::cli {
 namespace {
 
 std::string layout_help() {
-  std::string names;
-  for (const std::string& n : pack::builtin_layout_names()) names += (names.empty() ? "" : ", ") + n;
-  return "Layout: a preset (" + names + ") or a layout JSON file (docs/pack.md)";
+  return "Layout: a preset (" + join(pack::builtin_layout_names(), ", ") + ") or a layout JSON file (docs/pack.md)";
 }
 
 }  // namespace

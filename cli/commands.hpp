@@ -104,9 +104,9 @@ struct BakeAoSettings {
   std::string scene;
   std::string output;
   std::string dump;
-  image::Encoding encoding;  // of the occlusion textures
-  delivery::Options delivery;
-  AoSettings ao;
+  bake_ao::Options options;  // its tree (bake_ao::request_tree); output and dump set at run
+  std::vector<std::set<std::string>> given;
+  std::string dump_texture;
 };
 CLI::App* setup_bake_ao(CLI::App& app, BakeAoSettings& settings);
 int run_bake_ao(const BakeAoSettings& settings, const GlobalOptions& global);
@@ -116,8 +116,9 @@ struct ExportSettings {
   std::string output;
   std::vector<std::string> materials;  // NAME=[LAYOUT:]FILE,FILE...
   pack::MaterialOptions material_options;  // transfer, decode: how those files are read
-  exporter::Options options;
-  AoSettings ao;                       // AO is baked when any of its options is given
+  exporter::Options options;              // its tree (exporter::request_tree): AO once any --ao-* is given
+  std::vector<std::set<std::string>> given;
+  std::string dump_texture;
   std::string report;
 };
 CLI::App* setup_export(CLI::App& app, ExportSettings& settings);

@@ -1,5 +1,6 @@
 #include <tbb/global_control.h>
 
+#include <charconv>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -7,6 +8,7 @@
 #include "commands.hpp"
 #include "interrupt.hpp"
 #include "matbake/image.hpp"
+#include "matbake/join.hpp"
 #include "matbake/near_names.hpp"
 #include "matbake/version.hpp"
 
@@ -35,6 +37,33 @@ std::optional<std::string> unknown_option(const CLI::App& app, const CLI::ParseE
   return std::nullopt;
 }
 
+// A first word that is no command, with the nearest ones: "unknown command 'buidl'; did you mean build?".
+std::optional<std::string> unknown_command(const CLI::App& app) {
+  if (!app.get_subcommands().empty()) return std::nullopt;
+  std::vector<std::string> known;
+  for (const CLI::App* command : app.get_subcommands({})) known.push_back(command->get_name());
+  for (const std::string& word : app.remaining()) {  // what no global option took
+    if (word.starts_with("-")) continue;
+    if (std::find(known.begin(), known.end(), word) != known.end()) return std::nullopt;
+    const std::string near = matbake::did_you_mean(word, known);
+    return "unknown command '" + matbake::escape_control(word) + "'" +
+           (near.empty() ? " (commands: " + matbake::join(known, ", ") + ")" : near);
+  }
+  return std::nullopt;
+}
+
+// A whole number from `least` up, said in words when it is not one ("--jobs: a whole number, 0 or more").
+CLI::Validator whole_number_from(long long least, const std::string& meaning) {
+  return CLI::Validator(
+      [least, meaning](std::string& text) -> std::string {
+        long long value = 0;
+        const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
+        if (ec == std::errc() && end == text.data() + text.size() && value >= least) return "";
+        return "'" + text + "': " + meaning;
+      },
+      "");
+}
+
 // A command of the table main() dispatches from: its subcommand, and its run over the settings
 // the subcommand's flags fill (kept alive by the run).
 struct Command {
@@ -60,13 +89,14 @@ int main(int argc, char** argv) {
   GlobalOptions global;
   app.add_flag("--json", global.json, "Print a machine-readable result on stdout");
   app.add_flag("-q,--quiet", global.quiet, "Print nothing but errors");
-  app.add_option("-j,--jobs", global.jobs, "Worker threads (default: all cores)")->check(CLI::NonNegativeNumber);
+  app.add_option("-j,--jobs", global.jobs, "Worker threads (default: all cores)")
+      ->check(whole_number_from(0, "a count of worker threads, 0 (all cores) or more"));
   std::uint64_t max_pixels = matbake::image::kDefaultMaxPixels;
   app.add_option("--max-pixels", max_pixels,
                  "Largest image read or made, in pixels (width x height); larger declared sizes are refused before\n"
                  "anything is allocated")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(whole_number_from(1, "a count of pixels, 1 or more"));
   app.add_option("--ocio-config", global.ocio_config,
                  "OpenColorIO config for colour-space names (default: $OCIO, else the shipped presets/ocio/config.ocio)");
 
@@ -85,6 +115,7 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
     if (auto unknown = unknown_option(app, e)) return report_error(matbake::Error{"", *unknown + " (see matbake --help)", true});
+    if (auto unknown = unknown_command(app)) return report_error(matbake::Error{"", *unknown, true});
     std::string message = e.what();
     message = message.substr(0, message.find('\n'));
     return report_error(matbake::Error{"", message + " (see matbake --help)", true});

@@ -235,9 +235,12 @@ TEST(CliBuild, RebuildsWhatChangedAndOnlyThat) {
 
   // --force builds all; an unknown --only is a usage error.
   EXPECT_EQ(run_json({"build", manifest, "--force"})["built"], 6);
-  const RunResult unknown = matbake({"build", manifest, "--only", "material:nope"});
+  const RunResult unknown = matbake({"build", manifest, "--only", "texture:rubber"});
   EXPECT_EQ(unknown.exit_code, 2);
-  EXPECT_NE(unknown.err.find("no job 'material:nope' (jobs: material:glass, "), std::string::npos) << unknown.err;
+  EXPECT_NE(unknown.err.find("no job 'texture:rubber' (jobs: material:glass, "), std::string::npos) << unknown.err;
+  const RunResult misspelt = matbake({"build", manifest, "--only", "material:rubbr"});
+  EXPECT_EQ(misspelt.exit_code, 2);
+  EXPECT_NE(misspelt.err.find("no job 'material:rubbr'; did you mean material:rubber?"), std::string::npos) << misspelt.err;
 }
 
 TEST(CliBuild, AMovedOrCopiedTreeIsUpToDate) {

@@ -249,9 +249,9 @@ TEST_F(Parity, ExportAndAoGiveTheManifestsScene) {
            samples ? std::vector<std::string>{} : std::vector<std::string>{"--ao-samples", "8"}, ""};
     c.command.push_back(params::flag_name(p.spec, "ao-"));
     if (p.spec.kind != params::Kind::flag) c.command.push_back(p.spec.example);
-    if (!p.spec.needs.empty()) {
-      c.manifest += ", " + p.spec.needs + " = 8";
-      c.command.insert(c.command.end(), {"--ao-" + p.spec.needs, "8"});
+    for (const params::Condition& need : p.spec.needs) {
+      c.manifest += ", " + need.name + " = " + (need.value.empty() ? "8" : "\"" + need.value + "\"");
+      c.command.insert(c.command.end(), {params::flag_name({.name = need.name}, "ao-"), need.value.empty() ? "8" : need.value});
     }
     c.manifest += " }";
     cases.push_back(std::move(c));
@@ -472,6 +472,61 @@ TEST_F(Parity, ManifestTextureKeysAreChecked) {
     EXPECT_NE(r.err.find(problem), std::string::npos) << ao << ": " << r.err;
     EXPECT_FALSE(fs::exists(dir / "out" / "s.glb"));
   }
+}
+
+// The conflicts a new user met, accepted before with one setting silently winning: refused at both
+// doors, each naming both parameters in its own spelling, and nothing written.
+TEST_F(Parity, ConflictingSettingsAreRefusedAtBothDoors) {
+  for (const char* f : {"showroom.gltf", "showroom.bin"}) fs::copy_file(kExamples / f, dir / f);
+  const std::string scene = (dir / "showroom.gltf").string(), out = (dir / "cli" / "s.glb").string();
+  const struct {
+    std::string keys;
+    std::vector<std::string> flags;
+    std::string manifest_says, command_line_says;
+  } cases[] = {
+      {"ao = { samples = 128, texture = 512, into = \"_AO\" }", {"--ao-samples", "128", "--ao-texture", "512", "--ao-into", "_AO"},
+       "assets.toml:4:45: scenes.s.ao.into and scenes.s.ao.texture cannot be given together",
+       "--ao-into and --ao-texture cannot be given together"},
+      {"ao = { relative_distance = 0.3, max_distance = 2.0 }", {"--ao-relative-distance", "0.3", "--ao-max-distance", "2.0"},
+       "assets.toml:4:28: scenes.s.ao.relative_distance and scenes.s.ao.max_distance cannot be given together",
+       "--ao-relative-distance and --ao-max-distance cannot be given together"},
+      {"colour_codec = \"uastc\"\ncolour_quality = 200", {"--colour-codec", "uastc", "--colour-quality", "200"},
+       "assets.toml:4:16: scenes.s.colour_codec applies only with scenes.s.texture_format = \"ktx2\"",
+       "--colour-codec applies only with --texture-format ktx2"},
+      {"texture_format = \"ktx2\"\ncolour_codec = \"uastc\"\ncolour_quality = 200",
+       {"--texture-format", "ktx2", "--colour-codec", "uastc", "--colour-quality", "200"},
+       "assets.toml:6:18: scenes.s.colour_quality applies only with scenes.s.colour_codec = \"etc1s\"",
+       "--colour-quality applies only with --colour-codec etc1s"},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.keys);
+    write_bytes(dir / "assets.toml", "[scenes.s]\ninput = \"showroom.gltf\"\noutput = \"s.glb\"\n" + c.keys + "\n");
+    const RunResult built = matbake({"build", (dir / "assets.toml").string()});
+    EXPECT_EQ(built.exit_code, 1);
+    EXPECT_NE(built.err.find(c.manifest_says), std::string::npos) << built.err;
+    std::vector<std::string> args = {"export", scene, "-o", out};
+    args.insert(args.end(), c.flags.begin(), c.flags.end());
+    const RunResult exported = matbake(args);
+    EXPECT_EQ(exported.exit_code, 2);
+    EXPECT_EQ(exported.err, "matbake: error: " + c.command_line_says + "\n");
+    EXPECT_FALSE(fs::exists(dir / "out" / "s.glb"));
+    EXPECT_FALSE(fs::exists(out));
+  }
+  // A build's --status builds nothing: a flag about building beside it is refused, not ignored.
+  for (const char* flag : {"-n", "--force", "--prune", "--keep-stale"}) {
+    const RunResult r = matbake({"build", (dir / "assets.toml").string(), "--status", flag});
+    EXPECT_EQ(r.exit_code, 2) << flag;
+    EXPECT_NE(r.err.find("excludes --status"), std::string::npos) << r.err;
+  }
+}
+
+// A misspelt command gets the nearest names as a misspelt flag does; a count out of range is said in words.
+TEST(CliMain, AMisspeltCommandOrABadCountIsSaidInWords) {
+  EXPECT_EQ(matbake({"buidl", "x.toml"}).err, "matbake: error: unknown command 'buidl'; did you mean build?\n");
+  EXPECT_EQ(matbake({"-j", "2", "exprot"}).err, "matbake: error: unknown command 'exprot'; did you mean export?\n");
+  const RunResult jobs = matbake({"-j", "-1", "build", "x.toml"});
+  EXPECT_EQ(jobs.exit_code, 2);
+  EXPECT_EQ(jobs.err, "matbake: error: --jobs: '-1': a count of worker threads, 0 (all cores) or more (see matbake --help)\n");
 }
 
 }  // namespace

@@ -5,9 +5,9 @@
 
 #include <cstdlib>
 
-#include "cli/ao_options.hpp"
 #include "cli/params_cli.hpp"
 #include "matbake/ao_params.hpp"
+#include "matbake/bake_ao_params.hpp"
 #include "matbake/convert_params.hpp"
 #include "matbake/delivery_params.hpp"
 #include "matbake/encoding_params.hpp"
@@ -79,52 +79,200 @@ std::optional<Value> from_json(const nlohmann::json& j) {
   return std::nullopt;
 }
 
-Result<ao::Request> from_command_line(std::vector<std::string> args) {
-  CLI::App app;
-  cli::AoSettings settings;
-  cli::add_ao_options(app, settings, "ao-");
-  std::reverse(args.begin(), args.end());  // CLI11 takes them last first
-  app.parse(args);
-  return cli::ao_request(settings, "ao-");
-}
+// --- Each command's request tree, walked through both doors ------------------------------------------
 
-Result<ao::Request> from_manifest(const std::string& ao_table) {
-  auto m = pipeline::parse_manifest("[scenes.s]\ninput = \"s.gltf\"\nao = { " + ao_table + " }\n", "/p/assets.toml");
-  if (!m) return m.error();
-  return *m->scenes.at(0).options.ao;
-}
+// A parameter of a tree set to a value.
+template <class Root>
+struct Setting {
+  std::size_t branch;
+  const Spec* spec;
+  std::string value;
+};
 
-TEST(AoParams, EveryParameterReachesTheRequestFromBothDoorsAndRoundTripsThroughTheStamp) {
-  const Group<ao::Request>& group = ao::request_params();
-  const nlohmann::json defaults = to_json(group, ao::Request{});
-  ASSERT_EQ(group.params.size(), 20u);  // a new parameter is walked here too
-  for (const Param<ao::Request>& p : group.params) {
-    SCOPED_TRACE(p.spec.name);
-    // Its example, and the texture it needs, through each door.
-    std::vector<std::string> args = {flag_name(p.spec, "ao-")};
-    if (p.spec.kind != Kind::flag) args.push_back(p.spec.example);
-    std::string table = p.spec.name + " = " + test::toml_literal(p.spec);
-    if (!p.spec.needs.empty()) {
-      args.insert(args.end(), {"--ao-" + p.spec.needs, "16"});
-      table += ", " + p.spec.needs + " = 16";
+// The spec a rule names: in its own branch first, then in each in order (as check_rules looks).
+template <class Root>
+Setting<Root> find_setting(const Tree<Root>& tree, std::size_t own, const std::string& name, const std::string& value) {
+  for (std::size_t k = 0; k <= tree.size(); ++k) {
+    const std::size_t b = k == 0 ? own : k - 1;
+    for (const Spec* spec : tree[b].specs) {
+      if (spec->name == name) return {b, spec, value.empty() ? spec->example : value};
     }
-    auto cli = from_command_line(args);
-    auto manifest = from_manifest(table);
-    ASSERT_TRUE(cli) << cli.error().to_string();
-    ASSERT_TRUE(manifest) << manifest.error().to_string();
-    const nlohmann::json stamped = to_json(group, *cli);
-    EXPECT_EQ(stamped, to_json(group, *manifest));
-    EXPECT_NE(stamped.at(p.spec.name), defaults.at(p.spec.name)) << "the example must differ from the default";
+  }
+  ADD_FAILURE() << "no parameter " << name;
+  return {own, nullptr, value};
+}
 
-    // The stamp's values, given again where they are not the defaults, make the same request.
-    ao::Request again;
-    for (const Param<ao::Request>& q : group.params) {
-      if (auto v = from_json(stamped.at(q.spec.name)); v && stamped.at(q.spec.name) != defaults.at(q.spec.name)) {
-        EXPECT_EQ(apply(q, again, *v), std::nullopt) << q.spec.name;
+// The parameter at its example and what it needs that the defaults do not give (each at the value
+// it needs, or its example).
+template <class Root>
+std::vector<Setting<Root>> with_needs(const Tree<Root>& tree, std::size_t b, const Spec* spec) {
+  std::vector<Setting<Root>> out{{b, spec, spec->example}};
+  for (const Condition& c : spec->needs) {
+    const Setting<Root> needed = find_setting(tree, b, c.name, c.value);
+    if (c.value.empty() || value_text(tree[needed.branch].values(Root{}).at(c.name)) != c.value) out.push_back(needed);
+  }
+  return out;
+}
+
+template <class Root>
+std::string flag_of(const Tree<Root>& tree, const Setting<Root>& s) { return flag_name(*s.spec, tree[s.branch].flag_prefix); }
+
+template <class Root>
+std::string key_of(const Tree<Root>& tree, const Setting<Root>& s) {
+  return "scenes.s." + (tree[s.branch].table.empty() ? "" : tree[s.branch].table + ".") + s.spec->name;
+}
+
+// The command line's request from the settings, through the tree as a command adds it.
+template <class Root>
+Result<Root> from_flags(const Tree<Root>& tree, const std::vector<Setting<Root>>& settings) {
+  CLI::App app;
+  Root root;
+  std::vector<std::set<std::string>> given;
+  cli::add_tree(app, tree, root, given, std::vector<std::string>(tree.size(), "Options"));
+  std::vector<std::string> args;
+  for (const Setting<Root>& s : settings) {
+    const std::string flag = flag_of(tree, s);
+    if (s.spec->kind != Kind::flag) {
+      args.insert(args.end(), {flag, s.value});
+    } else {
+      args.push_back(s.value == "true" ? flag : "--no-" + flag.substr(2));
+    }
+  }
+  std::reverse(args.begin(), args.end());  // CLI11 takes them last first
+  try {
+    app.parse(args);
+  } catch (const CLI::ParseError& e) {
+    return Error{"", e.what(), true};
+  }
+  if (Status st = cli::finish_tree(tree, root, given); !st) return st.error();
+  return root;
+}
+
+// A manifest scene's request from the same settings: its own keys, and its tables' (ao = { ... }).
+Result<exporter::Options> from_scene_keys(const Tree<exporter::Options>& tree, const std::vector<Setting<exporter::Options>>& settings) {
+  std::string own, ao;
+  for (const Setting<exporter::Options>& s : settings) {
+    const std::string key = s.spec->name + " = " + toml_value_text(*s.spec, s.value);
+    if (tree[s.branch].table.empty()) {
+      own += key + "\n";
+    } else {
+      ao += (ao.empty() ? "" : ", ") + key;
+    }
+  }
+  auto m = pipeline::parse_manifest("[scenes.s]\ninput = \"s.gltf\"\n" + own + (ao.empty() ? "" : "ao = { " + ao + " }\n"),
+                                    "/p/assets.toml");
+  if (!m) return m.error();
+  return m->scenes.at(0).options;
+}
+
+// Export's tree is a manifest scene's: each parameter at its example (with what it needs) gives the
+// same request through the flags and the scene's keys, one that differs from the defaults.
+TEST(RequestTree, EveryParameterOfExportsTreeReachesTheSceneFromBothDoors) {
+  const Tree<exporter::Options>& tree = exporter::request_tree();
+  const nlohmann::json defaults = tree_json(tree, exporter::Options{});
+  std::size_t walked = 0;
+  for (std::size_t b = 0; b < tree.size(); ++b) {
+    for (const Spec* spec : tree[b].specs) {
+      SCOPED_TRACE(spec->name);
+      const auto settings = with_needs(tree, b, spec);
+      auto cli = from_flags(tree, settings);
+      auto manifest = from_scene_keys(tree, settings);
+      ASSERT_TRUE(cli) << cli.error().to_string();
+      ASSERT_TRUE(manifest) << manifest.error().to_string();
+      const nlohmann::json shown = tree_json(tree, *cli);
+      EXPECT_EQ(shown, tree_json(tree, *manifest));
+      EXPECT_NE(tree[b].values(*cli).at(spec->name), tree[b].values(exporter::Options{}).at(spec->name))
+          << "the example must differ from the default";
+      EXPECT_NE(shown, defaults);
+      // The values shown (as stamps hold them), given again where not the defaults, make the same request.
+      exporter::Options again;
+      for (const Branch<exporter::Options>& other : tree) {
+        const nlohmann::json values = other.values(*cli), unset = other.values(exporter::Options{});
+        for (const Spec* s : other.specs) {
+          if (auto v = from_json(values.at(s->name)); v && values.at(s->name) != unset.at(s->name)) {
+            EXPECT_EQ(other.apply(again, *s, *v), std::nullopt) << s->name;
+          }
+        }
+      }
+      EXPECT_EQ(tree_json(tree, again), shown);
+      ++walked;
+    }
+  }
+  EXPECT_EQ(walked, 51u);  // a new parameter is walked here too
+}
+
+// Each rule of a tree broken on purpose: refused at both doors, with one message in each door's spelling.
+template <class Root, class ManifestDoor>
+void walk_rules(const Tree<Root>& tree, ManifestDoor manifest_door, std::size_t expected_rules) {
+  std::size_t rules = 0;
+  for (std::size_t b = 0; b < tree.size(); ++b) {
+    for (const Spec* spec : tree[b].specs) {
+      const Setting<Root> self{b, spec, spec->example};
+      for (std::size_t i = 0; i < spec->needs.size(); ++i) {
+        const Condition& c = spec->needs[i];
+        SCOPED_TRACE(spec->name + " needs " + c.name);
+        std::vector<Setting<Root>> settings{self};
+        for (std::size_t j = 0; j < i; ++j) settings.push_back(find_setting(tree, b, spec->needs[j].name, spec->needs[j].value));
+        const Setting<Root> needed = find_setting(tree, b, c.name, "");
+        std::string flag_words = " as well", key_words = " as well";
+        if (!c.value.empty()) {  // the needed parameter at another of its values
+          const auto other = std::find_if(needed.spec->choices.begin(), needed.spec->choices.end(),
+                                          [&](const std::string& v) { return v != c.value; });
+          ASSERT_NE(other, needed.spec->choices.end());
+          settings.push_back({needed.branch, needed.spec, *other});
+          flag_words = " " + c.value;
+          key_words = " = " + toml_value_text(*needed.spec, c.value);
+        }
+        auto cli = from_flags(tree, settings);
+        ASSERT_FALSE(cli);
+        EXPECT_EQ(cli.error().message, flag_of(tree, self) + " applies only with " + flag_of(tree, needed) + flag_words);
+        manifest_door(settings, key_of(tree, self) + " applies only with " + key_of(tree, needed) + key_words);
+        ++rules;
+      }
+      for (const std::string& other : spec->excludes) {
+        SCOPED_TRACE(spec->name + " excludes " + other);
+        std::vector<Setting<Root>> settings = with_needs(tree, b, spec);
+        const Setting<Root> excluded = find_setting(tree, b, other, "");
+        settings.push_back(excluded);
+        auto cli = from_flags(tree, settings);
+        ASSERT_FALSE(cli);
+        EXPECT_EQ(cli.error().message, flag_of(tree, self) + " and " + flag_of(tree, excluded) + " cannot be given together");
+        manifest_door(settings, key_of(tree, self) + " and " + key_of(tree, excluded) + " cannot be given together");
+        ++rules;
       }
     }
-    EXPECT_EQ(to_json(group, again), stamped);
   }
+  EXPECT_EQ(rules, expected_rules);  // a new rule is walked here too
+}
+
+TEST(RequestTree, EveryRuleIsEnforcedAtBothDoorsInTheirOwnSpelling) {
+  const Tree<exporter::Options>& tree = exporter::request_tree();
+  walk_rules(tree, [&](const std::vector<Setting<exporter::Options>>& settings, const std::string& expected) {
+    auto manifest = from_scene_keys(tree, settings);
+    ASSERT_FALSE(manifest);
+    EXPECT_EQ(manifest.error().message, expected);
+    EXPECT_EQ(manifest.error().path.rfind("/p/assets.toml:", 0), 0u) << manifest.error().path;
+  }, 39);
+}
+
+// bake-ao's tree: the same groups as export's (so a manifest scene reaches each), its flags unprefixed,
+// each parameter reaching the request and each rule enforced in its spelling.
+TEST(RequestTree, BakeAosTreeIsExportsGroupsWithItsOwnFlags) {
+  const Tree<bake_ao::Options>& tree = bake_ao::request_tree();
+  const Tree<exporter::Options>& scene = exporter::request_tree();
+  for (const Branch<bake_ao::Options>& b : tree) {
+    EXPECT_TRUE(std::any_of(scene.begin(), scene.end(), [&](const Branch<exporter::Options>& s) { return s.specs == b.specs; }));
+    EXPECT_EQ(b.flag_prefix, "");
+  }
+  for (std::size_t b = 0; b < tree.size(); ++b) {
+    for (const Spec* spec : tree[b].specs) {
+      SCOPED_TRACE(spec->name);
+      auto cli = from_flags(tree, with_needs(tree, b, spec));
+      ASSERT_TRUE(cli) << cli.error().to_string();
+      EXPECT_NE(tree[b].values(*cli).at(spec->name), tree[b].values(bake_ao::Options{}).at(spec->name));
+    }
+  }
+  walk_rules(tree, [](const auto&, const std::string&) {}, 39);
 }
 
 // A request made by the command line from one parameter at its example (a flag on by default
@@ -155,29 +303,6 @@ TEST(ValidateParams, EveryParameterReachesTheMaterialsValidationFromBothDoors) {
     EXPECT_EQ(to_json(group, from_flags), to_json(group, m->materials[0].validation.options));
     EXPECT_NE(to_json(group, from_flags).at(p.spec.name), defaults.at(p.spec.name));
   }
-}
-
-// A group whose keys a manifest scene holds directly: each parameter at its example through the
-// command line's flags and the scene's key, the two requests' stamps equal and not the default's.
-template <class T, class Of>
-void walk_scene_keys(const Group<T>& group, Of of) {
-  const nlohmann::json defaults = to_json(group, T{});
-  for (const Param<T>& p : group.params) {
-    SCOPED_TRACE(p.spec.name);
-    const T from_flags = from_example_flag(group, p);
-    auto m = pipeline::parse_manifest("[scenes.s]\ninput = \"s.gltf\"\n" + p.spec.name + " = " + test::toml_literal(p.spec) + "\n",
-                                      "/p/assets.toml");
-    ASSERT_TRUE(m) << m.error().to_string();
-    EXPECT_EQ(to_json(group, from_flags), to_json(group, of(m->scenes[0])));
-    EXPECT_NE(to_json(group, from_flags).at(p.spec.name), defaults.at(p.spec.name));
-  }
-}
-
-TEST(SceneParams, EveryExportAndEncodingParameterReachesTheSceneFromBothDoors) {
-  walk_scene_keys(exporter::options_params(), [](const pipeline::SceneSpec& s) { return s.options; });
-  walk_scene_keys(image::encoding_params(), [](const pipeline::SceneSpec& s) { return s.options.encoding; });
-  walk_scene_keys(image::gltf_texture_params(), [](const pipeline::SceneSpec& s) { return s.options.encoding; });
-  walk_scene_keys(delivery::options_params(), [](const pipeline::SceneSpec& s) { return s.options.delivery; });
 }
 
 // A material's options: each at its example through the flags, a material's key and the manifest's
@@ -265,14 +390,15 @@ TEST(MaterialParams, AnOlderFlagWorksAsTheNewOne) {
 }
 
 TEST(AoParams, OlderManifestKeysAreReadWithANote) {
-  auto m = pipeline::parse_manifest("[scenes.s]\ninput = \"s.gltf\"\nao = { distance = 0.1, absolute_distance = 2 }\n",
+  auto m = pipeline::parse_manifest("[scenes.s]\ninput = \"s.gltf\"\nao = { distance = 0.1 }\n"
+                                    "[scenes.t]\ninput = \"s.gltf\"\nao = { absolute_distance = 2 }\n",
                                     "/p/assets.toml");
   ASSERT_TRUE(m) << m.error().to_string();
   EXPECT_DOUBLE_EQ(m->scenes[0].options.ao->options.relative_distance, 0.1);
-  EXPECT_DOUBLE_EQ(m->scenes[0].options.ao->options.absolute_distance, 2);
+  EXPECT_DOUBLE_EQ(m->scenes[1].options.ao->options.absolute_distance, 2);
   EXPECT_EQ(m->notes, (std::vector<std::string>{
-                          "/p/assets.toml:3:24: scenes.s.ao.absolute_distance is now called max_distance (the old name still works)",
-                          "/p/assets.toml:3:8: scenes.s.ao.distance is now called relative_distance (the old name still works)"}));
+                          "/p/assets.toml:3:8: scenes.s.ao.distance is now called relative_distance (the old name still works)",
+                          "/p/assets.toml:6:8: scenes.t.ao.absolute_distance is now called max_distance (the old name still works)"}));
 }
 
 // Each docs table made from a description stands between markers; MATBAKE_WRITE_DOCS=1 writes it.

@@ -7,5 +7,8 @@
 namespace matbake::exporter {
 
 const params::Group<Options>& options_params();
+// Everything an export (and a manifest scene) is asked: the glTF's textures (encoding, format),
+// export's own options, delivery and AO (the "ao" table; on the command line --ao-*).
+const params::Tree<Options>& request_tree();
 
 }  // namespace matbake::exporter

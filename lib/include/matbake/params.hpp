@@ -23,6 +23,12 @@
 
 namespace matbake::params {
 
+// A parameter another one applies with, and (when not empty) the value it must have.
+struct Condition {
+  std::string name;
+  std::string value;
+};
+
 // A value as a door gives it: the command line's text is turned into one by from_text, a
 // manifest's TOML value by its type.
 using Value = std::variant<bool, std::int64_t, double, std::string>;
@@ -47,11 +53,10 @@ struct Spec {
   std::string example;               // a value other than the default, as a flag takes it
   std::vector<std::string> aliases;  // older manifest keys, still read, with a note
   // Rules across parameters, run at both doors by check_rules with one message each (a door only
-  // spells the names): `needs` is the parameter this one applies with (texcoord: texture), in its
-  // own group or another of the request; with `needs_value`, only where that one has this value
-  // (colour_codec: texture_format = ktx2). `excludes`: parameters it cannot be given with.
-  std::string needs;
-  std::string needs_value;
+  // spells the names): `needs` are the parameters this one applies with, in its own group or
+  // another of the request: given (texcoord: texture), or set to a value (colour_quality:
+  // texture_format = ktx2, colour_codec = etc1s). `excludes`: parameters it cannot be given with.
+  std::vector<Condition> needs;
   std::vector<std::string> excludes;
   bool manifest_only = false;        // a manifest key with no flag (a build's own setting)
   // Read only where a material's own textures are written (bits, format), not where its maps are
@@ -157,6 +162,99 @@ template <class T>
 Status finish(const Group<T>& group, const T& target, const std::set<std::string>& given, const Spelling& spell) {
   if (auto broken = check_rules({state_of(group, target, given)}, spell)) return Error{"", broken->message, true};
   return group.check(target);
+}
+
+// --- A request's tree: its groups, each over the part of the request it fills -----------------------
+
+// One group of a request, over the request struct `Root`: its parameters (in the manifest either
+// among the entry's own keys or in a sub-table, on the command line with a prefix) and how to reach
+// the struct they fill. The doors, the rules, the stamps' and --json's options and the docs walk it.
+template <class Root>
+struct Branch {
+  std::string table;        // a manifest sub-table ("ao" for ao = { ... }), or "" for the entry's own keys
+  std::string flag_prefix;  // "ao-" where the command line prefixes them (export's --ao-samples)
+  std::vector<const Spec*> specs;
+  // Checks the value and stores it in the root (reaching an optional part makes it: AO is on).
+  std::function<std::optional<std::string>(Root&, const Spec&, const Value&)> apply;
+  std::function<nlohmann::json(const Root&)> values;  // to_json of its part (defaults when unmade)
+  std::function<bool(const Root&)> made;              // whether its part is in the request
+  std::function<Status(const Root&)> check;           // the group's own rules (when made)
+};
+
+template <class Root>
+using Tree = std::vector<Branch<Root>>;
+
+// A group as a branch of `Root`: `part(root)` gives the struct it fills (called with a Root& or a
+// const Root&); `made(root)` whether it is in the request (always, unless an optional part).
+template <class Root, class T, class Part>
+Branch<Root> branch(const Group<T>& group, std::string table, std::string flag_prefix, Part part,
+                    std::function<bool(const Root&)> made = [](const Root&) { return true; }) {
+  Branch<Root> b{std::move(table), std::move(flag_prefix), group.specs(), {}, {}, made, {}};
+  b.apply = [&group, part](Root& root, const Spec& spec, const Value& value) -> std::optional<std::string> {
+    return apply(*group.find(spec.name), part(root), value);
+  };
+  b.values = [&group, part, made](const Root& root) { return made(root) ? to_json(group, part(root)) : to_json(group, T{}); };
+  b.check = [&group, part, made](const Root& root) { return made(root) ? group.check(part(root)) : success(); };
+  return b;
+}
+
+// An optional part of a request (exporter::Options::ao): made by the first of its parameters given.
+template <class Root, class T>
+struct OptionalPart {
+  std::optional<T> Root::*member;
+  T& operator()(Root& r) const { return (r.*member) ? *(r.*member) : (r.*member).emplace(); }
+  const T& operator()(const Root& r) const { return *(r.*member); }
+};
+
+template <class Root, class T>
+Branch<Root> optional_branch(const Group<T>& group, std::string table, std::string flag_prefix,
+                             std::optional<T> Root::*member) {
+  return branch<Root>(group, std::move(table), std::move(flag_prefix), OptionalPart<Root, T>{member},
+                      [member](const Root& r) { return (r.*member).has_value(); });
+}
+
+// The branch a group is, by its table and prefix; null when none.
+template <class Root>
+const Branch<Root>* find_branch(const Tree<Root>& tree, std::string_view table) {
+  for (const Branch<Root>& b : tree) {
+    if (b.table == table) return &b;
+  }
+  return nullptr;
+}
+
+// Each branch's state for check_rules; `given[i]` the names the door gave branch i.
+template <class Root>
+std::vector<GroupState> states_of(const Tree<Root>& tree, const Root& root, const std::vector<std::set<std::string>>& given) {
+  std::vector<GroupState> states;
+  for (std::size_t i = 0; i < tree.size(); ++i) states.push_back({tree[i].specs, tree[i].values(root), given.at(i)});
+  return states;
+}
+
+// The rules across the tree's parameters, then each made branch's own: errors placed by the door
+// (`place` turns a broken rule or a branch's problem into its error).
+template <class Root>
+Status finish_tree(const Tree<Root>& tree, const Root& root, const std::vector<std::set<std::string>>& given,
+                   const Spelling& spell) {
+  if (auto broken = check_rules(states_of(tree, root, given), spell)) return Error{"", broken->message, true};
+  for (const Branch<Root>& b : tree) {
+    if (Status s = b.check(root); !s) return s;
+  }
+  return success();
+}
+
+// The request's options as --json and stamps show them: the entry's own keys flat, a table's
+// branch under its name (null when not made), sorted.
+template <class Root>
+nlohmann::json tree_json(const Tree<Root>& tree, const Root& root) {
+  nlohmann::json j = nlohmann::json::object();
+  for (const Branch<Root>& b : tree) {
+    if (b.table.empty()) {
+      j.update(b.values(root));
+    } else {
+      j[b.table] = b.made(root) ? b.values(root) : nlohmann::json(nullptr);
+    }
+  }
+  return j;
 }
 
 // The parameters `given` by a later door (the command line over a manifest) copied from its

@@ -50,7 +50,8 @@ Param<Request> into_attribute() {
             .kind = params::Kind::choice,
             .help = "Per-vertex values as COLOR_0 (multiplies the base colour in any viewer) or _AO (a float attribute)",
             .choices = {"COLOR_0", "_AO"},
-            .example = "_AO"};
+            .example = "_AO",
+            .excludes = {"texture"}};
   return {std::move(spec),
           [](Request& r, const Value& v) -> std::optional<std::string> {
             r.into = *into_from_names(std::get<std::string>(v), into_existing_colors_name(r.into));
@@ -64,7 +65,9 @@ Param<Request> existing_colors() {
             .kind = params::Kind::choice,
             .help = "With COLOR_0, a primitive's own COLOR_0: multiply (kept, times AO; alpha kept) or replace",
             .choices = {"multiply", "replace"},
-            .example = "replace"};
+            .example = "replace",
+            .needs = {{"into", "COLOR_0"}},
+            .excludes = {"texture"}};
   return {std::move(spec),
           [](Request& r, const Value& v) -> std::optional<std::string> {
             if (r.into != Into::attribute) r.into = *into_from_names("COLOR_0", std::get<std::string>(v));
@@ -79,7 +82,7 @@ Param<Request> existing_occlusion() {
             .help = "A material's own occlusion texture: multiply (times the bake) or replace",
             .choices = {"multiply", "replace"},
             .example = "replace",
-            .needs = "texture"};
+            .needs = {{"texture"}}};
   return {std::move(spec),
           [](Request& r, const Value& v) -> std::optional<std::string> {
             texture_of(r).multiply_existing = std::get<std::string>(v) == "multiply";
@@ -90,7 +93,7 @@ Param<Request> existing_occlusion() {
 
 Param<Request> bits() {
   auto p = params::integer<Request>(Spec{.name = "bits", .help = "Linear PNG bits of the texture: 8 or 16", .min = 8,
-                                         .max = 16, .example = "16", .needs = "texture"},
+                                         .max = 16, .example = "16", .needs = {{"texture"}}},
                                     [](auto& r) -> auto& { return texture_of(r).bits; });
   const auto store = p.set;
   p.set = [store](Request& r, const Value& v) -> std::optional<std::string> {
@@ -108,7 +111,7 @@ params::Group<Request> make_group() {
                                [](auto& r) -> auto& { return r.options.samples; }),
       params::number<Request>(Spec{.name = "relative_distance", .help = "d_max as a fraction of the scene radius",
                                    .min = 0, .max = kUnbounded, .above_min = true, .example = "0.1",
-                                   .aliases = {"distance"}},
+                                   .aliases = {"distance"}, .excludes = {"max_distance"}},
                               [](auto& r) -> auto& { return r.options.relative_distance; }),
       params::number<Request>(Spec{.name = "max_distance",
                                    .help = "d_max in scene units, instead of the relative distance (0: unset)",
@@ -155,17 +158,17 @@ params::Group<Request> make_group() {
       texture_size(),
       params::integer<Request>(Spec{.name = "texcoord",
                                     .help = "UV set of the texture (-1: the material's occlusionTexture texCoord, else 0)",
-                                    .min = -1, .max = 255, .example = "0", .needs = "texture"},
+                                    .min = -1, .max = 255, .example = "0", .needs = {{"texture"}}},
                                [](auto& r) -> auto& { return texture_of(r).texcoord; }),
       params::integer<Request>(Spec{.name = "padding",
                                     .help = "Texels around the UV islands that take the nearest island texel's value "
                                             "(-1: 16 at 1024, scaled)",
-                                    .min = -1, .max = kMaxTextureSide, .example = "2", .needs = "texture"},
+                                    .min = -1, .max = kMaxTextureSide, .example = "2", .needs = {{"texture"}}},
                                [](auto& r) -> auto& { return texture_of(r).size.padding; }),
       params::integer<Request>(Spec{.name = "texel_samples",
                                     .help = "Surface points per texel, stratified over its footprint; the rays are "
                                             "shared among them",
-                                    .min = 1, .max = kMaxSamples, .example = "2", .needs = "texture"},
+                                    .min = 1, .max = kMaxSamples, .example = "2", .needs = {{"texture"}}},
                                [](auto& r) -> auto& { return texture_of(r).size.texel_samples; }),
       bits(),
       existing_occlusion(),
@@ -173,7 +176,7 @@ params::Group<Request> make_group() {
                                  .help = "A mesh placed by several nodes: each placement its own material copy and "
                                          "texture (default: averaged)",
                                  .example = "true",
-                                 .needs = "texture"},
+                                 .needs = {{"texture"}}},
                             [](auto& r) -> auto& { return texture_of(r).per_instance; }),
   };
   g.check = [](const Request& r) -> Status {

@@ -27,27 +27,31 @@ void add_class(std::vector<Param<Options>>& out, TextureClass c) {
                            : c == TextureClass::data ? "data textures (metallic-roughness, occlusion, ORM)"
                                                      : "normal maps";
   const auto field = [c](auto member) { return [c, member](auto& o) -> auto& { return o.of(c).*member; }; };
+  // Codec settings act only in KTX2, each only under its codec.
+  const params::Condition ktx2{"texture_format", "ktx2"};
+  const auto under = [&](Codec codec) { return std::vector<params::Condition>{ktx2, {name + "_codec", std::string(name_in(kCodecNames, codec))}}; };
   out.push_back(params::choice<Options>(Spec{.name = name + "_codec",
-                                             .help = "Codec of " + what + " with --texture-format ktx2: etc1s, uastc, or png "
+                                             .help = "Codec of " + what + " in KTX2: etc1s, uastc, or png "
                                                      "(kept as PNG)",
-                                             .example = c == TextureClass::colour ? "uastc" : "etc1s"},
+                                             .example = c == TextureClass::colour ? "uastc" : "etc1s",
+                                             .needs = {ktx2}},
                                         field(&ClassOptions::codec), kCodecNames));
   out.push_back(params::integer<Options>(Spec{.name = name + "_quality", .help = "ETC1S quality of " + what + " (basisu -q)",
-                                              .min = 1, .max = 255, .example = "200"},
+                                              .min = 1, .max = 255, .example = "200", .needs = under(Codec::etc1s)},
                                          field(&ClassOptions::quality)));
   out.push_back(params::integer<Options>(Spec{.name = name + "_uastc_level",
                                               .help = "UASTC encoding level of " + what + " (basisu -uastc_level; higher: "
                                                       "slower, closer)",
-                                              .min = 0, .max = 4, .example = "3"},
+                                              .min = 0, .max = 4, .example = "3", .needs = under(Codec::uastc)},
                                          field(&ClassOptions::uastc_level)));
   out.push_back(params::number<Options>(Spec{.name = name + "_uastc_rdo",
                                              .help = "UASTC rate-distortion λ of " + what + " (basisu -uastc_rdo_l): higher "
                                                      "compresses better under zstd, with more error; 0 off",
-                                             .min = 0, .max = 100, .example = "1"},
+                                             .min = 0, .max = 100, .example = "1", .needs = under(Codec::uastc)},
                                         field(&ClassOptions::uastc_rdo)));
   out.push_back(params::integer<Options>(Spec{.name = name + "_zstd",
                                               .help = "zstd supercompression level of UASTC " + what + "; 0 none",
-                                              .min = 0, .max = 22, .example = "6"},
+                                              .min = 0, .max = 22, .example = "6", .needs = under(Codec::uastc)},
                                          field(&ClassOptions::zstd)));
   out.push_back(optional_integer(Spec{.name = name + "_max_size",
                                       .help = "Longest side of " + what + " at most this many texels (any texture "
@@ -76,13 +80,15 @@ const params::Group<Options>& options_params() {
                                                     .example = "box"},
                                                [](auto& o) -> auto& { return o.filter; }, kFilterNames));
     g.params.push_back(params::flag<Options>(Spec{.name = "mipmaps",
-                                                  .help = "Give KTX2 textures a full mip chain (--no-mipmaps: level 0 only)",
-                                                  .example = "false"},
+                                                  .help = "Give KTX2 textures a full mip chain (false: level 0 only)",
+                                                  .example = "false",
+                                                  .needs = {{"texture_format", "ktx2"}}},
                                              [](auto& o) -> auto& { return o.mipmaps; }));
     g.params.push_back(params::flag<Options>(Spec{.name = "png_fallback",
                                                   .help = "Keep each KTX2 texture's PNG as its core source, so that "
                                                           "KHR_texture_basisu is used but not required",
-                                                  .example = "true"},
+                                                  .example = "true",
+                                                  .needs = {{"texture_format", "ktx2"}}},
                                              [](auto& o) -> auto& { return o.png_fallback; }));
     g.params.push_back(params::number<Options>(Spec{.name = "texel_density",
                                                     .help = "Size each texture for this many texels per scene unit, from the "

@@ -1,3 +1,4 @@
+#include "matbake/join.hpp"
 #include "matbake/export.hpp"
 
 #include <algorithm>
@@ -377,13 +378,13 @@ struct Exporter {
 // The index of the material named `name` (or given as a number), or an error listing the names.
 Result<int> material_index(const gltf::Document& doc, const std::string& name) {
   const std::size_t count = doc.json.contains("materials") ? doc.json["materials"].size() : 0;
-  std::string names;
+  std::vector<std::string> names;
   for (std::size_t i = 0; i < count; ++i) {
     const std::string n = gltf::name_in(doc.json["materials"][i], "");
     if (n == name || std::to_string(i) == name) return int(i);
-    names += (names.empty() ? "" : ", ") + (n.empty() ? std::to_string(i) : n);
+    names.push_back(n.empty() ? std::to_string(i) : n);
   }
-  return Error{doc.file, "no material '" + name + "' in the scene" + (names.empty() ? "" : " (it has: " + names + ")"), true};
+  return Error{doc.file, "no material '" + name + "' in the scene" + (names.empty() ? "" : " (it has: " + join(names, ", ") + ")"), true};
 }
 
 // Every texCoord a material's textures use must exist on every primitive drawing with it.

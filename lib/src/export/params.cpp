@@ -1,5 +1,9 @@
 #include "matbake/export_params.hpp"
 
+#include "matbake/ao_params.hpp"
+#include "matbake/delivery_params.hpp"
+#include "matbake/encoding_params.hpp"
+
 namespace matbake::exporter {
 
 const params::Group<Options>& options_params() {
@@ -22,6 +26,17 @@ const params::Group<Options>& options_params() {
                             [](auto& o) -> auto& { return o.pack_orm; }),
   }};
   return group;
+}
+
+const params::Tree<Options>& request_tree() {
+  static const params::Tree<Options> tree{
+      params::branch<Options>(image::encoding_params(), "", "", [](auto& o) -> auto& { return o.encoding; }),
+      params::branch<Options>(image::gltf_texture_params(), "", "", [](auto& o) -> auto& { return o.encoding; }),
+      params::branch<Options>(options_params(), "", "", [](auto& o) -> auto& { return o; }),
+      params::branch<Options>(delivery::options_params(), "", "", [](auto& o) -> auto& { return o.delivery; }),
+      params::optional_branch<Options>(ao::request_params(), "ao", "ao-", &Options::ao),
+  };
+  return tree;
 }
 
 }  // namespace matbake::exporter

@@ -1,3 +1,4 @@
+#include "matbake/join.hpp"
 #include "matbake/read_file.hpp"
 #include "matbake/material_table.hpp"
 #include "matbake/near_names.hpp"
@@ -151,8 +152,7 @@ std::vector<std::string> near_names(const std::vector<Material>& table, std::str
 
 Result<const Material*> lookup(const std::vector<Material>& table, std::string_view name) {
   if (const Material* m = find(table, name)) return m;
-  std::string near;
-  for (const std::string& n : near_names(table, name)) near += (near.empty() ? "" : ", ") + n;
+  const std::string near = join(near_names(table, name), ", ");
   return Error{"", "unknown material '" + std::string(name) + "'" +
                        (near.empty() ? " (`matbake materials` lists them)" : "; near: " + near), true};
 }

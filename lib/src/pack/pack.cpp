@@ -1,3 +1,4 @@
+#include "matbake/join.hpp"
 #include "matbake/pack.hpp"
 
 #include <nlohmann/json.hpp>
@@ -243,9 +244,7 @@ Result<ResolvedLayout> resolve_layout(const std::string& reference, const fs::pa
   std::error_code ec;
   if (reference.empty() || !fs::is_regular_file(file, ec)) {
     const std::vector<std::string> presets = builtin_layout_names();
-    std::string names;
-    for (const std::string& n : presets) names += (names.empty() ? "" : ", ") + n;
-    return Error{"", "layout '" + reference + "': no preset of that name (presets: " + names +
+    return Error{"", "layout '" + reference + "': no preset of that name (presets: " + join(presets, ", ") +
                          did_you_mean(reference, presets) + ") and no layout file " + file.string(), true};
   }
   std::string text;
@@ -568,9 +567,9 @@ Result<std::vector<fs::path>> output_paths(const Layout& layout, const std::vect
     return paths;
   }
   if (outputs.size() == layout.textures.size()) return std::vector<fs::path>(outputs.begin(), outputs.end());
-  std::string names;
-  for (const Texture& t : layout.textures) names += (names.empty() ? "" : ", ") + t.name;
-  return Error{"", "layout " + layout.name + " writes " + std::to_string(layout.textures.size()) + " textures (" + names +
+  std::vector<std::string> names;
+  for (const Texture& t : layout.textures) names.push_back(t.name);
+  return Error{"", "layout " + layout.name + " writes " + std::to_string(layout.textures.size()) + " textures (" + join(names, ", ") +
                        "): give as many outputs, or one path with {texture}", true};
 }
 

@@ -1,3 +1,4 @@
+#include "matbake/join.hpp"
 #include "matbake/params.hpp"
 
 #include <charconv>
@@ -73,15 +74,14 @@ std::optional<RuleBreak> check_rules(const std::vector<GroupState>& groups, cons
           return RuleBreak{g, spec->name, self + " and " + spell(o->group, *o->spec, nullptr) + " cannot be given together"};
         }
       }
-      if (spec->needs.empty()) continue;
-      const auto needed = find(g, spec->needs);
-      if (!needed) continue;
-      if (spec->needs_value.empty()) {
-        if (!groups[needed->group].given.count(spec->needs)) {
-          return RuleBreak{g, spec->name, self + " applies only with " + spell(needed->group, *needed->spec, nullptr) + " as well"};
+      for (const Condition& c : spec->needs) {
+        const auto needed = find(g, c.name);
+        if (!needed) continue;
+        const GroupState& in = groups[needed->group];
+        if (c.value.empty() ? !in.given.count(c.name) : value_text(in.values.value(c.name, nlohmann::json())) != c.value) {
+          return RuleBreak{g, spec->name, self + " applies only with " + spell(needed->group, *needed->spec, c.value.empty() ? nullptr : &c.value) +
+                                              (c.value.empty() ? " as well" : "")};
         }
-      } else if (value_text(groups[needed->group].values.value(spec->needs, nlohmann::json())) != spec->needs_value) {
-        return RuleBreak{g, spec->name, self + " applies only with " + spell(needed->group, *needed->spec, &spec->needs_value)};
       }
     }
   }
@@ -180,6 +180,14 @@ std::string value_text(const nlohmann::json& value) {
   return value.dump();
 }
 
+// The docs' words for a parameter's rules: " (with `texture`; not with `into`)".
+std::string rules_text(const Spec& spec) {
+  std::vector<std::string> parts;
+  for (const Condition& c : spec.needs) parts.push_back("with `" + c.name + (c.value.empty() ? "" : " = " + c.value) + "`");
+  for (const std::string& other : spec.excludes) parts.push_back("not with `" + other + "`");
+  return parts.empty() ? "" : " (" + join(parts, "; ") + ")";
+}
+
 std::string markdown_table(const std::vector<const Spec*>& specs, const nlohmann::json& defaults,
                            std::string_view flag_prefix) {
   std::string out = "| flag | manifest key | type | default | what it does |\n|---|---|---|---|---|\n";
@@ -189,8 +197,7 @@ std::string markdown_table(const std::vector<const Spec*>& specs, const nlohmann
     const bool off_flag = s->kind == Kind::flag && d.is_boolean() && d.get<bool>();
     const std::string flag = flag_name(*s, flag_prefix);
     const std::string shown_flag = s->manifest_only ? "—" : "`" + (off_flag ? "--no-" + flag.substr(2) : flag) + "`";
-    out += "| " + shown_flag + " | `" + s->name + "` | " + type_text(*s) + " | " + shown + " | " +
-           s->help + (s->needs.empty() ? "" : " (with `" + s->needs + "`)") +
+    out += "| " + shown_flag + " | `" + s->name + "` | " + type_text(*s) + " | " + shown + " | " + s->help + rules_text(*s) +
            (s->aliases.empty() ? "" : "; older key: `" + s->aliases.front() + "`") + " |\n";
   }
   return out;

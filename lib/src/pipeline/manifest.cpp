@@ -7,6 +7,7 @@
 #include <set>
 #include <sstream>
 
+#include "matbake/join.hpp"
 #include "matbake/ao_params.hpp"
 #include "matbake/cluster.hpp"
 #include "matbake/delivery_params.hpp"
@@ -49,10 +50,8 @@ struct Reader {
     for (const auto& [key, value] : table) {
       if (std::find(keys.begin(), keys.end(), key.str()) != keys.end()) continue;
       const std::string near = did_you_mean(key.str(), keys);
-      std::string list;
-      for (const std::string& k : keys) list += (list.empty() ? "" : ", ") + k;
       return at(key.source(), "unknown key '" + std::string(key.str()) + "' in " + where +
-                                  (near.empty() ? " (known: " + list + ")" : near));
+                                  (near.empty() ? " (known: " + join(keys, ", ") + ")" : near));
     }
     return success();
   }
@@ -144,15 +143,20 @@ Status read_params_in(const Reader& r, const toml::table& t, const std::string& 
   return success();
 }
 
-// The keys a group describes, with their older names: for a table that holds other keys too.
-template <class T>
-std::vector<std::string> keys_of(const params::Group<T>& group) {
+// The keys parameters are read from, with their older names.
+std::vector<std::string> keys_of(const std::vector<const params::Spec*>& specs) {
   std::vector<std::string> keys;
-  for (const params::Spec* spec : group.specs()) {
+  for (const params::Spec* spec : specs) {
     keys.push_back(spec->name);
     keys.insert(keys.end(), spec->aliases.begin(), spec->aliases.end());
   }
   return keys;
+}
+
+// The keys a group describes: for a table that holds other keys too.
+template <class T>
+std::vector<std::string> keys_of(const params::Group<T>& group) {
+  return keys_of(group.specs());
 }
 
 template <class T>
@@ -168,6 +172,66 @@ Status read_params(const Reader& r, const toml::table& t, const std::string& whe
                    T& target, std::vector<std::string>& notes) {
   if (Status s = r.known_keys(t, where, keys_of(group)); !s) return s;
   return read_params_in(r, t, where, group, target, notes);
+}
+
+// The manifest keys of a request tree's entry: its plain branches' keys (with older names) and the
+// names of its tables.
+template <class Root>
+std::vector<std::string> keys_of_tree(const params::Tree<Root>& tree, std::vector<std::string> keys) {
+  for (const params::Branch<Root>& b : tree) {
+    const std::vector<std::string> own = b.table.empty() ? keys_of(b.specs) : std::vector<std::string>{b.table};
+    keys.insert(keys.end(), own.begin(), own.end());
+  }
+  return keys;
+}
+
+const params::Spec* spec_for_key(const std::vector<const params::Spec*>& specs, const std::string& key) {
+  for (const params::Spec* spec : specs) {
+    if (spec->name == key || std::find(spec->aliases.begin(), spec->aliases.end(), key) != spec->aliases.end()) return spec;
+  }
+  return nullptr;
+}
+
+// A request tree from an entry's table `t` (`where`: "scenes.s"): each plain branch from its own
+// keys, each table branch from its sub-table (which holds its keys only); then the rules across
+// the tree, in the manifest's spelling at the key at fault, and each branch's own.
+template <class Root>
+Status read_tree(const Reader& r, const toml::table& t, const std::string& where, const params::Tree<Root>& tree,
+                 Root& root, std::vector<std::string>& notes) {
+  std::vector<std::set<std::string>> given(tree.size());
+  std::vector<std::string> wheres;
+  std::vector<const toml::table*> tables;
+  for (std::size_t i = 0; i < tree.size(); ++i) {
+    const params::Branch<Root>& b = tree[i];
+    wheres.push_back(b.table.empty() ? where : where + "." + b.table);
+    const toml::node* node = b.table.empty() ? &static_cast<const toml::node&>(t) : t.get(b.table);
+    tables.push_back(node ? node->as_table() : nullptr);
+    if (node && !tables.back()) return r.at(*node, wheres[i] + " must be a table: " + b.table + " = { ... }");
+    if (!node) continue;
+    if (!b.table.empty()) {
+      if (Status s = r.known_keys(*tables[i], wheres[i], keys_of(b.specs)); !s) return s;
+    }
+    for (const auto& [key, value] : *tables[i]) {
+      const std::string name(key.str());
+      const params::Spec* spec = spec_for_key(b.specs, name);
+      if (!spec) continue;
+      if (name != spec->name) {
+        notes.push_back(r.origin(key.source()) + ": " + wheres[i] + "." + name + " is now called " + spec->name +
+                        " (the old name still works)");
+      }
+      auto v = toml_value(value);
+      std::optional<std::string> problem = v ? b.apply(root, *spec, *v) : v.error().message;
+      if (problem) return r.at(value, wheres[i] + "." + name + ": " + *problem);
+      given[i].insert(spec->name);
+    }
+  }
+  if (auto broken = params::check_rules(params::states_of(tree, root, given), key_spelling(wheres))) {
+    return r.at(node_or_table(*tables[broken->group], broken->name), broken->message);
+  }
+  for (std::size_t i = 0; i < tree.size(); ++i) {
+    if (Status s = tree[i].check(root); !s) return r.at(tables[i] ? *tables[i] : t, wheres[i] + ": " + s.error().message);
+  }
+  return success();
 }
 
 Status read_validation(const Reader& r, const toml::table& t, const std::string& where, ValidationRules& rules,
@@ -221,9 +285,11 @@ Status read_sources(const Reader& r, const toml::node& sources, const std::strin
   for (const auto& [key, value] : *sources.as_table()) {
     const std::string source(key.str());
     if (!material::find_source(source)) {
-      std::string known;
-      for (const material::Source& s : material::sources()) known += (known.empty() ? "" : ", ") + std::string(s.name);
-      return r.at(key.source(), where + ".sources: unknown source '" + source + "' (known: " + known + ")");
+      std::vector<std::string> known;
+      for (const material::Source& s : material::sources()) known.emplace_back(s.name);
+      const std::string near = did_you_mean(source, known);
+      return r.at(key.source(), where + ".sources: unknown source '" + source + "'" +
+                                    (near.empty() ? " (known: " + join(known, ", ") + ")" : near));
     }
     pack::SourceInput in{source, {}, {}};
     if (const toml::table* file = value.as_table()) {  // { file = "sg.png", channel = "a" }
@@ -428,30 +494,19 @@ Result<SceneSpec> read_scene(const Reader& r, const std::string& name, const tom
   const toml::table* t = node.as_table();
   if (!t) return r.at(node, where + " must be a table");
   if (!is_file_name_safe(name)) return r.at(node, "scene name '" + name + "': letters, digits, '_', '-' and '.' only");
-  if (Status s = r.known_keys(*t, where, with_keys_of(image::encoding_params(),
-                                                      with_keys_of(image::gltf_texture_params(),
-                                                                   with_keys_of(exporter::options_params(),
-                                                                                with_keys_of(delivery::options_params(),
-                                                                                             with_keys_of(scene_params(),
-                                                                                                          {"input", "output", "materials",
-                                                                                                           "ao"}))))));
+  if (Status s = r.known_keys(*t, where, with_keys_of(scene_params(), keys_of_tree(exporter::request_tree(), {"input", "output", "materials"})));
       !s) {
     return s.error();
   }
   SceneSpec spec;
-  spec.options.encoding = encoding;
-  for (Status s : {read_params_in(r, *t, where, image::encoding_params(), spec.options.encoding, notes),
-                   read_params_in(r, *t, where, image::gltf_texture_params(), spec.options.encoding, notes)}) {
-    if (!s) return s.error();
-  }
+  spec.options.encoding = encoding;  // the manifest's top level, which the scene may override
   spec.name = name;
   spec.origins.by_key[""] = r.origin(node.source());
   r.record(*t, "", spec.origins);
   std::string input, output = name + ".glb";
   for (Status s : {r.get(*t, "input", where, input), r.get(*t, "output", where, output),
                    read_params_in(r, *t, where, scene_params(), spec, notes),
-                   read_params_in(r, *t, where, exporter::options_params(), spec.options, notes),
-                   read_params_in(r, *t, where, delivery::options_params(), spec.options.delivery, notes)}) {
+                   read_tree(r, *t, where, exporter::request_tree(), spec.options, notes)}) {
     if (!s) return s.error();
   }
   if (input.empty()) return r.at(node, where + ": input = \"scene.gltf\" is required");
@@ -470,14 +525,6 @@ Result<SceneSpec> read_scene(const Reader& r, const std::string& name, const tom
       if (!target) return r.at(value, where + ".materials: a manifest material's name expected");
       spec.materials[std::string(key.str())] = *target;
     }
-  }
-  if (const toml::node* a = t->get("ao")) {
-    if (!a->is_table()) return r.at(*a, where + ".ao must be a table: ao = { samples = 64, ... }");
-    ao::Request request;
-    if (Status s = read_params(r, *a->as_table(), where + ".ao", ao::request_params(), request, notes); !s) {
-      return s.error();
-    }
-    spec.options.ao = request;
   }
   return spec;
 }

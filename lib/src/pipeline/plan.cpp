@@ -9,6 +9,7 @@
 
 #include "../gltf/document.hpp"
 #include "state.hpp"
+#include "matbake/join.hpp"
 #include "matbake/delivery.hpp"
 #include "matbake/encoding_params.hpp"
 #include "matbake/material_params.hpp"
@@ -400,13 +401,13 @@ Status check_side_outputs(const Manifest& manifest, const Plan& plan, std::span<
 }
 
 Result<std::string> depfile_text(const std::vector<fs::path>& targets, const std::vector<fs::path>& inputs) {
-  std::string text;
+  std::vector<std::string> words;
   for (const fs::path& t : targets) {
     auto path = depfile_path(t.native());
     if (!path) return path.error();
-    text += (text.empty() ? "" : " ") + *path;
+    words.push_back(*path);
   }
-  text += ":";
+  std::string text = join(words, " ") + ":";
   for (const fs::path& in : inputs) {
     auto path = depfile_path(in.native());
     if (!path) return path.error();

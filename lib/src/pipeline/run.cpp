@@ -10,6 +10,8 @@
 #include <mutex>
 #include <set>
 
+#include "matbake/join.hpp"
+#include "matbake/near_names.hpp"
 #include "matbake/atomic_file.hpp"
 #include "matbake/read_file.hpp"
 #include "matbake/pipeline.hpp"
@@ -366,9 +368,10 @@ Status finish_run(const Manifest& manifest, const Plan& plan, const RunOptions& 
 Result<Report> run(const Manifest& manifest, const Plan& plan, const RunOptions& options) {
   for (const std::string& name : options.only) {
     if (std::none_of(plan.jobs.begin(), plan.jobs.end(), [&](const Job& j) { return j.name == name; })) {
-      std::string names;
-      for (const Job& j : plan.jobs) names += (names.empty() ? "" : ", ") + j.name;
-      return Error{manifest.file.string(), "no job '" + name + "' (jobs: " + names + ")", true};
+      std::vector<std::string> names;
+      for (const Job& j : plan.jobs) names.push_back(j.name);
+      const std::string near = did_you_mean(name, names);
+      return Error{manifest.file.string(), "no job '" + name + "'" + (near.empty() ? " (jobs: " + join(names, ", ") + ")" : near), true};
     }
   }
   const StampRoots roots{plan.state_folder, manifest.folder, manifest.output};

@@ -147,13 +147,6 @@ nlohmann::json to_json(const bake_ao::TextureReport& t) {
           {"mean_ao", t.mean}};
 }
 
-nlohmann::json to_json(const exporter::Options& o) {
-  nlohmann::json j = params::to_json(exporter::options_params(), o);
-  j.update(params::to_json(image::encoding_params(), o.encoding));
-  j.update(params::to_json(image::gltf_texture_params(), o.encoding));
-  j.update(params::to_json(delivery::options_params(), o.delivery));
-  j["ao"] = o.ao ? to_json(*o.ao) : nlohmann::json(nullptr);
-  return j;
-}
+nlohmann::json to_json(const exporter::Options& o) { return params::tree_json(exporter::request_tree(), o); }
 
 }  // namespace matbake
