@@ -53,7 +53,7 @@ void add_output_dir_option(CLI::App& cmd, std::string& output_dir) {
 int run_status(const BuildSettings& s, const GlobalOptions& global, const pipeline::Manifest& manifest,
                const pipeline::Plan& plan) {
   auto statuses = pipeline::job_statuses(manifest, plan);
-  if (!statuses) return report_error(statuses.error());
+  if (!statuses) return report_error(statuses.error(), key_mention);
   std::map<pipeline::JobState, std::size_t> count;
   nlohmann::json jobs = nlohmann::json::array();
   for (const pipeline::JobStatus& st : *statuses) {
@@ -104,20 +104,20 @@ int run_slurm_plan(const PlanSettings& s, const GlobalOptions& global, pipeline:
   pipeline::RunOptions dry;
   dry.dry_run = true;
   auto report = pipeline::run(manifest, plan, dry);
-  if (!report) return report_error(report.error());
+  if (!report) return report_error(report.error(), key_mention);
   const auto submission = pipeline::slurm_submission(
       plan, *report, manifest.cluster,
       [&](const pipeline::Job& job) { return pipeline::job_footprint(job, manifest, int(manifest.cluster.cpus)); });
   const pipeline::SlurmTarget target{fs::absolute(s.output).lexically_normal(), self};
   auto lines = pipeline::sbatch_lines(submission, manifest.cluster, target);
   auto scripts = pipeline::slurm_scripts(manifest, submission, manifest.cluster, target);
-  if (!lines || !scripts) return report_error(!lines ? lines.error() : scripts.error());
+  if (!lines || !scripts) return report_error(!lines ? lines.error() : scripts.error(), key_mention);
   if (s.dry_run) {
     if (!global.json) {
       for (const std::string& line : *lines) std::printf("%s\n", line.c_str());
     }
   } else if (Status st = write_slurm_scripts(manifest, plan, *scripts, target.folder); !st) {
-    return report_error(st.error());
+    return report_error(st.error(), key_mention);
   }
   if (global.json) {
     nlohmann::json doc = {{"command", "plan"}, {"format", "slurm"}, {"folder", target.folder}, {"dry_run", s.dry_run},
@@ -193,15 +193,15 @@ CLI::App* setup_plan(CLI::App& app, PlanSettings& s) {
 int run_plan(const PlanSettings& s, const GlobalOptions& global) {
   pipeline::Manifest manifest;
   auto plan = load(s.manifest, s.output_dir, manifest);
-  if (!plan) return report_error(plan.error());
+  if (!plan) return report_error(plan.error(), key_mention);
   std::error_code ec;
   const fs::path self = s.matbake.empty() ? fs::read_symlink("/proc/self/exe", ec) : fs::absolute(s.matbake);
   if (s.format == "slurm") return run_slurm_plan(s, global, manifest, *plan, self);
   const NamedOutput ninja_file[] = {{fs::absolute(s.output).lexically_normal(), "-o"}};
-  if (Status st = pipeline::check_side_outputs(manifest, *plan, ninja_file); !st) return report_error(st.error());
+  if (Status st = pipeline::check_side_outputs(manifest, *plan, ninja_file); !st) return report_error(st.error(), key_mention);
   auto text = pipeline::ninja_text(manifest, *plan, self, ninja_file[0].path);
-  if (!text) return report_error(text.error());
-  if (Status st = write_file_atomically(ninja_file[0].path, *text); !st) return report_error(st.error());
+  if (!text) return report_error(text.error(), key_mention);
+  if (Status st = write_file_atomically(ninja_file[0].path, *text); !st) return report_error(st.error(), key_mention);
   if (global.json) {
     nlohmann::json jobs = nlohmann::json::array();
     for (const pipeline::Job& j : plan->jobs) jobs.push_back(j.name);
@@ -217,12 +217,12 @@ int run_build(const BuildSettings& s, const GlobalOptions& global) {
   const auto start = std::chrono::steady_clock::now();
   pipeline::Manifest manifest;
   auto plan = load(s.manifest, s.output_dir, manifest);
-  if (!plan) return report_error(plan.error());
+  if (!plan) return report_error(plan.error(), key_mention);
   if (s.status) return run_status(s, global, manifest, *plan);
   const NamedOutput side_outputs[] = {{s.depfile, "--depfile"}, {s.stamp, "--stamp"}};
-  if (Status st = pipeline::check_side_outputs(manifest, *plan, side_outputs); !st) return report_error(st.error());
+  if (Status st = pipeline::check_side_outputs(manifest, *plan, side_outputs); !st) return report_error(st.error(), key_mention);
   if (!s.depfile.empty()) {
-    if (Status st = pipeline::check_depfile_paths(manifest, *plan); !st) return report_error(st.error());
+    if (Status st = pipeline::check_depfile_paths(manifest, *plan); !st) return report_error(st.error(), key_mention);
   }
   if (!global.quiet) {
     for (const std::string& w : plan->warnings) std::cerr << "matbake: warning: " << w << "\n";
@@ -253,13 +253,13 @@ int run_build(const BuildSettings& s, const GlobalOptions& global) {
   auto report = pipeline::run(manifest, *plan, options);
   bar.finish();
   quiet.restore();
-  if (!report) return report_error(report.error());
+  if (!report) return report_error(report.error(), key_mention);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const std::size_t failed = report->count(pipeline::Outcome::failed);
 
   if (!s.dry_run) {
     if (Status st = pipeline::write_build_tool_files(manifest, *report, s.depfile, s.stamp); !st) {
-      return report_error(st.error());
+      return report_error(st.error(), key_mention);
     }
   }
   if (global.json) {
@@ -309,7 +309,7 @@ int run_build(const BuildSettings& s, const GlobalOptions& global) {
                                          " read it; its outputs are from the earlier bytes (as its stamp records): build again"});
     }
   }
-  if (!report->stale.held_back.empty()) std::cerr << "matbake: error: " << s.manifest << ": " << report->stale.held_back << "\n";
+  if (!report->stale.held_back.empty()) std::cerr << "matbake: error: " << s.manifest << ": " << spell_mentions(report->stale.held_back, key_mention) << "\n";
   if (failed) {
     std::cerr << "matbake: error: " << s.manifest << ": " << failed << " of " << report->jobs.size() << " jobs failed\n";
     return kFailed;

@@ -3,6 +3,7 @@
 // library and prints. Exit codes: 0 ok, 1 bad input or failed work, 2 bad usage.
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <iostream>
 #include <set>
 #include <string>
@@ -31,9 +32,19 @@ struct GlobalOptions {
   std::string ocio_config;
 };
 
-// Prints `matbake: error: <path>: <problem>` and returns the exit code the error calls for.
-inline int report_error(const Error& error) {
-  std::cerr << "matbake: error: " << error.to_string() << "\n";
+// A setting a library message mentions, as a flag: "--texture-rounding multiple-of-4", "--prune".
+inline std::string flag_mention(const std::string& name, const std::string& value) {
+  std::string flag = "--" + name;
+  std::replace(flag.begin(), flag.end(), '_', '-');
+  if (value == "true") return flag;
+  if (value == "false") return "--no-" + flag.substr(2);
+  return value.empty() ? flag : flag + " " + value;
+}
+
+// Prints `matbake: error: <path>: <problem>` and returns the exit code the error calls for. The
+// settings it mentions are spelt as flags, or (`build`, `plan`: the manifest's door) as keys.
+inline int report_error(const Error& error, MentionSpelling spell = flag_mention) {
+  std::cerr << "matbake: error: " << error.to_string(spell) << "\n";
   return error.usage ? kUsage : kFailed;
 }
 

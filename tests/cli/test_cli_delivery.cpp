@@ -370,8 +370,15 @@ TEST(CliDelivery, BadSettingsAndAMissingEncoderAreOneErrorLineAndNothingIsWritte
                                  "--colour-max-size", "30"},
                                 {"MATBAKE_BASISU=" + basisu});
   EXPECT_EQ(odd.exit_code, 2) << odd.err;
-  expect_one_error_line(odd, in, "texture 0 (colour) would be 30x30: KTX2 (KHR_texture_basisu) needs sides of 1, 2 or a multiple of 4");
+  expect_one_error_line(odd, in, "texture 0 (colour) would be 30x30: KTX2 (KHR_texture_basisu) needs sides of 1, 2 or a multiple of 4; "
+                                 "use --texture-rounding multiple-of-4 or power-of-two");
   EXPECT_TRUE(!fs::exists(dir / "out") || list_folder(dir / "out").empty());
+  // The same library error in a build speaks the manifest's words.
+  std::ofstream(dir / "assets.toml") << "[scenes.s]\ninput = \"quad.gltf\"\ntexture_format = \"ktx2\"\ntexture_rounding = \"none\"\n"
+                                        "colour_max_size = 30\n";
+  const RunResult keys = matbake({"build", (dir / "assets.toml").string()}, {"MATBAKE_BASISU=" + basisu});
+  EXPECT_EQ(keys.exit_code, 1) << keys.err;
+  EXPECT_NE(keys.err.find("; use texture_rounding = \"multiple-of-4\" or power-of-two (scene:s)"), std::string::npos) << keys.err;
   // The manifest's door: the same checks at the key's line and column.
   std::ofstream(dir / "assets.toml") << "[scenes.s]\ninput = \"quad.gltf\"\ntexture_format = \"ktx2\"\ncolour_max_size = 0\n";
   const RunResult manifest = matbake({"build", (dir / "assets.toml").string(), "-n"});

@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <cstdlib>
+#include <regex>
+#include <sstream>
 
 #include "cli/params_cli.hpp"
 #include "matbake/ao_params.hpp"
@@ -436,6 +438,31 @@ TEST(DocsTables, MatchTheParameterDescriptions) {
     EXPECT_EQ(doc.substr(body, end - body), t.text) << t.file << " " << t.marker
                                                     << ": run MATBAKE_WRITE_DOCS=1 ctest -R DocsTables to write it";
   }
+}
+
+// The library names a setting by its parameter (mention()); only a door spells it. A string literal
+// in lib/src with "--name" in it is a flag written where a manifest user would read it too. Allowed:
+// the commands matbake writes for Ninja and Slurm (they run the command line), sbatch's own flags,
+// and the docs table's flag column.
+TEST(Sources, NoFlagIsSpeltInTheLibrarysMessages) {
+  const std::regex literal_with_flag(R"re("[^"]*--[a-z][^"]*")re");
+  std::size_t files = 0;
+  for (const auto& entry : fs::recursive_directory_iterator(fs::path(MATBAKE_SOURCE_DIR) / "lib/src")) {
+    if (entry.path().extension() != ".cpp" && entry.path().extension() != ".hpp") continue;
+    const std::string name = entry.path().filename().string();
+    if (name == "slurm.cpp") continue;  // writes sbatch and matbake command lines
+    ++files;
+    std::istringstream lines(test::read_bytes(entry.path()));
+    int number = 0;
+    for (std::string line; std::getline(lines, line);) {
+      ++number;
+      if (!std::regex_search(line, literal_with_flag) || line.find("sbatch") != std::string::npos) continue;
+      if (line.find("command = $matbake") != std::string::npos) continue;  // the Ninja rules' command lines
+      if (name == "params.cpp" && line.find("shown_flag") != std::string::npos) continue;  // the docs' flag column
+      ADD_FAILURE() << entry.path().string() << ":" << number << ": " << line;
+    }
+  }
+  EXPECT_GT(files, 50u);
 }
 
 }  // namespace

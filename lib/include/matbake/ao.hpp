@@ -21,16 +21,12 @@ namespace matbake::ao {
 
 enum class Falloff { exponential, none };
 inline constexpr NameTable<Falloff, 2> kFalloffNames{{{Falloff::exponential, "exponential"}, {Falloff::none, "none"}}};
-inline std::string_view falloff_name(Falloff f) { return name_in(kFalloffNames, f); }
-inline std::optional<Falloff> falloff_from_name(std::string_view name) { return value_in(kFalloffNames, name); }
 
 enum class Sampler {
   sobol,   // (0, 2)-sequence in base 2, XOR-scrambled per vertex: low discrepancy
   random,  // independent uniform pairs per vertex: for comparison
 };
 inline constexpr NameTable<Sampler, 2> kSamplerNames{{{Sampler::sobol, "sobol"}, {Sampler::random, "random"}}};
-inline std::string_view sampler_name(Sampler s) { return name_in(kSamplerNames, s); }
-inline std::optional<Sampler> sampler_from_name(std::string_view name) { return value_in(kSamplerNames, name); }
 
 // Every option of the estimator, with its default: `bake-ao`, `export --ao-*` and a manifest's
 // `ao = { ... }` fill this struct and nothing else decides a default.

@@ -38,10 +38,6 @@ struct MaterialMaps {
 enum class DielectricF0 { specular, ior, none };
 inline constexpr NameTable<DielectricF0, 3> kDielectricF0Names{
     {{DielectricF0::specular, "specular"}, {DielectricF0::ior, "ior"}, {DielectricF0::none, "none"}}};
-inline std::string_view dielectric_f0_name(DielectricF0 d) { return name_in(kDielectricF0Names, d); }
-inline std::optional<DielectricF0> dielectric_f0_from_name(std::string_view name) {
-  return value_in(kDielectricF0Names, name);
-}
 
 struct Options {
   std::vector<MaterialMaps> materials;

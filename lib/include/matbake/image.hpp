@@ -21,7 +21,6 @@ enum class SampleType { u8, u16, half, f32 };
 
 inline constexpr NameTable<SampleType, 4> kSampleTypeNames{
     {{SampleType::u8, "8"}, {SampleType::u16, "16"}, {SampleType::half, "half"}, {SampleType::f32, "float"}}};
-inline std::optional<SampleType> sample_type_from_name(std::string_view name) { return value_in(kSampleTypeNames, name); }
 inline std::string_view sample_type_name(SampleType type) { return name_in(kSampleTypeNames, type); }
 // An image size as text: "1024" (square) or "2048x1024" (also "X"); any positive or not, the caller
 // judges the range.

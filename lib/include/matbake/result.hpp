@@ -35,13 +35,52 @@ inline std::string escape_control(std::string_view text) {
   return out;
 }
 
+// A setting named in a library message: the library says which parameter (and value), the door that
+// shows the message spells it — "--texture-rounding multiple-of-4" on the command line,
+// `texture_rounding = "multiple-of-4"` in a manifest's words — so no flag is written in lib/.
+// Held in the text between control characters that the door replaces before escaping the rest.
+inline std::string mention(std::string_view name, std::string_view value = {}) {
+  std::string out = "\x02";
+  out.append(name);
+  if (!value.empty()) out.append("\x1f").append(value);
+  return out.append("\x03");
+}
+
+// How a door spells a mention: its parameter's name and value ("" when none).
+using MentionSpelling = std::string (*)(const std::string& name, const std::string& value);
+
+// The manifest's spelling, the default: `name = value`, the value quoted unless a number or true/false.
+inline std::string key_mention(const std::string& name, const std::string& value) {
+  if (value.empty()) return name;
+  const bool bare = value == "true" || value == "false" || value.find_first_not_of("0123456789.-") == std::string::npos;
+  return name + " = " + (bare ? value : "\"" + value + "\"");
+}
+
+// `text` with each mention spelt.
+inline std::string spell_mentions(std::string_view text, MentionSpelling spell) {
+  std::string out;
+  for (std::size_t at = 0; at < text.size();) {
+    const std::size_t start = text.find('\x02', at), end = start == std::string_view::npos ? start : text.find('\x03', start);
+    if (end == std::string_view::npos) return out.append(text.substr(at));
+    const std::string_view inner = text.substr(start + 1, end - start - 1);
+    const std::size_t split = std::min(inner.find('\x1f'), inner.size());
+    out.append(text.substr(at, start - at))
+        .append(spell(std::string(inner.substr(0, split)), std::string(inner.substr(std::min(split + 1, inner.size())))));
+    at = end + 1;
+  }
+  return out;
+}
+
 struct Error {
   std::string path;     // the file the problem is about; empty when it is about no file
-  std::string message;  // one line, lower case, no trailing period
+  std::string message;  // one line, lower case, no trailing period; settings in it as mention()s
   bool usage = false;   // the command was called wrongly (exit 2), rather than given bad input (exit 1)
 
-  // One line whatever the path and message hold.
-  std::string to_string() const { return escape_control(path.empty() ? message : path + ": " + message); }
+  // One line whatever the path and message hold, its mentions spelt as the door says.
+  std::string to_string(MentionSpelling spell = key_mention) const {
+    const std::string text = spell_mentions(message, spell);
+    return escape_control(path.empty() ? text : path + ": " + text);
+  }
 };
 
 template <class T>

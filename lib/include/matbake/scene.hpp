@@ -66,10 +66,6 @@ Result<Scene> load_scene(const std::filesystem::path& path, const SceneContent& 
 enum class NormalWeighting { equal, area, angle };
 inline constexpr NameTable<NormalWeighting, 3> kNormalWeightingNames{
     {{NormalWeighting::equal, "equal"}, {NormalWeighting::area, "area"}, {NormalWeighting::angle, "angle"}}};
-inline std::string_view normal_weighting_name(NormalWeighting w) { return name_in(kNormalWeightingNames, w); }
-inline std::optional<NormalWeighting> normal_weighting_from_name(std::string_view name) {
-  return value_in(kNormalWeightingNames, name);
-}
 struct NormalResult {
   std::vector<Vec3> normals;
   std::size_t fallbacks = 0;

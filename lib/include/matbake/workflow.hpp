@@ -51,9 +51,6 @@ inline constexpr RoughnessMapping kDefaultRoughnessMapping = RoughnessMapping::f
 inline constexpr NameTable<RoughnessMapping, 2> kRoughnessMappingNames{
     {{RoughnessMapping::fitted, "fitted"}, {RoughnessMapping::walter, "walter"}}};
 inline std::string_view roughness_mapping_name(RoughnessMapping m) { return name_in(kRoughnessMappingNames, m); }
-inline std::optional<RoughnessMapping> roughness_mapping_from_name(std::string_view name) {
-  return value_in(kRoughnessMappingNames, name);
-}
 // g in [0, 1] (clamped); both mappings are strictly decreasing in g, so each has an inverse for a
 // given F0 (the mean of the specular colour's channels; walter ignores it).
 double roughness_from_gloss(double gloss, RoughnessMapping mapping, double f0 = kDielectricF0);

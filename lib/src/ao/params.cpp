@@ -133,7 +133,7 @@ params::Group<Request> make_group() {
                                  .help = "Surfaces seen from behind occlude too (default: only their fronts)",
                                  .example = "true"},
                             [](auto& r) -> auto& { return r.options.two_sided; }),
-      params::integer<Request>(Spec{.name = "seed", .help = "Sample scrambling seed (same seed, same values, any --jobs)",
+      params::integer<Request>(Spec{.name = "seed", .help = "Sample scrambling seed (same seed, same values, any thread count)",
                                     .min = 0, .max = 9007199254740992.0, .example = "3"},
                                [](auto& r) -> auto& { return r.options.seed; }),
       params::choice<Request>(Spec{.name = "sampler", .help = "Directions: scrambled Sobol or independent random",

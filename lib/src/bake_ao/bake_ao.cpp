@@ -64,7 +64,7 @@ Result<Report> bake_file(const fs::path& input, const Options& options) {
     const std::optional<ao::TextureRequest>& texture = options.ao.texture;
     if (texture) {
       if (Status s = ao::check(*texture, options.ao.options); !s) return s.error();
-      if (!options.dump.empty()) return Error{options.dump.string(), "--dump holds per-vertex values; with --texture use --dump-texture", true};
+      if (!options.dump.empty()) return Error{options.dump.string(), mention("dump") + " holds per-vertex values; with " + mention("texture") + " use " + mention("dump_texture"), true};
       if (options.output.empty()) return Error{"", "a texture bake writes a glTF (-o)", true};
     }
     // Read once: the scene to bake and the document the values go into.

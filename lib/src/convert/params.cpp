@@ -20,7 +20,7 @@ const params::Group<Options>& options_params() {
                                    .example = "16"},
                               [](auto& o) -> auto& { return o.bits; }, image::kSampleTypeNames),
       params::text<Options>(Spec{.name = "format",
-                                 .help = "Output format with --out-dir (unset: exr for a linear target, else png)",
+                                 .help = "Output format of files written into a folder (unset: exr for a linear target, else png)",
                                  .choices = {"exr", "png", "tif"},
                                  .example = "tif"},
                             [](auto& o) -> auto& { return o.format; }),

@@ -308,7 +308,7 @@ Result<std::vector<TextureReport>> deliver_textures(gltf::Document& doc, gltf::I
     if (w.codec != Codec::png && !sides_fit_ktx2(w.size)) {
       return Error{doc.file, "texture " + std::to_string(texture) + " (" + w.name + ") would be " + std::to_string(w.size.width) +
                                  "x" + std::to_string(w.size.height) + ": KTX2 (KHR_texture_basisu) needs sides of 1, 2 or a "
-                                 "multiple of 4; use --texture-rounding multiple-of-4 or power-of-two", true};
+                                 "multiple of 4; use " + mention("texture_rounding", "multiple-of-4") + " or power-of-two", true};
     }
     work.push_back(std::move(w));
   }

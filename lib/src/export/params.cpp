@@ -15,13 +15,13 @@ const params::Group<Options>& options_params() {
                                    .example = "ior"},
                               [](auto& o) -> auto& { return o.dielectric_f0; }, kDielectricF0Names),
       params::choice<Options>(Spec{.name = "mapping",
-                                   .help = "Gloss → roughness of the glTF's own spec-gloss materials (and of --material "
-                                           "pairs; a manifest material brings its own)",
+                                   .help = "Gloss → roughness of the glTF's own spec-gloss materials (and of export's "
+                                           "Schüler pairs; a manifest material brings its own)",
                                    .example = "walter"},
                               [](auto& o) -> auto& { return o.mapping; }, workflow::kRoughnessMappingNames),
       params::flag<Options>(Spec{.name = "orm",
                                  .help = "Pack occlusion and metallic-roughness textures of a material into one ORM "
-                                         "texture (--no-orm keeps them apart)",
+                                         "texture (false keeps them apart)",
                                  .example = "false"},
                             [](auto& o) -> auto& { return o.pack_orm; }),
   }};

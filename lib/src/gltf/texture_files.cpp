@@ -105,7 +105,7 @@ Status ImageCache::check(std::size_t index) {
 Result<ImageCache::Made> ImageCache::add_image(Document& doc, const image::Image& img, color::Transfer colour,
                                                const std::string& name, image::SampleType type) const {
   if (webp() && type != image::SampleType::u8) {
-    return Error{doc.file, name + ": WebP holds 8 bits per channel; write 16-bit textures as PNG (--texture-format png)"};
+    return Error{doc.file, name + ": WebP holds 8 bits per channel; write 16-bit textures as PNG (" + mention("texture_format", "png") + ")"};
   }
   image::WriteOptions options;
   options.colour = colour;

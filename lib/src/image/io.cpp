@@ -474,7 +474,7 @@ Status check_image_size(const std::string& file, std::int64_t width, std::int64_
   // width ≤ limit first, so the product cannot overflow.
   if (std::uint64_t(width) > limit || std::uint64_t(height) > limit / std::uint64_t(width)) {
     return Error{file, std::to_string(width) + "x" + std::to_string(height) + " is more than the limit of " +
-                           std::to_string(limit) + " pixels (--max-pixels raises it)"};
+                           std::to_string(limit) + " pixels (" + mention("max_pixels") + " raises it)"};
   }
   return success();
 }

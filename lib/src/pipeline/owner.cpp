@@ -41,7 +41,7 @@ Status claim_output_folder(const Manifest& manifest, const Plan& plan, bool reco
     return Error{manifest.file.string(), "its output folder " + manifest.output.string() + " belongs to " +
                                              resolved_path(owner->manifest, manifest.output).string() + " (" + file.string() +
                                              "); two manifests building into one folder remove each other's outputs: give this "
-                                             "one its own `output` (or --output-dir), or set shared_output = true in both"};
+                                             "one its own " + mention("output") + ", or set " + mention("shared_output", "true") + " in both"};
   }
   if (!record || (owner && owner->manifest == plan.owner && owner->shared == manifest.shared_output)) return success();
   if (owner && owner->manifest != plan.owner) return success();  // shared: the first stays recorded

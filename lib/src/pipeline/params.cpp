@@ -16,7 +16,7 @@ const params::Group<ValidationRules>& validation_params() {
                                     [](auto& r) -> auto& { return r.enabled; }),
       params::flag<ValidationRules>(Spec{.name = "heatmap",
                                          .help = "Also write the validation's heatmap, OUT/materials/NAME_validation.png "
-                                                 "(validate --heatmap FILE)",
+                                                 "(as the validate command's heatmap)",
                                          .example = "true",
                                          .manifest_only = true},
                                     [](auto& r) -> auto& { return r.heatmap; }),
@@ -73,8 +73,8 @@ const params::Group<ClusterOptions>& cluster_params() {
                        .example = "30:00"},
                   &ClusterOptions::time_limit, ":-", "minutes, MM:SS, HH:MM:SS or D-HH:MM:SS"),
       params::integer<ClusterOptions>(Spec{.name = "array_throttle",
-                                           .help = "At most this many material jobs running at once (sbatch "
-                                                   "--array=...%N; 0: no limit)",
+                                           .help = "At most this many material jobs running at once (0: no limit; "
+                                                   "as sbatch --array=...%N)",
                                            .min = 0,
                                            .max = 1e6,
                                            .example = "16"},
@@ -100,7 +100,7 @@ const params::Group<ClusterOptions>& cluster_params() {
                                       [](auto& o) -> auto& { return o.scene_memory_mb; }),
       params::integer<ClusterOptions>(Spec{.name = "cpus",
                                            .help = "Cores of each job (sbatch --cpus-per-task; the job runs with "
-                                                   "--jobs this); `plan --jobs N` sets it too",
+                                                   "as many worker threads); plan's thread count sets it too",
                                            .min = 1,
                                            .max = 4096,
                                            .example = "4",

@@ -322,7 +322,7 @@ Status check_scene_materials(const Manifest& manifest, const Plan& plan, const S
       const SceneSpec& s = manifest.scenes[job.spec];
       return Error{s.origins.of(""), "scenes." + s.name + ": its glTF material '" + gltf_name +
                                          "' was built with a manifest material the manifest no longer gives it; the scene would "
-                                         "fall back to the glTF's own material: restore it, or pass --prune (or set prune = true)"};
+                                         "fall back to the glTF's own material: restore it, or allow it with " + mention("prune", "true")};
     }
   }
   return success();
@@ -358,7 +358,7 @@ Status finish_run(const Manifest& manifest, const Plan& plan, const RunOptions& 
   if (full && !options.keep_stale && !prune && too_many && !report.stale.kept.empty()) {
     report.stale.held_back = "this run would remove " + std::to_string(report.stale.kept.size()) + " of the " + std::to_string(made) +
                              " files the build made (more than half: a renamed folder or a lost input looks like this); "
-                             "they are kept: pass --prune (or set prune = true) to remove them";
+                             "they are kept: " + mention("prune", "true") + " removes them";
   }
   return log == before ? success() : write_made_log(log, roots);  // a no-op run writes nothing
 }
