@@ -296,8 +296,14 @@ int run_build(const BuildSettings& s, const GlobalOptions& global) {
       std::printf("%zu of %zu jobs would be built\n", pending, report->jobs.size());
     } else {
       std::string also = skipped ? ", skipped " + std::to_string(skipped) : "";
-      if (const std::size_t over = report->over_validation_limit()) {
-        also += "; " + std::to_string(over) + " over their validation limit (advisory)";
+      std::size_t gated = 0;  // those over the limit with validate.gate on: among the failed
+      for (const pipeline::JobReport& r : report->jobs) {
+        const nlohmann::json& v = r.details.is_object() ? r.details.value("validation", nlohmann::json()) : nlohmann::json();
+        gated += v.is_object() && !v.value("passed", true) && v.value("gate", false);
+      }
+      if (gated) also += "; " + std::to_string(gated) + " failed validation";
+      if (const std::size_t over = report->over_validation_limit() - gated) {
+        also += "; " + std::to_string(over) + " over their validation limit (advisory: validate.gate is off)";
       }
       std::printf("built %zu, up to date %zu, failed %zu%s; %zu images decoded; %.2f s\n", built, current, failed,
                   also.c_str(), report->images_decoded, seconds);

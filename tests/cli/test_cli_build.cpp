@@ -403,6 +403,8 @@ TEST(CliBuild, AFailedMaterialSkipsItsScenesAndValidationCanBeAdvisory) {
   const RunResult gated = matbake({"build", manifest});
   EXPECT_EQ(gated.exit_code, 1);
   EXPECT_NE(gated.err.find("scene:showroom skipped: material:gold_trim failed"), std::string::npos) << gated.err;
+  EXPECT_NE(gated.out.find("failed 1, skipped 1; 1 failed validation;"), std::string::npos) << gated.out;
+  EXPECT_EQ(gated.out.find("advisory"), std::string::npos) << gated.out;
   const json report = run_json({"build", manifest}, 1);
   EXPECT_EQ(outcome_of(report, "scene:showroom"), "skipped: material:gold_trim failed");
   EXPECT_EQ(report["skipped"], 1);
@@ -416,7 +418,7 @@ TEST(CliBuild, AFailedMaterialSkipsItsScenesAndValidationCanBeAdvisory) {
   EXPECT_EQ(advisory.exit_code, 0) << advisory.err;
   EXPECT_NE(advisory.err.find("material:gold_trim: validation: "), std::string::npos) << advisory.err;
   EXPECT_NE(advisory.err.find("over the limit (advisory: validate.gate is off)"), std::string::npos) << advisory.err;
-  EXPECT_NE(advisory.out.find("; 1 over their validation limit (advisory)"), std::string::npos) << advisory.out;
+  EXPECT_NE(advisory.out.find("; 1 over their validation limit (advisory: validate.gate is off)"), std::string::npos) << advisory.out;
   EXPECT_TRUE(fs::exists(dir / "out/showroom.glb"));
   EXPECT_EQ(run_json({"build", manifest, "--force"})["over_validation_limit"], 1);
 }

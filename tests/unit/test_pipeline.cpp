@@ -158,6 +158,9 @@ TEST(BuildManifest, ErrorsSayWhereAndWhat) {
       {"[materials.a]\nsources = { gloss = { file = \"sg.png\", channel = \"alpha\" } }\n", "m.toml:2:50",
        "materials.a.sources.gloss.channel: 'alpha' is not r, g, b, a or rgb"},
       {"[materials.a]\nsources = { gloss = { channel = \"a\" } }\n", "m.toml:2:", "materials.a.sources.gloss: needs file"},
+      // Its text form's channel suffix, checked as the table form's is (not a missing file at run time).
+      {"[materials.a]\nsources = { gloss = \"sg.png:y\" }\n", "m.toml:2:21",
+       "materials.a.sources.gloss: 'sg.png:y': channel 'y' is not r, g, b, a or rgb"},
       {"png_compression = 13\n[materials.a]\nsources = { kd = 0.5 }\n", "m.toml:1:19",
        "manifest.png_compression: fast, default, small or a level 0 to 12"},
       {"[materials.a]\nsources = { kd = 0.5 }\npng_compression = \"quick\"\n", "m.toml:3:", "materials.a.png_compression"},
@@ -226,6 +229,10 @@ layout = "gltf-metal-rough"
                 .find("material_rules.lib.overrides.bb: no such match; did you mean b or a?"),
             std::string::npos)
       << error_of(rule + "[material_rules.lib.overrides.bb]\nlayout = \"schuler\"\n");
+  EXPECT_NE(error_of(rule + "[material_rules.lib.overrides.renamed]\nlayout = \"schuler\"\n")
+                .find("material_rules.lib.overrides.renamed: no such match (its matches now: a, b)"),
+            std::string::npos)
+      << error_of(rule + "[material_rules.lib.overrides.renamed]\nlayout = \"schuler\"\n");
   // A typo in the pattern (_OMR for _ORM) is an error at its line: it would drop every material the
   // rule made, and the cleaner their outputs.
   EXPECT_EQ(error_of("[material_rules.x]\nmatch = \"t/{name}_OMR.png\"\nsources = { kd = 0.5 }\n"),

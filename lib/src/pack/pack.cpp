@@ -272,7 +272,13 @@ Result<SourceInput> source_from_text(std::string_view name, const std::string& t
   if (numbers.empty()) {
     if (text.empty()) return Error{"", "a file name or 1 or 3 numbers expected", true};
     const std::size_t colon = text.rfind(':');
-    const auto channels = colon == std::string::npos ? std::nullopt : value_in(kFileChannelNames, std::string_view(text).substr(colon + 1));
+    const std::string suffix = colon == std::string::npos ? "" : text.substr(colon + 1);
+    const auto channels = value_in(kFileChannelNames, suffix);
+    // "file.png:y": a channel suffix that names no channel, said now rather than as a missing file.
+    if (!channels && colon > 0 && !suffix.empty() && suffix.size() <= 3 && suffix.find_first_of("./\\") == std::string::npos &&
+        !fs::exists(folder / text)) {
+      return Error{"", "'" + text + "': channel '" + suffix + "' is not " + names_in(kFileChannelNames), true};
+    }
     if (channels && colon > 0) input.channels = *channels;
     input.file = folder / (channels && colon > 0 ? text.substr(0, colon) : text);
     return input;

@@ -459,8 +459,9 @@ Status read_material_rule(const Reader& r, const std::string& rule, const toml::
     if (!overrides) return r.at(*o, where + ".overrides must be a table of tables: [" + where + ".overrides.NAME]");
     for (const auto& [key, value] : *overrides) {
       if (!std::binary_search(names->begin(), names->end(), std::string(key.str()))) {
+        const std::string near = did_you_mean(std::string(key.str()), *names);
         return r.at(key.source(), where + ".overrides." + std::string(key.str()) + ": no such match" +
-                                      did_you_mean(std::string(key.str()), *names));
+                                      (near.empty() ? " (its matches now: " + join(*names, ", ") + ")" : near));
       }
     }
   }
