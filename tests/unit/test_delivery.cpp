@@ -82,7 +82,7 @@ TEST(DeliveryResample, ConstantsStayAndACheckerboardAveragesToOneHalf) {
   const image::Image constant = make_image(24, 16, 2, [](int, int, int c) { return c == 0 ? 0.3f : 0.8f; });
   const image::Image checker = make_image(32, 32, 1, [](int x, int y, int) { return float((x + y) % 2); });
   for (Filter f : {Filter::kaiser, Filter::box}) {
-    for (Wrap w : {Wrap::repeat, Wrap::clamp, Wrap::mirror}) {
+    for (Wrap w : {Wrap::repeat, Wrap::clamp_to_edge, Wrap::mirrored_repeat}) {
       const Sampling s{f, w, w};
       const image::Image c = resample(constant, {7, 5}, s);
       for (std::size_t i = 0; i < c.pixels.size(); ++i) EXPECT_NEAR(c.pixels[i], i % 2 ? 0.8 : 0.3, 1e-6);
@@ -103,7 +103,7 @@ TEST(DeliveryResample, KeepsALinearRampAwayFromTheEdges) {
   const image::Image ramp = make_image(96, 4, 1, [](int x, int, int) { return float(0.01 * (x + 0.5)); });
   for (Filter f : {Filter::kaiser, Filter::box}) {
     for (int width : {48, 32, 20}) {
-      const image::Image out = resample(ramp, {width, 4}, {f, Wrap::clamp, Wrap::clamp});
+      const image::Image out = resample(ramp, {width, 4}, {f, Wrap::clamp_to_edge, Wrap::clamp_to_edge});
       const double step = 96.0 / width;
       const double tolerance = 96 % width == 0 ? 2e-6 : 0.01 * 0.01 * step;
       for (int x = 4; x < width - 4; ++x) {  // the Kaiser window reaches 3 output texels
@@ -139,14 +139,14 @@ TEST(DeliveryResample, EdgesFollowTheWrapMode) {
   std::mt19937 rng(9);
   std::uniform_real_distribution<float> u(0, 1);
   const image::Image tile = make_image(8, 1, 1, [&](int, int, int) { return u(rng); });
-  for (Wrap wrap : {Wrap::repeat, Wrap::mirror, Wrap::clamp}) {
+  for (Wrap wrap : {Wrap::repeat, Wrap::mirrored_repeat, Wrap::clamp_to_edge}) {
     const image::Image extended = make_image(40, 1, 1, [&](int x, int, int) {
       const int copy = x / 8, i = x % 8;
-      if (wrap == Wrap::clamp) return at(tile, std::clamp(x - 16, 0, 7), 0, 0);
-      return at(tile, wrap == Wrap::mirror && copy % 2 == 1 ? 7 - i : i, 0, 0);
+      if (wrap == Wrap::clamp_to_edge) return at(tile, std::clamp(x - 16, 0, 7), 0, 0);
+      return at(tile, wrap == Wrap::mirrored_repeat && copy % 2 == 1 ? 7 - i : i, 0, 0);
     });
     for (Filter f : {Filter::kaiser, Filter::box}) {
-      const image::Image whole = resample(extended, {10, 1}, {f, Wrap::clamp, Wrap::clamp});
+      const image::Image whole = resample(extended, {10, 1}, {f, Wrap::clamp_to_edge, Wrap::clamp_to_edge});
       const image::Image own = resample(tile, {2, 1}, {f, wrap, wrap});
       EXPECT_NEAR(at(own, 0, 0, 0), at(whole, 4, 0, 0), 1e-6) << int(wrap) << " " << int(f);
       EXPECT_NEAR(at(own, 1, 0, 0), at(whole, 5, 0, 0), 1e-6) << int(wrap) << " " << int(f);

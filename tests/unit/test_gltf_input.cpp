@@ -166,7 +166,7 @@ TEST(GltfInput, TextureTransformsSampleLikeTheExtensionsMatrix) {
   rotation.rotation = 0.3;
   all.offset = {0.1, 0.2}, all.scale = {0.6, 0.7}, all.rotation = -0.4;
   for (const Case& c : {Case{offset, "offset"}, Case{scale, "scale"}, Case{rotation, "rotation"}, Case{all, "all three"}}) {
-    const image::Image out = gltf::sample_through(source, c.t, ao::Wrap::clamp_to_edge, ao::Wrap::clamp_to_edge, 16, 16);
+    const image::Image out = gltf::sample_through(source, c.t, Wrap::clamp_to_edge, Wrap::clamp_to_edge, 16, 16);
     for (int y = 0; y < 16; ++y) {
       for (int x = 0; x < 16; ++x) {
         // The spec's matrix, T · R · S, written out: R's columns are (cos, sin) and (−sin, cos).
@@ -181,8 +181,8 @@ TEST(GltfInput, TextureTransformsSampleLikeTheExtensionsMatrix) {
   // Repeat and mirrored repeat past the edge: one texel beyond the right edge is texel 0 or texel 7.
   gltf::UvTransform shift;
   shift.offset = {1.0, 0.0};
-  const image::Image repeated = gltf::sample_through(source, shift, ao::Wrap::repeat, ao::Wrap::repeat, 8, 8);
-  const image::Image mirrored = gltf::sample_through(source, shift, ao::Wrap::mirrored_repeat, ao::Wrap::repeat, 8, 8);
+  const image::Image repeated = gltf::sample_through(source, shift, Wrap::repeat, Wrap::repeat, 8, 8);
+  const image::Image mirrored = gltf::sample_through(source, shift, Wrap::mirrored_repeat, Wrap::repeat, 8, 8);
   EXPECT_FLOAT_EQ(repeated.pixels[0], 0.0f);
   EXPECT_FLOAT_EQ(mirrored.pixels[0], 7.0f);
 }

@@ -16,6 +16,7 @@
 #include "matbake/enum_names.hpp"
 #include "matbake/result.hpp"
 #include "matbake/scene.hpp"
+#include "matbake/wrap.hpp"
 
 namespace matbake::ao {
 
@@ -99,7 +100,7 @@ std::optional<Into> into_from_names(std::string_view attribute, std::string_view
 // A texel mapped by several surfaces (overlapping islands, stacked copies, UVs wrapping past [0, 1],
 // a mesh placed by several nodes) holds their mean, and is counted as overlapped.
 
-enum class Wrap { repeat, mirrored_repeat, clamp_to_edge };  // a glTF sampler's wrapS / wrapT
+using matbake::Wrap;  // a glTF sampler's wrapS / wrapT
 
 // One texture: the triangles of some instances through one UV set.
 struct TextureTarget {

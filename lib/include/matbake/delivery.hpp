@@ -11,6 +11,7 @@
 
 #include "matbake/enum_names.hpp"
 #include "matbake/image.hpp"
+#include "matbake/wrap.hpp"
 
 namespace matbake::delivery {
 
@@ -36,10 +37,7 @@ inline constexpr NameTable<Rounding, 3> kRoundingNames{
 enum class Filter { kaiser, box };
 inline constexpr NameTable<Filter, 2> kFilterNames{{{Filter::kaiser, "kaiser"}, {Filter::box, "box"}}};
 
-// A sampler's wrap mode along one axis: where the filter reads past an edge.
-enum class Wrap { repeat, clamp, mirror };
-// glTF's sampler wrap values (10497 REPEAT, 33071 CLAMP_TO_EDGE, 33648 MIRRORED_REPEAT).
-Wrap wrap_from_gltf(int value);
+using matbake::Wrap;  // a sampler's wrap mode along one axis: where the filter reads past an edge
 
 struct ClassOptions {
   Codec codec = Codec::uastc;

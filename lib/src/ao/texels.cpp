@@ -43,18 +43,6 @@ bool inside(const UvTriangle& t, const dvec2& p) {
   return true;
 }
 
-long long wrap(long long i, long long size, Wrap mode) {
-  if (i >= 0 && i < size) return i;  // the common case, and the same in every mode
-  switch (mode) {
-    case Wrap::repeat: return ((i % size) + size) % size;
-    case Wrap::mirrored_repeat: {
-      const long long m = ((i % (2 * size)) + 2 * size) % (2 * size);
-      return m < size ? m : 2 * size - 1 - m;
-    }
-    case Wrap::clamp_to_edge: return std::clamp(i, 0LL, size - 1);
-  }
-  return 0;
-}
 
 // Squared distance transform of one row or column (Felzenszwalb and Huttenlocher 2012): the lower
 // envelope of the parabolas (q − r)² + f(r), in place. Unmapped samples hold kFar, a finite stand-in
@@ -191,7 +179,7 @@ struct Raster {
   double max_cells;  // of a triangle's bounding box (kMaxCopies textures)
 
   std::uint32_t texel_at(double i, double j) const {
-    return std::uint32_t(wrap((long long)j, height, target.wrap_t) * width + wrap((long long)i, width, target.wrap_s));
+    return std::uint32_t(wrapped_index((long long)j, height, target.wrap_t) * width + wrapped_index((long long)i, width, target.wrap_s));
   }
 
   // The chunk's usable triangles, positively oriented in texel space, and their `cells`, row by

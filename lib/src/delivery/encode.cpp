@@ -175,7 +175,7 @@ std::vector<std::string> encoder_arguments(const EncodeRequest& request) {
     args.insert(args.end(), {"-mipmap", "-mip_filter", request.sampling.filter == Filter::box ? "box" : "kaiser",
                              request.texture_class == TextureClass::colour ? "-mip_srgb" : "-mip_linear"});
     if (request.texture_class == TextureClass::normal) args.push_back("-mip_renorm");
-    if (request.sampling.wrap_s == Wrap::clamp || request.sampling.wrap_t == Wrap::clamp) args.push_back("-mip_clamp");
+    if (request.sampling.wrap_s == Wrap::clamp_to_edge || request.sampling.wrap_t == Wrap::clamp_to_edge) args.push_back("-mip_clamp");
   }
   return args;
 }

@@ -38,17 +38,6 @@ double kaiser_weight(double x) {
 
 namespace {
 
-int wrapped(int i, int n, Wrap wrap) {
-  switch (wrap) {
-    case Wrap::clamp: return std::clamp(i, 0, n - 1);
-    case Wrap::mirror: {
-      const int m = ((i % (2 * n)) + 2 * n) % (2 * n);
-      return m < n ? m : 2 * n - 1 - m;
-    }
-    case Wrap::repeat: break;
-  }
-  return ((i % n) + n) % n;
-}
 
 struct Tap {
   int index;
@@ -85,7 +74,7 @@ Axis axis_taps(int source, int target, Filter filter, Wrap wrap) {
     }
     double sum = 0;
     for (const auto& [i, w] : raw) sum += w;
-    for (const auto& [i, w] : raw) axis.taps.push_back({wrapped(i, source, wrap), float(w / sum)});
+    for (const auto& [i, w] : raw) axis.taps.push_back({int(wrapped_index(i, source, wrap)), float(w / sum)});
     axis.first.push_back(axis.taps.size());
   }
   return axis;
@@ -146,9 +135,6 @@ void keep_coverage(image::Image& level, float cutoff, double target) {
 
 }  // namespace
 
-Wrap wrap_from_gltf(int value) {
-  return value == 33071 ? Wrap::clamp : value == 33648 ? Wrap::mirror : Wrap::repeat;
-}
 
 std::vector<Size> mip_sizes(Size base) {
   std::vector<Size> sizes{base};

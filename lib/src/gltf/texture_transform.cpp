@@ -6,18 +6,7 @@ namespace matbake::gltf {
 namespace {
 
 // A texel index on one axis of `size` texels, wrapped.
-int wrapped(long long i, int size, ao::Wrap wrap) {
-  const long long n = size;
-  switch (wrap) {
-    case ao::Wrap::clamp_to_edge: return int(std::clamp(i, 0LL, n - 1));
-    case ao::Wrap::mirrored_repeat: {
-      const long long m = ((i % (2 * n)) + 2 * n) % (2 * n);
-      return int(m < n ? m : 2 * n - 1 - m);
-    }
-    case ao::Wrap::repeat: break;
-  }
-  return int(((i % n) + n) % n);
-}
+int wrapped(long long i, int size, Wrap wrap) { return int(wrapped_index(i, size, wrap)); }
 
 Result<glm::dvec2> pair_in(const Json& ext, const char* key, glm::dvec2 fallback, const std::string& file, const std::string& where) {
   if (!ext.contains(key)) return fallback;
@@ -60,7 +49,7 @@ Result<UvTransform> uv_transform_of(const Json& info, const std::string& file, c
   return t;
 }
 
-image::Image sample_through(const image::Image& source, const UvTransform& transform, ao::Wrap wrap_s, ao::Wrap wrap_t,
+image::Image sample_through(const image::Image& source, const UvTransform& transform, Wrap wrap_s, Wrap wrap_t,
                             int width, int height) {
   image::Image out;
   static_cast<image::ImageLayout&>(out) = source;
@@ -89,9 +78,6 @@ image::Image sample_through(const image::Image& source, const UvTransform& trans
   return out;
 }
 
-ao::Wrap wrap_of(const Json& sampler, const char* key) {
-  const int mode = integer_in<int>(sampler, key, 10497, 10497);
-  return mode == 33071 ? ao::Wrap::clamp_to_edge : mode == 33648 ? ao::Wrap::mirrored_repeat : ao::Wrap::repeat;
-}
+Wrap wrap_of(const Json& sampler, const char* key) { return wrap_from_gltf(integer_in<int>(sampler, key, 10497, 10497)); }
 
 }  // namespace matbake::gltf

@@ -5,7 +5,7 @@
 #include <glm/vec2.hpp>
 
 #include "document.hpp"
-#include "matbake/ao.hpp"  // ao::Wrap: a sampler's wrap modes
+#include "matbake/wrap.hpp"
 #include "matbake/image.hpp"
 
 namespace matbake::gltf {
@@ -26,10 +26,10 @@ Result<UvTransform> uv_transform_of(const Json& info, const std::string& file, c
 // A width × height image over raw UVs: texel (x, y) holds `source` sampled bilinearly (as a GPU does,
 // texel centres at half-integers) at transform((x + ½) / width, (y + ½) / height), wrapped per the
 // sampler's modes.
-image::Image sample_through(const image::Image& source, const UvTransform& transform, ao::Wrap wrap_s, ao::Wrap wrap_t,
+image::Image sample_through(const image::Image& source, const UvTransform& transform, Wrap wrap_s, Wrap wrap_t,
                             int width, int height);
 
 // A glTF sampler's wrap mode (10497 repeat, 33648 mirrored repeat, 33071 clamp); repeat by default.
-ao::Wrap wrap_of(const Json& sampler, const char* key);
+Wrap wrap_of(const Json& sampler, const char* key);
 
 }  // namespace matbake::gltf
