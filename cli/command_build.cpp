@@ -55,11 +55,8 @@ int run_status(const BuildSettings& s, const GlobalOptions& global, const pipeli
   auto statuses = pipeline::job_statuses(manifest, plan);
   if (!statuses) return report_error(statuses.error(), key_mention);
   std::map<pipeline::JobState, std::size_t> count;
-  nlohmann::json jobs = nlohmann::json::array();
   for (const pipeline::JobStatus& st : *statuses) {
     ++count[st.state];
-    const std::string state(name_in(pipeline::kJobStateNames, st.state));
-    jobs.push_back({{"name", st.job->name}, {"state", state}, {"detail", st.detail}});
     if (st.state == pipeline::JobState::failed) {
       std::cerr << "matbake: error: " << escape_control(st.detail) << " (" << st.job->name << ")\n";
     } else if (st.state == pipeline::JobState::not_built && !global.json && !global.quiet) {
@@ -68,32 +65,15 @@ int run_status(const BuildSettings& s, const GlobalOptions& global, const pipeli
   }
   const std::size_t failed = count[pipeline::JobState::failed];
   if (global.json) {
-    std::cout << nlohmann::json{{"command", "build"}, {"status", true}, {"manifest", manifest.file}, {"jobs", jobs},
-                                {"counts", {{"up_to_date", count[pipeline::JobState::up_to_date]}, {"failed", failed},
-                                            {"not_built", count[pipeline::JobState::not_built]}}}}
-                     .dump(2)
-              << "\n";
+    nlohmann::json doc = {{"command", "build"}};
+    doc.update(pipeline::status_json(manifest, *statuses));
+    std::cout << doc.dump(2) << "\n";
   } else if (!global.quiet) {
     std::printf("up to date %zu, failed %zu, not built %zu\n", count[pipeline::JobState::up_to_date], failed,
                 count[pipeline::JobState::not_built]);
   }
   if (failed) std::cerr << "matbake: error: " << s.manifest << ": " << failed << " of " << statuses->size() << " jobs failed\n";
   return failed ? kFailed : kOk;
-}
-
-// submit.sh and job.sh in `folder`, made if need be; neither may be a file the build reads or writes.
-Status write_slurm_scripts(const pipeline::Manifest& manifest, const pipeline::Plan& plan,
-                           const pipeline::SlurmScripts& scripts, const fs::path& folder) {
-  const NamedOutput outputs[] = {{folder / "submit.sh", "-o"}, {folder / "job.sh", "-o"}};
-  if (Status st = pipeline::check_side_outputs(manifest, plan, outputs); !st) return st;
-  std::error_code ec;
-  fs::create_directories(folder, ec);
-  if (ec) return Error{folder.string(), "cannot make the folder: " + ec.message()};
-  for (const auto& [output, text] : {std::pair{outputs[0].path, &scripts.submit}, std::pair{outputs[1].path, &scripts.job}}) {
-    if (Status st = write_file_atomically(output, *text); !st) return st;
-    fs::permissions(output, fs::perms::owner_exec | fs::perms::group_exec | fs::perms::others_exec, fs::perm_options::add, ec);
-  }
-  return success();
 }
 
 // The out-of-date jobs as a Slurm submission in s.output (or, with --dry-run, its sbatch commands).
@@ -116,23 +96,12 @@ int run_slurm_plan(const PlanSettings& s, const GlobalOptions& global, pipeline:
     if (!global.json) {
       for (const std::string& line : *lines) std::printf("%s\n", line.c_str());
     }
-  } else if (Status st = write_slurm_scripts(manifest, plan, *scripts, target.folder); !st) {
+  } else if (Status st = pipeline::write_slurm_scripts(manifest, plan, *scripts, target.folder); !st) {
     return report_error(st.error(), key_mention);
   }
   if (global.json) {
-    nlohmann::json doc = {{"command", "plan"}, {"format", "slurm"}, {"folder", target.folder}, {"dry_run", s.dry_run},
-                          {"up_to_date", submission.up_to_date}, {"cluster", params::to_json(pipeline::cluster_params(), manifest.cluster)},
-                          {"sbatch", *lines}};
-    doc["array"] = {{"memory_mb", submission.array_memory_mb}, {"jobs", nlohmann::json::array()}};
-    doc["array"]["task_memory_mb"] = nlohmann::json::array();  // each task's own estimate (or setting)
-    for (const pipeline::SlurmJob& j : submission.array) {
-      doc["array"]["jobs"].push_back(j.job->name);
-      doc["array"]["task_memory_mb"].push_back(j.memory_mb);
-    }
-    doc["scenes"] = nlohmann::json::array();
-    for (const pipeline::SlurmJob& j : submission.scenes) {
-      doc["scenes"].push_back({{"job", j.job->name}, {"memory_mb", j.memory_mb}, {"after_tasks", j.after}});
-    }
+    nlohmann::json doc = {{"command", "plan"}};
+    doc.update(pipeline::slurm_json(submission, manifest.cluster, target, s.dry_run, *lines));
     std::cout << doc.dump(2) << "\n";
   } else if (!global.quiet && !s.dry_run) {
     std::printf("%s: %s\n", (target.folder / "submit.sh").c_str(), pipeline::submission_counts(submission).c_str());

@@ -4,6 +4,8 @@
 // outputs it reads. Every task runs `matbake build MANIFEST --only JOB`, so a cluster run writes
 // and stamps as a local build does, and either is up to date after the other (docs/cluster.md).
 #include <cstdint>
+#include <nlohmann/json.hpp>
+
 #include <filesystem>
 #include <functional>
 #include <string>
@@ -79,5 +81,15 @@ struct SlurmScripts {
 };
 Result<SlurmScripts> slurm_scripts(const Manifest& manifest, const SlurmSubmission& submission, const ClusterOptions& options,
                                    const SlurmTarget& target);
+
+// submit.sh and job.sh written into `folder` (made if need be, executable); neither may be a file the
+// build reads or writes.
+Status write_slurm_scripts(const Manifest& manifest, const Plan& plan, const SlurmScripts& scripts,
+                           const std::filesystem::path& folder);
+
+// `plan --format slurm --json`: the folder, the settings, the sbatch lines, the array's tasks with each
+// one's memory, the scenes with theirs and the tasks they wait for.
+nlohmann::json slurm_json(const SlurmSubmission& submission, const ClusterOptions& options, const SlurmTarget& target,
+                          bool dry_run, const std::vector<std::string>& sbatch);
 
 }  // namespace matbake::pipeline

@@ -240,6 +240,8 @@ struct JobStatus {
   std::string detail;  // failed: the error line; not built: why ("no earlier build", "waits for material:x, which failed")
 };
 Result<std::vector<JobStatus>> job_statuses(const Manifest& manifest, const Plan& plan);
+// `build --status --json`: the manifest, each job's state and detail, and the counts per state.
+nlohmann::json status_json(const Manifest& manifest, const std::vector<JobStatus>& statuses);
 
 // The run as `build --json` prints it (without "command", "dry_run" and "seconds"): the manifest,
 // the output folder, each job (name, outcome, inputs, outputs, seconds, warnings, reason, error,

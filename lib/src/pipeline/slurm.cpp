@@ -2,7 +2,9 @@
 #include <cctype>
 #include <map>
 
+#include "matbake/atomic_file.hpp"
 #include "matbake/cluster.hpp"
+#include "matbake/output_check.hpp"
 #include "matbake/image.hpp"
 #include "matbake/script_text.hpp"
 #include "matbake/version.hpp"
@@ -187,6 +189,37 @@ Result<SlurmScripts> slurm_scripts(const Manifest& manifest, const SlurmSubmissi
   out.submit += "echo \"matbake: submitted " + counts + ":" + (submission.array.empty() ? "" : " array $array") +
                 (ids.empty() ? "" : " scenes" + ids) + "\"\n";
   return out;
+}
+
+Status write_slurm_scripts(const Manifest& manifest, const Plan& plan, const SlurmScripts& scripts, const fs::path& folder) {
+  const NamedOutput outputs[] = {{folder / "submit.sh", "-o"}, {folder / "job.sh", "-o"}};
+  if (Status st = check_side_outputs(manifest, plan, outputs); !st) return st;
+  std::error_code ec;
+  fs::create_directories(folder, ec);
+  if (ec) return Error{folder.string(), "cannot make the folder: " + ec.message()};
+  for (const auto& [output, text] : {std::pair{outputs[0].path, &scripts.submit}, std::pair{outputs[1].path, &scripts.job}}) {
+    if (Status st = write_file_atomically(output, *text); !st) return st;
+    fs::permissions(output, fs::perms::owner_exec | fs::perms::group_exec | fs::perms::others_exec, fs::perm_options::add, ec);
+  }
+  return success();
+}
+
+nlohmann::json slurm_json(const SlurmSubmission& submission, const ClusterOptions& options, const SlurmTarget& target,
+                          bool dry_run, const std::vector<std::string>& sbatch) {
+  nlohmann::json doc = {{"format", "slurm"}, {"folder", target.folder}, {"dry_run", dry_run},
+                        {"up_to_date", submission.up_to_date}, {"cluster", params::to_json(cluster_params(), options)},
+                        {"sbatch", sbatch}};
+  doc["array"] = {{"memory_mb", submission.array_memory_mb}, {"jobs", nlohmann::json::array()}};
+  doc["array"]["task_memory_mb"] = nlohmann::json::array();  // each task's own estimate (or setting)
+  for (const SlurmJob& j : submission.array) {
+    doc["array"]["jobs"].push_back(j.job->name);
+    doc["array"]["task_memory_mb"].push_back(j.memory_mb);
+  }
+  doc["scenes"] = nlohmann::json::array();
+  for (const SlurmJob& j : submission.scenes) {
+    doc["scenes"].push_back({{"job", j.job->name}, {"memory_mb", j.memory_mb}, {"after_tasks", j.after}});
+  }
+  return doc;
 }
 
 }  // namespace matbake::pipeline

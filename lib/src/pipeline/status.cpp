@@ -29,4 +29,15 @@ Result<std::vector<JobStatus>> job_statuses(const Manifest& manifest, const Plan
   return statuses;
 }
 
+nlohmann::json status_json(const Manifest& manifest, const std::vector<JobStatus>& statuses) {
+  nlohmann::json jobs = nlohmann::json::array(), counts = nlohmann::json::object();
+  for (const auto& [state, name] : kJobStateNames) counts[std::string(name)] = 0;
+  for (const JobStatus& st : statuses) {
+    const std::string state(name_in(kJobStateNames, st.state));
+    jobs.push_back({{"name", st.job->name}, {"state", state}, {"detail", st.detail}});
+    counts[state] = counts[state].get<int>() + 1;
+  }
+  return {{"status", true}, {"manifest", manifest.file}, {"jobs", jobs}, {"counts", counts}};
+}
+
 }  // namespace matbake::pipeline
