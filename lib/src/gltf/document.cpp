@@ -10,6 +10,7 @@
 #include "decode.hpp"
 #include "load_model.hpp"
 #include "references.hpp"
+#include "matbake/output_check.hpp"
 #include "matbake/read_file.hpp"
 #include "matbake/atomic_file.hpp"
 
@@ -380,15 +381,10 @@ Result<std::vector<fs::path>> write_document(const Document& doc, const fs::path
     const fs::path bin_path = output.parent_path() / (output.stem().string() + ".bin");
 
     // Every file the document came from, none of which may be written.
+    // (The one output rule: by real path and inode, so a link to an input is one too.)
     const std::vector<fs::path> inputs = source_files(doc.file, doc.json, doc.new_files);
-    const auto is_input = [&](const fs::path& p) {
-      const fs::path a = fs::absolute(p).lexically_normal();
-      return std::find(inputs.begin(), inputs.end(), a) != inputs.end();
-    };
-    if (is_input(output)) return Error{out_name, "would overwrite an input; write somewhere else", true};
-    if (!glb && is_input(bin_path)) {
-      return Error{out_name, "its buffer " + bin_path.filename().string() + " would overwrite an input; name the output differently", true};
-    }
+    const NamedOutput files_out[] = {{output, "glTF output"}, {glb ? fs::path() : bin_path, "its buffer"}};
+    if (Status s = check_outputs(files_out, inputs); !s) return s.error();
 
     // All buffers become one: each starts 4-byte aligned, the views move with it. Meshopt fallback
     // buffers (no bytes) stay buffers of their own after it, and their views keep their offsets.
@@ -440,7 +436,8 @@ Result<std::vector<fs::path>> write_document(const Document& doc, const fs::path
         if (!bytes) return bytes.error();
         if (!glb) {
           const fs::path target = output.parent_path() / decode_uri(uri);
-          if (is_input(target)) return Error{out_name, "writing image '" + uri + "' would overwrite an input", true};
+          const NamedOutput image_file{target, "image '" + uri + "'"};
+          if (Status s = check_outputs(std::span(&image_file, 1), inputs); !s) return s.error();
           files.emplace_back(target, std::move(*bytes));
           continue;
         }
