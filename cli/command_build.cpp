@@ -13,6 +13,7 @@
 #include "matbake/join.hpp"
 #include "matbake/atomic_file.hpp"
 #include "matbake/cluster.hpp"
+#include "matbake/image.hpp"
 #include "matbake/output_check.hpp"
 #include "matbake/pipeline.hpp"
 #include "progress_bar.hpp"
@@ -24,10 +25,13 @@ namespace {
 
 std::string job_error(const pipeline::JobReport& r) { return r.error->to_string() + " (" + r.job->name + ")"; }
 
-Result<pipeline::Plan> load(const std::string& manifest_file, const std::string& output_dir, pipeline::Manifest& manifest) {
+// The manifest and its plan; its pixel limit applies unless the command line gave one.
+Result<pipeline::Plan> load(const std::string& manifest_file, const std::string& output_dir, const GlobalOptions& global,
+                            pipeline::Manifest& manifest) {
   auto m = pipeline::read_manifest(manifest_file);
   if (!m) return m.error();
   manifest = std::move(*m);
+  if (manifest.max_pixels > 0 && !global.max_pixels_given) image::set_max_pixels(std::uint64_t(manifest.max_pixels));
   if (!output_dir.empty()) manifest.output = fs::absolute(output_dir).lexically_normal();
   return pipeline::make_plan(manifest);
 }
@@ -161,7 +165,7 @@ CLI::App* setup_plan(CLI::App& app, PlanSettings& s) {
 
 int run_plan(const PlanSettings& s, const GlobalOptions& global) {
   pipeline::Manifest manifest;
-  auto plan = load(s.manifest, s.output_dir, manifest);
+  auto plan = load(s.manifest, s.output_dir, global, manifest);
   if (!plan) return report_error(plan.error(), key_mention);
   std::error_code ec;
   const fs::path self = s.matbake.empty() ? fs::read_symlink("/proc/self/exe", ec) : fs::absolute(s.matbake);
@@ -185,7 +189,7 @@ int run_plan(const PlanSettings& s, const GlobalOptions& global) {
 int run_build(const BuildSettings& s, const GlobalOptions& global) {
   const auto start = std::chrono::steady_clock::now();
   pipeline::Manifest manifest;
-  auto plan = load(s.manifest, s.output_dir, manifest);
+  auto plan = load(s.manifest, s.output_dir, global, manifest);
   if (!plan) return report_error(plan.error(), key_mention);
   if (s.status) return run_status(s, global, manifest, *plan);
   const NamedOutput side_outputs[] = {{s.depfile, "--depfile"}, {s.stamp, "--stamp"}};

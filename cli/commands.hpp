@@ -30,6 +30,7 @@ struct GlobalOptions {
   bool quiet = false;
   int jobs = 0;  // 0: all cores
   std::string ocio_config;
+  bool max_pixels_given = false;  // --max-pixels, which wins over a manifest's max_pixels
 };
 
 // A setting a library message mentions, as a flag: "--texture-rounding multiple-of-4", "--prune".

@@ -94,7 +94,7 @@ int main(int argc, char** argv) {
   std::uint64_t max_pixels = matbake::image::kDefaultMaxPixels;
   app.add_option("--max-pixels", max_pixels,
                  "Largest image read or made, in pixels (width x height); larger declared sizes are refused before\n"
-                 "anything is allocated")
+                 "anything is allocated (given here, it wins over a manifest's max_pixels)")
       ->capture_default_str()
       ->check(whole_number_from(1, "a count of pixels, 1 or more"));
   app.add_option("--ocio-config", global.ocio_config,
@@ -128,6 +128,7 @@ int main(int argc, char** argv) {
   }
   matbake::image::set_thread_count(global.jobs);
   matbake::image::set_max_pixels(max_pixels);
+  global.max_pixels_given = app.count("--max-pixels") > 0;
 
   // The library turns its dependencies' exceptions into errors at its edges; this is the last net,
   // so that nothing ends in abort (exit 134) without a line saying why.

@@ -1,7 +1,7 @@
 #pragma once
 // Command-line flags made from a parameter description (matbake/params.hpp): each parameter as
 // --<prefix><name>, its text decoded and checked by the description, --help showing its default
-// (the request struct's) and accepted names. `given` collects the names set, for params::finish.
+// (the request struct's) and accepted names. `given` collects the names set, for the tree's rules (finish_tree).
 // An older name (Spec::aliases) is a hidden flag that works as the new one and says it was renamed.
 #include <CLI/CLI.hpp>
 
@@ -110,13 +110,6 @@ params::Spelling tree_flag_spelling(const params::Tree<Root>& tree) {
 template <class Root>
 Status finish_tree(const params::Tree<Root>& tree, const Root& root, const std::vector<std::set<std::string>>& given) {
   return params::finish_tree(tree, root, given, tree_flag_spelling(tree));
-}
-
-// The rules within a group, errors naming the flags.
-template <class T>
-Status finish_params(const params::Group<T>& group, const T& target, const std::set<std::string>& given,
-                     const std::string& prefix) {
-  return params::finish(group, target, given, flag_spelling({prefix}));
 }
 
 }  // namespace matbake::cli

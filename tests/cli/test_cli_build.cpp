@@ -603,6 +603,31 @@ TEST(CliPlan, NinjaBuildsTheEdges) {
   EXPECT_NE(ninja.out.find("[2/2] matbake scene:showroom"), std::string::npos) << ninja.out;
 }
 
+// The manifest's max_pixels is its jobs' limit, in a build and in the jobs Ninja runs; the command
+// line's --max-pixels wins; the refusal names the key in the manifest's words.
+TEST(CliBuild, TheManifestsPixelLimitHoldsInEveryJobAndTheFlagWins) {
+  TempDir dir;
+  write_raw(dir / "t.png", 16, 16, 3, "uint8", std::vector<double>(16 * 16 * 3, 100));
+  write_bytes(dir / "m.toml", "max_pixels = 100\n[materials.a]\nsources = { kd = \"t.png\", ks = 0.04, gloss = 0.5 }\n"
+                              "layout = \"gltf-orm\"\n");
+  const RunResult refused = matbake({"build", (dir / "m.toml").string()});
+  EXPECT_EQ(refused.exit_code, 1);
+  EXPECT_NE(refused.err.find((dir / "t.png").string() + ": 16x16 is more than the limit of 100 pixels (max_pixels raises it)"),
+            std::string::npos) << refused.err;
+  EXPECT_FALSE(fs::exists(dir / "out/materials/a_orm.png"));
+  const RunResult raised = matbake({"--max-pixels", "256", "build", (dir / "m.toml").string()});
+  EXPECT_EQ(raised.exit_code, 0) << raised.err;
+  EXPECT_TRUE(fs::exists(dir / "out/materials/a_orm.png"));
+
+  const RunResult which = run("/bin/sh", {"-c", "command -v ninja"});
+  if (which.exit_code != 0) GTEST_SKIP() << "ninja is not installed";
+  fs::remove_all(dir / "out");
+  ASSERT_EQ(matbake({"plan", (dir / "m.toml").string(), "-o", (dir / "build.ninja").string()}).exit_code, 0);
+  const RunResult ninja = run(which.out.substr(0, which.out.find('\n')), {"-C", dir.path().string()});
+  EXPECT_NE(ninja.exit_code, 0);
+  EXPECT_NE((ninja.out + ninja.err).find("more than the limit of 100 pixels"), std::string::npos) << ninja.out << ninja.err;
+}
+
 bool has(const std::vector<std::string>& args, const std::string& arg) {
   return std::find(args.begin(), args.end(), arg) != args.end();
 }

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdlib>
+#include <map>
 #include <regex>
 #include <sstream>
 
@@ -257,6 +258,74 @@ TEST(RequestTree, EveryRuleIsEnforcedAtBothDoorsInTheirOwnSpelling) {
   }, 39);
 }
 
+// A manifest entry's settings as TOML: the plain branches' as keys, each table's as name = { ... }.
+template <class Root>
+std::string toml_of(const Tree<Root>& tree, const std::vector<Setting<Root>>& settings) {
+  std::string own;
+  std::map<std::string, std::string> tables;
+  for (const Setting<Root>& s : settings) {
+    const std::string key = s.spec->name + " = " + toml_value_text(*s.spec, s.value);
+    const std::string& table = tree[s.branch].table;
+    if (table.empty()) {
+      own += key + "\n";
+    } else {
+      tables[table] += (tables[table].empty() ? "" : ", ") + key;
+    }
+  }
+  for (const auto& [table, keys] : tables) own += table + " = { " + keys + " }\n";
+  return own;
+}
+
+// Each parameter of an entry's tree given at the manifest's top level reaches the entry as if the
+// entry gave it (one rule for every group: materials' and scenes'), and the entry's own key wins.
+template <class Root, class Read>
+void walk_top_level(const Tree<Root>& tree, const std::string& entry, Read read, std::size_t expected) {
+  std::size_t walked = 0;
+  for (std::size_t b = 0; b < tree.size(); ++b) {
+    for (const Spec* spec : tree[b].specs) {
+      SCOPED_TRACE(spec->name);
+      const std::string keys = toml_of(tree, with_needs(tree, b, spec));
+      auto top = pipeline::parse_manifest(keys + entry, "/p/assets.toml");
+      auto own = pipeline::parse_manifest(entry + keys, "/p/assets.toml");
+      ASSERT_TRUE(top) << top.error().to_string();
+      ASSERT_TRUE(own) << own.error().to_string();
+      EXPECT_EQ(tree_json(tree, read(*top)), tree_json(tree, read(*own)));
+      EXPECT_NE(tree[b].values(read(*top)).at(spec->name), tree[b].values(Root{}).at(spec->name));
+      // The entry's default-valued key over the top level's example: the entry's value stands.
+      const std::string reset = spec->name + " = " +
+                                toml_value_text(*spec, value_text(tree[b].values(Root{}).at(spec->name)));
+      if (tree[b].table.empty() && !tree[b].values(Root{}).at(spec->name).is_null()) {
+        auto over = pipeline::parse_manifest(keys + entry + reset + "\n", "/p/assets.toml");
+        ASSERT_TRUE(over) << over.error().to_string();
+        EXPECT_EQ(tree[b].values(read(*over)).at(spec->name), tree[b].values(Root{}).at(spec->name));
+      }
+      ++walked;
+    }
+  }
+  EXPECT_EQ(walked, expected);
+}
+
+TEST(RequestTree, TheTopLevelGivesEveryMaterialAndSceneParameterItsDefault) {
+  walk_top_level(pipeline::scene_tree(), "[scenes.s]\ninput = \"s.gltf\"\n",
+                 [](const pipeline::Manifest& m) { return m.scenes.at(0); }, 52);
+  walk_top_level(pipeline::material_tree(), "[materials.m]\nsources = { kd = 0.5 }\n",
+                 [](const pipeline::Manifest& m) { return m.materials.at(0); }, 15);
+}
+
+// A rule is checked on each entry as inherited: the top level's colour_quality applies to a KTX2
+// scene, and is refused, at its own line, for a scene that is not KTX2.
+TEST(RequestTree, AnInheritedParameterIsCheckedInEachEntry) {
+  const std::string top = "colour_quality = 200\n[scenes.web]\ninput = \"s.gltf\"\ntexture_format = \"ktx2\"\n";
+  auto ok = pipeline::parse_manifest(top, "/p/assets.toml");
+  ASSERT_TRUE(ok) << ok.error().to_string();
+  EXPECT_EQ(ok->scenes.at(0).options.delivery.colour.quality, 200);
+  auto refused = pipeline::parse_manifest(top + "[scenes.plain]\ninput = \"s.gltf\"\n", "/p/assets.toml");
+  ASSERT_FALSE(refused);
+  EXPECT_EQ(refused.error().path, "/p/assets.toml:1:18");
+  EXPECT_EQ(refused.error().message,
+            "scenes.plain.colour_quality applies only with scenes.plain.texture_format = \"ktx2\"");
+}
+
 // bake-ao's tree: the same groups as export's (so a manifest scene reaches each), its flags unprefixed,
 // each parameter reaching the request and each rule enforced in its spelling.
 TEST(RequestTree, BakeAosTreeIsExportsGroupsWithItsOwnFlags) {
@@ -411,7 +480,6 @@ TEST(DocsTables, MatchTheParameterDescriptions) {
   const Table tables[] = {
       {"docs/build.md", "params:ao", markdown_table(ao::request_params(), "")},
       {"docs/build.md", "params:encoding", markdown_table(image::encoding_params(), "")},
-      {"docs/export.md", "params:texture", markdown_table(image::gltf_texture_params(), "")},
       {"docs/export.md", "params:export", markdown_table(exporter::options_params(), "")},
       {"docs/delivery.md", "params:delivery", markdown_table(delivery::options_params(), "")},
       {"docs/validate.md", "params:validate", markdown_table(validate::options_params(), "")},

@@ -49,7 +49,15 @@ struct ClassOptions {
   double scale = 1;       // both sides times this (0 < scale ≤ 1)
 };
 
+// The format of the textures a glTF is delivered with: PNG, or lossless 8-bit WebP (the texture then
+// names it through EXT_texture_webp, which the file requires), or KTX2: textures made as PNG, then
+// every texture the scene uses encoded by its class's codec (KHR_texture_basisu).
+enum class TextureFormat { png, webp, ktx2 };
+inline constexpr NameTable<TextureFormat, 3> kTextureFormatNames{
+    {{TextureFormat::png, "png"}, {TextureFormat::webp, "webp"}, {TextureFormat::ktx2, "ktx2"}}};
+
 struct Options {
+  TextureFormat texture_format = TextureFormat::png;
   ClassOptions colour{.codec = Codec::etc1s};
   ClassOptions data{.codec = Codec::uastc};
   ClassOptions normal{.codec = Codec::uastc};

@@ -105,17 +105,10 @@ inline constexpr int kPngLevelSmallest = 12;
 std::optional<int> png_level_from_name(std::string_view name);
 
 // How matbake encodes the images it writes, whichever command writes them (convert, pack, unpack,
-// workflow, export, bake-ao's textures, a build): its parameters are image::encoding_params().
-// The format of the textures matbake writes into a glTF: PNG, or lossless 8-bit WebP (the texture
-// then names it through EXT_texture_webp, which the file requires).
-// ktx2: textures made as PNG, then every texture of the scene delivered as KTX2 (delivery.hpp).
-enum class TextureFormat { png, webp, ktx2 };
-inline constexpr NameTable<TextureFormat, 3> kTextureFormatNames{
-    {{TextureFormat::png, "png"}, {TextureFormat::webp, "webp"}, {TextureFormat::ktx2, "ktx2"}}};
-
+// workflow, export, bake-ao's textures, a build): its parameters are image::encoding_params(). The
+// format of a glTF's textures is delivery's (delivery::Options::texture_format).
 struct Encoding {
   int png_level = kPngLevelDefault;  // 8/16-bit PNG deflate effort
-  TextureFormat texture_format = TextureFormat::png;  // of textures written into a glTF
 };
 
 struct WriteOptions {

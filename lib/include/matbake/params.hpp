@@ -156,14 +156,6 @@ GroupState state_of(const Group<T>& group, const T& target, const std::set<std::
   return {group.specs(), to_json(group, target), given};
 }
 
-// After every given parameter is set: the rules within the group (check_rules), then the group's
-// own (ao::check's ranges). The error has no path: the door places it (at the manifest's key).
-template <class T>
-Status finish(const Group<T>& group, const T& target, const std::set<std::string>& given, const Spelling& spell) {
-  if (auto broken = check_rules({state_of(group, target, given)}, spell)) return Error{"", broken->message, true};
-  return group.check(target);
-}
-
 // --- A request's tree: its groups, each over the part of the request it fills -----------------------
 
 // One group of a request, over the request struct `Root`: its parameters (in the manifest either
@@ -213,6 +205,21 @@ Branch<Root> optional_branch(const Group<T>& group, std::string table, std::stri
                       [member](const Root& r) { return (r.*member).has_value(); });
 }
 
+// A tree over a part of a larger request (a manifest scene's exporter::Options within its
+// SceneSpec): each branch reached through `part(outer)`.
+template <class Outer, class Root, class Part>
+Tree<Outer> subtree(const Tree<Root>& tree, Part part) {
+  Tree<Outer> out;
+  for (const Branch<Root>& b : tree) {
+    out.push_back({b.table, b.flag_prefix, b.specs,
+                   [b, part](Outer& o, const Spec& spec, const Value& v) { return b.apply(part(o), spec, v); },
+                   [b, part](const Outer& o) { return b.values(part(o)); },
+                   [b, part](const Outer& o) { return b.made(part(o)); },
+                   [b, part](const Outer& o) { return b.check(part(o)); }});
+  }
+  return out;
+}
+
 // The branch a group is, by its table and prefix; null when none.
 template <class Root>
 const Branch<Root>* find_branch(const Tree<Root>& tree, std::string_view table) {
@@ -243,15 +250,18 @@ Status finish_tree(const Tree<Root>& tree, const Root& root, const std::vector<s
 }
 
 // The request's options as --json and stamps show them: the entry's own keys flat, a table's
-// branch under its name (null when not made), sorted.
+// branches under its name (null when not made), sorted.
 template <class Root>
 nlohmann::json tree_json(const Tree<Root>& tree, const Root& root) {
   nlohmann::json j = nlohmann::json::object();
   for (const Branch<Root>& b : tree) {
     if (b.table.empty()) {
       j.update(b.values(root));
+    } else if (!b.made(root)) {
+      j[b.table] = nullptr;
     } else {
-      j[b.table] = b.made(root) ? b.values(root) : nlohmann::json(nullptr);
+      if (!j[b.table].is_object()) j[b.table] = nlohmann::json::object();
+      j[b.table].update(b.values(root));
     }
   }
   return j;

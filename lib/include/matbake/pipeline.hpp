@@ -116,6 +116,9 @@ struct Manifest {
   // it the folder belongs to the manifest that built it first (OUT/.matbake/owner.json).
   bool shared_output = false;
   bool prune = false;  // `prune = true`: as --prune on every run (RunOptions::prune)
+  // `max_pixels = N`: the largest image its jobs read or make (image::set_max_pixels), wherever they
+  // run (a build, Ninja's or Slurm's jobs); 0: the run's own limit.
+  std::int64_t max_pixels = 0;
 };
 
 // Errors name the manifest with line and column, and the key.

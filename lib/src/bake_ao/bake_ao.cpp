@@ -91,7 +91,7 @@ Result<Report> bake_file(const fs::path& input, const Options& options) {
     const auto start = std::chrono::steady_clock::now();
     if (texture) {
       ao::TextureBakes timing;
-      gltf::ImageCache cache(*doc, options.encoding);
+      gltf::ImageCache cache(*doc, options.encoding, delivery::made_format(options.delivery));
       auto textures = bake_occlusion_textures(*doc, *scene, cache, options.ao, targets, stem, OcclusionInto::texture, timing);
       if (!textures) return textures.error();
       report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -128,8 +128,8 @@ Result<Report> bake_file(const fs::path& input, const Options& options) {
       report.max_distance = baked->max_distance;
     }
     report.geometry = gltf::geometry_notes(*doc);
-    if (!options.output.empty() && delivery::changes_textures(options.delivery, options.encoding)) {
-      gltf::ImageCache cache(*doc, options.encoding);
+    if (!options.output.empty() && delivery::changes_textures(options.delivery)) {
+      gltf::ImageCache cache(*doc, options.encoding, delivery::made_format(options.delivery));
       auto delivered = delivery::deliver_textures(*doc, cache, options.delivery, options.output);
       if (!delivered) return delivered.error();
       report.delivered = std::move(*delivered);

@@ -9,7 +9,6 @@ namespace matbake::bake_ao {
 const params::Tree<Options>& request_tree() {
   static const params::Tree<Options> tree{
       params::branch<Options>(image::encoding_params(), "", "", [](auto& o) -> auto& { return o.encoding; }),
-      params::branch<Options>(image::gltf_texture_params(), "", "", [](auto& o) -> auto& { return o.encoding; }),
       params::branch<Options>(delivery::options_params(), "", "", [](auto& o) -> auto& { return o.delivery; }),
       params::branch<Options>(ao::request_params(), "ao", "", [](auto& o) -> auto& { return o.ao; }),
   };

@@ -263,18 +263,22 @@ std::vector<int> materials_of(const Use& use) {
 
 }  // namespace
 
-bool changes_textures(const Options& options, const image::Encoding& encoding) {
-  if (encoding.texture_format == image::TextureFormat::ktx2 || options.texel_density > 0) return true;
+bool changes_textures(const Options& options) {
+  if (options.texture_format == TextureFormat::ktx2 || options.texel_density > 0) return true;
   for (TextureClass c : {TextureClass::colour, TextureClass::data, TextureClass::normal}) {
     if (options.of(c).max_size > 0 || options.of(c).scale != 1) return true;
   }
   return false;
 }
 
+gltf::MadeFormat made_format(const Options& options) {
+  return options.texture_format == TextureFormat::webp ? gltf::MadeFormat::webp : gltf::MadeFormat::png;
+}
+
 Result<std::vector<TextureReport>> deliver_textures(gltf::Document& doc, gltf::ImageCache& cache, const Options& options,
                                                     const fs::path& output) {
-  if (!changes_textures(options, cache.encoding())) return std::vector<TextureReport>{};
-  const bool ktx2_out = cache.encoding().texture_format == image::TextureFormat::ktx2;
+  if (!changes_textures(options)) return std::vector<TextureReport>{};
+  const bool ktx2_out = options.texture_format == TextureFormat::ktx2;
   const std::string stem = output.stem().string();
   std::vector<Work> work;
   std::vector<TextureReport> reports;

@@ -10,9 +10,12 @@
 namespace matbake::delivery {
 
 // Whether the pass changes anything: KTX2 asked for, or a size setting.
-bool changes_textures(const Options& options, const image::Encoding& encoding);
+bool changes_textures(const Options& options);
 
-// Rewrites `doc`'s used textures: KTX2 (KHR_texture_basisu) when the encoding's texture format is
+// The format of the textures a scene's writer makes before delivery (KTX2 is made from PNG).
+gltf::MadeFormat made_format(const Options& options);
+
+// Rewrites `doc`'s used textures: KTX2 (KHR_texture_basisu) when the texture format is
 // ktx2 and the class's codec is not png, else resized PNG/WebP when the sizes say so. Scratch files go
 // beside `output`. Textures already KTX2 are kept. Call gltf::prune_unreachable afterwards: replaced
 // images are left unreferenced.

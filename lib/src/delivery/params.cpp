@@ -69,6 +69,13 @@ void add_class(std::vector<Param<Options>>& out, TextureClass c) {
 const params::Group<Options>& options_params() {
   static const params::Group<Options> group = [] {
     params::Group<Options> g;
+    g.params.push_back(params::choice<Options>(
+        Spec{.name = "texture_format",
+             .help = "Format of the textures written into a glTF: png or webp (lossless, 8-bit; the file then "
+                     "requires EXT_texture_webp) for those it makes (converted, ORM, occlusion), or ktx2: every "
+                     "texture the scene uses as KTX2 (KHR_texture_basisu, docs/delivery.md)",
+             .example = "webp"},
+        [](auto& o) -> auto& { return o.texture_format; }, kTextureFormatNames));
     for (TextureClass c : {TextureClass::colour, TextureClass::data, TextureClass::normal}) add_class(g.params, c);
     g.params.push_back(params::choice<Options>(Spec{.name = "texture_rounding",
                                                     .help = "Rounding of resized textures' sides: power-of-two, multiple-of-4 "

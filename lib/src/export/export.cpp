@@ -465,7 +465,7 @@ Result<Report> export_scene(const fs::path& input, const fs::path& output, const
       given[*index] = &m;
     }
 
-    gltf::ImageCache cache(*doc, options.encoding);
+    gltf::ImageCache cache(*doc, options.encoding, delivery::made_format(options.delivery));
     for (std::size_t i = 0; doc->json.contains("images") && i < doc->json["images"].size(); ++i) {
       if (Status s = cache.check(i); !s) return s.error();
     }

@@ -31,7 +31,6 @@ const params::Group<Options>& options_params() {
 const params::Tree<Options>& request_tree() {
   static const params::Tree<Options> tree{
       params::branch<Options>(image::encoding_params(), "", "", [](auto& o) -> auto& { return o.encoding; }),
-      params::branch<Options>(image::gltf_texture_params(), "", "", [](auto& o) -> auto& { return o.encoding; }),
       params::branch<Options>(options_params(), "", "", [](auto& o) -> auto& { return o; }),
       params::branch<Options>(delivery::options_params(), "", "", [](auto& o) -> auto& { return o.delivery; }),
       params::optional_branch<Options>(ao::request_params(), "ao", "ao-", &Options::ao),

@@ -20,9 +20,14 @@ image::Image at_size(const image::Image& im, int width, int height);
 // Names `name` in extensionsUsed, and in extensionsRequired too when `required` (each once).
 void require_extension(Document& doc, const std::string& name, bool required);
 
+// The format of the images a cache makes: PNG, or lossless 8-bit WebP (the file then requires
+// EXT_texture_webp).
+enum class MadeFormat { png, webp };
+
 class ImageCache {
  public:
-  ImageCache(const gltf::Document& doc, const image::Encoding& encoding) : doc_(doc), encoding_(encoding) {}
+  ImageCache(const gltf::Document& doc, const image::Encoding& encoding, MadeFormat made)
+      : doc_(doc), encoding_(encoding), made_(made) {}
   ImageCache(const ImageCache&) = delete;
   ImageCache& operator=(const ImageCache&) = delete;
 
@@ -34,7 +39,7 @@ class ImageCache {
   Status check(std::size_t index);
 
   // A new image of `doc` (the cache's document) holding `img`, its colour channels encoded with
-  // `colour`, in the encoding's texture format: a new file `<name>.png`, or `<name>.webp` (lossless,
+  // `colour`, in the cache's format: a new file `<name>.png`, or `<name>.webp` (lossless,
   // 8-bit), which the file then requires EXT_texture_webp for. Returns the image's index and URI.
   struct Made {
     int index = -1;  // of the image, or of the texture (add_texture)
@@ -46,12 +51,12 @@ class ImageCache {
   // sampler of texture `sampler_from` (none when −1). Returns the texture's index and the image's URI.
   Result<Made> add_texture(Document& doc, const image::Image& img, color::Transfer colour, const std::string& name,
                            int sampler_from, image::SampleType type = image::SampleType::u8) const;
-  const image::Encoding& encoding() const { return encoding_; }
-  bool webp() const { return encoding_.texture_format == image::TextureFormat::webp; }
+  bool webp() const { return made_ == MadeFormat::webp; }
 
  private:
   const gltf::Document& doc_;
   image::Encoding encoding_;
+  MadeFormat made_;
   std::map<std::pair<int, color::Transfer>, image::Image> images_;  // by (image index, transfer)
 };
 

@@ -22,16 +22,4 @@ const params::Group<Encoding>& encoding_params() {
   return group;
 }
 
-const params::Group<Encoding>& gltf_texture_params() {
-  static const params::Group<Encoding> group{
-      {params::choice<Encoding>(params::Spec{.name = "texture_format",
-                                             .help = "Format of the textures written into a glTF: png or webp (lossless, 8-bit; "
-                                                     "the file then requires EXT_texture_webp) for those it makes (converted, "
-                                                     "ORM, occlusion), or ktx2: every texture the scene uses as KTX2 "
-                                                     "(KHR_texture_basisu, docs/delivery.md)",
-                                             .example = "webp"},
-                                [](auto& e) -> auto& { return e.texture_format; }, kTextureFormatNames)}};
-  return group;
-}
-
 }  // namespace matbake::image

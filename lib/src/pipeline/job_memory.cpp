@@ -160,7 +160,7 @@ JobFootprint scene_footprint(const Job& job, const Manifest& manifest, int cpus)
     if (t.per_instance && json) textures += double(array_size(*json, "nodes"));
     f.ao = textures * double(t.size.width) * double(t.size.height) * kAoBytesPerTexel;
   }
-  if (s.options.encoding.texture_format == image::TextureFormat::ktx2) {
+  if (s.options.delivery.texture_format == delivery::TextureFormat::ktx2) {
     // Every texture decoded, then encoded in parallel, one per core: the largest, that many at once.
     f.encoder = delivered_texels * kDecodedTextureBytesPerTexel +
                 double(std::max(1, cpus)) * largest_texture * (kKtx2ParentBytesPerTexel + kBasisuBytesPerTexel);

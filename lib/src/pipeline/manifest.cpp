@@ -110,39 +110,6 @@ params::Spelling key_spelling(std::vector<std::string> wheres) {
   };
 }
 
-// Where an error about `key` of `t` points: its value, or the table when the key is not there.
-const toml::node& node_or_table(const toml::table& t, const std::string& key) {
-  const toml::node* at = t.get(key);
-  return at ? *at : static_cast<const toml::node&>(t);
-}
-
-// The keys of `t` that a parameter group describes (`where` names the table: "scenes.s.ao"), and
-// no others: each value checked and stored by its parameter, an older key read with a note; then
-// the group's rules across its parameters. Errors are at the value's line and column.
-template <class T>
-Status read_params_in(const Reader& r, const toml::table& t, const std::string& where, const params::Group<T>& group,
-                      T& target, std::vector<std::string>& notes) {
-  std::set<std::string> given;
-  for (const auto& [key, node] : t) {
-    const std::string name(key.str());
-    const params::Param<T>* p = group.find_key(name);
-    if (!p) continue;
-    if (name != p->spec.name) {
-      notes.push_back(r.origin(key.source()) + ": " + where + "." + name + " is now called " + p->spec.name +
-                      " (the old name still works)");
-    }
-    auto value = toml_value(node);
-    std::optional<std::string> problem = value ? params::apply(*p, target, *value) : value.error().message;
-    if (problem) return r.at(node, where + "." + name + ": " + *problem);
-    given.insert(p->spec.name);
-  }
-  if (auto broken = params::check_rules({params::state_of(group, target, given)}, key_spelling({where}))) {
-    return r.at(node_or_table(t, broken->name), broken->message);
-  }
-  if (Status s = group.check(target); !s) return r.at(t, where + ": " + s.error().message);
-  return success();
-}
-
 // The keys parameters are read from, with their older names.
 std::vector<std::string> keys_of(const std::vector<const params::Spec*>& specs) {
   std::vector<std::string> keys;
@@ -153,33 +120,25 @@ std::vector<std::string> keys_of(const std::vector<const params::Spec*>& specs) 
   return keys;
 }
 
-// The keys a group describes: for a table that holds other keys too.
-template <class T>
-std::vector<std::string> keys_of(const params::Group<T>& group) {
-  return keys_of(group.specs());
-}
-
-template <class T>
-std::vector<std::string> with_keys_of(const params::Group<T>& group, std::vector<std::string> keys) {
-  const std::vector<std::string> more = keys_of(group);
-  keys.insert(keys.end(), more.begin(), more.end());
-  return keys;
-}
-
-// A table that holds a group's keys and no others: an unknown key suggests the nearest names.
-template <class T>
-Status read_params(const Reader& r, const toml::table& t, const std::string& where, const params::Group<T>& group,
-                   T& target, std::vector<std::string>& notes) {
-  if (Status s = r.known_keys(t, where, keys_of(group)); !s) return s;
-  return read_params_in(r, t, where, group, target, notes);
-}
-
-// The manifest keys of a request tree's entry: its plain branches' keys (with older names) and the
-// names of its tables.
+// The manifest keys of a request tree's entry besides `keys`: its plain branches' keys (with older
+// names) and the names of its tables.
 template <class Root>
 std::vector<std::string> keys_of_tree(const params::Tree<Root>& tree, std::vector<std::string> keys) {
   for (const params::Branch<Root>& b : tree) {
-    const std::vector<std::string> own = b.table.empty() ? keys_of(b.specs) : std::vector<std::string>{b.table};
+    for (const std::string& key : b.table.empty() ? keys_of(b.specs) : std::vector<std::string>{b.table}) {
+      if (std::find(keys.begin(), keys.end(), key) == keys.end()) keys.push_back(key);
+    }
+  }
+  return keys;
+}
+
+// The keys of a tree's table `table` ("validate"): every branch's in it.
+template <class Root>
+std::vector<std::string> keys_in_table(const params::Tree<Root>& tree, const std::string& table) {
+  std::vector<std::string> keys;
+  for (const params::Branch<Root>& b : tree) {
+    if (b.table != table) continue;
+    const std::vector<std::string> own = keys_of(b.specs);
     keys.insert(keys.end(), own.begin(), own.end());
   }
   return keys;
@@ -192,58 +151,99 @@ const params::Spec* spec_for_key(const std::vector<const params::Spec*>& specs, 
   return nullptr;
 }
 
-// A request tree from an entry's table `t` (`where`: "scenes.s"): each plain branch from its own
-// keys, each table branch from its sub-table (which holds its keys only); then the rules across
-// the tree, in the manifest's spelling at the key at fault, and each branch's own.
+// The manifest's top level as errors name it: its own keys "manifest.png_compression", its tables'
+// "validate.tolerance".
+const std::string kTopLevel = "manifest";
+
+// How errors name a branch's table within an entry `where` ("scenes.s" → "scenes.s.ao").
 template <class Root>
-Status read_tree(const Reader& r, const toml::table& t, const std::string& where, const params::Tree<Root>& tree,
-                 Root& root, std::vector<std::string>& notes) {
-  std::vector<std::set<std::string>> given(tree.size());
-  std::vector<std::string> wheres;
-  std::vector<const toml::table*> tables;
+std::string where_of(const params::Branch<Root>& b, const std::string& where) {
+  if (b.table.empty()) return where;
+  return where == kTopLevel ? b.table : where + "." + b.table;
+}
+
+// Each branch's names a manifest gave: the top level's, then the entry's own.
+using Given = std::vector<std::set<std::string>>;
+
+// A request as a manifest entry (or the top level every entry starts from) gives it.
+template <class Root>
+struct Entry {
+  Root request;
+  Given given;
+};
+
+// The keys of `t` (`where`: "scenes.s") a tree describes, stored in `entry`: plain branches' among
+// the table's own keys, table branches' in their sub-table (which holds those only); an older key is
+// read with a note. The rules are check_tree's, once the entry is complete.
+template <class Root>
+Status read_branches(const Reader& r, const toml::table& t, const std::string& where, const params::Tree<Root>& tree,
+                     Entry<Root>& entry, std::vector<std::string>& notes) {
+  entry.given.resize(tree.size());
   for (std::size_t i = 0; i < tree.size(); ++i) {
     const params::Branch<Root>& b = tree[i];
-    wheres.push_back(b.table.empty() ? where : where + "." + b.table);
+    const std::string at = where_of(b, where);
     const toml::node* node = b.table.empty() ? &static_cast<const toml::node&>(t) : t.get(b.table);
-    tables.push_back(node ? node->as_table() : nullptr);
-    if (node && !tables.back()) return r.at(*node, wheres[i] + " must be a table: " + b.table + " = { ... }");
     if (!node) continue;
+    const toml::table* table = node->as_table();
+    if (!table) return r.at(*node, at + " must be a table: " + b.table + " = { ... }");
     if (!b.table.empty()) {
-      if (Status s = r.known_keys(*tables[i], wheres[i], keys_of(b.specs)); !s) return s;
+      if (Status s = r.known_keys(*table, at, keys_in_table(tree, b.table)); !s) return s;
     }
-    for (const auto& [key, value] : *tables[i]) {
+    for (const auto& [key, value] : *table) {
       const std::string name(key.str());
       const params::Spec* spec = spec_for_key(b.specs, name);
       if (!spec) continue;
       if (name != spec->name) {
-        notes.push_back(r.origin(key.source()) + ": " + wheres[i] + "." + name + " is now called " + spec->name +
+        notes.push_back(r.origin(key.source()) + ": " + at + "." + name + " is now called " + spec->name +
                         " (the old name still works)");
       }
       auto v = toml_value(value);
-      std::optional<std::string> problem = v ? b.apply(root, *spec, *v) : v.error().message;
-      if (problem) return r.at(value, wheres[i] + "." + name + ": " + *problem);
-      given[i].insert(spec->name);
+      std::optional<std::string> problem = v ? b.apply(entry.request, *spec, *v) : v.error().message;
+      if (problem) return r.at(value, at + "." + name + ": " + *problem);
+      entry.given[i].insert(spec->name);
     }
-  }
-  if (auto broken = params::check_rules(params::states_of(tree, root, given), key_spelling(wheres))) {
-    return r.at(node_or_table(*tables[broken->group], broken->name), broken->message);
-  }
-  for (std::size_t i = 0; i < tree.size(); ++i) {
-    if (Status s = tree[i].check(root); !s) return r.at(tables[i] ? *tables[i] : t, wheres[i] + ": " + s.error().message);
   }
   return success();
 }
 
-Status read_validation(const Reader& r, const toml::table& t, const std::string& where, ValidationRules& rules,
-                       std::vector<std::string>& notes) {
-  if (Status s = r.known_keys(t, where, with_keys_of(validate::options_params(), keys_of(validation_params()))); !s) {
-    return s;
+// Where a branch's key is written: in the entry `t`, else in the top level `top` it came from, else
+// the entry's table of the branch.
+template <class Root>
+const toml::node& key_node(const params::Branch<Root>& b, const std::string& key, const toml::table& t,
+                           const toml::table& top) {
+  for (const toml::table* in : {&t, &top}) {
+    const toml::table* table = b.table.empty() ? in : in->get_as<toml::table>(b.table);
+    if (const toml::node* found = table ? table->get(key) : nullptr) return *found;
   }
-  for (Status s : {read_params_in(r, t, where, validation_params(), rules, notes),
-                   read_params_in(r, t, where, validate::options_params(), rules.options, notes)}) {
-    if (!s) return s;
+  const toml::table* own = b.table.empty() ? &t : t.get_as<toml::table>(b.table);
+  return own ? *own : t;
+}
+
+// The rules across a complete entry's tree, in the manifest's spelling at the key at fault; then
+// each branch's own.
+template <class Root>
+Status check_tree(const Reader& r, const toml::table& t, const toml::table& top, const std::string& where,
+                  const params::Tree<Root>& tree, const Entry<Root>& entry) {
+  std::vector<std::string> wheres;
+  for (const params::Branch<Root>& b : tree) wheres.push_back(where_of(b, where));
+  if (auto broken = params::check_rules(params::states_of(tree, entry.request, entry.given), key_spelling(wheres))) {
+    return r.at(key_node(tree[broken->group], broken->name, t, top), broken->message);
+  }
+  for (std::size_t i = 0; i < tree.size(); ++i) {
+    if (Status s = tree[i].check(entry.request); !s) {
+      const toml::table* own = tree[i].table.empty() ? &t : t.get_as<toml::table>(tree[i].table);
+      return r.at(own ? *own : t, wheres[i] + ": " + s.error().message);
+    }
   }
   return success();
+}
+
+// An entry's request over `entry` (the top level's, which its keys override): read, then checked.
+template <class Root>
+Status read_entry(const Reader& r, const toml::table& t, const toml::table& top, const std::string& where,
+                  const params::Tree<Root>& tree, Entry<Root>& entry, std::vector<std::string>& notes) {
+  if (Status s = read_branches(r, t, where, tree, entry, notes); !s) return s;
+  return check_tree(r, t, top, where, tree, entry);
 }
 
 // layout = "gltf-orm" (a preset) or "layouts/mine" / "layouts/mine.json" (a file beside the manifest).
@@ -359,36 +359,37 @@ Status check_bits_and_format(const Reader& r, const toml::table& t, const std::s
                   options.format + "\": " + *problem);
 }
 
-Result<MaterialSpec> read_material(const Reader& r, const std::string& name, const std::string& where,
-                                   const toml::node& node, const Manifest& m, const MaterialSpec& defaults,
-                                   std::vector<std::string>& notes, std::vector<std::string> structure = {}) {
+// The manifest's top level: every entry starts from its values of the entry's parameters (one rule:
+// any key of a material's or a scene's request tree, tables included), then says otherwise.
+struct TopLevel {
+  const toml::table& table;
+  Entry<MaterialSpec> material;
+  Entry<SceneSpec> scene;
+};
+
+Result<Entry<MaterialSpec>> read_material(const Reader& r, const std::string& name, const std::string& where,
+                                          const toml::node& node, const Manifest& m, const toml::table& top,
+                                          const Entry<MaterialSpec>& defaults, std::vector<std::string>& notes,
+                                          std::vector<std::string> structure = {}) {
   const toml::table* t = node.as_table();
   if (!t) return r.at(node, where + " must be a table");
   if (!is_file_name_safe(name)) {
     return r.at(node, "material name '" + name + "': letters, digits, '_', '-' and '.' only (it names files)");
   }
-  structure.insert(structure.end(), {"sources", "packed", "layout", "reference", "validate"});
-  if (Status s = r.known_keys(*t, where, with_keys_of(pack::material_params(), with_keys_of(image::encoding_params(), structure)));
-      !s) {
-    return s.error();
-  }
-  MaterialSpec spec = defaults;
+  structure.insert(structure.end(), {"sources", "packed", "layout", "reference"});
+  if (Status s = r.known_keys(*t, where, keys_of_tree(material_tree(), structure)); !s) return s.error();
+  Entry<MaterialSpec> entry = defaults;
+  MaterialSpec& spec = entry.request;
   spec.name = name;
   spec.origins.by_key[""] = r.origin(node.source());
   r.record(*t, "", spec.origins);
-  for (Status s : {read_params_in(r, *t, where, image::encoding_params(), spec.encoding, notes),
-                   read_params_in(r, *t, where, pack::material_params(), spec.options, notes),
-                   r.get(*t, "reference", where, spec.reference)}) {
+  for (Status s : {read_entry(r, *t, top, where, material_tree(), entry, notes), r.get(*t, "reference", where, spec.reference)}) {
     if (!s) return s.error();
   }
   if (Status s = check_bits_and_format(r, *t, where, spec.options); !s) return s.error();
   auto layout = read_layout(r, *t, "layout", where, m.folder);
   if (!layout) return layout.error();
   if (*layout) spec.layout = std::move(*layout);  // else the defaults' (a rule's, for its overrides)
-  if (const toml::node* v = t->get("validate")) {
-    if (!v->is_table()) return r.at(*v, where + ".validate must be a table");
-    if (Status s = read_validation(r, *v->as_table(), where + ".validate", spec.validation, notes); !s) return s.error();
-  }
 
   const toml::node* sources = t->get("sources");
   const toml::node* packed = t->get("packed");
@@ -397,7 +398,7 @@ Result<MaterialSpec> read_material(const Reader& r, const std::string& name, con
   }
   if (Status s = sources ? read_sources(r, *sources, where, m, spec) : success(); !s) return s.error();
   if (Status s = packed ? read_packed_entry(r, *packed, where, m, spec) : success(); !s) return s.error();
-  return spec;
+  return entry;
 }
 
 // "{name}" in `text` replaced by `name`.
@@ -443,7 +444,7 @@ Result<std::vector<std::string>> rule_matches(const Reader& r, const toml::node&
 // [material_rules.NAME]: a material per file `match` finds, its keys those of a material with
 // "{name}" in its file names, and `overrides.NAME` tables of material keys for some of them.
 Status read_material_rule(const Reader& r, const std::string& rule, const toml::node& node, Manifest& m,
-                          const MaterialSpec& defaults) {
+                          const TopLevel& top) {
   const std::string where = "material_rules." + rule;
   const toml::table* t = node.as_table();
   if (!t) return r.at(node, where + " must be a table");
@@ -451,7 +452,7 @@ Status read_material_rule(const Reader& r, const std::string& rule, const toml::
   if (!match) return r.at(node, where + ": needs match = \"textures/{name}_BaseColor.png\" (a file per material)");
   auto names = rule_matches(r, *match, where, m, m.notes);
   if (!names) return names.error();
-  auto shared = read_material(r, rule, where, node, m, defaults, m.notes, {"match", "overrides"});
+  auto shared = read_material(r, rule, where, node, m, top.table, top.material, m.notes, {"match", "overrides"});
   if (!shared) return shared.error();
   const toml::table* overrides = nullptr;
   if (const toml::node* o = t->get("overrides")) {
@@ -467,15 +468,16 @@ Status read_material_rule(const Reader& r, const std::string& rule, const toml::
   }
   MaterialRule expanded{rule, r.origin(node.source()), {}, (m.folder / *match->value<std::string>()).parent_path()};
   for (const std::string& name : *names) {
-    MaterialSpec spec = *shared;
+    Entry<MaterialSpec> entry = *shared;
+    MaterialSpec& spec = entry.request;
     spec.name = name;
     for (pack::SourceInput& s : spec.sources) s.file = with_name(s.file.string(), name);
     for (fs::path& f : spec.packed_files) f = with_name(f.string(), name);
     spec.reference = with_name(spec.reference, name);
     if (const toml::node* own = overrides ? overrides->get(name) : nullptr) {
-      auto overridden = read_material(r, name, where + ".overrides." + name, *own, m, spec, m.notes);
+      auto overridden = read_material(r, name, where + ".overrides." + name, *own, m, top.table, entry, m.notes);
       if (!overridden) return overridden.error();
-      spec = std::move(*overridden);
+      entry = std::move(*overridden);
     }
     for (const MaterialSpec& other : m.materials) {
       if (other.name == name) {
@@ -490,24 +492,20 @@ Status read_material_rule(const Reader& r, const std::string& rule, const toml::
 }
 
 Result<SceneSpec> read_scene(const Reader& r, const std::string& name, const toml::node& node, const Manifest& m,
-                             const image::Encoding& encoding, std::vector<std::string>& notes) {
+                             const TopLevel& top, std::vector<std::string>& notes) {
   const std::string where = "scenes." + name;
   const toml::table* t = node.as_table();
   if (!t) return r.at(node, where + " must be a table");
   if (!is_file_name_safe(name)) return r.at(node, "scene name '" + name + "': letters, digits, '_', '-' and '.' only");
-  if (Status s = r.known_keys(*t, where, with_keys_of(scene_params(), keys_of_tree(exporter::request_tree(), {"input", "output", "materials"})));
-      !s) {
-    return s.error();
-  }
-  SceneSpec spec;
-  spec.options.encoding = encoding;  // the manifest's top level, which the scene may override
+  if (Status s = r.known_keys(*t, where, keys_of_tree(scene_tree(), {"input", "output", "materials"})); !s) return s.error();
+  Entry<SceneSpec> entry = top.scene;
+  SceneSpec& spec = entry.request;
   spec.name = name;
   spec.origins.by_key[""] = r.origin(node.source());
   r.record(*t, "", spec.origins);
   std::string input, output = name + ".glb";
   for (Status s : {r.get(*t, "input", where, input), r.get(*t, "output", where, output),
-                   read_params_in(r, *t, where, scene_params(), spec, notes),
-                   read_tree(r, *t, where, exporter::request_tree(), spec.options, notes)}) {
+                   read_entry(r, *t, top.table, where, scene_tree(), entry, notes)}) {
     if (!s) return s.error();
   }
   if (input.empty()) return r.at(node, where + ": input = \"scene.gltf\" is required");
@@ -527,7 +525,7 @@ Result<SceneSpec> read_scene(const Reader& r, const std::string& name, const tom
       spec.materials[std::string(key.str())] = *target;
     }
   }
-  return spec;
+  return std::move(entry.request);
 }
 
 }  // namespace
@@ -554,13 +552,9 @@ Result<Manifest> parse_manifest(std::string_view toml_text, const fs::path& file
                        std::to_string(e.source().begin.column),
                    "not valid TOML: " + std::string(e.description())};
     }
-    if (Status s = r.known_keys(doc, "the manifest",
-                                with_keys_of(pack::material_params(),
-                                             with_keys_of(image::encoding_params(),
-                                                          with_keys_of(image::gltf_texture_params(),
-                                                                       {"output", "table", "validate", "materials", "material_rules",
-                                                                        "scenes", "cluster", "shared_output", "prune"}))));
-        !s) {
+    const std::vector<std::string> own_keys{"output", "table", "materials", "material_rules", "scenes", "cluster",
+                                            "shared_output", "prune", "max_pixels"};
+    if (Status s = r.known_keys(doc, "the manifest", keys_of_tree(material_tree(), keys_of_tree(scene_tree(), own_keys))); !s) {
       return s.error();
     }
     m.origins.by_key[""] = file.string();
@@ -572,42 +566,51 @@ Result<Manifest> parse_manifest(std::string_view toml_text, const fs::path& file
     if (Status s = r.get(doc, "table", "manifest", table); !s) return s.error();
     if (Status s = r.get(doc, "shared_output", "manifest", m.shared_output); !s) return s.error();
     if (Status s = r.get(doc, "prune", "manifest", m.prune); !s) return s.error();
+    if (Status s = r.get(doc, "max_pixels", "manifest", m.max_pixels); !s) return s.error();
+    if (m.max_pixels < 0 || (doc.get("max_pixels") && m.max_pixels == 0)) {
+      return r.at(*doc.get("max_pixels"), "manifest.max_pixels: a count of pixels, 1 or more");
+    }
     m.output = (m.folder / output).lexically_normal();
     if (!table.empty()) m.table = m.folder / table;
-    // The top level's material options, encoding and validation are every material's defaults (the
-    // encoding and texture format every scene's too), each of which may say otherwise.
-    MaterialSpec defaults;
-    for (Status s : {read_params_in(r, doc, "manifest", pack::material_params(), defaults.options, m.notes),
-                     read_params_in(r, doc, "manifest", image::encoding_params(), defaults.encoding, m.notes),
-                     read_params_in(r, doc, "manifest", image::gltf_texture_params(), defaults.encoding, m.notes)}) {
+    TopLevel top{doc, {}, {}};
+    std::vector<std::string> top_notes;  // a key both trees read is noted once
+    for (Status s : {read_branches(r, doc, kTopLevel, material_tree(), top.material, top_notes),
+                     read_branches(r, doc, kTopLevel, scene_tree(), top.scene, top_notes)}) {
       if (!s) return s.error();
     }
-    if (const toml::node* v = doc.get("validate")) {
-      if (!v->is_table()) return r.at(*v, "validate must be a table");
-      if (Status s = read_validation(r, *v->as_table(), "validate", defaults.validation, m.notes); !s) return s.error();
+    for (std::string& note : top_notes) {
+      if (std::find(m.notes.begin(), m.notes.end(), note) == m.notes.end()) m.notes.push_back(std::move(note));
     }
     if (const toml::node* c = doc.get("cluster")) {
       if (!c->is_table()) return r.at(*c, "cluster must be a table: [cluster]");
-      if (Status s = read_params(r, *c->as_table(), "cluster", cluster_params(), m.cluster, m.notes); !s) return s.error();
+      static const params::Tree<ClusterOptions> cluster{
+          params::branch<ClusterOptions>(cluster_params(), "", "", [](auto& o) -> auto& { return o; })};
+      Entry<ClusterOptions> read{m.cluster, {}};
+      for (Status s : {r.known_keys(*c->as_table(), "cluster", keys_of_tree(cluster, {})),
+                       read_entry(r, *c->as_table(), *c->as_table(), "cluster", cluster, read, m.notes)}) {
+        if (!s) return s.error();
+      }
+      m.cluster = std::move(read.request);
     }
     if (const toml::node* mats = doc.get("materials")) {
       if (!mats->is_table()) return r.at(*mats, "materials must be a table of tables: [materials.NAME]");
       for (const auto& [key, value] : *mats->as_table()) {
-        auto spec = read_material(r, std::string(key.str()), "materials." + std::string(key.str()), value, m, defaults, m.notes);
-        if (!spec) return spec.error();
-        m.materials.push_back(std::move(*spec));
+        auto entry = read_material(r, std::string(key.str()), "materials." + std::string(key.str()), value, m, doc,
+                                   top.material, m.notes);
+        if (!entry) return entry.error();
+        m.materials.push_back(std::move(entry->request));
       }
     }
     if (const toml::node* rules = doc.get("material_rules")) {
       if (!rules->is_table()) return r.at(*rules, "material_rules must be a table of tables: [material_rules.NAME]");
       for (const auto& [key, value] : *rules->as_table()) {
-        if (Status s = read_material_rule(r, std::string(key.str()), value, m, defaults); !s) return s.error();
+        if (Status s = read_material_rule(r, std::string(key.str()), value, m, top); !s) return s.error();
       }
     }
     if (const toml::node* scenes = doc.get("scenes")) {
       if (!scenes->is_table()) return r.at(*scenes, "scenes must be a table of tables: [scenes.NAME]");
       for (const auto& [key, value] : *scenes->as_table()) {
-        auto spec = read_scene(r, std::string(key.str()), value, m, defaults.encoding, m.notes);
+        auto spec = read_scene(r, std::string(key.str()), value, m, top, m.notes);
         if (!spec) return spec.error();
         m.scenes.push_back(std::move(*spec));
       }

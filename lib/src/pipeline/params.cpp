@@ -2,7 +2,11 @@
 #include <cctype>
 
 #include "matbake/cluster.hpp"
+#include "matbake/encoding_params.hpp"
+#include "matbake/export_params.hpp"
+#include "matbake/material_params.hpp"
 #include "matbake/pipeline_params.hpp"
+#include "matbake/validate_params.hpp"
 
 namespace matbake::pipeline {
 
@@ -35,6 +39,29 @@ const params::Group<SceneSpec>& scene_params() {
                               [](auto& s) -> auto& { return s.match_names; }),
   }};
   return group;
+}
+
+const params::Tree<MaterialSpec>& material_tree() {
+  static const params::Tree<MaterialSpec> tree{
+      params::branch<MaterialSpec>(pack::material_params(), "", "", [](auto& m) -> auto& { return m.options; }),
+      params::branch<MaterialSpec>(image::encoding_params(), "", "", [](auto& m) -> auto& { return m.encoding; }),
+      params::branch<MaterialSpec>(validation_params(), "validate", "", [](auto& m) -> auto& { return m.validation; }),
+      params::branch<MaterialSpec>(validate::options_params(), "validate", "",
+                                   [](auto& m) -> auto& { return m.validation.options; }),
+  };
+  return tree;
+}
+
+const params::Tree<SceneSpec>& scene_tree() {
+  static const params::Tree<SceneSpec> tree = [] {
+    params::Tree<SceneSpec> t{params::branch<SceneSpec>(scene_params(), "", "", [](auto& s) -> auto& { return s; })};
+    for (params::Branch<SceneSpec>& b :
+         params::subtree<SceneSpec>(exporter::request_tree(), [](auto& s) -> auto& { return s.options; })) {
+      t.push_back(std::move(b));
+    }
+    return t;
+  }();
+  return tree;
 }
 
 namespace {

@@ -326,7 +326,7 @@ Result<Plan> make_plan(const Manifest& manifest) {
                                 {"materials", materials},
                                 {"export", to_json(s.options)}};
       // The encoder's version too: a new basisu rebuilds the KTX2 scenes.
-      if (s.options.encoding.texture_format == image::TextureFormat::ktx2) options["encoder"] = delivery::encoder_identity();
+      if (s.options.delivery.texture_format == delivery::TextureFormat::ktx2) options["encoder"] = delivery::encoder_identity();
       job.options = options.dump();
       scenes.push_back(std::move(job));
     }
