@@ -288,5 +288,30 @@ TEST(Hostile, BuildDoesNotWriteThroughLinksInTheOutputFolder) {
   EXPECT_TRUE(fs::exists(dir / "elsewhere" / "materials" / "a_a.png"));
 }
 
+// An output that is an input under another name — a hard link, or a link to a source that lives in
+// the output folder — is refused before anything runs, the source's bytes untouched.
+TEST(Hostile, AnOutputThatIsAnInputUnderAnotherNameIsRefused) {
+  for (const bool hard : {true, false}) {
+    SCOPED_TRACE(hard ? "hard link" : "symbolic link");
+    TempDir dir;
+    fs::create_directories(dir / "out" / "materials");
+    const fs::path source = dir / "out" / "kd.png";
+    write_raw(source, 4, 4, 3, "uint8", std::vector<double>(48, 120));
+    const std::string before = read_bytes(source);
+    const std::string manifest = (dir / "m.toml").string();
+    write_bytes(manifest, "[materials.a]\nsources = { kd = \"out/kd.png\", ks = 0.04, gloss = 0.5 }\nlayout = \"gltf-orm\"\n");
+    const fs::path output = dir / "out" / "materials" / "a_base_color.png";
+    if (hard) {
+      fs::create_hard_link(source, output);
+    } else {
+      fs::create_symlink(source, output);
+    }
+    const RunResult r = matbake({"build", manifest});
+    EXPECT_EQ(r.exit_code, 1);
+    expect_one_error_line(r, output.string(), "material:a would overwrite an input; matbake never does");
+    EXPECT_EQ(read_bytes(source), before);
+  }
+}
+
 }  // namespace
 }  // namespace matbake::test

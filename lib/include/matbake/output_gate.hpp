@@ -9,6 +9,7 @@
 #include <sys/types.h>
 
 #include <filesystem>
+#include <memory>
 #include <set>
 #include <span>
 #include <string>
@@ -31,12 +32,20 @@ struct RemoveResult {
   std::string why;  // refused: the reason, for the warning
 };
 
+class RealPaths;
+
+// One thread at a time: it remembers the real paths it has resolved.
 class OutputGate {
  public:
   // `folder` need not exist yet (a first run); `protect` are the files no write or delete may touch.
   OutputGate(const std::filesystem::path& folder, std::span<const std::filesystem::path> protect);
+  ~OutputGate();
+  OutputGate(OutputGate&&) noexcept;
 
   const std::filesystem::path& real_folder() const { return real_folder_; }
+
+  // Whether `file`'s real path is inside the output folder's (no link leads out of it).
+  bool holds(const std::filesystem::path& file) const;
 
   // A file written beside the outputs on a user's request (--depfile, --stamp, plan -o, a Slurm
   // folder): anywhere but never a protected file, nor inside the output folder's state folder
@@ -53,6 +62,7 @@ class OutputGate {
   bool is_protected(const std::filesystem::path& file) const;
 
  private:
+  std::unique_ptr<RealPaths> real_;
   std::filesystem::path folder_;
   std::filesystem::path real_folder_;
   std::set<std::pair<dev_t, ino_t>> protected_;   // those that exist, by identity

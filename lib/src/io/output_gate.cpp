@@ -1,5 +1,7 @@
 #include "matbake/output_gate.hpp"
 
+#include "real_paths.hpp"
+
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -31,12 +33,6 @@ std::string hex(XXH64_hash_t h) {
   char text[17];
   std::snprintf(text, sizeof text, "%016llx", (unsigned long long)h);
   return text;
-}
-
-fs::path real_path(const fs::path& p) {
-  std::error_code ec;
-  const fs::path real = fs::weakly_canonical(fs::absolute(p, ec), ec);
-  return ec ? fs::absolute(p, ec).lexically_normal() : real;
 }
 
 bool inside(const fs::path& folder, const fs::path& path) {
@@ -80,18 +76,23 @@ std::string recorded_path_problem(const std::string& recorded) {
 }
 
 OutputGate::OutputGate(const fs::path& folder, std::span<const fs::path> protect)
-    : folder_(fs::absolute(folder).lexically_normal()), real_folder_(real_path(folder)) {
+    : real_(std::make_unique<RealPaths>()), folder_(fs::absolute(folder).lexically_normal()), real_folder_(real_->of(folder)) {
   for (const fs::path& p : protect) {
     struct stat s;
     if (::stat(p.c_str(), &s) == 0) protected_.insert({s.st_dev, s.st_ino});
+    protected_real_.insert(real_->of(p).native());
   }
-  for (const fs::path& p : protect) protected_real_.insert(real_path(p).native());
 }
+
+OutputGate::~OutputGate() = default;
+OutputGate::OutputGate(OutputGate&&) noexcept = default;
+
+bool OutputGate::holds(const fs::path& file) const { return real_->inside(real_folder_, file); }
 
 bool OutputGate::is_protected(const fs::path& file) const {
   struct stat s;
   if (::stat(file.c_str(), &s) == 0 && protected_.count({s.st_dev, s.st_ino})) return true;
-  return protected_real_.count(real_path(file).native()) > 0;
+  return protected_real_.count(real_->of(file).native()) > 0;
 }
 
 Status OutputGate::check_side_output(const fs::path& target, const std::string& option) const {
@@ -103,7 +104,7 @@ Status OutputGate::check_side_output(const fs::path& target, const std::string& 
   }
   // The state folder holds matbake's stamps, logs and locks (.json, .failed, .lock); the depfiles of
   // its own Ninja plan (.d) live there too.
-  if (inside(real_folder_ / kStateFolder, real_path(target)) && target.extension() != ".d") {
+  if (inside(real_folder_ / kStateFolder, real_->of(target)) && target.extension() != ".d") {
     return Error{name, "is inside the output folder's state folder (.matbake), which only matbake writes", true};
   }
   return success();

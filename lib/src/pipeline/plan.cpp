@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <set>
 #include <unordered_map>
-#include <unordered_set>
 
 #include "../gltf/document.hpp"
 #include "state.hpp"
@@ -121,48 +120,6 @@ std::optional<Error> material_problem(const MaterialSpec& m, const Result<std::v
   }
   return std::nullopt;
 }
-
-// Real paths (links resolved, as fs::weakly_canonical gives them) of many files in few folders:
-// each folder is resolved and listed once (which of its entries are links), so a file costs no
-// system call (not a readlink per component, nor an lstat).
-class RealPaths {
- public:
-  const fs::path& of(const fs::path& absolute) {
-    if (const auto found = known_.find(absolute.native()); found != known_.end()) return found->second;
-    fs::path real = absolute;
-    if (absolute.has_relative_path()) {
-      const fs::path& folder = of(absolute.parent_path());
-      real = folder / absolute.filename();
-      if (links_in(folder).count(absolute.filename().native())) {
-        std::error_code ec;
-        real = fs::weakly_canonical(real, ec);
-        if (ec) real = absolute;
-      }
-    }
-    return known_.emplace(absolute.native(), std::move(real)).first->second;
-  }
-  bool inside(const fs::path& folder, const fs::path& path) {
-    const fs::path& f = of(folder.has_filename() ? folder : folder.parent_path());  // "out/" is "out"
-    const fs::path& p = of(path);
-    const auto [end, rest] = std::mismatch(f.begin(), f.end(), p.begin(), p.end());
-    return end == f.end();
-  }
-
- private:
-  const std::unordered_set<std::string>& links_in(const fs::path& folder) {
-    auto [found, added] = links_.try_emplace(folder.native());
-    if (added) {
-      std::error_code ec;
-      for (const auto& entry : fs::directory_iterator(folder, ec)) {
-        if (entry.is_symlink(ec)) found->second.insert(entry.path().filename().native());
-      }
-    }
-    return found->second;
-  }
-
-  std::unordered_map<std::string, fs::path> known_;  // by the native string: fs::path compares by component, slowly
-  std::unordered_map<std::string, std::unordered_set<std::string>> links_;  // folder → names of its links
-};
 
 void add_unique(std::vector<fs::path>& to, const std::vector<fs::path>& from) {
   for (const fs::path& p : from) {
@@ -355,24 +312,21 @@ Result<Plan> make_plan(const Manifest& manifest) {
       plan.jobs.push_back(std::move(s));
     }
 
-    // No file written twice, no input written at all (both by real path: links followed), and
-    // nothing written outside the output folder's real path (a link inside it to elsewhere).
-    RealPaths real;
-    std::unordered_map<std::string, std::string> writers;
-    std::unordered_set<std::string> inputs;
-    for (const Job& job : plan.jobs) {
-      for (const fs::path& in : job.inputs) inputs.insert(real.of(in).native());
-    }
-    inputs.insert(real.of(manifest.file).native());
-    if (!real.inside(manifest.output, plan.state_folder)) {
+    // No file written twice, no input written at all (by the output gate: real path and identity),
+    // and nothing written outside the output folder's real path (a link inside it to elsewhere).
+    std::vector<fs::path> inputs{manifest.file};
+    for (const Job& job : plan.jobs) inputs.insert(inputs.end(), job.inputs.begin(), job.inputs.end());
+    const OutputGate gate(manifest.output, inputs);
+    if (!gate.holds(plan.state_folder)) {
       return Error{plan.state_folder.string(), "is a link out of the output folder; matbake writes only inside it"};
     }
+    std::unordered_map<std::string, std::string> writers;
     for (const Job& job : plan.jobs) {
       for (const fs::path& out : job.outputs.all()) {
-        if (!real.inside(manifest.output, out)) {
+        if (!gate.holds(out)) {
           return Error{out.string(), job.name + " would be written outside the output folder (through a link); matbake writes only inside it"};
         }
-        if (inputs.count(real.of(out).native())) return Error{out.string(), job.name + " would overwrite an input; matbake never does"};
+        if (gate.is_protected(out)) return Error{out.string(), job.name + " would overwrite an input; matbake never does"};
         if (const auto [it, added] = writers.emplace(out.native(), job.name); !added) {
           return Error{out.string(), "written by both " + it->second + " and " + job.name};
         }
