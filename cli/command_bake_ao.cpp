@@ -23,7 +23,7 @@ CLI::App* setup_bake_ao(CLI::App& app, BakeAoSettings& s) {
                   "Output .gltf (+ .bin beside it) or .glb; everything but the baked attribute is kept as written");
   cmd->add_option("--dump", s.dump, "Raw values: .csv (node,mesh,primitive,vertex,x,y,z,ao) or .bin (float32)");
   add_tree(*cmd, bake_ao::request_tree(), s.options, s.given,
-           {"Options", "Options", "Texture delivery (docs/delivery.md)", "Options"});
+           {"Options", "Texture delivery (docs/delivery.md)", "Options"});
   add_dump_texture(*cmd, s.dump_texture, "", "Options");
   return cmd;
 }

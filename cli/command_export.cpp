@@ -66,7 +66,7 @@ CLI::App* setup_export(CLI::App& app, ExportSettings& s) {
   add_params(*cmd, pack::material_params(), s.material_options, "", "Options", nullptr, {"transfer", "decode", "normal_y"});
   // AO is baked when any --ao-* is given, as a manifest's ao = { ... }.
   add_tree(*cmd, exporter::request_tree(), s.options, s.given,
-           {"Options", "Options", "Options", "Texture delivery (docs/delivery.md)", "Ambient occlusion"});
+           {"Options", "Options", "Texture delivery (docs/delivery.md)", "Ambient occlusion"});
   add_dump_texture(*cmd, s.dump_texture, "ao-", "Ambient occlusion");
   cmd->add_option("--report", s.report, "Also write the report as JSON to this file");
   return cmd;

@@ -8,6 +8,7 @@
 #include <functional>
 #include <iostream>
 #include <set>
+#include <stdexcept>
 #include <string>
 
 #include "matbake/params.hpp"
@@ -41,7 +42,7 @@ inline void add_specs(CLI::App& cmd, const std::vector<const params::Spec*>& spe
     std::string help = p.help;
     if (p.kind == params::Kind::choice) help += ": " + params::type_text(p);
     for (const params::Condition& c : p.needs) {
-      help += " (with --" + prefix + c.name + (c.value.empty() ? "" : " " + c.value) + ")";
+      help += " (with " + params::flag_name(params::Spec{.name = c.name}, prefix) + (c.value.empty() ? "" : " " + c.value) + ")";
     }
     if (p.kind == params::Kind::flag) {  // on by default: --no-NAME turns it off
       const bool on = defaults.at(p.name) == true;
@@ -79,10 +80,11 @@ void add_params(CLI::App& cmd, const params::Group<T>& group, T& target, const s
 }
 
 // A request tree's parameters as flags over `root`: `given` gets one set per branch, `help_groups`
-// is each branch's --help heading.
+// is each branch's --help heading (one per branch: a tree that grows must be given its heading).
 template <class Root>
 void add_tree(CLI::App& cmd, const params::Tree<Root>& tree, Root& root, std::vector<std::set<std::string>>& given,
               const std::vector<std::string>& help_groups) {
+  if (help_groups.size() != tree.size()) throw std::logic_error("a --help heading per branch of the request tree");
   given.assign(tree.size(), {});
   for (std::size_t i = 0; i < tree.size(); ++i) {
     const params::Branch<Root>& b = tree[i];

@@ -6,10 +6,14 @@
 #include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <map>
+#include <sstream>
 #include <random>
 
 #include "lib/src/gltf/document.hpp"
 #include "matbake/ao_params.hpp"
+#include "matbake/bake_ao_params.hpp"
+#include "matbake/export_params.hpp"
 #include "matbake/image.hpp"
 #include "support/files.hpp"
 #include "support/gltf_files.hpp"
@@ -106,6 +110,48 @@ class Parity : public ::testing::Test {
 
   TempDir dir;
 };
+
+// Each flag of a command's tree as --help lists it: under its branch's heading, with the flags it
+// applies with spelt as flags.
+template <class Root>
+void expect_help_headings(const std::string& command, const params::Tree<Root>& tree,
+                          const std::vector<std::string>& headings) {
+  const RunResult help = matbake({command, "--help"});
+  ASSERT_EQ(help.exit_code, 0);
+  std::map<std::string, std::string> heading_of;  // flag → the heading above it
+  std::map<std::string, std::string> line_of;
+  std::string heading, last;
+  std::istringstream lines(help.out);
+  for (std::string line; std::getline(lines, line);) {
+    if (!line.empty() && line[0] != ' ' && line.back() == ':') heading = line.substr(0, line.size() - 1);
+    if (line.rfind("  --", 0) != 0) {  // a long help's further lines
+      if (!last.empty() && line.rfind("   ", 0) == 0) line_of[last] += line;
+      continue;
+    }
+    last = line.substr(2, line.find_first_of(" =", 2) - 2);
+    heading_of[last] = heading;
+    line_of[last] = line;
+  }
+  for (std::size_t b = 0; b < tree.size(); ++b) {
+    for (const params::Spec* spec : tree[b].specs) {
+      if (spec->manifest_only) continue;
+      std::string flag = params::flag_name(*spec, tree[b].flag_prefix);
+      if (spec->kind == params::Kind::flag && line_of.count(flag) == 0) flag = "--no-" + flag.substr(2);
+      SCOPED_TRACE(flag);
+      EXPECT_EQ(heading_of[flag], headings.at(b));
+      for (const params::Condition& c : spec->needs) {
+        EXPECT_NE(line_of[flag].find("(with " + params::flag_name(params::Spec{.name = c.name}, tree[b].flag_prefix)),
+                  std::string::npos) << line_of[flag];
+      }
+    }
+  }
+}
+
+TEST(Help, EveryTreeFlagStandsUnderItsBranchsHeading) {
+  expect_help_headings("export", exporter::request_tree(),
+                       {"Options", "Options", "Texture delivery (docs/delivery.md)", "Ambient occlusion"});
+  expect_help_headings("bake-ao", bake_ao::request_tree(), {"Options", "Texture delivery (docs/delivery.md)", "Options"});
+}
 
 TEST_F(Parity, PackAndWorkflowGiveTheManifestsBytes) {
   const std::vector<MaterialCase> cases = {
