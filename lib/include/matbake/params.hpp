@@ -96,15 +96,6 @@ struct Group {
     }
     return nullptr;
   }
-  // The parameter a manifest key names, by its name or an older alias.
-  const Param<T>* find_key(std::string_view key) const {
-    for (const Param<T>& p : params) {
-      if (p.spec.name == key || std::find(p.spec.aliases.begin(), p.spec.aliases.end(), key) != p.spec.aliases.end()) {
-        return &p;
-      }
-    }
-    return nullptr;
-  }
   std::vector<const Spec*> specs() const {
     std::vector<const Spec*> out;
     for (const Param<T>& p : params) out.push_back(&p.spec);
@@ -150,11 +141,6 @@ struct RuleBreak {
 // Every Spec's needs, needs_value and excludes over a request's groups; the first broken, or none.
 // A name is looked up in the parameter's own group first, then in the others in order.
 std::optional<RuleBreak> check_rules(const std::vector<GroupState>& groups, const Spelling& spell);
-
-template <class T>
-GroupState state_of(const Group<T>& group, const T& target, const std::set<std::string>& given) {
-  return {group.specs(), to_json(group, target), given};
-}
 
 // --- A request's tree: its groups, each over the part of the request it fills -----------------------
 
@@ -218,15 +204,6 @@ Tree<Outer> subtree(const Tree<Root>& tree, Part part) {
                    [b, part](const Outer& o) { return b.check(part(o)); }});
   }
   return out;
-}
-
-// The branch a group is, by its table and prefix; null when none.
-template <class Root>
-const Branch<Root>* find_branch(const Tree<Root>& tree, std::string_view table) {
-  for (const Branch<Root>& b : tree) {
-    if (b.table == table) return &b;
-  }
-  return nullptr;
 }
 
 // Each branch's state for check_rules; `given[i]` the names the door gave branch i.
