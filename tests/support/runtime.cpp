@@ -1,0 +1,104 @@
+#include "support/runtime.hpp"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <stdexcept>
+
+#include "matbake/image.hpp"
+#include "matbake/subprocess.hpp"
+
+namespace matbake::test {
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+const fs::path kHarness = fs::path(MATBAKE_SOURCE_DIR) / "tests" / "runtime";
+constexpr int kSkipExit = 77;  // render.mjs: Chromium cannot be started here
+
+RuntimeTexture texture_from(const json& t) {
+  RuntimeTexture out;
+  out.material = t.at("material");
+  out.slot = t.at("slot");
+  out.texture = t.at("texture");
+  out.color_space = t.at("colorSpace");
+  out.compressed = t.at("compressed");
+  out.width = t.at("width");
+  out.height = t.at("height");
+  out.levels = t.at("levels");
+  out.generate_mipmaps = t.at("generateMipmaps");
+  out.min_filter = t.at("minFilter");
+  return out;
+}
+
+}  // namespace
+
+std::optional<std::map<std::string, RuntimeModel>> render_in_three(
+    const fs::path& folder, const std::vector<std::pair<std::string, fs::path>>& models, std::string& why_not) {
+  for (const char* package : {"three", "puppeteer-core"}) {
+    if (!fs::exists(kHarness / "node_modules" / package / "package.json")) {
+      why_not = std::string("the runtime harness is not installed (no ") + package + "; bash scripts/install-runtime.sh)";
+      return std::nullopt;
+    }
+  }
+  SubprocessRequest request;
+  request.program = "/usr/bin/env";
+  request.args = {"node", (kHarness / "render.mjs").string(), "--out", folder.string(), "--timeout", "150"};
+  for (const auto& [name, file] : models) request.args.push_back(name + "=" + file.string());
+  request.time_limit = std::chrono::seconds(180);
+  const SubprocessResult result = run_supervised(request);
+  if (result.status == kSkipExit) {
+    why_not = "no runtime here: " + result.error_line();
+    return std::nullopt;
+  }
+  if (result.status != 0) throw std::runtime_error("the runtime harness failed: " + result.output_tail);
+
+  std::ifstream in(folder / "report.json");
+  const json report = json::parse(in);
+  std::map<std::string, RuntimeModel> out;
+  for (const auto& [name, model] : report.at("models").items()) {
+    RuntimeModel& m = out[name];
+    for (const json& t : model.at("textures")) m.textures.push_back(texture_from(t));
+    for (const json& line : model.at("console")) m.console.push_back(line);
+    for (const std::string& view : kRuntimeViews) m.renders[view] = folder / (name + "-" + view + ".png");
+  }
+  return out;
+}
+
+double render_psnr(const fs::path& reference, const fs::path& test) {
+  const auto a = image::read_image(reference, color::Transfer::linear);
+  const auto b = image::read_image(test, color::Transfer::linear);
+  if (!a || !b) throw std::runtime_error("render_psnr: a render could not be read");
+  if (a->width != b->width || a->height != b->height || a->channels != b->channels || a->channels < 3) {
+    throw std::runtime_error("render_psnr: the renders differ in size or channels");
+  }
+  const int c = a->channels;
+  const auto is_background = [&](const std::vector<float>& p, std::size_t i) {
+    for (int k = 0; k < 3; ++k) {
+      if (p[i + std::size_t(k)] != a->pixels[std::size_t(k)]) return false;
+    }
+    return true;
+  };
+  double squared = 0;
+  std::size_t samples = 0;
+  for (std::size_t i = 0; i < a->pixels.size(); i += std::size_t(c)) {
+    if (is_background(a->pixels, i) && is_background(b->pixels, i)) continue;
+    for (int k = 0; k < 3; ++k) {
+      const double d = 255.0 * (double(a->pixels[i + std::size_t(k)]) - double(b->pixels[i + std::size_t(k)]));
+      squared += d * d;
+    }
+    samples += 3;
+  }
+  if (samples == 0 || squared == 0) return std::numeric_limits<double>::infinity();
+  return 10.0 * std::log10(255.0 * 255.0 / (squared / double(samples)));
+}
+
+std::string color_space_of_slot(const std::string& slot) {
+  return slot == "baseColorTexture" || slot == "emissiveTexture" ? "srgb" : "";
+}
+
+}  // namespace matbake::test

@@ -1,0 +1,55 @@
+#pragma once
+// A real runtime: three.js (tests/runtime, npm, pinned) in Debian's Chromium, headless with
+// SwiftShader (tests/runtime/render.mjs, installed by scripts/install-runtime.sh). Each model is
+// rendered from three fixed views under a fixed light; what three.js made of each texture is read
+// back. Tests skip, saying why, only where the harness or Chromium is missing.
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace matbake::test {
+
+// One material slot as three.js loaded it.
+struct RuntimeTexture {
+  std::string material;     // the three.js material's name (the glTF material's)
+  std::string slot;         // "baseColorTexture", "normalTexture", ...
+  int texture = -1;         // the glTF texture index it came from
+  std::string color_space;  // "srgb", "srgb-linear" or "" (none: data)
+  bool compressed = false;  // a transcoded KTX2 texture
+  int width = 0, height = 0;
+  int levels = 0;           // mip levels in the file (1 for PNG: three.js makes its own)
+  bool generate_mipmaps = false;
+  std::string min_filter;   // "linear_mipmap_linear", "linear", ...
+};
+
+struct RuntimeModel {
+  std::vector<RuntimeTexture> textures;
+  std::vector<std::string> console;  // every warning and error the page raised while loading it
+  std::map<std::string, std::filesystem::path> renders;  // view ("fit", "near", "far") → PNG
+};
+
+inline const std::vector<std::string> kRuntimeViews = {"fit", "near", "far"};
+
+// Renders each (name, file) into `folder`; empty with `why_not` when the harness cannot run here.
+// A harness that runs and fails is not a skip: it throws std::runtime_error with its message.
+std::optional<std::map<std::string, RuntimeModel>> render_in_three(
+    const std::filesystem::path& folder, const std::vector<std::pair<std::string, std::filesystem::path>>& models,
+    std::string& why_not);
+
+// PSNR (dB) of render `test` against `reference` over the pixels where either is not the
+// background (the top-left pixel of the reference): 8-bit RGB, peak 255. Infinity when equal.
+double render_psnr(const std::filesystem::path& reference, const std::filesystem::path& test);
+
+// The colour space three.js must give a texture read for `slot`: "srgb" for colour, "" for data.
+std::string color_space_of_slot(const std::string& slot);
+
+}  // namespace matbake::test
+
+// In a test: `renders` for `models`, or skip the test when the runtime cannot run here.
+#define MATBAKE_RENDER_OR_SKIP(renders, folder, models)                               \
+  std::string renders##_why_not;                                                      \
+  const auto renders = ::matbake::test::render_in_three(folder, models, renders##_why_not); \
+  if (!renders) GTEST_SKIP() << renders##_why_not
