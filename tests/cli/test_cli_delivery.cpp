@@ -146,6 +146,62 @@ TEST(CliDelivery, KtxTexturesPerClassReadBackFieldByFieldAndValidate) {
   EXPECT_EQ(validator->warnings, 6) << validator->summary;
 }
 
+// KHR_texture_basisu: colour data BT.709 primaries and the sRGB transfer, non-colour data unspecified
+// primaries and the linear transfer, whichever codec wrote it (basisu's ETC1S files say BT.709 for
+// linear data and are corrected; matbake writes the UASTC descriptor itself).
+TEST(CliDelivery, EveryCodecGivesDataTexturesNoPrimariesAndColourBt709) {
+  MATBAKE_BASISU_OR_SKIP(basisu);
+  TempDir dir;
+  write_textured_quad(dir.path());
+  for (const std::string codec : {"etc1s", "uastc"}) {
+    SCOPED_TRACE(codec);
+    const fs::path out = dir / (codec + ".glb");
+    const RunResult r = matbake({"export", (dir / "quad.gltf").string(), "-o", out.string(), "--texture-format", "ktx2",
+                                 "--colour-codec", codec, "--data-codec", codec, "--normal-codec", codec},
+                                {"MATBAKE_BASISU=" + basisu});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const gltf::Document doc = read_output(out);
+    // Textures 0, 1, 2: base colour, metallic-roughness, normal.
+    const std::uint8_t primaries[] = {1, 0, 0}, transfers[] = {2, 1, 1};
+    for (int t = 0; t < 3; ++t) {
+      const std::vector<unsigned char> bytes = image_of(doc, t);
+      auto k = ktx2::read(bytes, "texture");
+      ASSERT_TRUE(k) << k.error().to_string();
+      EXPECT_EQ(k->descriptor.primaries, primaries[t]) << "texture " << t;
+      EXPECT_EQ(k->descriptor.transfer, transfers[t]) << "texture " << t;
+      const fs::path file = dir / (codec + std::to_string(t) + ".ktx2");
+      write_bytes(file, std::string(bytes.begin(), bytes.end()));
+      const RunResult validated = run(basisu, {"-validate", "-file", file.string()});
+      EXPECT_EQ(validated.exit_code, 0) << validated.out;
+    }
+  }
+}
+
+// KHR_texture_basisu: "pixelWidth and pixelHeight MUST be multiples of 4": sides of 1, 2 and 3 (which
+// rounds to 2) are raised to 4 (that they still look the same: Runtime.KhronosModels…, on
+// TextureEncodingTest's 1 × 1 textures).
+TEST(CliDelivery, TinyTexturesAreRaisedToFourTexelsInKtx2) {
+  MATBAKE_BASISU_OR_SKIP(basisu);
+  TempDir dir;
+  write_textured_quad(dir.path(), "OPAQUE");
+  write_raw(dir / "colour.png", 2, 1, 4, "uint8", {200, 100, 50, 255, 200, 100, 50, 255});
+  write_raw(dir / "orm.png", 1, 1, 3, "uint8", {255, 128, 0});
+  write_raw(dir / "normal.png", 3, 3, 3, "uint8", std::vector<double>(27, 128));
+  const fs::path out = dir / "tiny.glb";
+  const RunResult r = matbake({"export", (dir / "quad.gltf").string(), "-o", out.string(), "--texture-format", "ktx2"},
+                              {"MATBAKE_BASISU=" + basisu});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const gltf::Document doc = read_output(out);
+  for (int t = 0; t < 3; ++t) {
+    const std::vector<unsigned char> bytes = image_of(doc, t);
+    auto k = ktx2::read(bytes, "texture");
+    ASSERT_TRUE(k) << k.error().to_string();
+    EXPECT_EQ(k->width, 4u) << "texture " << t;
+    EXPECT_EQ(k->height, 4u) << "texture " << t;
+    EXPECT_EQ(k->levels.size(), 3u) << "texture " << t;  // 4, 2, 1
+  }
+}
+
 TEST(CliDelivery, UastcColourKeepsCoverageAtEveryLevelAndJobsDoNotChangeBytes) {
   MATBAKE_BASISU_OR_SKIP(basisu);
   TempDir dir;
@@ -364,13 +420,13 @@ TEST(CliDelivery, BadSettingsAndAMissingEncoderAreOneErrorLineAndNothingIsWritte
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
     EXPECT_NE(r.err.find(args[0]), std::string::npos) << r.err;
   }
-  // No rounding: a 30-texel side cannot be KTX2 (sides of 1, 2 or a multiple of 4).
+  // No rounding: a 30-texel side cannot be KTX2 (sides must be multiples of 4).
   MATBAKE_BASISU_OR_SKIP(basisu);
   const RunResult odd = matbake({"export", in, "-o", out, "--texture-format", "ktx2", "--texture-rounding", "none",
                                  "--colour-max-size", "30"},
                                 {"MATBAKE_BASISU=" + basisu});
   EXPECT_EQ(odd.exit_code, 2) << odd.err;
-  expect_one_error_line(odd, in, "texture 0 (colour) would be 30x30: KTX2 (KHR_texture_basisu) needs sides of 1, 2 or a multiple of 4; "
+  expect_one_error_line(odd, in, "texture 0 (colour) would be 30x30: KTX2 (KHR_texture_basisu) needs sides that are multiples of 4; "
                                  "use --texture-rounding multiple-of-4 or power-of-two");
   EXPECT_TRUE(!fs::exists(dir / "out") || list_folder(dir / "out").empty());
   // The same library error in a build speaks the manifest's words.

@@ -27,7 +27,8 @@ enum class Codec { etc1s, uastc, png };
 inline constexpr NameTable<Codec, 3> kCodecNames{{{Codec::etc1s, "etc1s"}, {Codec::uastc, "uastc"}, {Codec::png, "png"}}};
 
 // How a delivered size is rounded: to a power of two, to a multiple of 4 (what KHR_texture_basisu
-// needs: sides of 1 and 2 stay), or not at all. Never above the source.
+// needs; sides of 1 and 2 stay, and KTX2 delivery raises them to 4), or not at all. Never above the
+// source but for that.
 enum class Rounding { power_of_two, multiple_of_4, none };
 inline constexpr NameTable<Rounding, 3> kRoundingNames{
     {{Rounding::power_of_two, "power-of-two"}, {Rounding::multiple_of_4, "multiple-of-4"}, {Rounding::none, "none"}}};

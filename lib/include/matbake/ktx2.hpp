@@ -15,6 +15,14 @@ namespace matbake::ktx2 {
 enum : std::uint32_t { kSupercompressionNone = 0, kSupercompressionBasisLZ = 1, kSupercompressionZstd = 2 };
 enum : std::uint8_t { kModelETC1S = 163, kModelUASTC = 166 };
 enum : std::uint8_t { kTransferLinear = 1, kTransferSRGB = 2 };
+enum : std::uint8_t { kPrimariesUnspecified = 0, kPrimariesBT709 = 1 };
+
+// KHR_texture_basisu's colour primaries for a transfer: BT.709 for colour (sRGB transfer), none
+// (unspecified) for non-colour data (linear: normal, occlusion, metallic-roughness); three.js then
+// gives data textures no colour space rather than linear sRGB.
+constexpr std::uint8_t primaries_for(std::uint8_t transfer) {
+  return transfer == kTransferSRGB ? kPrimariesBT709 : kPrimariesUnspecified;
+}
 // The channel id of a UASTC sample (KHR_DF_CHANNEL_UASTC_*): what the block holds.
 enum : std::uint8_t { kUastcRGB = 0, kUastcRGBA = 3, kUastcRRR = 4, kUastcRRRG = 5, kUastcRG = 6 };
 
@@ -46,8 +54,8 @@ struct Texture {
 // A 2D KTX2 file read: header, level index, DFD, key/value pairs, global data. Errors name `name`.
 Result<Texture> read(std::span<const unsigned char> bytes, const std::string& name);
 
-// The DFD of a UASTC texture: one 128-bit sample of `channel`, sRGB or linear transfer; bytesPlane0
-// 16 unless zstd-supercompressed (then 0, as the specification asks).
+// The DFD of a UASTC texture: one 128-bit sample of `channel`, sRGB or linear transfer with its
+// primaries_for; bytesPlane0 16 unless zstd-supercompressed (then 0, as the specification asks).
 std::vector<std::uint32_t> uastc_descriptor(std::uint8_t transfer, std::uint8_t channel, bool supercompressed);
 
 // A level of raw UASTC blocks as a file stores it: supercompressed with zstd at `zstd_level` (1–22),
@@ -65,6 +73,10 @@ struct UastcFile {
   std::string writer;
 };
 Result<std::vector<unsigned char>> write_uastc(const UastcFile& file);
+
+// Sets the DFD primaries of `file` (which `read` accepts) to primaries_for its transfer: basisu writes
+// BT.709 for linear data too.
+Status conform_primaries(std::vector<unsigned char>& file, const std::string& name);
 
 // The uncompressed bytes of a level (zstd inflated; as stored otherwise; BasisLZ is not inflated).
 Result<std::vector<unsigned char>> level_data(const Texture& texture, std::size_t level, const std::string& name);

@@ -200,10 +200,10 @@ struct Work {
   Status status = success();
 };
 
-bool sides_fit_ktx2(Size s) {
-  const auto fits = [](int side) { return side == 1 || side == 2 || side % 4 == 0; };
-  return fits(s.width) && fits(s.height);
-}
+// KHR_texture_basisu: "pixelWidth and pixelHeight MUST be multiples of 4". A side below 4 (a 1 × 1
+// constant, a 2 × 2 swatch) is raised to 4, the one case where a delivered side exceeds its source.
+Size ktx2_size(Size s) { return {std::max(s.width, 4), std::max(s.height, 4)}; }
+bool sides_fit_ktx2(Size s) { return s.width % 4 == 0 && s.height % 4 == 0; }
 
 Status make(Work& w, const Options& options, const Encoder* encoder, const fs::path& output, int threads) {
   const MipRequest request{w.use.texture_class, w.sampling, w.use.alpha_cutoff};
@@ -309,10 +309,11 @@ Result<std::vector<TextureReport>> deliver_textures(gltf::Document& doc, gltf::I
     w.size = delivered_size(source_size, o, options.rounding, w.needed);
     w.codec = ktx2_out ? o.codec : Codec::png;
     w.name = base_name(doc.json, image, stem);
+    if (w.codec != Codec::png) w.size = ktx2_size(w.size);
     if (w.codec != Codec::png && !sides_fit_ktx2(w.size)) {
       return Error{doc.file, "texture " + std::to_string(texture) + " (" + w.name + ") would be " + std::to_string(w.size.width) +
-                                 "x" + std::to_string(w.size.height) + ": KTX2 (KHR_texture_basisu) needs sides of 1, 2 or a "
-                                 "multiple of 4; use " + mention("texture_rounding", "multiple-of-4") + " or power-of-two", true};
+                                 "x" + std::to_string(w.size.height) + ": KTX2 (KHR_texture_basisu) needs sides that are multiples "
+                                 "of 4; use " + mention("texture_rounding", "multiple-of-4") + " or power-of-two", true};
     }
     work.push_back(std::move(w));
   }

@@ -206,6 +206,7 @@ Result<Encoded> encode_texture(const Encoder& encoder, const image::Image& sourc
                                                  std::to_string(expected) + " levels)"};
     }
     out.levels = int(read->levels.size());
+    if (auto conformed = ktx2::conform_primaries(out.file, request.scratch.string()); !conformed) return conformed.error();
   } else {
     auto levels = uastc_levels(encoder, level0, work, rest, request);
     if (!levels) return levels.error();

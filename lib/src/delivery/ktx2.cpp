@@ -137,7 +137,7 @@ std::vector<std::uint32_t> uastc_descriptor(std::uint8_t transfer, std::uint8_t 
       4 + kBlockBytes,                                       // dfdTotalSize
       0,                                                     // vendor Khronos, basic descriptor type
       2u | (kBlockBytes << 16),                              // version 2, block size
-      kModelUASTC | (1u << 8) | (std::uint32_t(transfer) << 16),  // primaries BT.709, straight alpha
+      kModelUASTC | (std::uint32_t(primaries_for(transfer)) << 8) | (std::uint32_t(transfer) << 16),  // straight alpha
       3u | (3u << 8),                                        // 4 × 4 texel blocks
       supercompressed ? 0u : std::uint32_t(kUastcBlockBytes),  // bytesPlane0
       0,
@@ -146,6 +146,14 @@ std::vector<std::uint32_t> uastc_descriptor(std::uint8_t transfer, std::uint8_t 
       0,                                                     // sampleLower
       0xFFFFFFFFu,                                           // sampleUpper
   };
+}
+
+Status conform_primaries(std::vector<unsigned char>& file, const std::string& name) {
+  const auto texture = read(file, name);
+  if (!texture) return texture.error();
+  // The DFD's fourth word (after its total size and the block header): model, primaries, transfer.
+  file[u32_at(file, 48) + 12 + 1] = primaries_for(texture->descriptor.transfer);
+  return success();
 }
 
 Result<Level> uastc_level(std::vector<unsigned char> blocks, int zstd_level) {
