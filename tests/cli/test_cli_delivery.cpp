@@ -202,6 +202,32 @@ TEST(CliDelivery, TinyTexturesAreRaisedToFourTexelsInKtx2) {
   }
 }
 
+// --no-mipmaps: one level per KTX2 file, and samplers that do not ask for more: each texture's own
+// sampler with LINEAR minification (wraps kept), one new sampler shared by the textures that had none.
+TEST(CliDelivery, NoMipmapsGivesEachTextureASamplerWithoutMipmapFiltering) {
+  MATBAKE_BASISU_OR_SKIP(basisu);
+  TempDir dir;
+  write_textured_quad(dir.path());
+  const fs::path out = dir / "flat.gltf";
+  const RunResult r = matbake({"export", (dir / "quad.gltf").string(), "-o", out.string(), "--texture-format", "ktx2", "--no-mipmaps"},
+                              {"MATBAKE_BASISU=" + basisu});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const gltf::Document doc = read_output(out);
+  const json& textures = doc.json["textures"];
+  const json& samplers = doc.json["samplers"];
+  ASSERT_EQ(samplers.size(), 2u);  // the copy and the shared one (the quad's own, unused, is pruned)
+  EXPECT_EQ(samplers[std::size_t(textures[0]["sampler"])], (json{{"wrapS", 33071}, {"wrapT", 33071}, {"minFilter", 9729}}));
+  EXPECT_EQ(samplers[std::size_t(textures[1]["sampler"])], (json{{"minFilter", 9729}}));
+  EXPECT_EQ(textures[1]["sampler"], textures[2]["sampler"]);
+  for (int t = 0; t < 3; ++t) {
+    auto k = ktx2::read(image_of(doc, t), "texture");
+    ASSERT_TRUE(k) << k.error().to_string();
+    EXPECT_EQ(k->levels.size(), 1u) << "texture " << t;
+  }
+  MATBAKE_VALIDATE_OR_SKIP(report, out);
+  EXPECT_EQ(report->errors, 0) << report->summary;
+}
+
 TEST(CliDelivery, UastcColourKeepsCoverageAtEveryLevelAndJobsDoNotChangeBytes) {
   MATBAKE_BASISU_OR_SKIP(basisu);
   TempDir dir;

@@ -79,7 +79,7 @@ void expect_textures_as_their_slots(const RuntimeModel& model, const std::string
 }
 
 // The example's manifest built into `dir`/out; its scene then delivered as KTX2 (`.gltf` with its
-// .ktx2 files beside it, so a test can reach into one).
+// .ktx2 files beside it, so a test can reach into one), and as KTX2 without mipmaps (flat.glb).
 void build_example(const fs::path& dir) {
   const fs::path manifest = fs::path(MATBAKE_SOURCE_DIR) / "examples" / "showroom.toml";
   const RunResult built = matbake({"build", manifest.string(), "--output-dir", (dir / "out").string()});
@@ -87,6 +87,9 @@ void build_example(const fs::path& dir) {
   const RunResult ktx2 = matbake({"export", (dir / "out" / "showroom.glb").string(), "-o",
                                   (dir / "ktx2" / "showroom.gltf").string(), "--texture-format", "ktx2"});
   ASSERT_EQ(ktx2.exit_code, 0) << ktx2.err;
+  const RunResult flat = matbake({"export", (dir / "out" / "showroom.glb").string(), "-o", (dir / "flat.glb").string(),
+                                  "--texture-format", "ktx2", "--no-mipmaps"});
+  ASSERT_EQ(flat.exit_code, 0) << flat.err;
 }
 
 // The defect a runtime test must catch: a swapped transfer function, each .ktx2 file of a delivered
@@ -121,7 +124,8 @@ TEST(Runtime, TheExamplesKtx2SceneLooksAsItsPngSceneInThreeJs) {
   MATBAKE_RENDER_OR_SKIP(renders, dir / "renders",
                          (std::vector<std::pair<std::string, fs::path>>{{"png", dir / "out" / "showroom.glb"},
                                                                          {"ktx2", dir / "ktx2" / "showroom.gltf"},
-                                                                         {"defect", dir / "defect" / "showroom.gltf"}}));
+                                                                         {"defect", dir / "defect" / "showroom.gltf"},
+                                                                         {"flat", dir / "flat.glb"}}));
   const RuntimeModel& png = renders->at("png");
   const RuntimeModel& ktx2 = renders->at("ktx2");
   expect_textures_as_their_slots(png, "PNG scene");
@@ -132,6 +136,14 @@ TEST(Runtime, TheExamplesKtx2SceneLooksAsItsPngSceneInThreeJs) {
     EXPECT_EQ(ktx2.textures[i].texture, png.textures[i].texture) << ktx2.textures[i].material << " " << ktx2.textures[i].slot;
   }
   expect_renders_alike(png, ktx2, kKtx2RenderPsnr.at("example"), "example KTX2");
+
+  // Without mipmaps: one level, sampled without mipmap filtering, and no fallback warning.
+  const RuntimeModel& flat = renders->at("flat");
+  expect_textures_as_their_slots(flat, "KTX2 scene without mipmaps");
+  for (const RuntimeTexture& t : flat.textures) {
+    EXPECT_EQ(t.levels, 1) << t.material << " " << t.slot;
+    EXPECT_EQ(t.min_filter, "linear") << t.material << " " << t.slot;
+  }
 
   // The test can fail: the defect is seen both in the colour space and in the picture.
   const RuntimeModel& defect = renders->at("defect");

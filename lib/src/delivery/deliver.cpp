@@ -240,6 +240,29 @@ void point_texture(gltf::Document& doc, const Work& w, int image, bool png_fallb
   }
 }
 
+// A KTX2 file of one level (`--no-mipmaps`) under a mipmapped sampler makes runtimes fall back (three.js
+// samples a chain it does not have): the texture gets a sampler like its own with the minification
+// filter of the same kind without mipmaps, shared with any texture that needs the same.
+void sample_one_level(gltf::Document& doc, int texture_index) {
+  constexpr int kNearest = 9728, kLinear = 9729, kNearestMipmapNearest = 9984, kNearestMipmapLinear = 9986;
+  Json& texture = doc.json["textures"][std::size_t(texture_index)];
+  const int index = gltf::integer_in<int>(texture, "sampler", -1, -1);
+  const Json& given = gltf::array_in(doc.json, "samplers");
+  Json sampler = index >= 0 && std::size_t(index) < given.size() ? given[std::size_t(index)] : Json::object();
+  const int min_filter = gltf::integer_in<int>(sampler, "minFilter", -1, -1);
+  if (min_filter == kNearest || min_filter == kLinear) return;
+  const bool nearest = min_filter == kNearestMipmapNearest || min_filter == kNearestMipmapLinear;
+  sampler["minFilter"] = nearest ? kNearest : kLinear;
+  Json& samplers = doc.json["samplers"];
+  const auto same = std::find(samplers.begin(), samplers.end(), sampler);
+  if (same != samplers.end()) {
+    texture["sampler"] = int(same - samplers.begin());
+    return;
+  }
+  samplers.push_back(sampler);
+  texture["sampler"] = int(samplers.size()) - 1;
+}
+
 // EXT_texture_webp named only while a texture still uses it.
 void drop_unused_webp(gltf::Document& doc) {
   for (const Json& t : gltf::array_in(doc.json, "textures")) {
@@ -352,6 +375,7 @@ Result<std::vector<TextureReport>> deliver_textures(gltf::Document& doc, gltf::I
       doc.new_files[report.uri] = std::string(w.ktx2.begin(), w.ktx2.end());
       doc.json["images"].push_back({{"uri", report.uri}, {"mimeType", "image/ktx2"}});
       point_texture(doc, w, int(doc.json["images"].size()) - 1, options.png_fallback);
+      if (!options.mipmaps) sample_one_level(doc, w.texture);
       gltf::require_extension(doc, kBasisu, !options.png_fallback);
     } else if (!w.level0.pixels.empty()) {
       const color::Transfer transfer = w.use.texture_class == TextureClass::colour ? color::Transfer::srgb : color::Transfer::linear;

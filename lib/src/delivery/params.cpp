@@ -87,7 +87,7 @@ const params::Group<Options>& options_params() {
                                                     .example = "box"},
                                                [](auto& o) -> auto& { return o.filter; }, kFilterNames));
     g.params.push_back(params::flag<Options>(Spec{.name = "mipmaps",
-                                                  .help = "Give KTX2 textures a full mip chain (false: level 0 only)",
+                                                  .help = "Give KTX2 textures a full mip chain (false: level 0 only, sampled without mipmap filtering)",
                                                   .example = "false",
                                                   .needs = {{"texture_format", "ktx2"}}},
                                              [](auto& o) -> auto& { return o.mipmaps; }));
