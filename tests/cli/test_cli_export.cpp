@@ -12,6 +12,7 @@
 #include "lib/src/gltf/document.hpp"
 #include "matbake/ao.hpp"
 #include "matbake/color.hpp"
+#include "matbake/version.hpp"
 #include "matbake/workflow.hpp"
 #include "support/expect_error.hpp"
 #include "support/files.hpp"
@@ -271,6 +272,73 @@ TEST(CliExport, OnlyWhatTheSceneReachesAndTheSameBytesEveryTime) {
   expect_validator_clean(dir / "a.glb");
   ASSERT_EQ(matbake({"-q", "export", (dir / "in.gltf").string(), "-o", (dir / "b.glb").string(), "--ao-samples", "16"}).exit_code, 0);
   EXPECT_EQ(read_bytes(dir / "a.glb"), read_bytes(dir / "b.glb"));
+}
+
+// Identical images are stored once and the textures that then match are one (WaterBottle's normal
+// map was stored twice); --json's texture indices are the written file's, each naming its image.
+TEST(CliExport, IdenticalImagesAreStoredOnceAndTheReportUsesTheFilesIndices) {
+  TempDir dir;
+  std::vector<double> colour, normal;
+  for (int i = 0; i < 64; ++i) {
+    colour.insert(colour.end(), {double(i * 3), double(255 - i * 2), 40});
+    normal.insert(normal.end(), {128, 128, 255});
+  }
+  write_raw(dir / "a.png", 8, 8, 3, "uint8", colour);
+  write_raw(dir / "b.png", 8, 8, 3, "uint8", colour);  // the same bytes under another name
+  write_raw(dir / "n.png", 8, 8, 3, "uint8", normal);
+  GltfBuilder b = quad_scene(json::array({{{"name", "Lamp"},
+                                           {"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 1}}}}},
+                                           {"emissiveTexture", {{"index", 0}}},
+                                           {"emissiveFactor", {1, 1, 1}},
+                                           {"occlusionTexture", {{"index", 2}}}},
+                                          {{"name", "Unplaced"}}}));
+  b.doc["textures"] = {{{"source", 0}}, {{"source", 1}}, {{"source", 2}}};
+  b.doc["images"] = {{{"uri", "a.png"}}, {{"uri", "b.png"}}, {{"uri", "n.png"}}};
+  b.write(dir / "in.gltf", {0});
+
+  // As it is, and with the colour textures resized (delivery's report).
+  for (const std::vector<std::string>& extra : {std::vector<std::string>{}, std::vector<std::string>{"--colour-max-size", "4"}}) {
+    const fs::path out = dir / (extra.empty() ? "plain/out.gltf" : "resized/out.gltf");
+    std::vector<std::string> args = {(dir / "in.gltf").string(), "-o", out.string()};
+    args.insert(args.end(), extra.begin(), extra.end());
+    const json report = export_json(args);
+    ASSERT_FALSE(report.is_null());
+    const gltf::Document doc = read_output(out);
+    SCOPED_TRACE(out.string());
+    EXPECT_EQ(doc.json["images"].size(), 2u);
+    EXPECT_EQ(doc.json["textures"].size(), 2u);
+    const json& lamp = doc.json["materials"][0];
+    EXPECT_EQ(lamp["pbrMetallicRoughness"]["baseColorTexture"]["index"], lamp["emissiveTexture"]["index"]);
+    for (const json& t : report["textures"]) {
+      ASSERT_LT(t["texture"].get<std::size_t>(), doc.json["textures"].size());
+      const json& texture = doc.json["textures"][t["texture"].get<std::size_t>()];
+      if (!t["file"].get<std::string>().empty()) {
+        EXPECT_EQ(doc.json["images"][texture["source"].get<std::size_t>()]["uri"], t["file"]);
+      }
+      EXPECT_EQ(t["materials"], json::array({0}));
+    }
+    EXPECT_EQ(report["textures"].size(), extra.empty() ? 0u : 2u);  // the colour texture once, the occlusion map
+    expect_validator_clean(out);
+  }
+}
+
+// matbake wrote the file, so asset.generator says so; what made the input is kept beside it (and
+// not overwritten when matbake's output is exported again).
+TEST(CliExport, TheGeneratorIsMatbakeAndTheInputsIsKept) {
+  TempDir dir;
+  GltfBuilder b = quad_scene(json::array({{{"name", "Plain"}}, {{"name", "Unplaced"}}}));
+  b.doc["asset"]["generator"] = "babylon.js glTF exporter for 3dsmax";
+  b.write(dir / "in.gltf", {0});
+  const std::string mine = std::string("matbake ") + version;
+  ASSERT_EQ(matbake({"-q", "export", (dir / "in.gltf").string(), "-o", (dir / "a.gltf").string()}).exit_code, 0);
+  ASSERT_EQ(matbake({"-q", "export", (dir / "a.gltf").string(), "-o", (dir / "b.glb").string()}).exit_code, 0);
+  for (const char* out : {"a.gltf", "b.glb"}) {
+    const json asset = read_output(dir / out).json["asset"];
+    EXPECT_EQ(asset["version"], "2.0") << out;
+    EXPECT_EQ(asset["generator"], mine) << out;
+    EXPECT_EQ(asset["extras"]["source_generator"], "babylon.js glTF exporter for 3dsmax") << out;
+  }
+  expect_validator_clean(dir / "b.glb");
 }
 
 // Issue "One request layer": export decoded and encoded through a private folder under $TMPDIR

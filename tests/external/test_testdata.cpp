@@ -41,6 +41,16 @@ Result<convert::Report> convert_one(const fs::path& in, const fs::path& out, std
   return convert::convert_file(*convert::plan_conversion(options), in, out, options);
 }
 
+// Textures that differ once their names are set aside (TextureSettingsTest has two the same).
+std::size_t distinct_textures(const gltf::Json& json) {
+  std::set<gltf::Json> seen;
+  for (gltf::Json t : json.value("textures", gltf::Json::array())) {
+    t.erase("name");
+    seen.insert(t);
+  }
+  return seen.size();
+}
+
 // Every .gltf and .glb of the Khronos sample models.
 std::vector<fs::path> khronos_models() {
   std::vector<fs::path> files;
@@ -483,7 +493,7 @@ TEST(KhronosModels, ExportedScenesStayValidatorCleanWithTheirCounts) {
       if (orm) {
         EXPECT_LE(count(doc->json, "textures"), count(in->json, "textures") + (spec_gloss ? count(in->json, "materials") : 0)) << out;
       } else if (!spec_gloss) {
-        EXPECT_EQ(count(doc->json, "textures"), count(in->json, "textures")) << out;
+        EXPECT_EQ(count(doc->json, "textures"), distinct_textures(in->json)) << out;  // duplicates stored once
       }
       if (spec_gloss) {
         EXPECT_EQ(doc->json["materials"].dump().find("pbrSpecularGlossiness"), std::string::npos) << out;

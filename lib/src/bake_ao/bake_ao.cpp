@@ -4,7 +4,6 @@
 
 #include "../delivery/deliver.hpp"
 #include "../gltf/decode.hpp"
-#include "../gltf/prune.hpp"
 #include "../gltf/vertex_occlusion.hpp"
 #include "textures.hpp"
 #include "../scene/from_document.hpp"
@@ -133,7 +132,7 @@ Result<Report> bake_file(const fs::path& input, const Options& options) {
       auto delivered = delivery::deliver_textures(*doc, cache, options.delivery, options.output);
       if (!delivered) return delivered.error();
       report.delivered = std::move(*delivered);
-      (void)gltf::prune_unreachable(*doc);  // the images KTX2 or resized ones replaced
+      (void)delivery::store_once(*doc, report.delivered);  // the images KTX2 or resized ones replaced
     }
     if (!options.output.empty()) {
       auto written = gltf::write_document(*doc, options.output);

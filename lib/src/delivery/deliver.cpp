@@ -14,6 +14,7 @@
 #include <set>
 
 #include "../scene/from_document.hpp"
+#include "../gltf/prune.hpp"
 #include "../gltf/texture_transform.hpp"
 #include "encode.hpp"
 #include "matbake/ktx2.hpp"
@@ -395,6 +396,28 @@ Result<std::vector<TextureReport>> deliver_textures(gltf::Document& doc, gltf::I
   drop_unused_webp(doc);
   std::sort(reports.begin(), reports.end(), [](const TextureReport& a, const TextureReport& b) { return a.texture < b.texture; });
   return reports;
+}
+
+std::vector<std::string> store_once(gltf::Document& doc, std::vector<TextureReport>& reports) {
+  gltf::merge_identical_images(doc);
+  std::vector<int> remap;
+  std::vector<std::string> removed = gltf::prune_unreachable(doc, &remap);
+  std::vector<TextureReport> written;
+  for (TextureReport& r : reports) {
+    if (r.texture < 0 || std::size_t(r.texture) >= remap.size() || remap[std::size_t(r.texture)] < 0) continue;
+    r.texture = remap[std::size_t(r.texture)];
+    const auto same = std::find_if(written.begin(), written.end(), [&](const TextureReport& w) { return w.texture == r.texture; });
+    if (same == written.end()) {
+      written.push_back(std::move(r));
+      continue;
+    }
+    same->materials.insert(same->materials.end(), r.materials.begin(), r.materials.end());
+    std::sort(same->materials.begin(), same->materials.end());
+    same->materials.erase(std::unique(same->materials.begin(), same->materials.end()), same->materials.end());
+  }
+  std::sort(written.begin(), written.end(), [](const TextureReport& a, const TextureReport& b) { return a.texture < b.texture; });
+  reports = std::move(written);
+  return removed;
 }
 
 }  // namespace matbake::delivery

@@ -17,9 +17,15 @@ gltf::MadeFormat made_format(const Options& options);
 
 // Rewrites `doc`'s used textures: KTX2 (KHR_texture_basisu) when the texture format is
 // ktx2 and the class's codec is not png, else resized PNG/WebP when the sizes say so. Scratch files go
-// beside `output`. Textures already KTX2 are kept. Call gltf::prune_unreachable afterwards: replaced
-// images are left unreferenced.
+// beside `output`. Textures already KTX2 are kept. Call store_once afterwards: replaced images are
+// left unreferenced.
 Result<std::vector<TextureReport>> deliver_textures(gltf::Document& doc, gltf::ImageCache& cache, const Options& options,
                                                     const std::filesystem::path& output);
+
+// The document as it will be written: identical images stored once (and textures that then match
+// merged), what nothing reaches removed (gltf::prune_unreachable; its lines returned), and `reports`
+// renumbered to the written textures (a texture delivered twice under two indices is one report,
+// with both's materials).
+std::vector<std::string> store_once(gltf::Document& doc, std::vector<TextureReport>& reports);
 
 }  // namespace matbake::delivery

@@ -522,7 +522,7 @@ Result<Report> export_scene(const fs::path& input, const fs::path& output, const
     report.textures = std::move(*delivered);
     // What the conversions replaced (spec-gloss textures, separate occlusion maps, old colours) and
     // what delivery did (resized or KTX2 images).
-    for (std::string& s : gltf::prune_unreachable(*doc)) report.skipped.push_back(s + ": replaced");
+    for (std::string& s : delivery::store_once(*doc, report.textures)) report.skipped.push_back(s + ": replaced");
     report.images_decoded = cache.decoded();
     report.geometry = gltf::geometry_notes(*doc);
 

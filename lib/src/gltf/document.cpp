@@ -13,6 +13,7 @@
 #include "matbake/output_check.hpp"
 #include "matbake/read_file.hpp"
 #include "matbake/atomic_file.hpp"
+#include "matbake/version.hpp"
 
 namespace matbake::gltf {
 namespace fs = std::filesystem;
@@ -137,6 +138,19 @@ Status check_accessors(const Document& doc) {
     if (auto bytes = accessor_bytes(doc, a); !bytes) return bytes.error();
   }
   return success();
+}
+
+// asset.generator names matbake, which wrote every byte of the file; the input's own generator (what
+// made the geometry) is kept as asset.extras.source_generator where extras can hold it.
+void name_generator(Json& json) {
+  Json& asset = json["asset"];
+  if (!asset.is_object()) asset = Json{{"version", "2.0"}};
+  const std::string mine = std::string("matbake ") + version;
+  const Json given = asset.value("generator", Json());
+  if (given.is_string() && given != mine && (!asset.contains("extras") || asset["extras"].is_object())) {
+    asset["extras"]["source_generator"] = given;
+  }
+  asset["generator"] = mine;
 }
 
 }  // namespace
@@ -389,6 +403,7 @@ Result<std::vector<fs::path>> write_document(const Document& doc, const fs::path
     // All buffers become one: each starts 4-byte aligned, the views move with it. Meshopt fallback
     // buffers (no bytes) stay buffers of their own after it, and their views keep their offsets.
     Json json = doc.json;
+    name_generator(json);
     Chunks bin;  // the merged buffer as pieces of the document's own bytes: a large scene is not copied
     std::vector<std::size_t> base(doc.buffers.size());
     Json fallbacks = Json::array();

@@ -2,6 +2,7 @@
 
 #include <functional>
 #include <map>
+#include <unordered_map>
 
 namespace matbake::gltf {
 namespace {
@@ -169,7 +170,7 @@ void for_each_texture_index(Json& material, const std::function<void(Json&)>& f)
   }
 }
 
-std::vector<std::string> prune_unreachable(Document& doc) {
+std::vector<std::string> prune_unreachable(Document& doc, std::vector<int>* texture_remap_out) {
   Json& json = doc.json;
   std::vector<std::string> removed;
 
@@ -239,6 +240,7 @@ std::vector<std::string> prune_unreachable(Document& doc) {
   const auto mesh_remap = keep_marked(json, meshes, "mesh", removed);
   const auto material_remap = keep_marked(json, materials, "material", removed);
   const auto texture_remap = keep_marked(json, textures, "texture", removed);
+  if (texture_remap_out) *texture_remap_out = texture_remap;
   const auto image_remap = keep_marked(json, images, "image", removed);
   const auto sampler_remap = keep_marked(json, samplers, "sampler", removed);
   const auto accessor_remap = keep_marked(json, accessors, "accessor", removed);
@@ -302,6 +304,48 @@ std::vector<std::string> prune_unreachable(Document& doc) {
   }
   doc.added_buffer = -1;
   return removed;
+}
+
+int merge_identical_images(Document& doc) {
+  Json& json = doc.json;
+  // Image i → the first image with the same bytes.
+  std::vector<int> first(count_of(json, "images"));
+  std::unordered_map<std::size_t, std::vector<std::pair<int, std::string>>> by_hash;
+  int merged = 0;
+  for (std::size_t i = 0; i < first.size(); ++i) {
+    first[i] = int(i);
+    auto bytes = image_bytes(doc, i);
+    if (!bytes) continue;  // unreadable: left to whoever reads it
+    auto& same_hash = by_hash[std::hash<std::string>{}(*bytes)];
+    const auto same = std::find_if(same_hash.begin(), same_hash.end(), [&](const auto& e) { return e.second == *bytes; });
+    if (same != same_hash.end()) {
+      first[i] = same->first;
+      ++merged;
+    } else {
+      same_hash.emplace_back(int(i), std::move(*bytes));
+    }
+  }
+  for_each_in(json, "textures", [&](Json& t) {
+    for_each_texture_source(t, [&](Json& i) {
+      if (i.is_number_integer() && i.get<std::int64_t>() >= 0 && i.get<std::uint64_t>() < first.size()) i = first[i.get<std::size_t>()];
+    });
+  });
+  // Textures that are now the same (source, sampler, extensions; a name aside) → the first of them.
+  std::vector<int> texture_first(count_of(json, "textures"));
+  std::map<Json, int> seen;
+  for (std::size_t t = 0; t < texture_first.size(); ++t) {
+    Json key = json["textures"][t];
+    key.erase("name");
+    texture_first[t] = seen.emplace(std::move(key), int(t)).first->second;
+  }
+  for_each_in(json, "materials", [&](Json& m) {
+    for_each_texture_index(m, [&](Json& t) {
+      if (t.is_number_integer() && t.get<std::int64_t>() >= 0 && t.get<std::uint64_t>() < texture_first.size()) {
+        t = texture_first[t.get<std::size_t>()];
+      }
+    });
+  });
+  return merged;
 }
 
 }  // namespace matbake::gltf

@@ -12,8 +12,14 @@
 
 namespace matbake::gltf {
 
-// Returns one line per removed object ("material 2 'Unused'"), for the report.
-std::vector<std::string> prune_unreachable(Document& doc);
+// Returns one line per removed object ("material 2 'Unused'"), for the report; `texture_remap`, when
+// given, receives each old texture index's new one (−1: removed).
+std::vector<std::string> prune_unreachable(Document& doc, std::vector<int>* texture_remap = nullptr);
+
+// Images with the same bytes become one: every texture's reference moves to the first of them; then
+// textures that are the same (name aside) become one likewise, for every material. What is left
+// unused goes with the next prune_unreachable. Returns how many images were merged.
+int merge_identical_images(Document& doc);
 
 // Calls f(index) for every texture index a material names, core and extensions alike.
 void for_each_texture_index(Json& material, const std::function<void(Json& index)>& f);
