@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <set>
 
 #include "lib/src/gltf/document.hpp"
 #include "matbake/ao.hpp"
@@ -320,6 +321,29 @@ TEST(CliExport, IdenticalImagesAreStoredOnceAndTheReportUsesTheFilesIndices) {
     EXPECT_EQ(report["textures"].size(), extra.empty() ? 0u : 2u);  // the colour texture once, the occlusion map
     expect_validator_clean(out);
   }
+}
+
+// Made textures are named from their material and slot (its name made safe for a file, not its
+// index), files, images and textures alike; a texture delivery rewrites loses its stale name.
+TEST(CliExport, MadeTexturesAreNamedFromTheirMaterialAndSlot) {
+  TempDir dir;
+  std::vector<double> base, mr;
+  for (int i = 0; i < 16; ++i) base.insert(base.end(), {double(i * 16), 90, 200}), mr.insert(mr.end(), {0, double(i * 16), 0});
+  write_raw(dir / "base.png", 4, 4, 3, "uint8", base);
+  write_raw(dir / "mr.png", 4, 4, 3, "uint8", mr);
+  GltfBuilder b = quad_scene(json::array({{{"name", "Lamp Shade!"}}, {{"name", "Unplaced"}}}));
+  b.write(dir / "in.gltf", {0});
+  const RunResult r = matbake({"-q", "export", (dir / "in.gltf").string(), "-o", (dir / "out" / "room.gltf").string(),
+                               "--material", "Lamp Shade!=gltf-metal-rough:" + (dir / "base.png").string() + "," + (dir / "mr.png").string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const gltf::Document doc = read_output(dir / "out" / "room.gltf");
+  std::set<std::string> images, textures;
+  for (const auto& i : doc.json["images"]) images.insert(i["name"].get<std::string>() + "=" + i["uri"].get<std::string>());
+  for (const auto& t : doc.json["textures"]) textures.insert(t["name"].get<std::string>());
+  EXPECT_EQ(images, (std::set<std::string>{"room_LampShade_base_color=room_LampShade_base_color.png",
+                                           "room_LampShade_metallic_roughness=room_LampShade_metallic_roughness.png"}));
+  EXPECT_EQ(textures, (std::set<std::string>{"room_LampShade_base_color", "room_LampShade_metallic_roughness"}));
+  EXPECT_TRUE(fs::exists(dir / "out" / "room_LampShade_base_color.png"));
 }
 
 // matbake wrote the file, so asset.generator says so; what made the input is kept beside it (and

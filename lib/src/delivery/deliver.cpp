@@ -139,21 +139,8 @@ std::string base_name(const Json& json, int image, const std::string& stem) {
   } else {
     name = gltf::name_in(img, "");
   }
-  name.erase(std::remove_if(name.begin(), name.end(), [](char c) { return !std::isalnum((unsigned char)c) && c != '_' && c != '-'; }),
-             name.end());
+  name = gltf::uri_safe(name);
   return name.empty() ? stem + "_image" + std::to_string(image) : name;
-}
-
-// `name` + `extension`, or name_2, name_3... when a file of the document already has that URI.
-std::string free_uri(const gltf::Document& doc, const std::string& name, const std::string& extension) {
-  std::set<std::string> taken;
-  for (const auto& [uri, bytes] : doc.new_files) taken.insert(uri);
-  for (const Json& img : gltf::array_in(doc.json, "images")) {
-    if (img.contains("uri") && img["uri"].is_string()) taken.insert(gltf::decode_uri(img["uri"].get<std::string>()));
-  }
-  std::string uri = name + extension;
-  for (int n = 2; taken.count(uri); ++n) uri = name + "_" + std::to_string(n) + extension;
-  return uri;
 }
 
 double triangle_area(glm::dvec3 a, glm::dvec3 b, glm::dvec3 c) { return 0.5 * glm::length(glm::cross(b - a, c - a)); }
@@ -371,23 +358,26 @@ Result<std::vector<TextureReport>> deliver_textures(gltf::Document& doc, gltf::I
     report.source_bytes = source_bytes->size();
     report.bytes = report.source_bytes;
     if (!w.ktx2.empty()) {
-      report.uri = free_uri(doc, w.name, ".ktx2");
+      report.uri = gltf::free_uri(doc, w.name, ".ktx2");
       report.bytes = w.ktx2.size();
       doc.new_files[report.uri] = std::string(w.ktx2.begin(), w.ktx2.end());
-      doc.json["images"].push_back({{"uri", report.uri}, {"mimeType", "image/ktx2"}});
+      const std::string name = fs::path(report.uri).stem().string();
+      doc.json["images"].push_back({{"uri", report.uri}, {"mimeType", "image/ktx2"}, {"name", name}});
       point_texture(doc, w, int(doc.json["images"].size()) - 1, options.png_fallback);
+      doc.json["textures"][std::size_t(w.texture)]["name"] = name;
       if (!options.mipmaps) sample_one_level(doc, w.texture);
       gltf::require_extension(doc, kBasisu, !options.png_fallback);
     } else if (!w.level0.pixels.empty()) {
       const color::Transfer transfer = w.use.texture_class == TextureClass::colour ? color::Transfer::srgb : color::Transfer::linear;
       const std::string extension = cache.webp() ? ".webp" : ".png";
       const std::string uri =
-          free_uri(doc, w.name + "_" + std::to_string(w.size.width) + "x" + std::to_string(w.size.height), extension);
+          gltf::free_uri(doc, w.name + "_" + std::to_string(w.size.width) + "x" + std::to_string(w.size.height), extension);
       auto made = cache.add_image(doc, w.level0, transfer, uri.substr(0, uri.size() - extension.size()));
       if (!made) return made.error();
       report.uri = made->uri;
       report.bytes = doc.new_files[made->uri].size();
       point_texture(doc, w, made->index, options.png_fallback);
+      doc.json["textures"][std::size_t(w.texture)]["name"] = doc.json["images"][std::size_t(made->index)]["name"];
     } else {
       report.note = "kept as it is (its size and format are what was asked)";
     }

@@ -283,7 +283,7 @@ struct Exporter {
     Json info = ext.contains(mapped_by) ? ext[mapped_by] : Json::object();
     info.erase("index");
     const int sampler_of = ext.contains(mapped_by) ? int_in(ext[mapped_by], "index", -1) : -1;
-    if (Status s = write_metal_rough(material, *maps, "material" + std::to_string(index), info, sampler_of); !s) return s;
+    if (Status s = write_metal_rough(material, *maps, gltf::material_file_name(material, index), info, sampler_of); !s) return s;
     add_dielectric_f0(material, conversion, out);
     out.conversion = conversion;
     Json remembered = {{"pbr", material["pbrMetallicRoughness"]}};
@@ -312,7 +312,7 @@ struct Exporter {
       sampler_of = int_in(info, "index", -1);
       info.erase("index");
     }
-    const std::string name = "material" + std::to_string(index);
+    const std::string name = gltf::material_file_name(material, index);
     if (given.find(material::kKd)) {
       workflow::ConversionReport conversion;
       auto maps = workflow::metal_rough_from_spec_gloss(given, replacement.mapping.value_or(options.mapping), conversion);

@@ -1,6 +1,8 @@
 #include "texture_files.hpp"
 
 #include <algorithm>
+#include <cctype>
+#include <set>
 
 namespace matbake::gltf {
 namespace {
@@ -113,11 +115,13 @@ Result<ImageCache::Made> ImageCache::add_image(Document& doc, const image::Image
   options.png_level = encoding_.png_level;
   if (webp()) options.compression = "lossless";  // data (occlusion, roughness) survives as written
   Made made;
-  made.uri = name + (webp() ? ".webp" : ".png");
+  made.uri = free_uri(doc, name, webp() ? ".webp" : ".png");
   auto bytes = image::encode_image(webp() && img.channels < 3 ? as_rgb(img) : img, made.uri, options);
   if (!bytes) return bytes.error();
   doc.new_files[made.uri] = std::move(*bytes);
-  doc.json["images"].push_back({{"uri", made.uri}, {"mimeType", webp() ? "image/webp" : "image/png"}});
+  doc.json["images"].push_back({{"uri", made.uri},
+                                {"mimeType", webp() ? "image/webp" : "image/png"},
+                                {"name", made.uri.substr(0, made.uri.rfind('.'))}});
   made.index = int(doc.json["images"].size()) - 1;
   if (webp()) require_extension(doc, "EXT_texture_webp", true);
   return made;
@@ -128,6 +132,7 @@ Result<ImageCache::Made> ImageCache::add_texture(Document& doc, const image::Ima
   auto made = add_image(doc, img, colour, name, type);
   if (!made) return made.error();
   Json texture = webp() ? Json{{"extensions", {{"EXT_texture_webp", {{"source", made->index}}}}}} : Json{{"source", made->index}};
+  texture["name"] = doc.json["images"][std::size_t(made->index)]["name"];
   if (sampler_from >= 0 && doc.json["textures"][std::size_t(sampler_from)].contains("sampler")) {
     texture["sampler"] = doc.json["textures"][std::size_t(sampler_from)]["sampler"];
   }
@@ -142,6 +147,29 @@ void require_extension(Document& doc, const std::string& name, bool required) {
     Json& names = doc.json[std::string(list)];
     if (std::find(names.begin(), names.end(), name) == names.end()) names.push_back(name);
   }
+}
+
+std::string uri_safe(const std::string& name) {
+  std::string out = name;
+  out.erase(std::remove_if(out.begin(), out.end(), [](char c) { return !std::isalnum((unsigned char)c) && c != '_' && c != '-'; }),
+            out.end());
+  return out;
+}
+
+std::string free_uri(const Document& doc, const std::string& name, const std::string& extension) {
+  std::set<std::string> taken;
+  for (const auto& [uri, bytes] : doc.new_files) taken.insert(uri);
+  for (const Json& img : array_in(doc.json, "images")) {
+    if (img.contains("uri") && img["uri"].is_string()) taken.insert(decode_uri(img["uri"].get<std::string>()));
+  }
+  std::string uri = name + extension;
+  for (int n = 2; taken.count(uri); ++n) uri = name + "_" + std::to_string(n) + extension;
+  return uri;
+}
+
+std::string material_file_name(const Json& material, int index) {
+  const std::string name = uri_safe(name_in(material, ""));
+  return name.empty() ? "material" + std::to_string(index) : name;
 }
 
 }  // namespace matbake::gltf

@@ -20,6 +20,15 @@ image::Image at_size(const image::Image& im, int width, int height);
 // Names `name` in extensionsUsed, and in extensionsRequired too when `required` (each once).
 void require_extension(Document& doc, const std::string& name, bool required);
 
+// `name` with only the characters safe in a URI and a file name kept (letters, digits, _ and -).
+std::string uri_safe(const std::string& name);
+
+// `name` + `extension`, or name_2, name_3... when a file of the document already has that URI.
+std::string free_uri(const Document& doc, const std::string& name, const std::string& extension);
+
+// What names the files made for material `index`: its name made uri_safe, else "material<index>".
+std::string material_file_name(const Json& material, int index);
+
 // The format of the images a cache makes: PNG, or lossless 8-bit WebP (the file then requires
 // EXT_texture_webp).
 enum class MadeFormat { png, webp };
