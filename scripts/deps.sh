@@ -16,17 +16,4 @@ packages=(
 # `deps.sh cluster`: also Slurm and munge, for scripts/test-cluster.sh.
 [ "${1:-}" = cluster ] && packages+=(slurm-wlm munge)
 
-missing=()
-for p in "${packages[@]}"; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q 'install ok installed' || missing+=("$p")
-done
-[ ${#missing[@]} -eq 0 ] && exit 0
-
-if [ "$(id -u)" -ne 0 ]; then
-  echo "matbake: missing packages: ${missing[*]} (run this script as root, or install them)" >&2
-  exit 1
-fi
-echo "matbake: installing ${missing[*]}" >&2
-export DEBIAN_FRONTEND=noninteractive
-apt-get update -qq
-apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+bash "$(dirname "${BASH_SOURCE[0]}")/apt-install.sh" "matbake cannot be built" "${packages[@]}"

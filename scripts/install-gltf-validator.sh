@@ -10,7 +10,7 @@ installed=$(node -p "require('$here/node_modules/gltf-validator/package.json').v
 wanted=$(node -p "require('$here/package.json').dependencies['gltf-validator']" 2>/dev/null || true)
 if [ -n "$installed" ] && [ "$installed" = "$wanted" ]; then exit 0; fi
 
-bash "$(dirname "${BASH_SOURCE[0]}")/apt-install.sh" "glTF validator tests" node:nodejs npm:npm
+bash "$(dirname "${BASH_SOURCE[0]}")/apt-install.sh" "glTF validator tests will skip" node:nodejs npm:npm
 echo "matbake: installing the glTF-Validator (npm gltf-validator $(node -p "require('$here/package.json').dependencies['gltf-validator']"))" >&2
 if ! (cd "$here" && npm ci --no-audit --no-fund --loglevel=error >/dev/null); then
   echo "matbake: could not install gltf-validator from npm — glTF validator tests will skip" >&2
