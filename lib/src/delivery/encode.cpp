@@ -1,8 +1,10 @@
 #include "encode.hpp"
 
+#include <tbb/parallel_for.h>
 #include <tbb/task_group.h>
 #include <unistd.h>
 
+#include <deque>
 #include <fstream>
 
 #include "matbake/atomic_file.hpp"
@@ -49,6 +51,10 @@ Result<std::vector<unsigned char>> read_output(const fs::path& path, std::uintma
   if (!read_whole_file(path, bytes) || bytes.size() > limit) return Error{what, "the encoder's output cannot be read"};
   return bytes;
 }
+
+// UASTC blocks per basisu run when a level is split (512 × 512 texels): RDO's window (its LZ dictionary,
+// 4 KiB: 256 blocks) is far smaller, so a split costs a few blocks' worth of bytes.
+constexpr int kStripBlocks = 16384;
 
 std::uint64_t texels_of(const image::Image& level) { return std::uint64_t(level.width) * std::uint64_t(level.height); }
 
@@ -107,43 +113,107 @@ Result<std::vector<unsigned char>> blocks_of(const Encoder& encoder, const std::
   return ktx2::level_data(*texture, 0, name);
 }
 
-// UASTC: level 0 encoded while the other levels are made, then the other levels in one run while
-// level 0 is supercompressed.
+// One basisu run of UASTC: the pieces it encodes, each a whole level or a strip of one.
+struct Piece {
+  std::size_t level = 0;  // its index in the chain
+  const image::Image* image = nullptr;
+  int first_row = 0, rows = 0;  // texel rows of the level
+};
+
+// Rows `first` to `first + rows` of `level`.
+image::Image rows_of(const image::Image& level, int first, int rows) {
+  image::Image strip;
+  static_cast<image::ImageLayout&>(strip) = level;
+  strip.height = rows;
+  const std::size_t row = std::size_t(level.width) * std::size_t(level.channels);
+  strip.pixels.assign(level.pixels.begin() + std::ptrdiff_t(row * std::size_t(first)),
+                      level.pixels.begin() + std::ptrdiff_t(row * std::size_t(first + rows)));
+  return strip;
+}
+
+// The basisu runs of a chain's UASTC levels from `first_level` on: a level larger than a strip
+// (kStripBlocks) in strips of whole block rows, each its own run; the smaller ones in one run.
+std::vector<std::vector<Piece>> plan_runs(const std::vector<const image::Image*>& levels, std::size_t first_level) {
+  std::vector<std::vector<Piece>> runs;
+  std::vector<Piece> small;
+  for (std::size_t l = first_level; l < levels.size(); ++l) {
+    const image::Image& level = *levels[l];
+    const int strip_rows = 4 * std::max(1, kStripBlocks / ((level.width + 3) / 4));
+    if (level.height <= strip_rows) {
+      small.push_back({l, &level, 0, level.height});
+      continue;
+    }
+    for (int y = 0; y < level.height; y += strip_rows) runs.push_back({{l, &level, y, std::min(strip_rows, level.height - y)}});
+  }
+  if (!small.empty()) runs.push_back(std::move(small));
+  return runs;
+}
+
+// One run: each piece's blocks (row-major, as the level stores them).
+Result<std::vector<std::vector<unsigned char>>> encode_run(const Encoder& encoder, const std::vector<Piece>& run,
+                                                           const EncodeRequest& request, const std::vector<std::string>& args) {
+  std::vector<image::Image> strips;
+  std::vector<const image::Image*> inputs;
+  strips.reserve(run.size());
+  for (const Piece& piece : run) {
+    const image::Image& level = *piece.image;
+    const bool whole = piece.rows == level.height;
+    if (!whole) strips.push_back(rows_of(level, piece.first_row, piece.rows));
+    inputs.push_back(whole ? &level : &strips.back());
+  }
+  auto files = run_on(encoder, inputs, request, args);
+  if (!files) return files.error();
+  std::vector<std::vector<unsigned char>> blocks;
+  for (std::size_t i = 0; i < inputs.size(); ++i) {
+    auto b = blocks_of(encoder, (*files)[i], *inputs[i], request.scratch.string());
+    if (!b) return b.error();
+    blocks.push_back(std::move(*b));
+  }
+  return blocks;
+}
+
+// UASTC, every level's runs in parallel (level 0's while the other levels are made), one encoder
+// thread each: RDO works through a run's blocks in order, so its bytes depend on where runs split,
+// and the split depends on the level's size alone, never on the thread count; then each level
+// supercompressed.
 Result<std::vector<ktx2::Level>> uastc_levels(const Encoder& encoder, const image::Image& level0, tbb::task_group& work,
                                               const std::vector<image::Image>& rest, const EncodeRequest& request) {
+  EncodeRequest one_thread = request;
+  one_thread.threads = 1;
   const std::vector<std::string> args = encoder_arguments(request);
-  std::vector<Result<ktx2::Level>> stored;
-  auto first = run_on(encoder, {&level0}, request, args);
-  work.wait();  // the other levels
-  if (!first) return first.error();
-  std::vector<const image::Image*> others;
-  for (const image::Image& l : rest) others.push_back(&l);
-  std::vector<std::vector<unsigned char>> blocks(1 + rest.size());
-  stored.assign(blocks.size(), Error{"", "not encoded"});
-  const std::string name = request.scratch.string();
-  auto supercompress = [&](std::size_t l, const image::Image& level, const std::vector<unsigned char>& file) {
-    auto b = blocks_of(encoder, file, level, name);
-    if (!b) {
-      stored[l] = b.error();
-      return;
+  std::vector<const image::Image*> levels{&level0};
+  // Deques: a run started keeps its place while later ones are added.
+  std::deque<std::vector<Piece>> runs;
+  std::deque<Result<std::vector<std::vector<unsigned char>>>> encoded;
+  tbb::task_group encoding;
+  auto start = [&](std::vector<std::vector<Piece>> planned) {
+    for (std::vector<Piece>& run : planned) {
+      const std::vector<Piece>& pieces = runs.emplace_back(std::move(run));
+      auto& result = encoded.emplace_back(Error{"", "not encoded"});
+      encoding.run([&encoder, &one_thread, &args, p = &pieces, out = &result] { *out = encode_run(encoder, *p, one_thread, args); });
     }
-    blocks[l] = std::move(*b);
-    work.run([&stored, &blocks, l, zstd = request.options.zstd] { stored[l] = ktx2::uastc_level(std::move(blocks[l]), zstd); });
   };
-  supercompress(0, level0, (*first)[0]);
-  auto later = others.empty() ? Result<std::vector<std::vector<unsigned char>>>(std::vector<std::vector<unsigned char>>{})
-                              : run_on(encoder, others, request, args);
-  if (later) {
-    for (std::size_t i = 0; i < rest.size(); ++i) supercompress(i + 1, rest[i], (*later)[i]);
+  start(plan_runs(levels, 0));
+  work.wait();  // the other levels
+  for (const image::Image& l : rest) levels.push_back(&l);
+  start(plan_runs(levels, 1));
+  encoding.wait();
+  std::vector<std::vector<unsigned char>> blocks(levels.size());
+  for (std::size_t r = 0; r < runs.size(); ++r) {  // in order: a level's strips join top to bottom
+    if (!encoded[r]) return encoded[r].error();
+    for (std::size_t i = 0; i < runs[r].size(); ++i) {
+      std::vector<unsigned char>& level = blocks[runs[r][i].level];
+      level.insert(level.end(), (*encoded[r])[i].begin(), (*encoded[r])[i].end());
+    }
   }
-  work.wait();
-  if (!later) return later.error();
-  std::vector<ktx2::Level> levels;
+  std::vector<Result<ktx2::Level>> stored(blocks.size(), Error{"", "not stored"});
+  tbb::parallel_for(std::size_t(0), blocks.size(), [&](std::size_t l) { stored[l] = ktx2::uastc_level(std::move(blocks[l]), request.options.zstd); });
+  std::vector<ktx2::Level> out;
   for (Result<ktx2::Level>& l : stored) {
     if (!l) return l.error();
-    levels.push_back(std::move(*l));
+    out.push_back(std::move(*l));
   }
-  return levels;
+  return out;
 }
 
 }  // namespace
@@ -164,7 +234,8 @@ std::vector<std::string> encoder_arguments(const EncodeRequest& request) {
   else if (request.texture_class == TextureClass::data) args.push_back("-linear");
   if (o.codec == Codec::uastc) {
     args.insert(args.end(), {"-uastc", "-uastc_level", std::to_string(o.uastc_level), "-ktx2_no_zstandard"});
-    // Single-threaded RDO: basisu's threaded RDO depends on the thread count; this does not.
+    // basisu's own threaded RDO splits a level by its thread count (and the machine's): matbake splits
+    // it by size (uastc_levels) and runs each piece single-threaded.
     if (o.uastc_rdo > 0) args.insert(args.end(), {"-uastc_rdo_l", std::to_string(o.uastc_rdo), "-uastc_rdo_m"});
     return args;
   }
