@@ -13,7 +13,7 @@ bash "$root/scripts/build.sh" "$root/build"
 matbake=$root/build/cli/matbake
 "$matbake" build "$root/examples/showroom.toml"
 # The occlusion textures alone (the build puts them in the ORM textures' red channel), as
-# docs/bake-ao.md shows crate 1's: examples/out/ao/showroom_ao_occlusion_0.png.
+# docs/bake-ao.md shows crate 1's: examples/out/ao/showroom_ao_painted_metal_occlusion.png.
 mkdir -p "$root/examples/out/ao"
 "$matbake" bake-ao "$root/examples/showroom.gltf" -o "$root/examples/out/ao/showroom_ao.gltf" \
   --texture 256 --per-instance --samples 256

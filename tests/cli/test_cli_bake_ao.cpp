@@ -378,7 +378,7 @@ TEST(CliBakeAo, TexturesAreWrittenAsLosslessWebpWhenAsked) {
   ASSERT_EQ(png.exit_code, 0) << png.err;
   const auto webp = with({"-o", (dir / "webp.gltf").string(), "--texture-format", "webp"});
   ASSERT_EQ(webp.exit_code, 0) << webp.err;
-  EXPECT_TRUE(fs::exists(dir / "webp_occlusion_0.webp"));
+  EXPECT_TRUE(fs::exists(dir / "webp_floor_occlusion.webp"));  // named from its material
   EXPECT_EQ(occlusion_texels(dir / "png.glb"), occlusion_texels(dir / "webp.gltf"));
   const auto doc = gltf::read_document(dir / "webp.gltf");
   ASSERT_TRUE(doc);

@@ -324,8 +324,8 @@ TEST(CliExport, IdenticalImagesAreStoredOnceAndTheReportUsesTheFilesIndices) {
   }
 }
 
-// Made textures are named from their material and slot (its name made safe for a file, not its
-// index), files, images and textures alike; a texture delivery rewrites loses its stale name.
+// Made textures are named from their material and slot (its name made safe for a file — "Lamp
+// Shade!" is Lamp_Shade — not its index), files, images and textures alike; a texture delivery rewrites loses its stale name.
 TEST(CliExport, MadeTexturesAreNamedFromTheirMaterialAndSlot) {
   TempDir dir;
   std::vector<double> base, mr;
@@ -341,10 +341,10 @@ TEST(CliExport, MadeTexturesAreNamedFromTheirMaterialAndSlot) {
   std::set<std::string> images, textures;
   for (const auto& i : doc.json["images"]) images.insert(i["name"].get<std::string>() + "=" + i["uri"].get<std::string>());
   for (const auto& t : doc.json["textures"]) textures.insert(t["name"].get<std::string>());
-  EXPECT_EQ(images, (std::set<std::string>{"room_LampShade_base_color=room_LampShade_base_color.png",
-                                           "room_LampShade_metallic_roughness=room_LampShade_metallic_roughness.png"}));
-  EXPECT_EQ(textures, (std::set<std::string>{"room_LampShade_base_color", "room_LampShade_metallic_roughness"}));
-  EXPECT_TRUE(fs::exists(dir / "out" / "room_LampShade_base_color.png"));
+  EXPECT_EQ(images, (std::set<std::string>{"room_Lamp_Shade_base_color=room_Lamp_Shade_base_color.png",
+                                           "room_Lamp_Shade_metallic_roughness=room_Lamp_Shade_metallic_roughness.png"}));
+  EXPECT_EQ(textures, (std::set<std::string>{"room_Lamp_Shade_base_color", "room_Lamp_Shade_metallic_roughness"}));
+  EXPECT_TRUE(fs::exists(dir / "out" / "room_Lamp_Shade_base_color.png"));
 }
 
 // matbake wrote the file, so asset.generator says so; what made the input is kept beside it (and

@@ -248,13 +248,14 @@ Result<std::vector<TextureReport>> bake_occlusion_textures(gltf::Document& doc, 
         orm.pixels[p * 3 + 1] = gltf::rgba(source, p, 1);
         orm.pixels[p * 3 + 2] = gltf::rgba(source, p, 2);
       }
-      auto made = cache.add_texture(doc, orm, color::Transfer::linear, stem + "_orm_ao_" + std::to_string(m), mr_index);
+      auto made = cache.add_texture(doc, orm, color::Transfer::linear, stem + "_" + gltf::material_file_name(material, m) + "_orm_ao",
+                                    mr_index);
       if (!made) return made.error();
       report.file = made->uri;
       index = made->index;
       material["pbrMetallicRoughness"]["metallicRoughnessTexture"]["index"] = index;
     } else {
-      auto made = cache.add_texture(doc, img, color::Transfer::linear, stem + "_occlusion_" + std::to_string(m), sampler_from,
+      auto made = cache.add_texture(doc, img, color::Transfer::linear, stem + "_" + gltf::material_file_name(material, m) + "_occlusion", sampler_from,
                                     texture.bits == 16 ? image::SampleType::u16 : image::SampleType::u8);
       if (!made) return made.error();
       report.file = made->uri;

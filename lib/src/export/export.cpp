@@ -331,7 +331,7 @@ struct Exporter {
   }
 
   // Occlusion and metallic-roughness in two textures of the same texCoord become one ORM texture.
-  Status pack_orm(Json& material, MaterialReport& out) {
+  Status pack_orm(int index, Json& material, MaterialReport& out) {
     if (!material.contains("occlusionTexture") || !material.contains("pbrMetallicRoughness") ||
         !material["pbrMetallicRoughness"].contains("metallicRoughnessTexture")) {
       return success();
@@ -364,7 +364,8 @@ struct Exporter {
         packed.pixels[p * 3 + 1] = gltf::rgba(m, p, 1);
         packed.pixels[p * 3 + 2] = gltf::rgba(m, p, 2);
       }
-      auto texture = add_texture(packed, color::Transfer::linear, "orm" + std::to_string(orm_made.size()), mr_index);
+      // Named after the first material that reads the pair.
+      auto texture = add_texture(packed, color::Transfer::linear, gltf::material_file_name(material, index) + "_orm", mr_index);
       if (!texture) return texture.error();
       orm = orm_made[{mr_index, occlusion_index}] = *texture;
     }
@@ -483,7 +484,7 @@ Result<Report> export_scene(const fs::path& input, const fs::path& output, const
       } else if (material.contains("extensions") && material["extensions"].contains(kSpecGloss)) {
         done = exporter.from_spec_gloss(int(i), material, out);
       }
-      if (done && options.pack_orm) done = exporter.pack_orm(material, out);
+      if (done && options.pack_orm) done = exporter.pack_orm(int(i), material, out);
       if (!done) return done.error();
       out.alpha_mode = material.value("alphaMode", "OPAQUE");
       report.materials.push_back(std::move(out));

@@ -150,9 +150,13 @@ void require_extension(Document& doc, const std::string& name, bool required) {
 }
 
 std::string uri_safe(const std::string& name) {
-  std::string out = name;
-  out.erase(std::remove_if(out.begin(), out.end(), [](char c) { return !std::isalnum((unsigned char)c) && c != '_' && c != '-'; }),
-            out.end());
+  std::string out;
+  for (const char c : name) {
+    const bool safe = std::isalnum((unsigned char)c) || c == '_' || c == '-';
+    if (safe) out += c;
+    else if (!out.empty() && out.back() != '_') out += '_';  // "Paint (crate 2)" → Paint_crate_2
+  }
+  while (!out.empty() && out.back() == '_') out.pop_back();
   return out;
 }
 

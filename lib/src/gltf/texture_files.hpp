@@ -20,7 +20,8 @@ image::Image at_size(const image::Image& im, int width, int height);
 // Names `name` in extensionsUsed, and in extensionsRequired too when `required` (each once).
 void require_extension(Document& doc, const std::string& name, bool required);
 
-// `name` with only the characters safe in a URI and a file name kept (letters, digits, _ and -).
+// `name` with only the characters safe in a URI and a file name (letters, digits, _ and -): each run
+// of others becomes one _, none at either end.
 std::string uri_safe(const std::string& name);
 
 // `name` + `extension`, or name_2, name_3... when a file of the document already has that URI.
