@@ -9,6 +9,7 @@
 #include <cmath>
 #include <thread>
 #include <fstream>
+#include <map>
 
 #include "lib/src/gltf/document.hpp"
 #include "matbake/color.hpp"
@@ -265,14 +266,14 @@ TEST(CliDelivery, UastcColourKeepsCoverageAtEveryLevelAndJobsDoNotChangeBytes) {
   }
 }
 
-// Level 0 of a 768 × 640 UASTC texture is larger than one encoder run's strip (16 384 blocks): it is
+// Level 0 of a 1024 × 1088 UASTC texture is larger than one encoder run's strip (65 536 blocks): it is
 // encoded in two strips in parallel, RDO on. The bytes are the same for any --jobs, and the strips
 // land where they belong: level 0 transcoded (basisu -unpack, BC7) is within UASTC's error of the
 // source in every band of 64 rows (a strip out of place or order misses by tens of codes).
 TEST(CliDelivery, LargeLevelsEncodeInStripsInPlaceWithBytesIndependentOfJobs) {
   MATBAKE_BASISU_OR_SKIP(basisu);
   TempDir dir;
-  const int width = 768, height = 640;
+  const int width = 1024, height = 1088;
   GltfBuilder b = quad_with_material_0();
   b.doc["materials"] = {{{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}}};
   b.doc["textures"] = {{{"source", 0}}};
@@ -319,6 +320,81 @@ TEST(CliDelivery, LargeLevelsEncodeInStripsInPlaceWithBytesIndependentOfJobs) {
     }
     EXPECT_LT(std::sqrt(squared / (64.0 * width * 3)), 3.0) << "rows " << band * 64 << "–" << band * 64 + 63;
   }
+}
+
+// The example twice in one build, both KTX2 with AO into their ORM textures at 64 texels: every
+// texture is encoded by one of the two scenes and read from the encode cache by the other (same
+// bytes). Then the twin's AO changes: it rebuilds, the showroom does not, and exactly the twin's
+// textures whose bytes changed (its ORM textures) are encoded again. A damaged entry is encoded again.
+TEST(CliDelivery, TheEncodeCacheEncodesEachTextureOnceAndAnAoChangeOnlyWhatItChanged) {
+  MATBAKE_BASISU_OR_SKIP(basisu);
+  TempDir dir;
+  copy_example(dir.path());
+  std::string manifest = read_bytes(dir / "showroom.toml");
+  const std::string ao = "samples = 128, relative_distance = 0.25, texture = 256";
+  manifest.replace(manifest.find(ao), ao.size(), "samples = 8, relative_distance = 0.25, texture = 64");
+  const std::string ktx2 = "texture_format = \"ktx2\"\ncolour_max_size = 64\ndata_max_size = 64\n";
+  manifest += ktx2 + "\n[scenes.twin]\ninput = \"showroom.gltf\"\noutput = \"twin.glb\"\n" + ktx2 +
+              "ao = { samples = 8, relative_distance = 0.25, texture = 64, per_instance = true }\n";
+  write_bytes(dir / "showroom.toml", manifest);
+  const std::vector<std::string> env = {"MATBAKE_BASISU=" + basisu};
+  const auto build = [&] {
+    std::map<std::string, json> scenes;
+    const json report = run_json({"build", (dir / "showroom.toml").string()}, env);
+    for (const json& job : report["jobs"]) {
+      if (job["details"].contains("textures")) scenes[job["name"]] = job["details"]["textures"];
+    }
+    return scenes;
+  };
+  const auto bytes_of = [&](const std::string& scene, const json& textures) {  // each texture's KTX2 file in the .glb
+    const gltf::Document doc = read_output(dir / "out" / (scene + ".glb"));
+    std::vector<std::vector<unsigned char>> files;
+    for (const json& t : textures) files.push_back(image_of(doc, t["texture"]));
+    return files;
+  };
+  std::map<std::string, json> first = build();
+  ASSERT_EQ(first.size(), 2u);
+  const json &showroom = first["scene:showroom"], &twin = first["scene:twin"];
+  ASSERT_EQ(showroom.size(), twin.size());
+  ASSERT_GE(showroom.size(), 10u);
+  const auto showroom_bytes = bytes_of("showroom", showroom), twin_bytes = bytes_of("twin", twin);
+  for (std::size_t i = 0; i < showroom.size(); ++i) {
+    EXPECT_NE(showroom[i]["reused"].get<bool>(), twin[i]["reused"].get<bool>()) << "texture " << i << ": encoded once";
+    EXPECT_EQ(showroom_bytes[i], twin_bytes[i]) << "texture " << i;
+    EXPECT_GT(twin_bytes[i].size(), 100u) << "texture " << i;
+  }
+
+  manifest.replace(manifest.rfind("samples = 8"), 11, "samples = 16");
+  write_bytes(dir / "showroom.toml", manifest);
+  std::map<std::string, json> second = build();
+  ASSERT_EQ(second.size(), 1u) << "the showroom is up to date";
+  const json& rebuilt = second["scene:twin"];
+  const auto rebuilt_bytes = bytes_of("twin", rebuilt);
+  int encoded = 0;
+  for (std::size_t i = 0; i < rebuilt.size(); ++i) {
+    const bool reused = rebuilt[i]["reused"];
+    EXPECT_EQ(reused, rebuilt_bytes[i] == twin_bytes[i]) << rebuilt[i]["file"];
+    EXPECT_EQ(reused, rebuilt[i]["file"].get<std::string>().find("_orm_") == std::string::npos) << rebuilt[i]["file"];
+    encoded += reused ? 0 : 1;
+  }
+  EXPECT_GT(encoded, 0);
+  EXPECT_LT(encoded, int(rebuilt.size()));
+
+  for (const fs::directory_entry& e : fs::directory_iterator(dir / "out" / ".matbake" / "encode-cache")) {
+    fs::resize_file(e.path(), fs::file_size(e.path()) / 2);  // every entry damaged
+  }
+  const RunResult forced = matbake({"--json", "build", (dir / "showroom.toml").string(), "--force", "--only", "scene:twin"}, env);
+  ASSERT_EQ(forced.exit_code, 0) << forced.err;
+  for (const json& job : json::parse(forced.out)["jobs"]) {
+    for (const json& t : job["details"].value("textures", json::array())) EXPECT_FALSE(t["reused"].get<bool>()) << t["file"];
+  }
+  EXPECT_EQ(bytes_of("twin", rebuilt), rebuilt_bytes);
+
+  std::vector<std::string> bad_env = env;
+  bad_env.push_back("MATBAKE_ENCODE_CACHE_MB=lots");
+  const RunResult bad = matbake({"build", (dir / "showroom.toml").string(), "--force"}, bad_env);
+  EXPECT_EQ(bad.exit_code, 2);
+  expect_one_error_line(bad, "MATBAKE_ENCODE_CACHE_MB", "'lots': a whole number of MiB (0 turns the encode cache off)");
 }
 
 TEST(CliDelivery, PngFallbackKeepsTheSourceAndTheExtensionIsOnlyUsed) {

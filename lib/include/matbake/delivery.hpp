@@ -4,6 +4,7 @@
 // colour in linear light, normals renormalised, alpha coverage kept for MASK materials — and
 // written as KTX2 (KHR_texture_basisu) through Basis Universal's `basisu`, or kept as PNG.
 #include <cstdint>
+#include <filesystem>
 #include <optional>
 #include <string>
 #include <utility>
@@ -67,6 +68,10 @@ struct Options {
   bool mipmaps = true;          // a full chain down to 1×1
   bool png_fallback = false;    // keep the PNG as the texture's core source (the extension then optional)
   double texel_density = 0;     // texels per scene unit the textures are sized for; 0: their own sizes
+  // Not parameters (no stamp records them): where a build keeps encoded textures between runs
+  // (OUT/.matbake/encode-cache) and how many bytes at most; an empty folder or 0: none kept.
+  std::filesystem::path encode_cache;
+  std::uint64_t encode_cache_bytes = 0;
 
   const ClassOptions& of(TextureClass c) const { return c == TextureClass::colour ? colour : c == TextureClass::data ? data : normal; }
   ClassOptions& of(TextureClass c) { return c == TextureClass::colour ? colour : c == TextureClass::data ? data : normal; }
@@ -162,6 +167,7 @@ struct TextureReport {
   std::optional<float> alpha_cutoff;         // a MASK material's
   std::vector<double> coverage;              // with alpha_cutoff: the source's, then each level's (8-bit, before encoding)
   std::string note;                          // why it was kept, when it was
+  bool reused = false;                       // KTX2: read from the encode cache, not encoded
 };
 
 }  // namespace matbake::delivery

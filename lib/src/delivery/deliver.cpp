@@ -16,7 +16,7 @@
 #include "../scene/from_document.hpp"
 #include "../gltf/prune.hpp"
 #include "../gltf/texture_transform.hpp"
-#include "encode.hpp"
+#include "encode_cache.hpp"
 #include "matbake/ktx2.hpp"
 #include "matbake/version.hpp"
 
@@ -185,6 +185,7 @@ struct Work {
   image::Image level0;  // png: the resized texture
   int levels = 1;
   std::vector<double> coverage;
+  bool reused = false;  // from the encode cache
   Status status = success();
 };
 
@@ -203,8 +204,8 @@ Status make(Work& w, const Options& options, const Encoder* encoder, const fs::p
   EncodeRequest encode{.texture_class = w.use.texture_class, .options = options.of(w.use.texture_class), .sampling = w.sampling,
                        .mipmaps = options.mipmaps, .alpha = has_alpha(*w.source),
                        .scratch = output.parent_path() / (w.name + ".ktx2"), .threads = threads};
-  auto made = encode_texture(*encoder, *w.source, w.size, request, encode,
-                             "matbake " + std::string(matbake::version) + " / basisu " + encoder->version);
+  auto made = encode_with_cache({options.encode_cache, options.encode_cache_bytes}, *encoder, *w.source, w.size, request, encode,
+                                 "matbake " + std::string(matbake::version) + " / basisu " + encoder->version, w.reused);
   if (!made) return made.error();
   w.ktx2 = std::move(made->file);
   w.levels = made->levels;
@@ -352,7 +353,7 @@ Result<std::vector<TextureReport>> deliver_textures(gltf::Document& doc, gltf::I
     TextureReport report{.texture = w.texture, .texture_class = w.use.texture_class, .codec = w.codec,
                          .source = {w.source->width, w.source->height}, .delivered = w.size, .needed = w.needed,
                          .materials = materials_of(w.use), .levels = w.levels,
-                         .alpha_cutoff = w.use.alpha_cutoff, .coverage = w.coverage};
+                         .alpha_cutoff = w.use.alpha_cutoff, .coverage = w.coverage, .reused = w.reused};
     auto source_bytes = gltf::image_bytes(doc, std::size_t(w.image));
     if (!source_bytes) return source_bytes.error();
     report.source_bytes = source_bytes->size();

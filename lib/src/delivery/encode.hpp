@@ -1,6 +1,6 @@
 #pragma once
 // A texture through basisu. UASTC: matbake's levels, each an 8-bit PNG in and a one-level KTX2 out
-// (a large level in strips of 512 × 512 texels' blocks, each strip its own single-threaded run, in
+// (a large level in strips of 1024 × 1024 texels' blocks, each strip its own single-threaded run, in
 // parallel; the small levels in one run), their blocks assembled by ktx2::write_uastc with zstd
 // supercompression. ETC1S: one run from level 0, basisu making the mips
 // (its BasisLZ codebooks span every level, so given levels cannot be joined).

@@ -19,6 +19,7 @@
 #include "matbake/report_json.hpp"
 #include "matbake/validate.hpp"
 #include "matbake/workflow_maps.hpp"
+#include "../delivery/encode_cache.hpp"
 #include "made_log.hpp"
 #include "state.hpp"
 
@@ -132,6 +133,7 @@ struct JobContext {
   DecodeCache& cache;
   const std::vector<material_table::Material>* table;  // null when it could not be read
   const Error* table_error;
+  std::uint64_t encode_cache_bytes;  // OUT/.matbake/encode-cache's limit
 };
 
 Status ensure_folder(const fs::path& folder) {
@@ -231,6 +233,9 @@ Result<std::vector<fs::path>> run_scene(const Job& job, const JobContext& ctx, J
   return guarded(ctx.manifest.scenes[job.spec].input.string(), [&]() -> Result<std::vector<fs::path>> {
     const SceneSpec& s = ctx.manifest.scenes[job.spec];
     exporter::Options options = s.options;
+    // Content-keyed, so shared by every manifest that builds into the folder.
+    options.delivery.encode_cache = ctx.manifest.output / ".matbake" / "encode-cache";
+    options.delivery.encode_cache_bytes = ctx.encode_cache_bytes;
     for (const auto& [gltf_name, m] : job.materials) {
       const MaterialSpec& spec = ctx.manifest.materials[m];
       auto maps = load_material(spec, ctx.cache);
@@ -430,7 +435,9 @@ Result<Report> run(const Manifest& manifest, const Plan& plan, const RunOptions&
   DecodeCache cache(uses);
   auto table = manifest.table.empty() ? Result<std::vector<material_table::Material>>(material_table::builtin_table())
                                       : material_table::load_table(manifest.table);
-  const JobContext ctx{manifest, cache, table ? &*table : nullptr, table ? nullptr : &table.error()};
+  auto encode_cache_bytes = delivery::encode_cache_limit();
+  if (!encode_cache_bytes) return encode_cache_bytes.error();
+  const JobContext ctx{manifest, cache, table ? &*table : nullptr, table ? nullptr : &table.error(), *encode_cache_bytes};
 
   // Jobs that depend on none first, then the others (a scene after its materials' jobs), each
   // skipped when a job it depends on failed in this run.

@@ -1,0 +1,228 @@
+#include "encode_cache.hpp"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <tbb/collaborative_call_once.h>
+#include <unistd.h>
+#include <xxhash.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <cstring>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+
+#include "matbake/atomic_file.hpp"
+#include "matbake/ktx2.hpp"
+
+namespace matbake::delivery {
+namespace fs = std::filesystem;
+namespace {
+
+constexpr std::string_view kMagic = "matbake encoded texture 1\n";
+constexpr std::string_view kSuffix = ".ktx2e";
+constexpr std::size_t kKeyDigits = 32;
+constexpr std::uint32_t kMostLevels = 32;
+
+// A descriptor closed when it goes.
+struct Descriptor {
+  int fd = -1;
+  explicit Descriptor(int f) : fd(f) {}
+  Descriptor(const Descriptor&) = delete;
+  ~Descriptor() {
+    if (fd >= 0) ::close(fd);
+  }
+};
+
+bool is_entry_name(const std::string& name) {
+  return name.size() == kKeyDigits + kSuffix.size() && name.ends_with(kSuffix) &&
+         std::all_of(name.begin(), name.begin() + kKeyDigits, [](char c) { return (c >= '0' && c <= '9') || (c >= 'a' && c <= 'f'); });
+}
+
+// The most bytes an entry of level 0 at `base` can hold: what read_output allows the encoder, plus
+// the header.
+std::uint64_t entry_limit(Size base) {
+  return 2 * std::uint64_t(base.width) * std::uint64_t(base.height) + (1u << 20) + kMagic.size() + 8 + 8 * (kMostLevels + 1);
+}
+
+template <typename T>
+void hash_value(XXH3_state_t* state, const T& value) {
+  XXH3_128bits_update(state, &value, sizeof value);
+}
+
+void hash_text(XXH3_state_t* state, const std::string& text) {
+  hash_value(state, text.size());
+  XXH3_128bits_update(state, text.data(), text.size());
+}
+
+// An entry's bytes: the magic, the level count, the coverage count and values, the KTX2 file.
+std::string header_of(const Encoded& e) {
+  std::string h(kMagic);
+  const std::uint32_t counts[2] = {std::uint32_t(e.levels), std::uint32_t(e.coverage.size())};
+  h.append(reinterpret_cast<const char*>(counts), sizeof counts);
+  h.append(reinterpret_cast<const char*>(e.coverage.data()), e.coverage.size() * sizeof(double));
+  return h;
+}
+
+std::optional<Encoded> parse_entry(const std::vector<unsigned char>& bytes, Size base, const std::string& name) {
+  if (bytes.size() < kMagic.size() + 8 || std::memcmp(bytes.data(), kMagic.data(), kMagic.size()) != 0) return std::nullopt;
+  std::uint32_t counts[2];
+  std::memcpy(counts, bytes.data() + kMagic.size(), sizeof counts);
+  if (counts[0] == 0 || counts[0] > kMostLevels || counts[1] > kMostLevels + 1) return std::nullopt;
+  const std::size_t file_at = kMagic.size() + sizeof counts + counts[1] * sizeof(double);
+  if (bytes.size() <= file_at) return std::nullopt;
+  Encoded e;
+  e.levels = int(counts[0]);
+  e.coverage.resize(counts[1]);
+  std::memcpy(e.coverage.data(), bytes.data() + kMagic.size() + sizeof counts, counts[1] * sizeof(double));
+  e.file.assign(bytes.begin() + std::ptrdiff_t(file_at), bytes.end());
+  auto read = ktx2::read(e.file, name);
+  if (!read || read->width != unsigned(base.width) || read->height != unsigned(base.height) || read->levels.size() != counts[0]) {
+    return std::nullopt;
+  }
+  return e;
+}
+
+// The entry of `key`, when there is a well-formed one; marked as used now (its modification time,
+// which eviction orders by).
+std::optional<Encoded> read_entry(const fs::path& folder, const std::string& key, Size base) {
+  const Descriptor dir(::open(folder.c_str(), O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC));
+  if (dir.fd < 0) return std::nullopt;
+  const std::string name = key + std::string(kSuffix);
+  const Descriptor file(::openat(dir.fd, name.c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC | O_NONBLOCK));
+  struct stat st {};
+  if (file.fd < 0 || ::fstat(file.fd, &st) != 0 || !S_ISREG(st.st_mode) || std::uint64_t(st.st_size) > entry_limit(base)) {
+    return std::nullopt;
+  }
+  std::vector<unsigned char> bytes(std::size_t(st.st_size));
+  std::size_t got = 0;
+  while (got < bytes.size()) {
+    const ssize_t n = ::read(file.fd, bytes.data() + got, bytes.size() - got);
+    if (n <= 0) return std::nullopt;
+    got += std::size_t(n);
+  }
+  auto entry = parse_entry(bytes, base, (folder / name).string());
+  if (entry) ::futimens(file.fd, nullptr);
+  return entry;
+}
+
+// Whether the regular file `name` in `dir` begins as an entry does: what eviction may remove.
+bool holds_an_entry(int dir, const std::string& name) {
+  const Descriptor file(::openat(dir, name.c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC | O_NONBLOCK));
+  char head[kMagic.size()];
+  return file.fd >= 0 && ::read(file.fd, head, sizeof head) == ssize_t(sizeof head) && std::string_view(head, sizeof head) == kMagic;
+}
+
+void keep_entry(const EncodeCache& cache, const std::string& key, const Encoded& e) {
+  std::error_code ec;
+  fs::create_directory(cache.folder, ec);
+  if (!fs::is_directory(fs::symlink_status(cache.folder, ec))) return;  // a link or a file: no cache
+  const std::string header = header_of(e);
+  const std::string_view parts[2] = {header, std::string_view(reinterpret_cast<const char*>(e.file.data()), e.file.size())};
+  if (!write_file_atomically(cache.folder / (key + std::string(kSuffix)), parts)) return;  // a full disk: encoded, not kept
+  evict_encoded(cache.folder, cache.limit_bytes);
+}
+
+// One key encoded once per process: callers of a key share one flag while any of them holds it.
+struct InFlight {
+  tbb::collaborative_once_flag once;
+};
+
+std::shared_ptr<InFlight> in_flight(const std::string& key) {
+  static std::mutex lock;
+  static std::map<std::string, std::weak_ptr<InFlight>> flights;
+  const std::lock_guard<std::mutex> held(lock);
+  std::erase_if(flights, [](const auto& f) { return f.second.expired(); });
+  std::weak_ptr<InFlight>& slot = flights[key];
+  std::shared_ptr<InFlight> flight = slot.lock();
+  if (!flight) slot = flight = std::make_shared<InFlight>();
+  return flight;
+}
+
+}  // namespace
+
+void evict_encoded(const fs::path& folder, std::uint64_t limit) {
+  const Descriptor dir(::open(folder.c_str(), O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC));
+  if (dir.fd < 0) return;
+  struct Found {
+    std::int64_t used_ns = 0;
+    std::uint64_t bytes = 0;
+    std::string name;
+  };
+  std::vector<Found> entries;
+  std::uint64_t total = 0;
+  std::error_code ec;
+  for (const fs::directory_entry& e : fs::directory_iterator(folder, ec)) {
+    const std::string name = e.path().filename().string();
+    struct stat st {};
+    if (!is_entry_name(name) || ::fstatat(dir.fd, name.c_str(), &st, AT_SYMLINK_NOFOLLOW) != 0 || !S_ISREG(st.st_mode)) continue;
+    entries.push_back({std::int64_t(st.st_mtim.tv_sec) * 1000000000 + st.st_mtim.tv_nsec, std::uint64_t(st.st_size), name});
+    total += std::uint64_t(st.st_size);
+  }
+  std::sort(entries.begin(), entries.end(), [](const Found& a, const Found& b) { return a.used_ns < b.used_ns; });
+  for (const Found& e : entries) {
+    if (total <= limit) break;
+    if (holds_an_entry(dir.fd, e.name) && ::unlinkat(dir.fd, e.name.c_str(), 0) == 0) total -= e.bytes;
+  }
+}
+
+Result<std::uint64_t> encode_cache_limit() {
+  const char* value = std::getenv("MATBAKE_ENCODE_CACHE_MB");
+  if (value == nullptr) return std::uint64_t(1024) << 20;
+  const std::string text(value);
+  if (text.empty() || text.size() > 9 || !std::all_of(text.begin(), text.end(), [](char c) { return c >= '0' && c <= '9'; })) {
+    return Error{"MATBAKE_ENCODE_CACHE_MB", "'" + text + "': a whole number of MiB (0 turns the encode cache off)", true};
+  }
+  return std::uint64_t(std::stoull(text)) << 20;
+}
+
+std::string encode_key(const image::Image& source, Size base, const MipRequest& mips, const EncodeRequest& request,
+                       const std::string& writer) {
+  const std::unique_ptr<XXH3_state_t, decltype(&XXH3_freeState)> state(XXH3_createState(), XXH3_freeState);
+  XXH3_128bits_reset(state.get());
+  XXH3_state_t* s = state.get();
+  hash_text(s, std::string(kMagic) + writer);
+  for (const std::string& arg : encoder_arguments(request)) hash_text(s, arg);
+  const ClassOptions& o = request.options;
+  for (const double v : {double(o.codec), double(o.quality), double(o.uastc_level), o.uastc_rdo, double(o.zstd)}) hash_value(s, v);
+  for (const int v : {source.width, source.height, source.channels, source.alpha_channel, base.width, base.height,
+                      int(mips.texture_class), int(mips.sampling.filter), int(mips.sampling.wrap_s), int(mips.sampling.wrap_t),
+                      int(request.texture_class), int(request.mipmaps), int(request.alpha), int(mips.alpha_cutoff.has_value())}) {
+    hash_value(s, v);
+  }
+  hash_value(s, mips.alpha_cutoff.value_or(0.0f));
+  for (const std::string& name : source.channel_names) hash_text(s, name);
+  XXH3_128bits_update(s, source.pixels.data(), source.pixels.size() * sizeof(float));
+  XXH128_canonical_t canonical;
+  XXH128_canonicalFromHash(&canonical, XXH3_128bits_digest(s));
+  static constexpr char kHex[] = "0123456789abcdef";
+  std::string key;
+  for (const unsigned char byte : canonical.digest) key += {kHex[byte >> 4], kHex[byte & 15]};
+  return key;
+}
+
+Result<Encoded> encode_with_cache(const EncodeCache& cache, const Encoder& encoder, const image::Image& source, Size base,
+                                  const MipRequest& mips, const EncodeRequest& request, const std::string& writer, bool& reused) {
+  reused = false;
+  if (cache.folder.empty() || cache.limit_bytes == 0) return encode_texture(encoder, source, base, mips, request, writer);
+  const std::string key = encode_key(source, base, mips, request, writer);
+  if (auto hit = read_entry(cache.folder, key, base)) {
+    reused = true;
+    return std::move(*hit);
+  }
+  std::optional<Result<Encoded>> made;
+  tbb::collaborative_call_once(in_flight(key)->once, [&] {
+    made = encode_texture(encoder, source, base, mips, request, writer);
+    if (*made) keep_entry(cache, key, **made);
+  });
+  if (made) return std::move(*made);
+  if (auto hit = read_entry(cache.folder, key, base)) {  // another task of this process encoded it
+    reused = true;
+    return std::move(*hit);
+  }
+  return encode_texture(encoder, source, base, mips, request, writer);  // it failed there, or was not kept
+}
+
+}  // namespace matbake::delivery

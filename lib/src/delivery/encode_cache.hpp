@@ -1,0 +1,41 @@
+#pragma once
+// Encoded textures kept between runs, so that a scene rebuilt for another reason (an AO setting, a
+// material that changed one texture) encodes only the textures whose pixels or settings changed, and
+// two scenes of one build sharing a texture encode it once. A build keeps them in its output folder's
+// state (OUT/.matbake/encode-cache/), one file per encode named by its key; least recently used
+// entries are removed past a size limit. Entries are outside input: read through O_NOFOLLOW, size-
+// limited and parsed as a KTX2 file of the asked size, or ignored (encoded again).
+#include <cstdint>
+#include <filesystem>
+
+#include "encode.hpp"
+
+namespace matbake::delivery {
+
+// MATBAKE_ENCODE_CACHE_MB when set (0: no cache), else 1024: the most an output folder's encode cache
+// holds. An error names the variable when its value is not a whole number of MiB.
+Result<std::uint64_t> encode_cache_limit();
+
+struct EncodeCache {
+  std::filesystem::path folder;  // empty: no cache
+  std::uint64_t limit_bytes = 0;
+};
+
+// Least recently used entries (by modification time: a read marks it) removed from `folder` until its
+// entries fit in `limit` bytes. Only regular files named as entries (32 hex digits + ".ktx2e") that
+// begin as one are removed, by name relative to the folder's descriptor (no link is followed).
+void evict_encoded(const std::filesystem::path& folder, std::uint64_t limit);
+
+// The key of an encode: XXH3-128 of everything its bytes depend on — the source's layout and pixels
+// (level 0 and every level are made from them), the size of level 0, the mip request, the class's
+// codec settings, the encoder's arguments and `writer` (matbake's and basisu's versions).
+std::string encode_key(const image::Image& source, Size base, const MipRequest& mips, const EncodeRequest& request,
+                       const std::string& writer);
+
+// encode_texture through the cache: an entry found is used (and marked recently used), else the
+// texture is encoded and kept. `reused` says which. Within a process one key is encoded once: a
+// second caller waits for the first (its thread working on other tasks meanwhile) and reads its entry.
+Result<Encoded> encode_with_cache(const EncodeCache& cache, const Encoder& encoder, const image::Image& source, Size base,
+                                  const MipRequest& mips, const EncodeRequest& request, const std::string& writer, bool& reused);
+
+}  // namespace matbake::delivery
