@@ -385,6 +385,9 @@ TEST(CliDelivery, TheEncodeCacheEncodesEachTextureOnceAndAnAoChangeOnlyWhatItCha
   }
   const RunResult forced = matbake({"--json", "build", (dir / "showroom.toml").string(), "--force", "--only", "scene:twin"}, env);
   ASSERT_EQ(forced.exit_code, 0) << forced.err;
+  EXPECT_NE(forced.err.find(" scene:twin built ("), std::string::npos) << forced.err;
+  EXPECT_NE(forced.err.find(" ms, KTX2: " + std::to_string(rebuilt.size()) + " encoded, 0 from the encode cache)"), std::string::npos)
+      << forced.err;
   for (const json& job : json::parse(forced.out)["jobs"]) {
     for (const json& t : job["details"].value("textures", json::array())) EXPECT_FALSE(t["reused"].get<bool>()) << t["file"];
   }
