@@ -87,3 +87,22 @@ for s in "${scenes[@]}"; do
   "$matbake" --json export "$scene" -o "$work/density/$(basename "${scene%.*}").glb" --texel-density "$density" |
     python3 "$work/summary.py" "$(basename "$scene")" "$density"
 done
+
+# A whole scene: wall time and peak RSS of one KTX2 export (ten 2048² textures, all UASTC at level 0,
+# the fastest encode, so that decoding and holding images weigh most), and the bytes once more with
+# --jobs 1 (they must be the same).
+if [ -d "$bottle" ]; then
+  echo
+  echo "### A whole scene: time and peak memory (SpecGlossVsMetalRough, all UASTC level 0)"
+  echo
+  echo "| --jobs | wall s | peak RSS MB | bytes |"
+  echo "|---|---|---|---|"
+  for jobs in $(nproc) 1; do
+    out=$work/scene-$jobs/out.glb
+    /usr/bin/time -f "%e %M" -o "$work/time-$jobs" "$matbake" --jobs "$jobs" export "$bottle/SpecGlossVsMetalRough.gltf" -o "$out" \
+      --texture-format ktx2 --colour-codec uastc --colour-uastc-level 0 --data-uastc-level 0 --normal-uastc-level 0 >/dev/null
+    read -r wall rss <"$work/time-$jobs"
+    echo "| $jobs | $wall | $((rss / 1024)) | $(stat -c %s "$out") |"
+  done
+  cmp -s "$work/scene-$(nproc)/out.glb" "$work/scene-1/out.glb" || { echo "matbake: bytes differ between --jobs" >&2; exit 1; }
+fi

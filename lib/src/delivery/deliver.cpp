@@ -175,7 +175,8 @@ struct Work {
   int texture = -1, image = -1;
   Use use;
   Sampling sampling;
-  const image::Image* source = nullptr;
+  color::Transfer transfer = color::Transfer::linear;  // how its image is decoded (sRGB for colour)
+  Size source_size;
   Size size;
   std::optional<int> needed;
   Codec codec = Codec::png;
@@ -194,17 +195,17 @@ struct Work {
 Size ktx2_size(Size s) { return {std::max(s.width, 4), std::max(s.height, 4)}; }
 bool sides_fit_ktx2(Size s) { return s.width % 4 == 0 && s.height % 4 == 0; }
 
-Status make(Work& w, const Options& options, const Encoder* encoder, const fs::path& output, int threads) {
+Status make(Work& w, const image::Image& source, const Options& options, const Encoder* encoder, const fs::path& output, int threads) {
   const MipRequest request{w.use.texture_class, w.sampling, w.use.alpha_cutoff};
   if (w.codec == Codec::png) {
-    w.level0 = std::move(mip_chain(*w.source, w.size, request, false)[0]);
-    if (w.use.alpha_cutoff) w.coverage = {alpha_coverage(*w.source, *w.use.alpha_cutoff), alpha_coverage(w.level0, *w.use.alpha_cutoff)};
+    w.level0 = std::move(mip_chain(source, w.size, request, false)[0]);
+    if (w.use.alpha_cutoff) w.coverage = {alpha_coverage(source, *w.use.alpha_cutoff), alpha_coverage(w.level0, *w.use.alpha_cutoff)};
     return success();
   }
   EncodeRequest encode{.texture_class = w.use.texture_class, .options = options.of(w.use.texture_class), .sampling = w.sampling,
-                       .mipmaps = options.mipmaps, .alpha = has_alpha(*w.source),
+                       .mipmaps = options.mipmaps, .alpha = has_alpha(source),
                        .scratch = output.parent_path() / (w.name + ".ktx2"), .threads = threads};
-  auto made = encode_with_cache({options.encode_cache, options.encode_cache_bytes}, *encoder, *w.source, w.size, request, encode,
+  auto made = encode_with_cache({options.encode_cache, options.encode_cache_bytes}, *encoder, source, w.size, request, encode,
                                  "matbake " + std::string(matbake::version) + " / basisu " + encoder->version, w.reused);
   if (!made) return made.error();
   w.ktx2 = std::move(made->file);
@@ -312,11 +313,18 @@ Result<std::vector<TextureReport>> deliver_textures(gltf::Document& doc, gltf::I
       continue;
     }
     const color::Transfer transfer = use.texture_class == TextureClass::colour ? color::Transfer::srgb : color::Transfer::linear;
-    auto source = cache.texture(texture, transfer);
-    if (!source) return source.error();
-    Work w{.texture = texture, .image = image, .use = use, .sampling = sampling_of(doc.json, t, options.filter), .source = *source};
+    // Decoded here for its size and so that a bad image fails the pass before any encode; decoded
+    // again when its turn comes (a decode is milliseconds next to an encode), so that only the
+    // textures being worked on are held.
+    Size source_size;
+    if (auto decoded = cache.decode(texture, transfer); decoded) {
+      source_size = {decoded->width, decoded->height};
+    } else {
+      return decoded.error();
+    }
+    Work w{.texture = texture, .image = image, .use = use, .sampling = sampling_of(doc.json, t, options.filter),
+           .transfer = transfer, .source_size = source_size};
     const ClassOptions& o = options.of(use.texture_class);
-    const Size source_size{(*source)->width, (*source)->height};
     if (options.texel_density > 0) w.needed = needed_side(mapped[texture], source_size, options.texel_density);
     w.size = delivered_size(source_size, o, options.rounding, w.needed);
     w.codec = ktx2_out ? o.codec : Codec::png;
@@ -329,6 +337,7 @@ Result<std::vector<TextureReport>> deliver_textures(gltf::Document& doc, gltf::I
     }
     work.push_back(std::move(w));
   }
+  cache.forget_decoded();  // the earlier passes' images: delivery decodes each texture in its turn
   const Encoder* encoder = nullptr;
   std::optional<Encoder> found;
   if (std::any_of(work.begin(), work.end(), [](const Work& w) { return w.codec != Codec::png; })) {
@@ -342,8 +351,15 @@ Result<std::vector<TextureReport>> deliver_textures(gltf::Document& doc, gltf::I
   const int threads = std::max(1, jobs / std::max(1, std::min<int>(jobs, int(work.size()))));
   tbb::parallel_for(std::size_t(0), work.size(), [&](std::size_t i) {
     Work& w = work[i];
-    const bool unchanged = w.codec == Codec::png && w.size == Size{w.source->width, w.source->height};
-    if (!unchanged) w.status = guarded(doc.file, [&] { return make(w, options, encoder, output, threads); });
+    if (w.codec == Codec::png && w.size == w.source_size) return;  // unchanged
+    // Decoded in its turn and dropped when made. Not isolated: a thread waiting inside one texture's
+    // encode may start another (isolating cost 15% of the wall time on SpecGlossVsMetalRough for the
+    // same peak), so a few more than --jobs textures can be held at once.
+    w.status = guarded(doc.file, [&]() -> Status {
+      auto source = cache.decode(w.texture, w.transfer);
+      if (!source) return source.error();
+      return make(w, *source, options, encoder, output, threads);
+    });
   }, tbb::simple_partitioner());
   for (Work& w : work) {
     if (!w.status) return w.status.error();
@@ -351,7 +367,7 @@ Result<std::vector<TextureReport>> deliver_textures(gltf::Document& doc, gltf::I
 
   for (Work& w : work) {
     TextureReport report{.texture = w.texture, .texture_class = w.use.texture_class, .codec = w.codec,
-                         .source = {w.source->width, w.source->height}, .delivered = w.size, .needed = w.needed,
+                         .source = w.source_size, .delivered = w.size, .needed = w.needed,
                          .materials = materials_of(w.use), .levels = w.levels,
                          .alpha_cutoff = w.use.alpha_cutoff, .coverage = w.coverage, .reused = w.reused};
     auto source_bytes = gltf::image_bytes(doc, std::size_t(w.image));

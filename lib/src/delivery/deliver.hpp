@@ -18,7 +18,7 @@ gltf::MadeFormat made_format(const Options& options);
 // Rewrites `doc`'s used textures: KTX2 (KHR_texture_basisu) when the texture format is
 // ktx2 and the class's codec is not png, else resized PNG/WebP when the sizes say so. Scratch files go
 // beside `output`. Textures already KTX2 are kept. Call store_once afterwards: replaced images are
-// left unreferenced.
+// left unreferenced. The cache's decoded images are dropped; each texture is decoded in its turn.
 Result<std::vector<TextureReport>> deliver_textures(gltf::Document& doc, gltf::ImageCache& cache, const Options& options,
                                                     const std::filesystem::path& output);
 

@@ -69,7 +69,8 @@ image::Image at_size(const image::Image& im, int width, int height) {
   return im.width == width && im.height == height ? im : image::resize_image(im, width, height);
 }
 
-Result<const image::Image*> ImageCache::texture(int texture, color::Transfer colour) {
+// The image a texture's texels are read from, or why there is none.
+Result<int> ImageCache::source_of(int texture) const {
   const gltf::Json& json = doc_.json;
   if (texture < 0 || !json.contains("textures") || std::size_t(texture) >= json["textures"].size()) {
     return Error{doc_.file, "texture " + std::to_string(texture) + " does not exist"};
@@ -81,14 +82,32 @@ Result<const image::Image*> ImageCache::texture(int texture, color::Transfer col
                                                        "and this work needs its texels"
                                                      : "no PNG, JPEG or WebP image to read")};
   }
-  if (const auto found = images_.find({source, colour}); found != images_.end()) return &found->second;
+  return source;
+}
+
+Result<image::Image> ImageCache::decode_source(int source, color::Transfer colour) const {
   auto bytes = gltf::image_bytes(doc_, std::size_t(source));
   if (!bytes) return bytes.error();
   const char* extension = extension_of(*bytes);
   if (!*extension) return Error{doc_.file, "image " + std::to_string(source) + " is not PNG, JPEG or WebP"};
   auto decoded = image::decode_image(as_bytes(*bytes), std::string("image") + extension, colour);
   if (!decoded) return Error{doc_.file, "image " + std::to_string(source) + ": " + decoded.error().message};
-  return &(images_[{source, colour}] = std::move(*decoded));
+  return decoded;
+}
+
+Result<const image::Image*> ImageCache::texture(int texture, color::Transfer colour) {
+  auto source = source_of(texture);
+  if (!source) return source.error();
+  if (const auto found = images_.find({*source, colour}); found != images_.end()) return &found->second;
+  auto decoded = decode_source(*source, colour);
+  if (!decoded) return decoded.error();
+  return &(images_[{*source, colour}] = std::move(*decoded));
+}
+
+Result<image::Image> ImageCache::decode(int texture, color::Transfer colour) const {
+  auto source = source_of(texture);
+  if (!source) return source.error();
+  return decode_source(*source, colour);
 }
 
 Status ImageCache::check(std::size_t index) {

@@ -43,7 +43,12 @@ class ImageCache {
 
   // The image of texture `texture`, colour channels decoded with `colour` (alpha stays linear).
   Result<const image::Image*> texture(int texture, color::Transfer colour);
+  // The same, decoded anew and not kept: safe from several threads while the document does not
+  // change, for work that holds one texture at a time.
+  Result<image::Image> decode(int texture, color::Transfer colour) const;
   std::size_t decoded() const { return images_.size(); }
+  // Drops every decoded image kept (texture() decodes again when asked).
+  void forget_decoded() { images_.clear(); }
 
   // Image `index` is a PNG, JPEG or WebP whose header reads, or a KTX2 file (passed through).
   Status check(std::size_t index);
@@ -64,6 +69,9 @@ class ImageCache {
   bool webp() const { return made_ == MadeFormat::webp; }
 
  private:
+  Result<int> source_of(int texture) const;
+  Result<image::Image> decode_source(int source, color::Transfer colour) const;
+
   const gltf::Document& doc_;
   image::Encoding encoding_;
   MadeFormat made_;
