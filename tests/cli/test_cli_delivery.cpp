@@ -341,8 +341,9 @@ TEST(CliDelivery, TheEncodeCacheEncodesEachTextureOnceAndAnAoChangeOnlyWhatItCha
   const auto build = [&] {
     std::map<std::string, json> scenes;
     const json report = run_json({"build", (dir / "showroom.toml").string()}, env);
-    for (const json& job : report["jobs"]) {
-      if (job["details"].contains("textures")) scenes[job["name"]] = job["details"]["textures"];
+    for (const json& job : report["jobs"]) {  // an up-to-date job has no details
+      const json details = job.value("details", json::object());
+      if (details.contains("textures")) scenes[job["name"]] = details["textures"];
     }
     return scenes;
   };
@@ -388,8 +389,10 @@ TEST(CliDelivery, TheEncodeCacheEncodesEachTextureOnceAndAnAoChangeOnlyWhatItCha
   EXPECT_NE(forced.err.find(" scene:twin built ("), std::string::npos) << forced.err;
   EXPECT_NE(forced.err.find(" ms, KTX2: " + std::to_string(rebuilt.size()) + " encoded, 0 from the encode cache)"), std::string::npos)
       << forced.err;
-  for (const json& job : json::parse(forced.out)["jobs"]) {
-    for (const json& t : job["details"].value("textures", json::array())) EXPECT_FALSE(t["reused"].get<bool>()) << t["file"];
+  const json forced_report = json::parse(forced.out);  // named: a range over a temporary's member dangles
+  for (const json& job : forced_report["jobs"]) {
+    const json textures = job.value("details", json::object()).value("textures", json::array());
+    for (const json& t : textures) EXPECT_FALSE(t["reused"].get<bool>()) << t["file"];
   }
   EXPECT_EQ(bytes_of("twin", rebuilt), rebuilt_bytes);
 

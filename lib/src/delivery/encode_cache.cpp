@@ -62,7 +62,7 @@ std::string header_of(const Encoded& e) {
   std::string h(kMagic);
   const std::uint32_t counts[2] = {std::uint32_t(e.levels), std::uint32_t(e.coverage.size())};
   h.append(reinterpret_cast<const char*>(counts), sizeof counts);
-  h.append(reinterpret_cast<const char*>(e.coverage.data()), e.coverage.size() * sizeof(double));
+  if (!e.coverage.empty()) h.append(reinterpret_cast<const char*>(e.coverage.data()), e.coverage.size() * sizeof(double));
   return h;
 }
 
@@ -76,7 +76,9 @@ std::optional<Encoded> parse_entry(const std::vector<unsigned char>& bytes, Size
   Encoded e;
   e.levels = int(counts[0]);
   e.coverage.resize(counts[1]);
-  std::memcpy(e.coverage.data(), bytes.data() + kMagic.size() + sizeof counts, counts[1] * sizeof(double));
+  if (counts[1] > 0) {  // memcpy to an empty vector's null data() is undefined, even of 0 bytes
+    std::memcpy(e.coverage.data(), bytes.data() + kMagic.size() + sizeof counts, counts[1] * sizeof(double));
+  }
   e.file.assign(bytes.begin() + std::ptrdiff_t(file_at), bytes.end());
   auto read = ktx2::read(e.file, name);
   if (!read || read->width != unsigned(base.width) || read->height != unsigned(base.height) || read->levels.size() != counts[0]) {
