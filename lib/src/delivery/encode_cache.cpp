@@ -16,6 +16,7 @@
 
 #include "matbake/atomic_file.hpp"
 #include "matbake/ktx2.hpp"
+#include "../io/unique_fd.hpp"
 
 namespace matbake::delivery {
 namespace fs = std::filesystem;
@@ -26,15 +27,7 @@ constexpr std::string_view kSuffix = ".ktx2e";
 constexpr std::size_t kKeyDigits = 32;
 constexpr std::uint32_t kMostLevels = 32;
 
-// A descriptor closed when it goes.
-struct Descriptor {
-  int fd = -1;
-  explicit Descriptor(int f) : fd(f) {}
-  Descriptor(const Descriptor&) = delete;
-  ~Descriptor() {
-    if (fd >= 0) ::close(fd);
-  }
-};
+using Descriptor = UniqueFd;
 
 bool is_entry_name(const std::string& name) {
   return name.size() == kKeyDigits + kSuffix.size() && name.ends_with(kSuffix) &&

@@ -1,6 +1,7 @@
 #include "matbake/output_gate.hpp"
 
 #include "real_paths.hpp"
+#include "unique_fd.hpp"
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -19,15 +20,7 @@ namespace {
 
 constexpr const char* kStateFolder = ".matbake";
 
-struct Fd {
-  int fd = -1;
-  explicit Fd(int f) : fd(f) {}
-  Fd(const Fd&) = delete;
-  Fd& operator=(const Fd&) = delete;
-  ~Fd() {
-    if (fd >= 0) ::close(fd);
-  }
-};
+using Fd = UniqueFd;
 
 std::string hex(XXH64_hash_t h) {
   char text[17];
