@@ -58,6 +58,27 @@ enum class TextureFormat { png, webp, ktx2 };
 inline constexpr NameTable<TextureFormat, 3> kTextureFormatNames{
     {{TextureFormat::png, "png"}, {TextureFormat::webp, "webp"}, {TextureFormat::ktx2, "ktx2"}}};
 
+// How a glTF's meshes are delivered (docs/delivery.md, "Geometry"). Either setting on reorders each
+// triangle list for the GPU's vertex cache and vertex fetch (meshoptimizer) first.
+// quantize: KHR_mesh_quantization. POSITION as unsigned integers of position_bits on one uniform grid
+// per mesh (the dequantizing translation and scale on a child node placing the mesh), NORMAL and
+// TANGENT as normalized bytes, TEXCOORD_n as normalized shorts of texcoord_bits over the scene's range
+// of that set (undone by KHR_texture_transform in the materials), COLOR_n as normalized bytes; what
+// cannot be so (a skinned, morphed or instanced mesh's positions; UVs beyond [0, 1] no material's
+// transform can take) stays as it was. compression meshopt: EXT_meshopt_compression on the vertex and
+// index buffers (required: the file has no uncompressed copy).
+enum class MeshCompression { none, meshopt };
+inline constexpr NameTable<MeshCompression, 2> kMeshCompressionNames{{{MeshCompression::none, "none"}, {MeshCompression::meshopt, "meshopt"}}};
+
+struct GeometryOptions {
+  bool quantize = false;
+  int position_bits = 14;  // 8–16
+  int texcoord_bits = 12;  // 8–16
+  MeshCompression compression = MeshCompression::none;
+
+  bool any() const { return quantize || compression != MeshCompression::none; }
+};
+
 struct Options {
   TextureFormat texture_format = TextureFormat::png;
   ClassOptions colour{.codec = Codec::etc1s};
@@ -68,6 +89,7 @@ struct Options {
   bool mipmaps = true;          // a full chain down to 1×1
   bool png_fallback = false;    // keep the PNG as the texture's core source (the extension then optional)
   double texel_density = 0;     // texels per scene unit the textures are sized for; 0: their own sizes
+  GeometryOptions geometry;
   // Not parameters (no stamp records them): where a build keeps encoded textures between runs
   // (OUT/.matbake/encode-cache) and how many bytes at most; an empty folder or 0: none kept.
   std::filesystem::path encode_cache;

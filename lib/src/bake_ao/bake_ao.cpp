@@ -3,6 +3,7 @@
 #include <chrono>
 
 #include "../delivery/deliver.hpp"
+#include "../delivery/geometry.hpp"
 #include "../gltf/decode.hpp"
 #include "../gltf/vertex_occlusion.hpp"
 #include "textures.hpp"
@@ -133,6 +134,11 @@ Result<Report> bake_file(const fs::path& input, const Options& options) {
       if (!delivered) return delivered.error();
       report.delivered = std::move(*delivered);
       (void)delivery::store_once(*doc, report.delivered);  // the images KTX2 or resized ones replaced
+    }
+    if (!options.output.empty() && options.delivery.geometry.any()) {
+      auto geometry = delivery::deliver_geometry(*doc, options.delivery.geometry);
+      if (!geometry) return geometry.error();
+      report.geometry = std::move(*geometry);
     }
     if (!options.output.empty()) {
       auto written = gltf::write_document(*doc, options.output);

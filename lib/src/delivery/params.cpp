@@ -64,6 +64,29 @@ void add_class(std::vector<Param<Options>>& out, TextureClass c) {
                                         field(&ClassOptions::scale)));
 }
 
+void add_geometry(std::vector<Param<Options>>& out) {
+  const params::Condition quantized{"mesh_quantization", "true"};
+  out.push_back(params::flag<Options>(Spec{.name = "mesh_quantization",
+                                           .help = "Store vertex attributes as integers (KHR_mesh_quantization): positions "
+                                                   "of position_bits per mesh, normals and tangents in bytes, UVs of "
+                                                   "texcoord_bits, colours in bytes",
+                                           .example = "true"},
+                                      [](auto& o) -> auto& { return o.geometry.quantize; }));
+  out.push_back(params::integer<Options>(Spec{.name = "position_bits",
+                                              .help = "Bits of a quantized position along the mesh's longest side",
+                                              .min = 8, .max = 16, .example = "16", .needs = {quantized}},
+                                         [](auto& o) -> auto& { return o.geometry.position_bits; }));
+  out.push_back(params::integer<Options>(Spec{.name = "texcoord_bits",
+                                              .help = "Bits of a quantized texture coordinate over its set's range",
+                                              .min = 8, .max = 16, .example = "14", .needs = {quantized}},
+                                         [](auto& o) -> auto& { return o.geometry.texcoord_bits; }));
+  out.push_back(params::choice<Options>(Spec{.name = "mesh_compression",
+                                             .help = "Compression of vertex and index buffers: none, or meshopt "
+                                                     "(EXT_meshopt_compression, required by the file)",
+                                             .example = "meshopt"},
+                                        [](auto& o) -> auto& { return o.geometry.compression; }, kMeshCompressionNames));
+}
+
 }  // namespace
 
 const params::Group<Options>& options_params() {
@@ -102,6 +125,7 @@ const params::Group<Options>& options_params() {
                                                             "UVs (and texture transforms) that read it; 0 off",
                                                     .min = 0, .max = 1e9, .example = "256"},
                                                [](auto& o) -> auto& { return o.texel_density; }));
+    add_geometry(g.params);
     return g;
   }();
   return group;

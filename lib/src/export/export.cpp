@@ -13,6 +13,7 @@
 #include "../bake_ao/vertices.hpp"
 #include "../bake_ao/textures.hpp"
 #include "../delivery/deliver.hpp"
+#include "../delivery/geometry.hpp"
 #include "matbake/output_check.hpp"
 #include "../gltf/texture_files.hpp"
 
@@ -525,7 +526,13 @@ Result<Report> export_scene(const fs::path& input, const fs::path& output, const
     // what delivery did (resized or KTX2 images).
     for (std::string& s : delivery::store_once(*doc, report.textures)) report.skipped.push_back(s + ": replaced");
     report.images_decoded = cache.decoded();
-    report.geometry = gltf::geometry_notes(*doc);
+    if (options.delivery.geometry.any()) {
+      auto geometry = delivery::deliver_geometry(*doc, options.delivery.geometry);
+      if (!geometry) return geometry.error();
+      report.geometry = std::move(*geometry);
+    } else {
+      report.geometry = gltf::geometry_notes(*doc);
+    }
 
     auto written = gltf::write_document(*doc, output);
     if (!written) return written.error();

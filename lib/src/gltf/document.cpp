@@ -165,6 +165,51 @@ std::size_t components_of(const std::string& type) {
   return 0;
 }
 
+float component_value(const unsigned char* p, int component_type, bool normalized) {
+  const auto as = [p]<class T>(T) {
+    T v;
+    std::memcpy(&v, p, sizeof v);
+    return v;
+  };
+  switch (component_type) {
+    case kFloat: return as(float{});
+    case kByte: {
+      const float v = float(as(std::int8_t{}));
+      return normalized ? std::max(v / 127.0f, -1.0f) : v;
+    }
+    case kUnsignedByte: {
+      const float v = float(as(std::uint8_t{}));
+      return normalized ? v / 255.0f : v;
+    }
+    case kShort: {
+      const float v = float(as(std::int16_t{}));
+      return normalized ? std::max(v / 32767.0f, -1.0f) : v;
+    }
+    case kUnsignedShort: {
+      const float v = float(as(std::uint16_t{}));
+      return normalized ? v / 65535.0f : v;
+    }
+    case kUnsignedInt: return float(as(std::uint32_t{}));
+    default: return 0.0f;
+  }
+}
+
+std::uint32_t index_value(const unsigned char* p, int component_type) {
+  switch (component_type) {
+    case kUnsignedByte: return *p;
+    case kUnsignedShort: {
+      std::uint16_t v;
+      std::memcpy(&v, p, 2);
+      return v;
+    }
+    default: {
+      std::uint32_t v;
+      std::memcpy(&v, p, 4);
+      return v;
+    }
+  }
+}
+
 std::size_t component_size_of(int component_type) {
   switch (component_type) {
     case 5120: case 5121: return 1;  // byte, unsigned byte

@@ -66,6 +66,15 @@ Result<std::span<const unsigned char>> view_bytes(const Document& doc, std::size
 std::size_t components_of(const std::string& type);
 std::size_t component_size_of(int component_type);
 
+// accessor.componentType values.
+constexpr int kByte = 5120, kUnsignedByte = 5121, kShort = 5122, kUnsignedShort = 5123, kUnsignedInt = 5125, kFloat = 5126;
+
+// One component at `p` as a float: FLOAT as stored, integers as KHR_mesh_quantization reads them
+// (normalized: unsigned v / max, signed max(v / max, −1); else the integer's value); 0 for an unknown type.
+float component_value(const unsigned char* p, int component_type, bool normalized);
+// One index at `p` (unsigned byte, short or int).
+std::uint32_t index_value(const unsigned char* p, int component_type);
+
 constexpr int kArrayBuffer = 34962;         // bufferView.target of vertex attributes
 constexpr int kElementArrayBuffer = 34963;  // and of indices
 

@@ -158,16 +158,20 @@ void remap_value(Json& value, const std::vector<int>& remap) {
 
 }  // namespace
 
-void for_each_texture_index(Json& material, const std::function<void(Json&)>& f) {
+void for_each_texture_info(Json& material, const std::function<void(Json& info)>& f) {
   if (material.is_array()) {
-    for (Json& item : material) for_each_texture_index(item, f);
+    for (Json& item : material) for_each_texture_info(item, f);
     return;
   }
   if (!material.is_object()) return;
   for (auto& [key, value] : material.items()) {
-    if (key.ends_with("Texture") && value.is_object() && value.contains("index")) f(value["index"]);
-    for_each_texture_index(value, f);
+    if (key.ends_with("Texture") && value.is_object() && value.contains("index")) f(value);
+    for_each_texture_info(value, f);
   }
+}
+
+void for_each_texture_index(Json& material, const std::function<void(Json&)>& f) {
+  for_each_texture_info(material, [&](Json& info) { f(info["index"]); });
 }
 
 std::vector<std::string> prune_unreachable(Document& doc, std::vector<int>* texture_remap_out) {

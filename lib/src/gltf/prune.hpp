@@ -21,6 +21,9 @@ std::vector<std::string> prune_unreachable(Document& doc, std::vector<int>* text
 // unused goes with the next prune_unreachable. Returns how many images were merged.
 int merge_identical_images(Document& doc);
 
+// Calls f(info) for every textureInfo of a material (an object under a key ending in "Texture" with
+// an index), core and extensions alike.
+void for_each_texture_info(Json& material, const std::function<void(Json& info)>& f);
 // Calls f(index) for every texture index a material names, core and extensions alike.
 void for_each_texture_index(Json& material, const std::function<void(Json& index)>& f);
 

@@ -21,52 +21,7 @@ using Json = gltf::Json;
 using gltf::array_in;
 
 constexpr int kTriangles = 4, kTriangleStrip = 5, kTriangleFan = 6;
-constexpr int kFloat = 5126, kByte = 5120, kUnsignedByte = 5121, kShort = 5122, kUnsignedShort = 5123, kUnsignedInt = 5125;
-
-float component(const unsigned char* p, int type, bool normalized) {
-  const auto as = [p]<class T>(T) {
-    T v;
-    std::memcpy(&v, p, sizeof v);
-    return v;
-  };
-  switch (type) {
-    case kFloat: return as(float{});
-    case kByte: {
-      const float v = float(as(std::int8_t{}));
-      return normalized ? std::max(v / 127.0f, -1.0f) : v;
-    }
-    case kUnsignedByte: {
-      const float v = float(as(std::uint8_t{}));
-      return normalized ? v / 255.0f : v;
-    }
-    case kShort: {
-      const float v = float(as(std::int16_t{}));
-      return normalized ? std::max(v / 32767.0f, -1.0f) : v;
-    }
-    case kUnsignedShort: {
-      const float v = float(as(std::uint16_t{}));
-      return normalized ? v / 65535.0f : v;
-    }
-    case kUnsignedInt: return float(as(std::uint32_t{}));
-    default: return 0.0f;
-  }
-}
-
-std::uint32_t index_at(const unsigned char* p, int type) {
-  switch (type) {
-    case kUnsignedByte: return *p;
-    case kUnsignedShort: {
-      std::uint16_t v;
-      std::memcpy(&v, p, 2);
-      return v;
-    }
-    default: {
-      std::uint32_t v;
-      std::memcpy(&v, p, 4);
-      return v;
-    }
-  }
-}
+using gltf::kUnsignedByte, gltf::kUnsignedShort, gltf::kUnsignedInt;
 
 struct Reader {
   const gltf::Document& doc;
@@ -93,7 +48,7 @@ struct Reader {
     for (std::size_t i = 0; i < bytes->count; ++i) {
       const unsigned char* element = bytes->first + i * bytes->stride;
       for (std::size_t c = 0; c < components; ++c) {
-        v[c] = component(element + c * bytes->component_size, bytes->component_type, bytes->normalized);
+        v[c] = gltf::component_value(element + c * bytes->component_size, bytes->component_type, bytes->normalized);
       }
       use(i, v);
     }
@@ -109,7 +64,7 @@ struct Reader {
     }
     std::vector<std::uint32_t> out(bytes->count);
     for (std::size_t i = 0; i < bytes->count; ++i) {
-      const std::uint32_t v = index_at(bytes->first + i * bytes->stride, type);
+      const std::uint32_t v = gltf::index_value(bytes->first + i * bytes->stride, type);
       if (v >= vertex_count) {
         return error("index accessor " + std::to_string(index) + ": index " + std::to_string(v) + " at " + std::to_string(i) +
                      " is beyond the " + std::to_string(vertex_count) + " vertices");
