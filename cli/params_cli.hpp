@@ -93,11 +93,12 @@ void add_tree(CLI::App& cmd, const params::Tree<Root>& tree, Root& root, std::ve
   }
 }
 
-// The command line's spelling of a group's parameters: --PREFIXNAME, and "--NAME VALUE".
+// The command line's spelling of a group's parameters: --PREFIXNAME, and "--NAME VALUE" (a flag at
+// true is the flag alone).
 inline params::Spelling flag_spelling(std::vector<std::string> prefixes) {
   return [prefixes = std::move(prefixes)](std::size_t group, const params::Spec& spec, const std::string* value) {
     const std::string flag = params::flag_name(spec, prefixes.at(group));
-    return value ? flag + " " + *value : flag;
+    return value && !(spec.kind == params::Kind::flag && *value == "true") ? flag + " " + *value : flag;
   };
 }
 

@@ -212,5 +212,52 @@ TEST(DeliveryGeometry, CompressionAloneIsLosslessAndSmaller) {
   EXPECT_EQ(report->warnings, 0) << report->summary;
 }
 
+// A mesh with a primitive the pass cannot rewrite (lines) keeps its positions as floats, since its
+// node's dequantization would also scale the lines; the other mesh is quantized; both read back.
+TEST(DeliveryGeometry, AMeshWithAPrimitiveKeptAsReadKeepsFloatPositions) {
+  test::TempDir dir;
+  test::GltfBuilder b;
+  const int square = b.add_vec3({0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0});
+  const int mixed = b.add_mesh(square, b.add_indices({0, 1, 2, 0, 2, 3}));
+  b.doc["meshes"][std::size_t(mixed)]["primitives"].push_back({{"attributes", {{"POSITION", square}}}, {"mode", 1}});
+  const int plain = b.add_mesh(b.add_vec3({0, 0, 1, 2, 0, 1, 2, 2, 1}));
+  const fs::path in = dir / "mixed.gltf", out = dir / "mixed_q.glb";
+  b.write(in, {b.add_node({{"mesh", mixed}}), b.add_node({{"mesh", plain}, {"translation", {3.0, 0.0, 0.0}}})});
+  export_ok(in, out, {"--mesh-quantization"});
+  const gltf::Document doc = test::read_output(out);
+  const auto position_type = [&](std::size_t m, std::size_t p) {
+    return doc.json["accessors"][doc.json["meshes"][m]["primitives"][p]["attributes"]["POSITION"].get<std::size_t>()]["componentType"].get<int>();
+  };
+  EXPECT_EQ(position_type(0, 0), gltf::kFloat);
+  EXPECT_EQ(position_type(0, 1), gltf::kFloat);
+  EXPECT_EQ(position_type(1, 0), gltf::kUnsignedShort);
+  const scene::Scene before = load(in), after = load(out);
+  ASSERT_EQ(after.instances.size(), 2u);  // lines are not ray-cast: one triangle list per mesh
+  for (std::size_t i = 0; i < 2; ++i) {
+    for (std::size_t v = 0; v < before.instances[i].positions.size(); ++v) {
+      const auto& p = before.instances[i].positions[v];
+      const auto& q = after.instances[i].positions;
+      const double nearest = glm::length(*std::min_element(q.begin(), q.end(), [&](auto& l, auto& r) { return glm::length(l - p) < glm::length(r - p); }) - p);
+      EXPECT_LE(nearest, std::sqrt(3.0) * delivery::position_error_bound(2.0, 14)) << i << " " << v;
+    }
+  }
+  MATBAKE_VALIDATE_OR_SKIP(report, out);
+  EXPECT_EQ(report->errors, 0) << report->summary;
+}
+
+// A position no grid holds is the input's fault: one error line naming the file and the primitive,
+// and nothing written.
+TEST(DeliveryGeometry, ANonFinitePositionIsAnErrorAtItsPrimitive) {
+  test::TempDir dir;
+  test::GltfBuilder b;
+  const int mesh = b.add_mesh(b.add_floats({0, 0, 0, 1, 0, 0, 0, std::numeric_limits<float>::infinity(), 0}, "VEC3", 3));
+  const fs::path in = dir / "infinite.gltf", out = dir / "infinite_q.glb";
+  b.write(in, {b.add_node({{"mesh", mesh}})});
+  const test::RunResult r = test::matbake({"export", in.string(), "-o", out.string(), "--mesh-quantization"});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_EQ(r.err, "matbake: error: " + in.string() + ": /meshes/0/primitives/0: POSITION element 2 is not finite\n");
+  EXPECT_FALSE(fs::exists(out));
+}
+
 }  // namespace
 }  // namespace matbake

@@ -201,7 +201,7 @@ TEST(RequestTree, EveryParameterOfExportsTreeReachesTheSceneFromBothDoors) {
       ++walked;
     }
   }
-  EXPECT_EQ(walked, 51u);  // a new parameter is walked here too
+  EXPECT_EQ(walked, 55u);  // a new parameter is walked here too
 }
 
 // Each rule of a tree broken on purpose: refused at both doors, with one message in each door's spelling.
@@ -219,11 +219,15 @@ void walk_rules(const Tree<Root>& tree, ManifestDoor manifest_door, std::size_t 
         const Setting<Root> needed = find_setting(tree, b, c.name, "");
         std::string flag_words = " as well", key_words = " as well";
         if (!c.value.empty()) {  // the needed parameter at another of its values
-          const auto other = std::find_if(needed.spec->choices.begin(), needed.spec->choices.end(),
-                                          [&](const std::string& v) { return v != c.value; });
-          ASSERT_NE(other, needed.spec->choices.end());
-          settings.push_back({needed.branch, needed.spec, *other});
-          flag_words = " " + c.value;
+          const bool flag = needed.spec->kind == Kind::flag;
+          const std::vector<std::string> values = flag ? std::vector<std::string>{"true", "false"} : needed.spec->choices;
+          const auto other = std::find_if(values.begin(), values.end(), [&](const std::string& v) { return v != c.value; });
+          ASSERT_NE(other, values.end());
+          // A flag at its default is a flag not given (a default-false flag has no --no- form).
+          if (!flag || *other != value_text(tree[needed.branch].values(Root{}).at(needed.spec->name))) {
+            settings.push_back({needed.branch, needed.spec, *other});
+          }
+          flag_words = flag && c.value == "true" ? "" : " " + c.value;  // "--mesh-quantization", not "... true"
           key_words = " = " + toml_value_text(*needed.spec, c.value);
         }
         auto cli = from_flags(tree, settings);
@@ -255,7 +259,7 @@ TEST(RequestTree, EveryRuleIsEnforcedAtBothDoorsInTheirOwnSpelling) {
     ASSERT_FALSE(manifest);
     EXPECT_EQ(manifest.error().message, expected);
     EXPECT_EQ(manifest.error().path.rfind("/p/assets.toml:", 0), 0u) << manifest.error().path;
-  }, 39);
+  }, 41);
 }
 
 // A manifest entry's settings as TOML: the plain branches' as keys, each table's as name = { ... }.
@@ -307,7 +311,7 @@ void walk_top_level(const Tree<Root>& tree, const std::string& entry, Read read,
 
 TEST(RequestTree, TheTopLevelGivesEveryMaterialAndSceneParameterItsDefault) {
   walk_top_level(pipeline::scene_tree(), "[scenes.s]\ninput = \"s.gltf\"\n",
-                 [](const pipeline::Manifest& m) { return m.scenes.at(0); }, 52);
+                 [](const pipeline::Manifest& m) { return m.scenes.at(0); }, 56);
   walk_top_level(pipeline::material_tree(), "[materials.m]\nsources = { kd = 0.5 }\n",
                  [](const pipeline::Manifest& m) { return m.materials.at(0); }, 15);
 }
@@ -343,7 +347,7 @@ TEST(RequestTree, BakeAosTreeIsExportsGroupsWithItsOwnFlags) {
       EXPECT_NE(tree[b].values(*cli).at(spec->name), tree[b].values(bake_ao::Options{}).at(spec->name));
     }
   }
-  walk_rules(tree, [](const auto&, const std::string&) {}, 39);
+  walk_rules(tree, [](const auto&, const std::string&) {}, 41);
 }
 
 // A request made by the command line from one parameter at its example (a flag on by default

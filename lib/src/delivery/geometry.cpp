@@ -126,6 +126,9 @@ Result<Plan> plan_geometry(const gltf::Document& doc) {
         if (!a) return a.error();
         for (std::size_t i = 0; i < a->count; ++i) {
           const auto v = element(*a, i);
+          if (!std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2])) {  // as the scene reader refuses it
+            return Error{doc.file, primitive_pointer(m, p) + ": " + name + " element " + std::to_string(i) + " is not finite"};
+          }
           if (name == "POSITION") {
             plan.meshes[m].lo = glm::min(plan.meshes[m].lo, glm::dvec3(v[0], v[1], v[2]));
             plan.meshes[m].hi = glm::max(plan.meshes[m].hi, glm::dvec3(v[0], v[1], v[2]));
@@ -137,8 +140,9 @@ Result<Plan> plan_geometry(const gltf::Document& doc) {
       }
     }
   }
-  for (MeshGrid& g : plan.meshes) g.quantize = g.quantize && g.lo.x <= g.hi.x;
-  for (auto& [set, uv] : plan.uv) uv.quantize = uv.quantize && uv.lo.x <= uv.hi.x;
+  // A range a double cannot hold (±1e308 apart) has no grid either.
+  for (MeshGrid& g : plan.meshes) g.quantize = g.quantize && g.lo.x <= g.hi.x && std::isfinite(g.step(16));
+  for (auto& [set, uv] : plan.uv) uv.quantize = uv.quantize && uv.lo.x <= uv.hi.x && std::isfinite(uv.range().x + uv.range().y);
   return plan;
 }
 
