@@ -69,6 +69,14 @@ int texcoord_set(const std::string& attribute) {
   return std::stoi(digits);
 }
 
+// An attribute's kind: its name without the set number ("COLOR_1": "COLOR"; "_AO" stays).
+std::string attribute_kind(const std::string& name) {
+  const std::size_t underscore = name.rfind('_');
+  if (underscore == std::string::npos || underscore + 1 == name.size()) return name;
+  const bool numbered = std::all_of(name.begin() + std::ptrdiff_t(underscore) + 1, name.end(), ::isdigit);
+  return numbered ? name.substr(0, underscore) : name;
+}
+
 // Element i's components as floats, as a runtime reads them.
 std::array<float, 4> element(const gltf::AccessorBytes& a, std::size_t i) {
   std::array<float, 4> v{0, 0, 0, 1};
@@ -273,37 +281,58 @@ Stream encode_attribute(const AttributeJob& a, const std::vector<std::uint32_t>&
   return s;
 }
 
-// Views and accessors written by this pass, each stored once.
+// The accessors this pass writes, each stored once, then laid out as gltfpack does: one buffer view
+// per kind of stream (position, normal, TEXCOORD, ..., 16- or 32-bit indices), the accessors one
+// after another in it, so that meshopt compresses long streams rather than many short ones.
 struct Writer {
   gltf::Document& doc;
-  std::unordered_map<std::size_t, std::vector<int>> views_by_hash;
-  std::map<std::string, int> accessors;
-  std::size_t bytes = 0;  // of the distinct views written
+  struct Pending {
+    Stream stream;
+    std::string group;  // its view: target, kind and stride
+    int accessor = -1;
+  };
+  std::vector<Pending> pending;
+  std::unordered_map<std::size_t, std::vector<std::size_t>> by_hash;  // into pending
+  std::size_t bytes = 0;                                              // of the views written
 
-  int view(const Stream& s, int target) {
+  // `s` as an accessor of the kind `kind` ("TEXCOORD", "indices"): its index, the same for the same stream.
+  int accessor(Stream s, const std::string& kind) {
+    const std::string json = s.accessor.dump();
     const std::string_view bytes_view(reinterpret_cast<const char*>(s.bytes.data()), s.bytes.size());
-    std::vector<int>& same_hash = views_by_hash[std::hash<std::string_view>{}(bytes_view) ^ std::size_t(s.stride * 31 + target)];
-    for (int v : same_hash) {
-      const Json& view = doc.json["bufferViews"][std::size_t(v)];
-      auto existing = gltf::view_bytes(doc, std::size_t(v));
-      if (existing && view.value("target", 0) == target && view.value("byteStride", std::size_t(0)) == (target == gltf::kArrayBuffer ? s.stride : 0) &&
-          std::equal(existing->begin(), existing->end(), s.bytes.begin(), s.bytes.end())) {
-        return v;
-      }
+    auto& same_hash = by_hash[std::hash<std::string_view>{}(bytes_view) ^ std::hash<std::string>{}(json)];
+    for (std::size_t k : same_hash) {
+      if (pending[k].stream.bytes == s.bytes && pending[k].stream.accessor == s.accessor) return pending[k].accessor;
     }
-    const int v = gltf::add_view(doc, s.bytes, target);
-    if (target == gltf::kArrayBuffer) doc.json["bufferViews"][std::size_t(v)]["byteStride"] = s.stride;
-    same_hash.push_back(v);
-    bytes += s.bytes.size();
-    return v;
+    const int index = int(array_in(doc.json, "accessors").size());
+    doc.json["accessors"].push_back(s.accessor);
+    same_hash.push_back(pending.size());
+    std::string group = kind + "/" + std::to_string(s.stride);
+    pending.push_back({std::move(s), std::move(group), index});
+    return index;
   }
 
-  int accessor(const Stream& s, int target) {
-    Json json = s.accessor;
-    json["bufferView"] = view(s, target);
-    const auto [it, added] = accessors.emplace(json.dump(), int(array_in(doc.json, "accessors").size()));
-    if (added) doc.json["accessors"].push_back(std::move(json));
-    return it->second;
+  // Every pending accessor placed in its group's view.
+  void write_views() {
+    std::map<std::string, std::vector<const Pending*>> groups;
+    for (const Pending& p : pending) groups[p.group].push_back(&p);
+    for (const auto& [group, members] : groups) {
+      const bool indices = group.starts_with("indices");
+      const std::size_t stride = members.front()->stream.stride;
+      std::vector<unsigned char> joined;
+      for (const Pending* p : members) {
+        doc.json["accessors"][std::size_t(p->accessor)]["byteOffset"] = joined.size();
+        joined.insert(joined.end(), p->stream.bytes.begin(), p->stream.bytes.end());
+      }
+      const int view = gltf::add_view(doc, joined, indices ? gltf::kElementArrayBuffer : gltf::kArrayBuffer);
+      if (!indices) doc.json["bufferViews"][std::size_t(view)]["byteStride"] = stride;
+      for (const Pending* p : members) {
+        Json& accessor = doc.json["accessors"][std::size_t(p->accessor)];
+        accessor["bufferView"] = view;
+        if (accessor["byteOffset"] == 0) accessor.erase("byteOffset");
+      }
+      bytes += joined.size();
+    }
+    pending.clear();
   }
 };
 
@@ -370,13 +399,13 @@ Status rewrite_primitive(Writer& writer, const Plan& plan, std::size_t m, std::s
   const std::size_t used = meshopt_optimizeVertexFetchRemap(remap.data(), indices->data(), indices->size(), vertices);
   meshopt_remapIndexBuffer(indices->data(), indices->data(), indices->size(), remap.data());
 
-  // Every stream made before any is written: writing appends to a buffer the attributes may lie in.
-  std::vector<std::pair<std::string, Stream>> streams;
-  for (const AttributeJob& a : attributes) streams.emplace_back(a.name, encode_attribute(a, remap, used, plan, m, options));
-  Stream index = index_stream(*indices, used);
+  // Only accessors are made here; their views are written once every primitive is (Writer::write_views),
+  // so no attribute being read moves.
   Json written = primitive;
-  for (const auto& [name, stream] : streams) written["attributes"][name] = writer.accessor(stream, gltf::kArrayBuffer);
-  written["indices"] = writer.accessor(index, gltf::kElementArrayBuffer);
+  for (const AttributeJob& a : attributes) {
+    written["attributes"][a.name] = writer.accessor(encode_attribute(a, remap, used, plan, m, options), attribute_kind(a.name));
+  }
+  written["indices"] = writer.accessor(index_stream(*indices, used), "indices");
   doc.json["meshes"][m]["primitives"][p] = std::move(written);
   return success();
 }
@@ -435,6 +464,32 @@ Status undo_uv_grids(gltf::Document& doc, const Plan& plan, const GeometryOption
   return success();
 }
 
+// A view's bytes meshopt-encoded, and the extension's fields but for where they lie.
+struct Encoded {
+  std::vector<unsigned char> bytes;
+  Json extension;
+};
+
+Encoded encode_vertices(std::span<const unsigned char> plain, std::size_t stride) {
+  const std::size_t count = plain.size() / stride;
+  Encoded e{std::vector<unsigned char>(meshopt_encodeVertexBufferBound(count, stride)),
+            {{"byteStride", stride}, {"count", count}, {"mode", "ATTRIBUTES"}}};
+  e.bytes.resize(meshopt_encodeVertexBuffer(e.bytes.data(), e.bytes.size(), plain.data(), count, stride));
+  return e;
+}
+
+Encoded encode_triangles(std::span<const unsigned char> plain, std::size_t index_size) {
+  const std::size_t count = plain.size() / index_size;
+  std::vector<std::uint32_t> indices(count);
+  const int type = index_size == 2 ? gltf::kUnsignedShort : gltf::kUnsignedInt;
+  for (std::size_t k = 0; k < count; ++k) indices[k] = gltf::index_value(plain.data() + k * index_size, type);
+  const std::size_t vertices = indices.empty() ? 0 : std::size_t(*std::max_element(indices.begin(), indices.end())) + 1;
+  Encoded e{std::vector<unsigned char>(meshopt_encodeIndexBufferBound(count, vertices)),
+            {{"byteStride", index_size}, {"count", count}, {"mode", "TRIANGLES"}}};
+  e.bytes.resize(meshopt_encodeIndexBuffer(e.bytes.data(), e.bytes.size(), indices.data(), count));
+  return e;
+}
+
 // The views of the rewritten primitives, compressed: their meshopt bytes in buffer 0, the views
 // themselves in a fallback buffer with no bytes. Every other view is copied into buffer 0 (a view
 // compressed before keeps its compression). Runs after pruning, so no view is left unused.
@@ -451,7 +506,7 @@ Result<std::size_t> compress_views(gltf::Document& doc, const Plan& plan) {
     index_views[view_of(primitive["indices"])] = gltf::component_size_of(indices.value("componentType", 0));
   }
   std::vector<unsigned char> main;
-  std::size_t fallback = 0, compressed = 0;
+  std::size_t fallback = 0, written = 0;
   const auto append = [&](std::span<const unsigned char> bytes) {
     main.resize((main.size() + 3) / 4 * 4, 0);
     const std::size_t at = main.size();
@@ -473,21 +528,13 @@ Result<std::size_t> compress_views(gltf::Document& doc, const Plan& plan) {
     Json& view = json["bufferViews"][v];
     auto plain = gltf::view_bytes(doc, v);
     if (!plain) return plain.error();
-    std::vector<unsigned char> encoded;
-    if (const auto a = attribute_views.find(v); a != attribute_views.end()) {
-      const std::size_t count = plain->size() / a->second;
-      encoded.resize(meshopt_encodeVertexBufferBound(count, a->second));
-      encoded.resize(meshopt_encodeVertexBuffer(encoded.data(), encoded.size(), plain->data(), count, a->second));
-      into_fallback(view, append(encoded), encoded.size(), {{"byteStride", a->second}, {"count", count}, {"mode", "ATTRIBUTES"}});
-    } else if (const auto i = index_views.find(v); i != index_views.end()) {
-      const std::size_t count = plain->size() / i->second;
-      std::vector<std::uint32_t> indices(count);
-      const int type = i->second == 2 ? gltf::kUnsignedShort : gltf::kUnsignedInt;
-      for (std::size_t k = 0; k < count; ++k) indices[k] = gltf::index_value(plain->data() + k * i->second, type);
-      const std::size_t vertices = indices.empty() ? 0 : *std::max_element(indices.begin(), indices.end()) + 1;
-      encoded.resize(meshopt_encodeIndexBufferBound(count, vertices));
-      encoded.resize(meshopt_encodeIndexBuffer(encoded.data(), encoded.size(), indices.data(), count));
-      into_fallback(view, append(encoded), encoded.size(), {{"byteStride", i->second}, {"count", count}, {"mode", "TRIANGLES"}});
+    std::optional<Encoded> encoded;
+    if (const auto a = attribute_views.find(v); a != attribute_views.end()) encoded = encode_vertices(*plain, a->second);
+    if (const auto i = index_views.find(v); i != index_views.end()) encoded = encode_triangles(*plain, i->second);
+    if (encoded && encoded->bytes.size() < plain->size()) {  // tiny streams grow: they stay plain
+      written += encoded->bytes.size();
+      into_fallback(view, append(encoded->bytes), encoded->bytes.size(), std::move(encoded->extension));
+      doc.decoded.views[v].assign(plain->begin(), plain->end());
     } else if (view.contains("extensions") && view["extensions"].contains(kMeshopt)) {  // compressed as read
       Json ext = view["extensions"][kMeshopt];
       const std::size_t b = gltf::size_in(ext, "buffer", SIZE_MAX), at = gltf::size_in(ext, "byteOffset", 0), length = gltf::size_in(ext, "byteLength", 0);
@@ -495,14 +542,11 @@ Result<std::size_t> compress_views(gltf::Document& doc, const Plan& plan) {
         return Error{doc.file, "/bufferViews/" + std::to_string(v) + ": its compressed bytes reach beyond their buffer"};
       }
       into_fallback(view, append({doc.buffers[b].data() + at, length}), length, std::move(ext));
-      continue;
     } else {
+      written += encoded ? plain->size() : 0;
       view["buffer"] = 0;
       view["byteOffset"] = append(*plain);
-      continue;
     }
-    compressed += encoded.size();
-    doc.decoded.views[v].assign(plain->begin(), plain->end());
   }
   json["buffers"] = Json::array({{{"byteLength", main.size()}}});
   doc.buffers.clear();
@@ -512,7 +556,7 @@ Result<std::size_t> compress_views(gltf::Document& doc, const Plan& plan) {
     doc.buffers.emplace_back();
   }
   doc.added_buffer = -1;
-  return compressed;
+  return written;
 }
 
 }  // namespace
@@ -529,6 +573,7 @@ Result<std::vector<std::string>> deliver_geometry(gltf::Document& doc, const Geo
   for (const auto& [m, p] : plan->rewritten) {
     if (Status s = rewrite_primitive(writer, *plan, m, p, options); !s) return s.error();
   }
+  writer.write_views();
   bool transformed = false;
   if (options.quantize) {
     place_on_grids(doc, *plan, options);
@@ -548,7 +593,7 @@ Result<std::vector<std::string>> deliver_geometry(gltf::Document& doc, const Geo
   if (options.compression == MeshCompression::meshopt && !plan->rewritten.empty()) {
     auto compressed = compress_views(doc, *plan);
     if (!compressed) return compressed.error();
-    add_extension(doc.json, kMeshopt, true);
+    if (gltf::is_fallback_buffer(doc.json, doc.buffers.size() - 1)) add_extension(doc.json, kMeshopt, true);  // any compressed
     notes.push_back(std::string(kMeshopt) + ": " + std::to_string(writer.bytes) + " → " + std::to_string(*compressed) + " bytes");
   }
   for (const std::string& k : plan->kept) notes.push_back(k + ": kept as read");
