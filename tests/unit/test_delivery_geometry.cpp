@@ -189,6 +189,7 @@ TEST(DeliveryGeometry, QuantizedAndCompressedReadsBackWithinTheStatedBoundsWithE
     EXPECT_EQ(doc.json["accessors"][attributes["POSITION"].get<std::size_t>()]["componentType"], gltf::kUnsignedShort);
     EXPECT_EQ(doc.json["accessors"][attributes["NORMAL"].get<std::size_t>()]["componentType"], gltf::kByte);
     EXPECT_EQ(doc.json["accessors"][attributes["TEXCOORD_0"].get<std::size_t>()]["componentType"], gltf::kUnsignedShort);
+    EXPECT_FALSE(attributes.contains("TANGENT")) << "no normal map reads it";
     MATBAKE_VALIDATE_OR_SKIP(report, out);
     EXPECT_EQ(report->errors, 0) << report->summary;
     EXPECT_EQ(report->warnings, 0) << report->summary;

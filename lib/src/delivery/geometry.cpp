@@ -294,6 +294,7 @@ struct Writer {
   std::vector<Pending> pending;
   std::unordered_map<std::size_t, std::vector<std::size_t>> by_hash;  // into pending
   std::size_t bytes = 0;                                              // of the views written
+  std::map<std::string, int> dropped;                                 // unread attributes, by name
 
   // `s` as an accessor of the kind `kind` ("TEXCOORD", "indices"): its index, the same for the same stream.
   int accessor(Stream s, const std::string& kind) {
@@ -373,14 +374,51 @@ Stream index_stream(const std::vector<std::uint32_t>& indices, std::size_t verti
   return s;
 }
 
+// The attributes no material of the primitive reads (its own and its KHR_materials_variants ones):
+// a TEXCOORD_n no texture samples, a TANGENT where no normal map or anisotropy needs one. gltfpack
+// drops them too; a runtime never fetches them.
+std::set<std::string> unread_attributes(gltf::Document& doc, const Json& primitive) {
+  std::vector<std::size_t> materials;
+  if (const std::size_t m = gltf::size_in(primitive, "material", SIZE_MAX); m != SIZE_MAX) materials.push_back(m);
+  if (primitive.contains("extensions") && primitive["extensions"].contains("KHR_materials_variants")) {
+    for (const Json& mapping : array_in(primitive["extensions"]["KHR_materials_variants"], "mappings")) {
+      materials.push_back(gltf::size_in(mapping, "material", SIZE_MAX));
+    }
+  }
+  std::set<int> sets;
+  bool tangents = false;
+  for (std::size_t m : materials) {
+    if (m >= array_in(doc.json, "materials").size()) return {};  // unknown: nothing is dropped
+    Json& material = doc.json["materials"][m];
+    tangents = tangents || (material.contains("extensions") && material["extensions"].contains("KHR_materials_anisotropy"));
+    bool readable = true;
+    gltf::for_each_texture_info(material, [&](Json& info) {
+      auto t = gltf::uv_transform_of(info, doc.file, "");
+      readable = readable && bool(t);
+      if (t) sets.insert(t->texcoord >= 0 ? t->texcoord : gltf::integer_in(info, "texCoord", 0, -1));
+    });
+    if (!readable) return {};
+    const std::string text = material.dump();
+    tangents = tangents || text.find("ormalTexture\"") != std::string::npos;  // normalTexture, clearcoatNormalTexture
+  }
+  std::set<std::string> unread;
+  for (const auto& [name, index] : primitive["attributes"].items()) {
+    const int set = texcoord_set(name);
+    if ((set >= 0 && !sets.contains(set)) || (name == "TANGENT" && !tangents)) unread.insert(name);
+  }
+  return unread;
+}
+
 // Mesh m's primitive p written anew: reordered, its attributes encoded as planned.
 Status rewrite_primitive(Writer& writer, const Plan& plan, std::size_t m, std::size_t p, const GeometryOptions& options) {
   gltf::Document& doc = writer.doc;
   gltf::uncompress_draco_primitive(doc, m, p);  // its accessors then read their decoded elements
   const std::string where = primitive_pointer(m, p);
   const Json primitive = doc.json["meshes"][m]["primitives"][p];
+  const std::set<std::string> unread = unread_attributes(doc, primitive);
   std::vector<AttributeJob> attributes;
   for (const auto& [name, index] : primitive["attributes"].items()) {
+    if (unread.contains(name) && name != "POSITION") continue;
     auto a = gltf::accessor_bytes(doc, index.get<std::size_t>());
     if (!a) return a.error();
     attributes.push_back({name, *a});
@@ -402,6 +440,10 @@ Status rewrite_primitive(Writer& writer, const Plan& plan, std::size_t m, std::s
   // Only accessors are made here; their views are written once every primitive is (Writer::write_views),
   // so no attribute being read moves.
   Json written = primitive;
+  for (const std::string& name : unread) {
+    written["attributes"].erase(name);
+    ++writer.dropped[name];
+  }
   for (const AttributeJob& a : attributes) {
     written["attributes"][a.name] = writer.accessor(encode_attribute(a, remap, used, plan, m, options), attribute_kind(a.name));
   }
@@ -595,6 +637,9 @@ Result<std::vector<std::string>> deliver_geometry(gltf::Document& doc, const Geo
     if (!compressed) return compressed.error();
     if (gltf::is_fallback_buffer(doc.json, doc.buffers.size() - 1)) add_extension(doc.json, kMeshopt, true);  // any compressed
     notes.push_back(std::string(kMeshopt) + ": " + std::to_string(writer.bytes) + " → " + std::to_string(*compressed) + " bytes");
+  }
+  for (const auto& [name, count] : writer.dropped) {
+    notes.push_back(name + " dropped from " + std::to_string(count) + " primitives: no material reads it");
   }
   for (const std::string& k : plan->kept) notes.push_back(k + ": kept as read");
   return notes;
