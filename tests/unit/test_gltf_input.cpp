@@ -288,7 +288,16 @@ TEST(GltfInput, DracoAndMeshoptVariantsBakeAndExportLikeThePlainScene) {
     }
     const test::RunResult e = test::matbake({"export", file.string(), "-o", exported.string(), "--ao-samples", "16"});
     ASSERT_EQ(e.exit_code, 0) << e.err;
-    for (const fs::path& out : {ao, textured, exported}) {
+    // Delivered again with quantized, compressed geometry (Draco made plain, meshopt and quantized
+    // input re-quantized under its own dequantizing nodes): within one more 14-bit step of the scene.
+    const fs::path redelivered = dir / ("geometry_" + v.name);
+    const test::RunResult g = test::matbake({"export", file.string(), "-o", redelivered.string(), "--mesh-quantization", "--mesh-compression", "meshopt"});
+    ASSERT_EQ(g.exit_code, 0) << g.err;
+    auto requantized = scene::load_scene(redelivered);
+    ASSERT_TRUE(requantized) << requantized.error().to_string();
+    EXPECT_LE(farthest_vertex(*requantized, *plain_scene), v.position_step + extent / 16383) << v.name;
+    EXPECT_LE(farthest_vertex(*plain_scene, *requantized), v.position_step + extent / 16383) << v.name;
+    for (const fs::path& out : {ao, textured, exported, redelivered}) {
       if (out == textured && !has_uvs) continue;
       MATBAKE_VALIDATE_OR_SKIP(report, out);
       EXPECT_EQ(report->errors, 0) << out << ": " << report->summary;
