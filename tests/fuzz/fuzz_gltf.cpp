@@ -1,6 +1,7 @@
 // glTF loading: the document (JSON, references, buffers, Draco / meshopt / sparse decoding, accessor
 // checks) and the flattened scene built from it,
-// as export and bake-ao read them, and the texel coverage of a texture bake over its UVs. MATBAKE_FUZZ_EXTENSION is ".gltf" or ".glb" (two targets).
+// as export and bake-ao read them, the texel coverage of a texture bake over its UVs, and the
+// geometry pass of delivery (quantization, meshopt compression) over the document. MATBAKE_FUZZ_EXTENSION is ".gltf" or ".glb" (two targets).
 #include <unistd.h>
 
 #include <cstddef>
@@ -14,6 +15,7 @@
 
 #include "lib/src/ao/texels.hpp"
 #include "lib/src/bake_ao/textures.hpp"
+#include "lib/src/delivery/geometry.hpp"
 #include "lib/src/gltf/document.hpp"
 #include "lib/src/gltf/texture_transform.hpp"
 #include "lib/src/scene/from_document.hpp"
@@ -65,6 +67,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   }
   for (std::size_t i = 0; doc->json.contains("images") && doc->json["images"].is_array() && i < doc->json["images"].size(); ++i) {
     (void)matbake::gltf::image_bytes(*doc, i);
+  }
+  // Geometry for delivery, quantized and compressed, over whatever the file holds; then every
+  // accessor still reads.
+  const matbake::delivery::GeometryOptions geometry{.quantize = true, .compression = matbake::delivery::MeshCompression::meshopt};
+  if (matbake::delivery::deliver_geometry(*doc, geometry)) {
+    for (std::size_t i = 0; i < matbake::gltf::array_in(doc->json, "accessors").size(); ++i) (void)matbake::gltf::accessor_bytes(*doc, i);
   }
   return 0;
 }

@@ -109,7 +109,10 @@ Result<Plan> plan_geometry(const gltf::Document& doc) {
   plan.meshes.resize(meshes.size());
   for (const Json& node : array_in(doc.json, "nodes")) {
     const std::size_t m = gltf::size_in(node, "mesh", SIZE_MAX);
-    const bool placed_otherwise = node.contains("skin") || (node.contains("extensions") && node["extensions"].contains("EXT_mesh_gpu_instancing"));
+    // Skinned or instanced: the node's transform does not come right after the vertices'. Children
+    // not a list: the dequantizing child cannot be added.
+    const bool placed_otherwise = node.contains("skin") || (node.contains("extensions") && node["extensions"].contains("EXT_mesh_gpu_instancing")) ||
+                                  (node.contains("children") && !node["children"].is_array());
     if (m < meshes.size() && placed_otherwise) plan.meshes[m].quantize = false;
   }
   for (std::size_t m = 0; m < meshes.size(); ++m) {
@@ -456,6 +459,7 @@ void add_extension(Json& json, const char* name, bool required) {
   for (const char* list : {"extensionsUsed", "extensionsRequired"}) {
     if (list[9] == 'R' && !required) continue;
     Json& names = json[list];
+    if (!names.is_array()) names = Json::array();  // a malformed list (the validator's error) replaced
     if (std::find(names.begin(), names.end(), Json(name)) == names.end()) names.push_back(name);
   }
 }
@@ -494,6 +498,10 @@ Status undo_uv_grids(gltf::Document& doc, const Plan& plan, const GeometryOption
       const int set = t->texcoord >= 0 ? t->texcoord : gltf::integer_in(info, "texCoord", 0, -1);
       const auto uv = plan.uv.find(set);
       if (uv == plan.uv.end() || !uv->second.quantize) return;
+      if (info.contains("extensions") && !info["extensions"].is_object()) {
+        status = Error{doc.file, "/materials/" + std::to_string(m) + ": a texture's extensions are not an object"};
+        return;
+      }
       const glm::dvec2 s = uv->second.range() * (65535.0 / double((1 << options.texcoord_bits) - 1));
       const glm::dvec2 offset = t->apply(uv->second.lo), scale = t->scale * s;
       Json& ext = info["extensions"][kTransform];
