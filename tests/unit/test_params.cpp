@@ -3,6 +3,8 @@
 // round-tripped through the stamp's JSON, and documented in docs/build.md's table.
 #include <gtest/gtest.h>
 
+#include "lib/src/delivery/profiles.hpp"
+
 #include <cstdlib>
 #include <map>
 #include <regex>
@@ -201,7 +203,7 @@ TEST(RequestTree, EveryParameterOfExportsTreeReachesTheSceneFromBothDoors) {
       ++walked;
     }
   }
-  EXPECT_EQ(walked, 55u);  // a new parameter is walked here too
+  EXPECT_EQ(walked, 56u);  // a new parameter is walked here too
 }
 
 // Each rule of a tree broken on purpose: refused at both doors, with one message in each door's spelling.
@@ -311,9 +313,52 @@ void walk_top_level(const Tree<Root>& tree, const std::string& entry, Read read,
 
 TEST(RequestTree, TheTopLevelGivesEveryMaterialAndSceneParameterItsDefault) {
   walk_top_level(pipeline::scene_tree(), "[scenes.s]\ninput = \"s.gltf\"\n",
-                 [](const pipeline::Manifest& m) { return m.scenes.at(0); }, 56);
+                 [](const pipeline::Manifest& m) { return m.scenes.at(0); }, 57);
   walk_top_level(pipeline::material_tree(), "[materials.m]\nsources = { kd = 0.5 }\n",
                  [](const pipeline::Manifest& m) { return m.materials.at(0); }, 15);
+}
+
+// A delivery profile sets its values first, whatever the order it is given in at either door; the
+// settings beside it (and an entry's, over the top level's profile) override them.
+TEST(RequestTree, ADeliveryProfileIsSetBeforeTheSettingsBesideIt) {
+  const Tree<exporter::Options> tree = exporter::request_tree();
+  const auto setting = [&](const std::string& name, const std::string& value) { return find_setting(tree, 0, name, value); };
+  const auto web_with_quality = [](const exporter::Options& o) {
+    EXPECT_EQ(o.delivery.profile, "web");
+    EXPECT_EQ(o.delivery.texture_format, delivery::TextureFormat::ktx2);
+    EXPECT_TRUE(o.delivery.geometry.quantize);
+    EXPECT_EQ(o.delivery.geometry.compression, delivery::MeshCompression::meshopt);
+    EXPECT_EQ(o.delivery.colour.quality, 200);  // the profile's is 192
+  };
+  for (bool profile_first : {true, false}) {
+    std::vector<Setting<exporter::Options>> settings = {setting("delivery_profile", "web"), setting("colour_quality", "200")};
+    if (!profile_first) std::swap(settings[0], settings[1]);
+    auto cli = from_flags(tree, settings);
+    ASSERT_TRUE(cli) << cli.error().to_string();
+    web_with_quality(*cli);
+    const std::string keys = profile_first ? "delivery_profile = \"web\"\ncolour_quality = 200\n" : "colour_quality = 200\ndelivery_profile = \"web\"\n";
+    auto m = pipeline::parse_manifest("[scenes.s]\ninput = \"s.gltf\"\n" + keys, "/p/assets.toml");
+    ASSERT_TRUE(m) << m.error().to_string();
+    web_with_quality(m->scenes.at(0).options);
+  }
+  auto inherited = pipeline::parse_manifest("delivery_profile = \"web\"\n[scenes.s]\ninput = \"s.gltf\"\ncolour_quality = 200\n", "/p/assets.toml");
+  ASSERT_TRUE(inherited) << inherited.error().to_string();
+  web_with_quality(inherited->scenes.at(0).options);
+  // A setting the profile's values rule out is refused as any other.
+  auto refused = pipeline::parse_manifest("[scenes.s]\ninput = \"s.gltf\"\ndelivery_profile = \"desktop\"\ncolour_quality = 200\n", "/p/assets.toml");
+  ASSERT_FALSE(refused);
+  EXPECT_EQ(refused.error().message, "scenes.s.colour_quality applies only with scenes.s.colour_codec = \"etc1s\"");
+}
+
+// Every profile applies as its parameters read it, keeps the rules, and is what its file says.
+TEST(RequestTree, EveryDeliveryProfileAppliesCleanly) {
+  ASSERT_EQ(delivery::profile_names(), (std::vector<std::string>{"archive", "desktop", "mobile", "web"}));
+  for (const std::string& name : delivery::profile_names()) {
+    auto m = pipeline::parse_manifest("[scenes.s]\ninput = \"s.gltf\"\ndelivery_profile = \"" + name + "\"\n", "/p/assets.toml");
+    ASSERT_TRUE(m) << name << ": " << m.error().to_string();
+    EXPECT_EQ(m->scenes.at(0).options.delivery.profile, name);
+    EXPECT_NE(to_json(delivery::options_params(), m->scenes.at(0).options.delivery), to_json(delivery::options_params(), delivery::Options{})) << name;
+  }
 }
 
 // A rule is checked on each entry as inherited: the top level's colour_quality applies to a KTX2

@@ -90,6 +90,7 @@ struct Options {
   bool png_fallback = false;    // keep the PNG as the texture's core source (the extension then optional)
   double texel_density = 0;     // texels per scene unit the textures are sized for; 0: their own sizes
   GeometryOptions geometry;
+  std::string profile;          // the delivery profile these values started from (presets/delivery/); "": none
   // Not parameters (no stamp records them): where a build keeps encoded textures between runs
   // (OUT/.matbake/encode-cache) and how many bytes at most; an empty folder or 0: none kept.
   std::filesystem::path encode_cache;

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "matbake/delivery_params.hpp"
+#include "profiles.hpp"
 
 namespace matbake::delivery {
 namespace {
@@ -64,6 +65,20 @@ void add_class(std::vector<Param<Options>>& out, TextureClass c) {
                                         field(&ClassOptions::scale)));
 }
 
+Param<Options> profile_param() {
+  Spec spec{.name = "delivery_profile",
+            .help = "Start from a delivery profile (presets/delivery/: web, mobile, desktop, archive); the "
+                    "settings given beside it override its values",
+            .example = "web"};
+  spec.kind = params::Kind::choice;
+  spec.choices = profile_names();
+  return {std::move(spec), [](Options& o, const params::Value& v) { return apply_profile(o, std::get<std::string>(v)); },
+          [](const Options& o) -> nlohmann::json {
+            if (o.profile.empty()) return nullptr;
+            return o.profile;
+          }};
+}
+
 void add_geometry(std::vector<Param<Options>>& out) {
   const params::Condition quantized{"mesh_quantization", "true"};
   out.push_back(params::flag<Options>(Spec{.name = "mesh_quantization",
@@ -92,6 +107,9 @@ void add_geometry(std::vector<Param<Options>>& out) {
 const params::Group<Options>& options_params() {
   static const params::Group<Options> group = [] {
     params::Group<Options> g;
+    // First: both doors apply a group's parameters in this order, so that those given beside the
+    // profile override its values.
+    g.params.push_back(profile_param());
     g.params.push_back(params::choice<Options>(
         Spec{.name = "texture_format",
              .help = "Format of the textures written into a glTF: png or webp (lossless, 8-bit; the file then "

@@ -19,6 +19,7 @@
 #include "matbake/validate_params.hpp"
 #include "matbake/read_file.hpp"
 #include "matbake/pipeline.hpp"
+#include "../params/toml_value.hpp"
 
 namespace matbake::pipeline {
 namespace fs = std::filesystem;
@@ -89,17 +90,6 @@ bool is_file_name_safe(const std::string& name) {
   return true;
 }
 
-
-// A TOML value as a parameter takes it (params::accept then checks its kind).
-Result<params::Value> toml_value(const toml::node& node) {
-  if (auto b = node.value_exact<bool>()) return params::Value(*b);
-  // Integers only from integer nodes: toml++ 3.3 converts a float by a cast that is undefined
-  // beyond the integer's range (found by fuzzing: samples = 2e52).
-  if (node.is_integer()) return params::Value(*node.value<std::int64_t>());
-  if (auto d = node.value_exact<double>()) return params::Value(*d);
-  if (auto text = node.value_exact<std::string>()) return params::Value(*text);
-  return Error{"", "a number, a string or true/false expected"};
-}
 
 // A manifest's spelling of a request's groups' parameters, each group in its table `wheres[g]`
 // ("scenes.s.ao"): "scenes.s.ao.texture", "scenes.s.texture_format = \"ktx2\"".
@@ -172,6 +162,20 @@ struct Entry {
   Given given;
 };
 
+// One key `name` of branch `b` (of index `i`), read into the entry: an older name with a note.
+template <class Root>
+Status read_key(const Reader& r, const params::Branch<Root>& b, const std::string& at, const params::Spec& spec,
+                const std::string& name, const toml::node& value, Entry<Root>& entry, std::size_t i, std::vector<std::string>& notes) {
+  if (name != spec.name) {
+    notes.push_back(r.origin(value.source()) + ": " + at + "." + name + " is now called " + spec.name + " (the old name still works)");
+  }
+  auto v = params::toml_value(value);
+  std::optional<std::string> problem = v ? b.apply(entry.request, spec, *v) : v.error().message;
+  if (problem) return r.at(value, at + "." + name + ": " + *problem);
+  entry.given[i].insert(spec.name);
+  return success();
+}
+
 // The keys of `t` (`where`: "scenes.s") a tree describes, stored in `entry`: plain branches' among
 // the table's own keys, table branches' in their sub-table (which holds those only); an older key is
 // read with a note. The rules are check_tree's, once the entry is complete.
@@ -189,22 +193,20 @@ Status read_branches(const Reader& r, const toml::table& t, const std::string& w
     if (!b.table.empty()) {
       if (Status s = r.known_keys(*table, at, keys_in_table(tree, b.table)); !s) return s;
     }
-    for (const auto& [key, value] : *table) {
-      const std::string name(key.str());
-      const params::Spec* spec = spec_for_key(b.specs, name);
-      if (!spec) continue;
-      if (name != spec->name) {
-        notes.push_back(r.origin(key.source()) + ": " + at + "." + name + " is now called " + spec->name +
-                        " (the old name still works)");
+    // In the group's order, not the table's: a delivery profile is set before the keys beside it.
+    for (const params::Spec* spec : b.specs) {
+      std::vector<std::string> names = spec->aliases;
+      names.insert(names.begin(), spec->name);
+      for (const std::string& name : names) {
+        const toml::node* found = table->get(name);
+        if (!found) continue;
+        if (Status s = read_key(r, b, at, *spec, name, *found, entry, i, notes); !s) return s;
       }
-      auto v = toml_value(value);
-      std::optional<std::string> problem = v ? b.apply(entry.request, *spec, *v) : v.error().message;
-      if (problem) return r.at(value, at + "." + name + ": " + *problem);
-      entry.given[i].insert(spec->name);
     }
   }
   return success();
 }
+
 
 // Where a branch's key is written: in the entry `t`, else in the top level `top` it came from, else
 // the entry's table of the branch.
