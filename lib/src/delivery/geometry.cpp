@@ -617,6 +617,9 @@ double texcoord_error_bound(double range, int bits) { return 0.5 * range / doubl
 Result<std::vector<std::string>> deliver_geometry(gltf::Document& doc, const GeometryOptions& options) {
   std::vector<std::string> notes;
   if (!options.any()) return notes;
+  // Only what the default scene reaches (export has pruned already): the pruning after the rewrite
+  // then removes accessors and views only, and the primitives planned keep their indices.
+  (void)gltf::prune_unreachable(doc);
   auto plan = plan_geometry(doc);
   if (!plan) return plan.error();
   Writer writer{doc, {}, {}};
