@@ -7,7 +7,10 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <iomanip>
+#include <iostream>
 #include <fstream>
 
 #include "matbake/ktx2.hpp"
@@ -229,6 +232,69 @@ TEST(Runtime, KhronosModelsDeliveredByMatbakeLookAsTheOriginalsInThreeJs) {
     expect_textures_as_their_slots(renders->at(name + "-ktx2"), name + " KTX2");
     expect_renders_alike(original, renders->at(name + "-png"), kPngRenderPsnr, name + " PNG");
     expect_renders_alike(original, renders->at(name + "-ktx2"), kKtx2RenderPsnr.at(name), name + " KTX2");
+  }
+}
+
+// Not a test: the rate–distortion measurement the delivery profiles were chosen from, run by
+// scripts/bench-profiles.sh (disabled here: minutes, and a measurement rather than a check). Each
+// model of kKhronosModels delivered as each profile and as variants of "web" one setting apart;
+// per variant the bytes of all models together, the render PSNR against the originals (mean and
+// worst over models, per view) and the export's time. Markdown on stdout.
+TEST(Runtime, DISABLED_DeliveryProfilesRateDistortion) {
+  SKIP_UNDER_SANITIZERS();
+  const fs::path testdata = MATBAKE_TESTDATA_DIR;
+  if (!fs::is_directory(testdata / "gltf")) GTEST_SKIP() << (testdata / "gltf").string() << " is absent";
+  MATBAKE_BASISU_OR_SKIP(basisu);
+  const std::vector<std::pair<std::string, std::vector<std::string>>> variants = {
+      {"png (as authored)", {}},
+      {"profile web", {"--delivery-profile", "web"}},
+      {"profile mobile", {"--delivery-profile", "mobile"}},
+      {"profile desktop", {"--delivery-profile", "desktop"}},
+      {"profile archive", {"--delivery-profile", "archive"}},
+      {"web, colour etc1s q128", {"--delivery-profile", "web", "--colour-quality", "128"}},
+      {"web, colour etc1s q255", {"--delivery-profile", "web", "--colour-quality", "255"}},
+      {"web, colour uastc λ1", {"--delivery-profile", "web", "--colour-codec", "uastc", "--colour-uastc-rdo", "1"}},
+      {"web, normal uastc λ0", {"--delivery-profile", "web", "--normal-uastc-rdo", "0"}},
+      {"web, normal uastc λ4", {"--delivery-profile", "web", "--normal-uastc-rdo", "4"}},
+      {"web, normal etc1s q255", {"--delivery-profile", "web", "--normal-codec", "etc1s", "--normal-quality", "255"}},
+      {"web, data etc1s q128", {"--delivery-profile", "web", "--data-codec", "etc1s"}},
+  };
+  TempDir dir;
+  std::vector<std::pair<std::string, fs::path>> models;
+  std::vector<std::uintmax_t> bytes(variants.size());
+  std::vector<double> seconds(variants.size());
+  for (const char* relative : kKhronosModels) {
+    const fs::path source = testdata / "gltf" / relative;
+    const std::string name = source.stem().string();
+    models.emplace_back(name, source);
+    for (std::size_t v = 0; v < variants.size(); ++v) {
+      const fs::path out = dir / (name + "-" + std::to_string(v) + ".glb");
+      std::vector<std::string> args = {"export", source.string(), "-o", out.string()};
+      args.insert(args.end(), variants[v].second.begin(), variants[v].second.end());
+      const auto start = std::chrono::steady_clock::now();
+      const RunResult r = matbake(args);
+      seconds[v] += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      ASSERT_EQ(r.exit_code, 0) << relative << " " << variants[v].first << ": " << r.err;
+      bytes[v] += fs::file_size(out);
+      models.emplace_back(name + "-" + std::to_string(v), out);
+    }
+  }
+  MATBAKE_RENDER_OR_SKIP(renders, dir / "renders", models);
+  std::cout << "| variant | bytes, all models | render PSNR fit / near / far, dB (mean) | worst model and view, dB | export s |\n"
+            << "|---|---:|---|---:|---:|\n";
+  for (std::size_t v = 0; v < variants.size(); ++v) {
+    std::map<std::string, double> mean;
+    double worst = 99;
+    for (const char* relative : kKhronosModels) {
+      const std::string name = fs::path(relative).stem().string();
+      for (const std::string& view : kRuntimeViews) {
+        const double psnr = std::min(99.0, render_psnr(renders->at(name).renders.at(view), renders->at(name + "-" + std::to_string(v)).renders.at(view)));
+        mean[view] += psnr / double(std::size(kKhronosModels));
+        worst = std::min(worst, psnr);
+      }
+    }
+    std::cout << std::fixed << std::setprecision(1) << "| " << variants[v].first << " | " << bytes[v] << " | " << mean["fit"] << " / "
+              << mean["near"] << " / " << mean["far"] << " | " << worst << " | " << seconds[v] << " |\n";
   }
 }
 
