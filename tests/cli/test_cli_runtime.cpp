@@ -11,6 +11,7 @@
 #include <cmath>
 #include <iomanip>
 #include <iostream>
+#include <sstream>
 #include <fstream>
 
 #include "matbake/ktx2.hpp"
@@ -295,6 +296,83 @@ TEST(Runtime, DISABLED_DeliveryProfilesRateDistortion) {
     }
     std::cout << std::fixed << std::setprecision(1) << "| " << variants[v].first << " | " << bytes[v] << " | " << mean["fit"] << " / "
               << mean["near"] << " / " << mean["far"] << " | " << worst << " | " << seconds[v] << " |\n";
+  }
+}
+
+// Not a test: matbake against gltfpack with BasisU at equal codec settings, run by
+// scripts/bench-vs-gltfpack.sh with GLTFPACK (an executable) and BASISU_PATH set. Each model of
+// kKhronosModels delivered by both with quantized, meshopt-compressed geometry; per model and
+// setting, each tool's bytes, wall time, peak memory (the tool and the encoders it starts) and render
+// PSNR against the original (fit / near / far). Markdown on stdout.
+TEST(Runtime, DISABLED_AgainstGltfpack) {
+  SKIP_UNDER_SANITIZERS();
+  const fs::path testdata = MATBAKE_TESTDATA_DIR;
+  if (!fs::is_directory(testdata / "gltf")) GTEST_SKIP() << (testdata / "gltf").string() << " is absent";
+  const char* gltfpack = std::getenv("GLTFPACK");
+  if (gltfpack == nullptr) GTEST_SKIP() << "GLTFPACK is not set";
+  MATBAKE_BASISU_OR_SKIP(basisu);
+  struct Setting {
+    std::string name;
+    std::vector<std::string> gltfpack_args, matbake_args;
+  };
+  const std::vector<std::string> geometry = {"--mesh-quantization", "--mesh-compression", "meshopt"};
+  const std::vector<Setting> settings = {
+      {"ETC1S colour, UASTC data and normals", {"-c", "-tc", "-tu", "normal,attrib"}, {"--texture-format", "ktx2"}},
+      {"all UASTC", {"-c", "-tc", "-tu"}, {"--texture-format", "ktx2", "--colour-codec", "uastc"}},
+      {"all ETC1S", {"-c", "-tc"}, {"--texture-format", "ktx2", "--data-codec", "etc1s", "--normal-codec", "etc1s"}},
+  };
+  TempDir dir;
+  struct Run {
+    std::uintmax_t bytes = 0;
+    double seconds = 0, peak_mb = 0;
+  };
+  std::map<std::string, Run> runs;  // "model/setting/tool"
+  std::vector<std::pair<std::string, fs::path>> models;
+  const auto measure = [&](const std::string& key, const std::string& program, const std::vector<std::string>& args,
+                           const fs::path& out, const std::vector<std::string>& env) {
+    const auto start = std::chrono::steady_clock::now();
+    const RunResult r = run_measured(program, args, env);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    ASSERT_EQ(r.exit_code, 0) << key << ": " << r.err;
+    runs[key] = {fs::file_size(out), seconds, r.peak_mb};
+    models.emplace_back(key, out);
+  };
+  for (const char* relative : kKhronosModels) {
+    const fs::path source = testdata / "gltf" / relative;
+    const std::string name = source.stem().string();
+    models.emplace_back(name, source);
+    for (std::size_t s = 0; s < settings.size(); ++s) {
+      const std::string key = name + "/" + std::to_string(s);
+      const fs::path theirs = dir / (name + "-" + std::to_string(s) + "-gltfpack.glb"), ours = dir / (name + "-" + std::to_string(s) + "-matbake.glb");
+      std::vector<std::string> gp = {"-i", source.string(), "-o", theirs.string()};
+      gp.insert(gp.end(), settings[s].gltfpack_args.begin(), settings[s].gltfpack_args.end());
+      ASSERT_NO_FATAL_FAILURE(measure(key + "/gltfpack", gltfpack, gp, theirs, {}));
+      std::vector<std::string> mb = {"export", source.string(), "-o", ours.string()};
+      mb.insert(mb.end(), settings[s].matbake_args.begin(), settings[s].matbake_args.end());
+      mb.insert(mb.end(), geometry.begin(), geometry.end());
+      ASSERT_NO_FATAL_FAILURE(measure(key + "/matbake", matbake_exe(), mb, ours, matbake_environment()));
+    }
+  }
+  MATBAKE_RENDER_OR_SKIP(renders, dir / "renders", models);
+  const auto psnr_text = [&](const std::string& model, const std::string& key) {
+    std::ostringstream text;
+    text << std::fixed << std::setprecision(1);
+    for (const std::string& view : kRuntimeViews) {
+      text << (view == "fit" ? "" : " / ") << std::min(99.0, render_psnr(renders->at(model).renders.at(view), renders->at(key).renders.at(view)));
+    }
+    return text.str();
+  };
+  std::cout << "| model | setting | gltfpack: bytes, s, MB | matbake: bytes, s, MB | render PSNR fit / near / far, gltfpack | matbake |\n"
+            << "|---|---|---|---|---|---|\n";
+  for (const char* relative : kKhronosModels) {
+    const std::string name = fs::path(relative).stem().string();
+    for (std::size_t s = 0; s < settings.size(); ++s) {
+      const std::string key = name + "/" + std::to_string(s);
+      const Run &g = runs[key + "/gltfpack"], &m = runs[key + "/matbake"];
+      std::cout << std::fixed << std::setprecision(2) << "| " << name << " | " << settings[s].name << " | " << g.bytes << ", " << g.seconds << ", "
+                << std::setprecision(0) << g.peak_mb << " | " << m.bytes << ", " << std::setprecision(2) << m.seconds << ", " << std::setprecision(0)
+                << m.peak_mb << " | " << psnr_text(name, key + "/gltfpack") << " | " << psnr_text(name, key + "/matbake") << " |\n";
+    }
   }
 }
 

@@ -135,6 +135,10 @@ Result<Plan> plan_geometry(const gltf::Document& doc) {
         if (name != "POSITION" && set < 0) continue;
         auto a = gltf::accessor_bytes(doc, index.get<std::size_t>());
         if (!a) return a.error();
+        if (a->components != (set < 0 ? 3u : 2u)) {  // not what glTF says it is: written as read, so no grid
+          (set < 0 ? plan.meshes[m].quantize : plan.uv[set].quantize) = false;
+          continue;
+        }
         for (std::size_t i = 0; i < a->count; ++i) {
           const auto v = element(*a, i);
           if (!std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2])) {  // as the scene reader refuses it
