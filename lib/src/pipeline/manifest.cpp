@@ -134,13 +134,6 @@ std::vector<std::string> keys_in_table(const params::Tree<Root>& tree, const std
   return keys;
 }
 
-const params::Spec* spec_for_key(const std::vector<const params::Spec*>& specs, const std::string& key) {
-  for (const params::Spec* spec : specs) {
-    if (spec->name == key || std::find(spec->aliases.begin(), spec->aliases.end(), key) != spec->aliases.end()) return spec;
-  }
-  return nullptr;
-}
-
 // The manifest's top level as errors name it: its own keys "manifest.png_compression", its tables'
 // "validate.tolerance".
 const std::string kTopLevel = "manifest";
