@@ -326,7 +326,7 @@ TEST(Runtime, DISABLED_AgainstGltfpack) {
     std::uintmax_t bytes = 0;
     double seconds = 0, peak_mb = 0;
   };
-  std::map<std::string, Run> runs;  // "model/setting/tool"
+  std::map<std::string, Run> runs;  // "model-setting-tool" (render names: letters, digits, - and _)
   std::vector<std::pair<std::string, fs::path>> models;
   const auto measure = [&](const std::string& key, const std::string& program, const std::vector<std::string>& args,
                            const fs::path& out, const std::vector<std::string>& env) {
@@ -342,15 +342,15 @@ TEST(Runtime, DISABLED_AgainstGltfpack) {
     const std::string name = source.stem().string();
     models.emplace_back(name, source);
     for (std::size_t s = 0; s < settings.size(); ++s) {
-      const std::string key = name + "/" + std::to_string(s);
+      const std::string key = name + "-" + std::to_string(s);
       const fs::path theirs = dir / (name + "-" + std::to_string(s) + "-gltfpack.glb"), ours = dir / (name + "-" + std::to_string(s) + "-matbake.glb");
       std::vector<std::string> gp = {"-i", source.string(), "-o", theirs.string()};
       gp.insert(gp.end(), settings[s].gltfpack_args.begin(), settings[s].gltfpack_args.end());
-      ASSERT_NO_FATAL_FAILURE(measure(key + "/gltfpack", gltfpack, gp, theirs, {}));
+      ASSERT_NO_FATAL_FAILURE(measure(key + "-gltfpack", gltfpack, gp, theirs, {}));
       std::vector<std::string> mb = {"export", source.string(), "-o", ours.string()};
       mb.insert(mb.end(), settings[s].matbake_args.begin(), settings[s].matbake_args.end());
       mb.insert(mb.end(), geometry.begin(), geometry.end());
-      ASSERT_NO_FATAL_FAILURE(measure(key + "/matbake", matbake_exe(), mb, ours, matbake_environment()));
+      ASSERT_NO_FATAL_FAILURE(measure(key + "-matbake", matbake_exe(), mb, ours, matbake_environment()));
     }
   }
   MATBAKE_RENDER_OR_SKIP(renders, dir / "renders", models);
@@ -367,11 +367,11 @@ TEST(Runtime, DISABLED_AgainstGltfpack) {
   for (const char* relative : kKhronosModels) {
     const std::string name = fs::path(relative).stem().string();
     for (std::size_t s = 0; s < settings.size(); ++s) {
-      const std::string key = name + "/" + std::to_string(s);
-      const Run &g = runs[key + "/gltfpack"], &m = runs[key + "/matbake"];
+      const std::string key = name + "-" + std::to_string(s);
+      const Run &g = runs[key + "-gltfpack"], &m = runs[key + "-matbake"];
       std::cout << std::fixed << std::setprecision(2) << "| " << name << " | " << settings[s].name << " | " << g.bytes << ", " << g.seconds << ", "
                 << std::setprecision(0) << g.peak_mb << " | " << m.bytes << ", " << std::setprecision(2) << m.seconds << ", " << std::setprecision(0)
-                << m.peak_mb << " | " << psnr_text(name, key + "/gltfpack") << " | " << psnr_text(name, key + "/matbake") << " |\n";
+                << m.peak_mb << " | " << psnr_text(name, key + "-gltfpack") << " | " << psnr_text(name, key + "-matbake") << " |\n";
     }
   }
 }
