@@ -158,9 +158,10 @@ struct Entry {
 // One key `name` of branch `b` (of index `i`), read into the entry: an older name with a note.
 template <class Root>
 Status read_key(const Reader& r, const params::Branch<Root>& b, const std::string& at, const params::Spec& spec,
-                const std::string& name, const toml::node& value, Entry<Root>& entry, std::size_t i, std::vector<std::string>& notes) {
+                const toml::key& key, const toml::node& value, Entry<Root>& entry, std::size_t i, std::vector<std::string>& notes) {
+  const std::string name(key.str());
   if (name != spec.name) {
-    notes.push_back(r.origin(value.source()) + ": " + at + "." + name + " is now called " + spec.name + " (the old name still works)");
+    notes.push_back(r.origin(key.source()) + ": " + at + "." + name + " is now called " + spec.name + " (the old name still works)");
   }
   auto v = params::toml_value(value);
   std::optional<std::string> problem = v ? b.apply(entry.request, spec, *v) : v.error().message;
@@ -191,9 +192,9 @@ Status read_branches(const Reader& r, const toml::table& t, const std::string& w
       std::vector<std::string> names = spec->aliases;
       names.insert(names.begin(), spec->name);
       for (const std::string& name : names) {
-        const toml::node* found = table->get(name);
-        if (!found) continue;
-        if (Status s = read_key(r, b, at, *spec, name, *found, entry, i, notes); !s) return s;
+        const auto found = table->find(name);
+        if (found == table->end()) continue;
+        if (Status s = read_key(r, b, at, *spec, found->first, found->second, entry, i, notes); !s) return s;
       }
     }
   }
