@@ -316,10 +316,22 @@ TEST(Runtime, DISABLED_AgainstGltfpack) {
     std::vector<std::string> gltfpack_args, matbake_args;
   };
   const std::vector<std::string> geometry = {"--mesh-quantization", "--mesh-compression", "meshopt"};
+  // gltfpack 0.17 runs basisu with "-uastc -uastc_level 1 -uastc_rdo_l 0.29 -uastc_rdo_d 1024
+  // -ktx2_zstandard_level 9" and "-comp_level 1 -q 192" (its arguments, logged): matbake is given
+  // the same codec settings per class.
+  const auto uastc = [](const std::string& c) {
+    return std::vector<std::string>{"--" + c + "-codec", "uastc", "--" + c + "-uastc-level", "1", "--" + c + "-uastc-rdo", "0.29", "--" + c + "-zstd", "9"};
+  };
+  const auto etc1s = [](const std::string& c) { return std::vector<std::string>{"--" + c + "-codec", "etc1s", "--" + c + "-quality", "192"}; };
+  const auto matbake_args = [](std::vector<std::vector<std::string>> parts) {
+    std::vector<std::string> out = {"--texture-format", "ktx2"};
+    for (const auto& p : parts) out.insert(out.end(), p.begin(), p.end());
+    return out;
+  };
   const std::vector<Setting> settings = {
-      {"ETC1S colour, UASTC data and normals", {"-c", "-tc", "-tu", "normal,attrib"}, {"--texture-format", "ktx2"}},
-      {"all UASTC", {"-c", "-tc", "-tu"}, {"--texture-format", "ktx2", "--colour-codec", "uastc"}},
-      {"all ETC1S", {"-c", "-tc"}, {"--texture-format", "ktx2", "--data-codec", "etc1s", "--normal-codec", "etc1s"}},
+      {"ETC1S colour, UASTC data and normals", {"-c", "-tc", "-tu", "normal,attrib"}, matbake_args({etc1s("colour"), uastc("data"), uastc("normal")})},
+      {"all UASTC", {"-c", "-tc", "-tu"}, matbake_args({uastc("colour"), uastc("data"), uastc("normal")})},
+      {"all ETC1S", {"-c", "-tc"}, matbake_args({etc1s("colour"), etc1s("data"), etc1s("normal")})},
   };
   TempDir dir;
   struct Run {
