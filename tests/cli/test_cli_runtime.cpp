@@ -320,7 +320,8 @@ TEST(Runtime, DISABLED_AgainstGltfpack) {
   // -ktx2_zstandard_level 9" and "-comp_level 1 -q 192" (its arguments, logged): matbake is given
   // the same codec settings per class.
   const auto uastc = [](const std::string& c) {
-    return std::vector<std::string>{"--" + c + "-codec", "uastc", "--" + c + "-uastc-level", "1", "--" + c + "-uastc-rdo", "0.29", "--" + c + "-zstd", "9"};
+    return std::vector<std::string>{"--" + c + "-codec", "uastc", "--" + c + "-uastc-level", "1", "--" + c + "-uastc-rdo", "0.29",
+                                    "--" + c + "-uastc-rdo-dictionary", "1024", "--" + c + "-zstd", "9"};
   };
   const auto etc1s = [](const std::string& c) { return std::vector<std::string>{"--" + c + "-codec", "etc1s", "--" + c + "-quality", "192"}; };
   const auto matbake_args = [](std::vector<std::vector<std::string>> parts) {

@@ -402,6 +402,10 @@ TEST(EncodeCache, TheKeyFollowsWhatTheBytesDependOn) {
   keys.insert(encode_key(source, {8, 8}, {TextureClass::data, {}, 0.5f}, request, writer));
   for (auto change : std::vector<std::function<void(EncodeRequest&)>>{
            [](EncodeRequest& r) { r.options.uastc_level = 3; }, [](EncodeRequest& r) { r.options.uastc_rdo = 0.5; },
+           [](EncodeRequest& r) {
+             r.options.uastc_rdo = 0.5;
+             r.options.uastc_rdo_dictionary = 1024;
+           },
            [](EncodeRequest& r) { r.options.zstd = 3; }, [](EncodeRequest& r) { r.mipmaps = false; },
            [](EncodeRequest& r) { r.alpha = true; }, [](EncodeRequest& r) { r.texture_class = TextureClass::normal; },
            [](EncodeRequest& r) { r.options.codec = Codec::etc1s; }}) {
@@ -410,7 +414,7 @@ TEST(EncodeCache, TheKeyFollowsWhatTheBytesDependOn) {
     keys.insert(encode_key(source, {8, 8}, mips, changed, writer));
   }
   keys.insert(encode_key(source, {8, 8}, mips, request, "matbake 0.2.0 / basisu 1.16.5"));
-  EXPECT_EQ(keys.size(), 14u);  // each of the 13 changes a key of its own
+  EXPECT_EQ(keys.size(), 15u);  // each of the 14 changes a key of its own
 }
 
 // Eviction removes the least recently used entries until the rest fit, and nothing that is not an

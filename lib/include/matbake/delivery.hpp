@@ -46,6 +46,7 @@ struct ClassOptions {
   int quality = 128;      // ETC1S: basisu -q, 1–255
   int uastc_level = 2;    // UASTC: basisu -uastc_level, 0–4
   double uastc_rdo = 0;   // UASTC: rate-distortion λ (basisu -uastc_rdo_l); 0: off
+  int uastc_rdo_dictionary = 4096;  // UASTC RDO: bytes of history it searches (basisu -uastc_rdo_d), 64–65536
   int zstd = 18;          // UASTC: zstd supercompression level, 1–22; 0: none
   int max_size = 0;       // the longer side at most this (1–16384); 0: no limit
   double scale = 1;       // both sides times this (0 < scale ≤ 1)

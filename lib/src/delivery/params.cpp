@@ -50,6 +50,12 @@ void add_class(std::vector<Param<Options>>& out, TextureClass c) {
                                                      "compresses better under zstd, with more error; 0 off",
                                              .min = 0, .max = 100, .example = "1", .needs = under(Codec::uastc)},
                                         field(&ClassOptions::uastc_rdo)));
+  out.push_back(params::integer<Options>(Spec{.name = name + "_uastc_rdo_dictionary",
+                                              .help = "Bytes of earlier blocks UASTC rate-distortion of " + what +
+                                                      " searches for matches (basisu -uastc_rdo_d): smaller is faster and "
+                                                      "compresses less",
+                                              .min = 64, .max = 65536, .example = "1024", .needs = under(Codec::uastc)},
+                                         field(&ClassOptions::uastc_rdo_dictionary)));
   out.push_back(params::integer<Options>(Spec{.name = name + "_zstd",
                                               .help = "zstd supercompression level of UASTC " + what + "; 0 none",
                                               .min = 0, .max = 22, .example = "6", .needs = under(Codec::uastc)},
