@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <map>
 #include <sstream>
 
 #include "support/temp_dir.hpp"
@@ -36,32 +37,45 @@ std::vector<std::string> merged_environment(const std::vector<std::string>& chan
   return env;
 }
 
-// The resident memory (bytes) of every process in process group `group`.
-double group_resident_bytes(pid_t group) {
-  double bytes = 0;
-  const double page = double(sysconf(_SC_PAGESIZE));
+// /proc/PID/FILE's text (at most `limit` bytes), empty when the process has ended. read(2), not a
+// stream: a process that ends meanwhile fails the read (ESRCH), not the test.
+std::string proc_text(const std::string& pid, const char* file, std::size_t limit) {
+  const int fd = open(("/proc/" + pid + "/" + file).c_str(), O_RDONLY);
+  if (fd < 0) return {};
+  std::string text(limit, '\0');
+  const ssize_t got = read(fd, text.data(), text.size());
+  close(fd);
+  text.resize(got > 0 ? std::size_t(got) : 0);
+  return text;
+}
+
+// The memory (bytes) the process tree under `root` holds: each process's proportional set size
+// (a page shared by n processes counts 1/n to each, so a forked child not yet running its program
+// adds nothing), summed over `root` and every descendant, whatever process group it is in (matbake
+// starts its encoders in groups of their own) — as a cluster's cgroup counts a job.
+double tree_memory_bytes(pid_t root) {
+  std::map<long, std::vector<std::string>> children;
   std::error_code ec;
   for (const auto& entry : std::filesystem::directory_iterator("/proc", ec)) {
     const std::string pid = entry.path().filename().string();
     if (pid.empty() || pid.find_first_not_of("0123456789") != std::string::npos) continue;
-    // read(2), not a stream: a process that ends meanwhile fails the read (ESRCH), not the test.
-    const int fd = open((entry.path() / "stat").c_str(), O_RDONLY);
-    if (fd < 0) continue;
-    std::string text(1024, '\0');
-    const ssize_t got = read(fd, text.data(), text.size());
-    close(fd);
-    if (got <= 0) continue;
-    text.resize(std::size_t(got));
-    const std::size_t close = text.rfind(')');  // the command name may hold spaces
-    if (close == std::string::npos) continue;
-    std::istringstream fields(text.substr(close + 2));
-    std::string field;
-    long pgrp = 0, rss = 0;
-    for (int i = 3; i <= 24 && fields >> field; ++i) {
-      if (i == 5) pgrp = std::atol(field.c_str());
-      if (i == 24) rss = std::atol(field.c_str());
-    }
-    if (pgrp == group) bytes += double(rss) * page;
+    const std::string stat = proc_text(pid, "stat", 1024);
+    const std::size_t close = stat.rfind(')');  // the command name may hold spaces
+    if (close == std::string::npos || close + 2 > stat.size()) continue;
+    std::istringstream fields(stat.substr(close + 2));
+    std::string state;
+    long ppid = 0;
+    if (fields >> state >> ppid) children[ppid].push_back(pid);
+  }
+  double bytes = 0;
+  std::vector<std::string> pending{std::to_string(root)};
+  while (!pending.empty()) {
+    const std::string pid = pending.back();
+    pending.pop_back();
+    const std::string rollup = proc_text(pid, "smaps_rollup", 4096);
+    if (const std::size_t at = rollup.find("\nPss:"); at != std::string::npos) bytes += std::atof(rollup.c_str() + at + 5) * 1024;
+    const auto found = children.find(std::atol(pid.c_str()));
+    if (found != children.end()) pending.insert(pending.end(), found->second.begin(), found->second.end());
   }
   return bytes;
 }
@@ -98,7 +112,7 @@ RunResult run_program(const std::string& program, const std::vector<std::string>
     setpgid(pid, pid);  // as the child does: whichever runs first
     struct rusage usage {};
     while (wait4(pid, &status, WNOHANG, &usage) == 0) {
-      result.peak_mb = std::max(result.peak_mb, group_resident_bytes(pid) / (1024.0 * 1024.0));
+      result.peak_mb = std::max(result.peak_mb, tree_memory_bytes(pid) / (1024.0 * 1024.0));
       usleep(1000);
     }
     result.peak_mb = std::max(result.peak_mb, double(usage.ru_maxrss) / 1024.0);

@@ -8,7 +8,7 @@ struct RunResult {
   int exit_code = -1;  // 128 + signal when killed by one
   std::string out;
   std::string err;
-  double peak_mb = 0;  // run_measured: the most memory its processes held at once (RSS, MiB)
+  double peak_mb = 0;  // run_measured: the most memory its processes held at once (MiB)
 };
 
 // Runs `program args...` with stdout and stderr captured; `env` entries ("NAME=value") are added
@@ -16,9 +16,10 @@ struct RunResult {
 RunResult run(const std::string& program, const std::vector<std::string>& args,
               const std::vector<std::string>& env = {});
 
-// run, in a process group of its own whose resident memory is summed every millisecond, as a
-// cluster's cgroup counts a job and the encoders it starts: the peak of the sums, or the largest
-// single process's own peak (the kernel's, between samples) when that is higher.
+// run, in a process group of its own (killed as one), its memory and its descendants' summed every
+// millisecond as proportional set sizes (tree_memory_bytes in run.cpp), as a cluster's cgroup
+// counts a job and the encoders it starts: the peak of the sums, or the largest single process's
+// own peak (the kernel's, between samples) when that is higher.
 RunResult run_measured(const std::string& program, const std::vector<std::string>& args,
                        const std::vector<std::string>& env = {});
 

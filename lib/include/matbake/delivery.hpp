@@ -171,6 +171,8 @@ std::vector<image::Image> mip_chain(const image::Image& source, Size base, const
                                     bool whole_chain = true);
 // The same for the levels of `sizes` alone (of a chain whose other levels are made elsewhere).
 std::vector<image::Image> mip_levels(const image::Image& source, const std::vector<Size>& sizes, const MipRequest& request);
+// The source consumed: a level of its own size is the source itself, not a copy.
+std::vector<image::Image> mip_levels(image::Image&& source, const std::vector<Size>& sizes, const MipRequest& request);
 
 // The fraction of texels whose alpha, stored in 8 bits, is at least `cutoff` (what a MASK material
 // renders). 1 when the image has no alpha.

@@ -195,7 +195,7 @@ struct Work {
 Size ktx2_size(Size s) { return {std::max(s.width, 4), std::max(s.height, 4)}; }
 bool sides_fit_ktx2(Size s) { return s.width % 4 == 0 && s.height % 4 == 0; }
 
-Status make(Work& w, const image::Image& source, const Options& options, const Encoder* encoder, const fs::path& output, int threads) {
+Status make(Work& w, image::Image source, const Options& options, const Encoder* encoder, const fs::path& output, int threads) {
   const MipRequest request{w.use.texture_class, w.sampling, w.use.alpha_cutoff};
   if (w.codec == Codec::png) {
     w.level0 = std::move(mip_chain(source, w.size, request, false)[0]);
@@ -205,7 +205,7 @@ Status make(Work& w, const image::Image& source, const Options& options, const E
   EncodeRequest encode{.texture_class = w.use.texture_class, .options = options.of(w.use.texture_class), .sampling = w.sampling,
                        .mipmaps = options.mipmaps, .alpha = has_alpha(source),
                        .scratch = output.parent_path() / (w.name + ".ktx2"), .threads = threads};
-  auto made = encode_with_cache({options.encode_cache, options.encode_cache_bytes}, *encoder, source, w.size, request, encode,
+  auto made = encode_with_cache({options.encode_cache, options.encode_cache_bytes}, *encoder, std::move(source), w.size, request, encode,
                                  "matbake " + std::string(matbake::version) + " / basisu " + encoder->version, w.reused);
   if (!made) return made.error();
   w.ktx2 = std::move(made->file);
@@ -358,7 +358,7 @@ Result<std::vector<TextureReport>> deliver_textures(gltf::Document& doc, gltf::I
     w.status = guarded(doc.file, [&]() -> Status {
       auto source = cache.decode(w.texture, w.transfer);
       if (!source) return source.error();
-      return make(w, *source, options, encoder, output, threads);
+      return make(w, std::move(*source), options, encoder, output, threads);
     });
   }, tbb::simple_partitioner());
   for (Work& w : work) {

@@ -4,7 +4,9 @@
 #include <tbb/task_group.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <deque>
+#include <limits>
 #include <fstream>
 
 #include "matbake/atomic_file.hpp"
@@ -52,12 +54,19 @@ Result<std::vector<unsigned char>> read_output(const fs::path& path, std::uintma
   return bytes;
 }
 
-// UASTC blocks per basisu run when a level is split (1024 × 1024 texels). Each run's RDO starts afresh:
-// on WaterBottle's 2048² colour texture (λ 1, zstd 18) 4 strips cost 2.0% more bytes than one run,
-// 16 strips 4.0% (docs/delivery.md).
-constexpr int kStripBlocks = 65536;
+// UASTC blocks per basisu run (1024 × 1024 texels): a larger level is split into strips of whole
+// block rows. Each run's RDO starts afresh: on WaterBottle's 2048² colour texture (λ 1, zstd 18) 4
+// strips cost 2.0% more bytes than one run, 16 strips 4.0% (docs/delivery.md).
+constexpr std::uint64_t kStripBlocks = 65536;
 
-std::uint64_t texels_of(const image::Image& level) { return std::uint64_t(level.width) * std::uint64_t(level.height); }
+std::uint64_t blocks_of(Size s) { return std::uint64_t((s.width + 3) / 4) * std::uint64_t((s.height + 3) / 4); }
+
+// What basisu encodes in one file: a whole level or a strip of one, as the 8-bit PNG it reads.
+struct Piece {
+  std::size_t level = 0;  // its index in the chain
+  Size size;
+  std::string png;
+};
 
 // Files basisu names itself (after its inputs), removed when the run's scratch files go.
 struct EncoderOutputs {
@@ -67,20 +76,19 @@ struct EncoderOutputs {
   }
 };
 
-// One basisu run over `levels`: each written as a scratch PNG, each encoded into a KTX2 file beside
-// it; their bytes, in order.
-Result<std::vector<std::vector<unsigned char>>> run_on(const Encoder& encoder, const std::vector<const image::Image*>& levels,
+// One basisu run over `pieces`: each written as a scratch PNG, each encoded into a KTX2 file beside
+// it (basisu encodes every input file on its own, so a piece's bytes do not depend on its run);
+// their bytes, in order.
+Result<std::vector<std::vector<unsigned char>>> run_on(const Encoder& encoder, const std::vector<const Piece*>& pieces,
                                                        const EncodeRequest& request, std::vector<std::string> args) {
   std::vector<AtomicFile> inputs;
   std::uint64_t texels = 0;
-  for (const image::Image* level : levels) {
-    texels += texels_of(*level);
-    auto png = png_bytes(*level, request);
-    if (!png) return png.error();
+  for (const Piece* piece : pieces) {
+    texels += std::uint64_t(piece->size.width) * std::uint64_t(piece->size.height);
     auto input = AtomicFile::create(fs::path(request.scratch).replace_extension(".basisu-in.png"));
     if (!input) return input.error();
     std::ofstream out(input->temp_path(), std::ios::binary);
-    out.write(png->data(), std::streamsize(png->size()));
+    out.write(piece->png.data(), std::streamsize(piece->png.size()));
     if (!out) return Error{input->temp_path().string(), "cannot write the encoder's input"};
     inputs.push_back(std::move(*input));
   }
@@ -95,31 +103,25 @@ Result<std::vector<std::vector<unsigned char>>> run_on(const Encoder& encoder, c
   std::vector<std::vector<unsigned char>> files;
   for (std::size_t i = 0; i < outputs.paths.size(); ++i) {
     // UASTC is a byte a texel; ETC1S less; a whole mip chain under 4/3 of that; plus the header.
-    auto bytes = read_output(outputs.paths[i], 2 * texels_of(*levels[i]) + (1u << 20), what);
+    const Size s = pieces[i]->size;
+    auto bytes = read_output(outputs.paths[i], 2 * std::uint64_t(s.width) * std::uint64_t(s.height) + (1u << 20), what);
     if (!bytes) return bytes.error();
     files.push_back(std::move(*bytes));
   }
   return files;
 }
 
-// The UASTC blocks of each file basisu wrote for one level.
-Result<std::vector<unsigned char>> blocks_of(const Encoder& encoder, const std::vector<unsigned char>& file, const image::Image& level,
-                                             const std::string& name) {
+// The UASTC blocks of the file basisu wrote for one piece.
+Result<std::vector<unsigned char>> uastc_blocks(const Encoder& encoder, const std::vector<unsigned char>& file, Size size,
+                                                const std::string& name) {
   auto texture = ktx2::read(file, name + " (basisu's output)");
   if (!texture) return texture.error();
   if (texture->descriptor.model != ktx2::kModelUASTC || texture->supercompression != ktx2::kSupercompressionNone ||
-      texture->width != unsigned(level.width) || texture->height != unsigned(level.height)) {
+      texture->width != unsigned(size.width) || texture->height != unsigned(size.height)) {
     return Error{name, "basisu " + encoder.version + " wrote an unexpected KTX2 file (not plain UASTC of the level's size)"};
   }
   return ktx2::level_data(*texture, 0, name);
 }
-
-// One basisu run of UASTC: the pieces it encodes, each a whole level or a strip of one.
-struct Piece {
-  std::size_t level = 0;  // its index in the chain
-  const image::Image* image = nullptr;
-  int first_row = 0, rows = 0;  // texel rows of the level
-};
 
 // Rows `first` to `first + rows` of `level`.
 image::Image rows_of(const image::Image& level, int first, int rows) {
@@ -132,89 +134,143 @@ image::Image rows_of(const image::Image& level, int first, int rows) {
   return strip;
 }
 
-// The basisu runs of a chain's UASTC levels from `first_level` on: a level larger than a strip
-// (kStripBlocks) in strips of whole block rows, each its own run; the smaller ones in one run.
-std::vector<std::vector<Piece>> plan_runs(const std::vector<const image::Image*>& levels, std::size_t first_level) {
-  std::vector<std::vector<Piece>> runs;
-  std::vector<Piece> small;
-  for (std::size_t l = first_level; l < levels.size(); ++l) {
+// A chain's levels as pieces, in order: a level of more than `max_blocks` blocks in strips of whole
+// block rows (where it splits depends on its size alone, never on the thread count), the others whole.
+Result<std::vector<Piece>> pieces_of(const std::vector<const image::Image*>& levels, const EncodeRequest& request,
+                                     std::uint64_t max_blocks) {
+  struct Cut {
+    std::size_t level;
+    int first_row, rows;
+  };
+  std::vector<Cut> cuts;
+  for (std::size_t l = 0; l < levels.size(); ++l) {
     const image::Image& level = *levels[l];
-    const int strip_rows = 4 * std::max(1, kStripBlocks / ((level.width + 3) / 4));
-    if (level.height <= strip_rows) {
-      small.push_back({l, &level, 0, level.height});
-      continue;
-    }
-    for (int y = 0; y < level.height; y += strip_rows) runs.push_back({{l, &level, y, std::min(strip_rows, level.height - y)}});
+    const std::uint64_t rows = std::max<std::uint64_t>(1, max_blocks / std::uint64_t((level.width + 3) / 4));
+    const int strip_rows = int(std::min<std::uint64_t>(4 * rows, std::uint64_t(level.height)));
+    for (int y = 0; y < level.height; y += strip_rows) cuts.push_back({l, y, std::min(strip_rows, level.height - y)});
   }
-  if (!small.empty()) runs.push_back(std::move(small));
+  std::vector<Piece> pieces(cuts.size());
+  std::vector<Status> made(cuts.size(), success());
+  tbb::parallel_for(std::size_t(0), cuts.size(), [&](std::size_t i) {
+    const image::Image& level = *levels[cuts[i].level];
+    const bool whole = cuts[i].rows == level.height;
+    auto png = png_bytes(whole ? level : rows_of(level, cuts[i].first_row, cuts[i].rows), request);
+    if (!png) {
+      made[i] = png.error();
+      return;
+    }
+    pieces[i] = {cuts[i].level, {level.width, cuts[i].rows}, std::move(*png)};
+  });
+  for (Status& s : made) {
+    if (!s) return s.error();
+  }
+  return pieces;
+}
+
+// Consecutive pieces joined into runs of at most kStripBlocks blocks (a piece alone may fill one):
+// a process per small level would cost more than its encode.
+std::vector<std::vector<std::size_t>> plan_runs(const std::vector<Piece>& pieces) {
+  std::vector<std::vector<std::size_t>> runs;
+  std::uint64_t filled = kStripBlocks;
+  for (std::size_t i = 0; i < pieces.size(); ++i) {
+    const std::uint64_t blocks = blocks_of(pieces[i].size);
+    if (filled + blocks > kStripBlocks) {
+      runs.emplace_back();
+      filled = 0;
+    }
+    runs.back().push_back(i);
+    filled += blocks;
+  }
   return runs;
 }
 
-// One run: each piece's blocks (row-major, as the level stores them).
-Result<std::vector<std::vector<unsigned char>>> encode_run(const Encoder& encoder, const std::vector<Piece>& run,
-                                                           const EncodeRequest& request, const std::vector<std::string>& args) {
-  std::vector<image::Image> strips;
-  std::vector<const image::Image*> inputs;
-  strips.reserve(run.size());
-  for (const Piece& piece : run) {
-    const image::Image& level = *piece.image;
-    const bool whole = piece.rows == level.height;
-    if (!whole) strips.push_back(rows_of(level, piece.first_row, piece.rows));
-    inputs.push_back(whole ? &level : &strips.back());
+// A part of a UASTC chain on its way through basisu: its pieces, their runs (largest first), and
+// each piece's blocks once encoded.
+struct Batch {
+  std::vector<Piece> pieces;
+  std::vector<std::vector<std::size_t>> runs;
+  std::vector<Result<std::vector<unsigned char>>> blocks;
+  std::atomic<std::size_t> next{0};  // the run the next task takes
+};
+
+// Starts `batch`'s runs in `encoding`, one encoder thread each: RDO works through a piece's blocks
+// in order, so its bytes depend on where a level splits, never on the thread count. Each task takes
+// the next run in order, so that the largest start first and no long one starts last.
+void start_runs(tbb::task_group& encoding, Batch& batch, const Encoder& encoder, const EncodeRequest& request,
+                const std::vector<std::string>& args) {
+  batch.runs = plan_runs(batch.pieces);
+  const auto blocks = [&](const std::vector<std::size_t>& run) {
+    std::uint64_t n = 0;
+    for (std::size_t i : run) n += blocks_of(batch.pieces[i].size);
+    return n;
+  };
+  std::stable_sort(batch.runs.begin(), batch.runs.end(), [&](const auto& x, const auto& y) { return blocks(x) > blocks(y); });
+  batch.blocks.assign(batch.pieces.size(), Error{"", "not encoded"});
+  for (std::size_t r = 0; r < batch.runs.size(); ++r) {
+    encoding.run([&batch, &encoder, &request, &args] {
+      const std::vector<std::size_t>& run = batch.runs[batch.next++];
+      std::vector<const Piece*> inputs;
+      for (std::size_t i : run) inputs.push_back(&batch.pieces[i]);
+      auto files = run_on(encoder, inputs, request, args);
+      for (std::size_t k = 0; k < run.size(); ++k) {
+        const Piece& piece = batch.pieces[run[k]];
+        batch.blocks[run[k]] = files ? uastc_blocks(encoder, (*files)[k], piece.size, request.scratch.string())
+                                     : Result<std::vector<unsigned char>>(files.error());
+      }
+    });
   }
-  auto files = run_on(encoder, inputs, request, args);
-  if (!files) return files.error();
-  std::vector<std::vector<unsigned char>> blocks;
-  for (std::size_t i = 0; i < inputs.size(); ++i) {
-    auto b = blocks_of(encoder, (*files)[i], *inputs[i], request.scratch.string());
-    if (!b) return b.error();
-    blocks.push_back(std::move(*b));
-  }
-  return blocks;
 }
 
-// UASTC, every level's runs in parallel (level 0's while the other levels are made), one encoder
-// thread each: RDO works through a run's blocks in order, so its bytes depend on where runs split,
-// and the split depends on the level's size alone, never on the thread count; then each level
+// The levels of `batches` (in chain order), each level's blocks joined top to bottom and
 // supercompressed.
-Result<std::vector<ktx2::Level>> uastc_levels(const Encoder& encoder, const image::Image& level0, tbb::task_group& work,
-                                              const std::vector<image::Image>& rest, const EncodeRequest& request) {
-  EncodeRequest one_thread = request;
-  one_thread.threads = 1;
-  const std::vector<std::string> args = encoder_arguments(request);
-  std::vector<const image::Image*> levels{&level0};
-  // Deques: a run started keeps its place while later ones are added.
-  std::deque<std::vector<Piece>> runs;
-  std::deque<Result<std::vector<std::vector<unsigned char>>>> encoded;
-  tbb::task_group encoding;
-  auto start = [&](std::vector<std::vector<Piece>> planned) {
-    for (std::vector<Piece>& run : planned) {
-      const std::vector<Piece>& pieces = runs.emplace_back(std::move(run));
-      auto& result = encoded.emplace_back(Error{"", "not encoded"});
-      encoding.run([&encoder, &one_thread, &args, p = &pieces, out = &result] { *out = encode_run(encoder, *p, one_thread, args); });
-    }
-  };
-  start(plan_runs(levels, 0));
-  work.wait();  // the other levels
-  for (const image::Image& l : rest) levels.push_back(&l);
-  start(plan_runs(levels, 1));
-  encoding.wait();
-  std::vector<std::vector<unsigned char>> blocks(levels.size());
-  for (std::size_t r = 0; r < runs.size(); ++r) {  // in order: a level's strips join top to bottom
-    if (!encoded[r]) return encoded[r].error();
-    for (std::size_t i = 0; i < runs[r].size(); ++i) {
-      std::vector<unsigned char>& level = blocks[runs[r][i].level];
-      level.insert(level.end(), (*encoded[r])[i].begin(), (*encoded[r])[i].end());
+Result<std::vector<ktx2::Level>> join_levels(std::deque<Batch>& batches, std::size_t level_count, int zstd) {
+  std::vector<std::vector<unsigned char>> level_blocks(level_count);
+  for (Batch& batch : batches) {
+    for (std::size_t i = 0; i < batch.pieces.size(); ++i) {
+      if (!batch.blocks[i]) return batch.blocks[i].error();
+      std::vector<unsigned char>& level = level_blocks[batch.pieces[i].level];
+      level.insert(level.end(), batch.blocks[i]->begin(), batch.blocks[i]->end());
     }
   }
-  std::vector<Result<ktx2::Level>> stored(blocks.size(), Error{"", "not stored"});
-  tbb::parallel_for(std::size_t(0), blocks.size(), [&](std::size_t l) { stored[l] = ktx2::uastc_level(std::move(blocks[l]), request.options.zstd); });
+  std::vector<Result<ktx2::Level>> stored(level_count, Error{"", "not stored"});
+  tbb::parallel_for(std::size_t(0), level_count, [&](std::size_t l) { stored[l] = ktx2::uastc_level(std::move(level_blocks[l]), zstd); });
   std::vector<ktx2::Level> out;
   for (Result<ktx2::Level>& l : stored) {
     if (!l) return l.error();
     out.push_back(std::move(*l));
   }
   return out;
+}
+
+// The chain of `source` as UASTC levels: level 0 made and its runs (the largest) started first, the
+// other levels made from the source meanwhile, then theirs. Levels are held as basisu reads them
+// (8-bit PNG, a quarter of the floats) from when they are made; the source goes with the last.
+Result<std::vector<ktx2::Level>> uastc_chain(const Encoder& encoder, image::Image source, const std::vector<Size>& sizes,
+                                             const MipRequest& mips, const EncodeRequest& request, std::vector<double>& coverage) {
+  EncodeRequest one_thread = request;
+  one_thread.threads = 1;
+  const std::vector<std::string> args = encoder_arguments(request);
+  std::deque<Batch> batches;  // a batch keeps its place while its runs read it
+  tbb::task_group encoding;
+  const auto add_batch = [&](const std::vector<image::Image>& levels, std::size_t first_level) -> Status {
+    std::vector<const image::Image*> chain;
+    for (const image::Image& l : levels) {
+      chain.push_back(&l);
+      if (mips.alpha_cutoff) coverage.push_back(alpha_coverage(l, *mips.alpha_cutoff));
+    }
+    auto pieces = pieces_of(chain, request, kStripBlocks);
+    if (!pieces) return pieces.error();
+    for (Piece& p : *pieces) p.level += first_level;
+    Batch& batch = batches.emplace_back();
+    batch.pieces = std::move(*pieces);
+    start_runs(encoding, batch, encoder, one_thread, args);
+    return success();
+  };
+  Status status = add_batch(mip_levels(source, {sizes[0]}, mips), 0);
+  if (status && sizes.size() > 1) status = add_batch(mip_levels(std::move(source), {sizes.begin() + 1, sizes.end()}, mips), 1);
+  encoding.wait();
+  if (!status) return status.error();
+  return join_levels(batches, sizes.size(), request.options.zstd);
 }
 
 }  // namespace
@@ -254,35 +310,13 @@ std::vector<std::string> encoder_arguments(const EncodeRequest& request) {
   return args;
 }
 
-Result<Encoded> encode_texture(const Encoder& encoder, const image::Image& source, Size base, const MipRequest& mips,
+Result<Encoded> encode_texture(const Encoder& encoder, image::Image source, Size base, const MipRequest& mips,
                                const EncodeRequest& request, const std::string& writer) {
-  const bool uastc = request.options.codec == Codec::uastc;
-  std::vector<Size> sizes = uastc && request.mipmaps ? mip_sizes(base) : std::vector<Size>{base};
-  const image::Image level0 = std::move(mip_levels(source, {base}, mips)[0]);
-  std::vector<image::Image> rest;
-  tbb::task_group work;
-  if (sizes.size() > 1) work.run([&] { rest = mip_levels(source, {sizes.begin() + 1, sizes.end()}, mips); });
   Encoded out;
-  if (!uastc) {
-    auto file = run_on(encoder, {&level0}, request, encoder_arguments(request));
-    work.wait();
-    if (!file) return file.error();
-    out.file = std::move((*file)[0]);
-    auto read = ktx2::read(out.file, request.scratch.string());  // basisu's own chain
-    if (!read) return read.error();
-    const std::size_t expected = request.mipmaps ? mip_sizes(base).size() : 1;
-    if (read->descriptor.model != ktx2::kModelETC1S || read->width != unsigned(base.width) || read->height != unsigned(base.height) ||
-        read->levels.size() != expected) {
-      return Error{request.scratch.string(), "basisu " + encoder.version + " wrote an unexpected KTX2 file (" +
-                                                 std::to_string(read->width) + "x" + std::to_string(read->height) + ", " +
-                                                 std::to_string(read->levels.size()) + " levels; asked for ETC1S " +
-                                                 std::to_string(base.width) + "x" + std::to_string(base.height) + ", " +
-                                                 std::to_string(expected) + " levels)"};
-    }
-    out.levels = int(read->levels.size());
-    if (auto conformed = ktx2::conform_primaries(out.file, request.scratch.string()); !conformed) return conformed.error();
-  } else {
-    auto levels = uastc_levels(encoder, level0, work, rest, request);
+  if (mips.alpha_cutoff) out.coverage.push_back(alpha_coverage(source, *mips.alpha_cutoff));
+  if (request.options.codec == Codec::uastc) {
+    const std::vector<Size> sizes = request.mipmaps ? mip_sizes(base) : std::vector<Size>{base};
+    auto levels = uastc_chain(encoder, std::move(source), sizes, mips, request, out.coverage);
     if (!levels) return levels.error();
     ktx2::UastcFile file{.width = unsigned(base.width), .height = unsigned(base.height),
                          .transfer = request.texture_class == TextureClass::colour ? ktx2::kTransferSRGB : ktx2::kTransferLinear,
@@ -292,11 +326,30 @@ Result<Encoded> encode_texture(const Encoder& encoder, const image::Image& sourc
     if (!bytes) return bytes.error();
     out.file = std::move(*bytes);
     out.levels = int(sizes.size());
+    return out;
   }
-  if (mips.alpha_cutoff) {
-    out.coverage = {alpha_coverage(source, *mips.alpha_cutoff), alpha_coverage(level0, *mips.alpha_cutoff)};
-    for (const image::Image& l : rest) out.coverage.push_back(alpha_coverage(l, *mips.alpha_cutoff));
+  // ETC1S: level 0 alone, basisu making the chain.
+  std::vector<image::Image> level0 = mip_levels(std::move(source), {base}, mips);
+  if (mips.alpha_cutoff) out.coverage.push_back(alpha_coverage(level0[0], *mips.alpha_cutoff));
+  auto pieces = pieces_of({&level0[0]}, request, std::numeric_limits<std::uint64_t>::max());
+  if (!pieces) return pieces.error();
+  level0.clear();
+  auto file = run_on(encoder, {&pieces->front()}, request, encoder_arguments(request));
+  if (!file) return file.error();
+  out.file = std::move((*file)[0]);
+  auto read = ktx2::read(out.file, request.scratch.string());  // basisu's own chain
+  if (!read) return read.error();
+  const std::size_t expected = request.mipmaps ? mip_sizes(base).size() : 1;
+  if (read->descriptor.model != ktx2::kModelETC1S || read->width != unsigned(base.width) || read->height != unsigned(base.height) ||
+      read->levels.size() != expected) {
+    return Error{request.scratch.string(), "basisu " + encoder.version + " wrote an unexpected KTX2 file (" +
+                                               std::to_string(read->width) + "x" + std::to_string(read->height) + ", " +
+                                               std::to_string(read->levels.size()) + " levels; asked for ETC1S " +
+                                               std::to_string(base.width) + "x" + std::to_string(base.height) + ", " +
+                                               std::to_string(expected) + " levels)"};
   }
+  out.levels = int(read->levels.size());
+  if (auto conformed = ktx2::conform_primaries(out.file, request.scratch.string()); !conformed) return conformed.error();
   return out;
 }
 

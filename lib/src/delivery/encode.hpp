@@ -1,8 +1,8 @@
 #pragma once
 // A texture through basisu. UASTC: matbake's levels, each an 8-bit PNG in and a one-level KTX2 out
-// (a large level in strips of 1024 × 1024 texels' blocks, each strip its own single-threaded run, in
-// parallel; the small levels in one run), their blocks assembled by ktx2::write_uastc with zstd
-// supercompression. ETC1S: one run from level 0, basisu making the mips
+// (a large level in strips of 1024 × 1024 texels' blocks; runs of at most that many blocks, each
+// single-threaded, in parallel, the largest first), their blocks assembled by ktx2::write_uastc with
+// zstd supercompression. ETC1S: one run from level 0, basisu making the mips
 // (its BasisLZ codebooks span every level, so given levels cannot be joined).
 #include <filesystem>
 #include <vector>
@@ -32,9 +32,9 @@ struct Encoded {
   std::vector<double> coverage;     // with an alpha cutoff: the source's, then each level made here
 };
 
-// `source` as a KTX2 file of level 0 at `base`: the chain made with `mips` (level 1 onwards while
-// level 0 is encoded), encoded as the request says. `writer` is KTXwriter's value for files made here.
-Result<Encoded> encode_texture(const Encoder& encoder, const image::Image& source, Size base, const MipRequest& mips,
+// `source` as a KTX2 file of level 0 at `base`: the chain made with `mips` (the source consumed, and
+// the levels held as 8-bit PNG while basisu runs), encoded as the request says. `writer` is KTXwriter's value for files made here.
+Result<Encoded> encode_texture(const Encoder& encoder, image::Image source, Size base, const MipRequest& mips,
                                const EncodeRequest& request, const std::string& writer);
 
 // basisu's arguments for a class's codec settings, without files.

@@ -198,10 +198,10 @@ std::string encode_key(const image::Image& source, Size base, const MipRequest& 
   return key;
 }
 
-Result<Encoded> encode_with_cache(const EncodeCache& cache, const Encoder& encoder, const image::Image& source, Size base,
+Result<Encoded> encode_with_cache(const EncodeCache& cache, const Encoder& encoder, image::Image source, Size base,
                                   const MipRequest& mips, const EncodeRequest& request, const std::string& writer, bool& reused) {
   reused = false;
-  if (cache.folder.empty() || cache.limit_bytes == 0) return encode_texture(encoder, source, base, mips, request, writer);
+  if (cache.folder.empty() || cache.limit_bytes == 0) return encode_texture(encoder, std::move(source), base, mips, request, writer);
   const std::string key = encode_key(source, base, mips, request, writer);
   if (auto hit = read_entry(cache.folder, key, base)) {
     reused = true;
@@ -209,7 +209,7 @@ Result<Encoded> encode_with_cache(const EncodeCache& cache, const Encoder& encod
   }
   std::optional<Result<Encoded>> made;
   tbb::collaborative_call_once(in_flight(key)->once, [&] {
-    made = encode_texture(encoder, source, base, mips, request, writer);
+    made = encode_texture(encoder, std::move(source), base, mips, request, writer);
     if (*made) keep_entry(cache, key, **made);
   });
   if (made) return std::move(*made);
@@ -217,7 +217,8 @@ Result<Encoded> encode_with_cache(const EncodeCache& cache, const Encoder& encod
     reused = true;
     return std::move(*hit);
   }
-  return encode_texture(encoder, source, base, mips, request, writer);  // it failed there, or was not kept
+  // It failed there, or was not kept; this call's own source is still whole (its function did not run).
+  return encode_texture(encoder, std::move(source), base, mips, request, writer);
 }
 
 }  // namespace matbake::delivery

@@ -35,7 +35,7 @@ std::string encode_key(const image::Image& source, Size base, const MipRequest& 
 // encode_texture through the cache: an entry found is used (and marked recently used), else the
 // texture is encoded and kept. `reused` says which. Within a process one key is encoded once: a
 // second caller waits for the first (its thread working on other tasks meanwhile) and reads its entry.
-Result<Encoded> encode_with_cache(const EncodeCache& cache, const Encoder& encoder, const image::Image& source, Size base,
+Result<Encoded> encode_with_cache(const EncodeCache& cache, const Encoder& encoder, image::Image source, Size base,
                                   const MipRequest& mips, const EncodeRequest& request, const std::string& writer, bool& reused);
 
 }  // namespace matbake::delivery

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <optional>
 
 #include "matbake/delivery.hpp"
 
@@ -149,16 +150,17 @@ image::Image resample(const image::Image& in, Size size, const Sampling& samplin
   const Axis columns = axis_taps(in.width, size.width, sampling.filter, sampling.wrap_s);
   const Axis rows = axis_taps(in.height, size.height, sampling.filter, sampling.wrap_t);
   const std::size_t ch = std::size_t(in.channels);
-  // Columns first: the source's rows at the output's width.
-  std::vector<float> across(std::size_t(in.height) * std::size_t(size.width) * ch);
-  tbb::parallel_for(0, in.height, [&](int y) {
-    const float* row = &in.pixels[std::size_t(y) * std::size_t(in.width) * ch];
-    float* out = &across[std::size_t(y) * std::size_t(size.width) * ch];
-    for (int x = 0; x < size.width; ++x) {
-      for (std::size_t t = columns.first[std::size_t(x)]; t < columns.first[std::size_t(x) + 1]; ++t) {
-        const float* texel = row + std::size_t(columns.taps[t].index) * ch;
-        for (std::size_t c = 0; c < ch; ++c) out[std::size_t(x) * ch + c] += columns.taps[t].weight * texel[c];
-      }
+  // Rows first, over whole source rows: the pass that reads every source texel (6 per output texel
+  // and tap span) is then a sum of contiguous rows, which the compiler vectorises; the columns'
+  // pass reads only the rows made.
+  const std::size_t source_row = std::size_t(in.width) * ch;
+  std::vector<float> down(std::size_t(size.height) * source_row);
+  tbb::parallel_for(0, size.height, [&](int y) {
+    float* dst = &down[std::size_t(y) * source_row];
+    for (std::size_t t = rows.first[std::size_t(y)]; t < rows.first[std::size_t(y) + 1]; ++t) {
+      const float* src = &in.pixels[std::size_t(rows.taps[t].index) * source_row];
+      const float w = rows.taps[t].weight;
+      for (std::size_t i = 0; i < source_row; ++i) dst[i] += w * src[i];
     }
   });
   image::Image out;
@@ -166,13 +168,14 @@ image::Image resample(const image::Image& in, Size size, const Sampling& samplin
   out.width = size.width, out.height = size.height;
   image::reserve_pixels(out.pixels, out.sample_count());
   out.pixels.assign(out.sample_count(), 0.0f);
-  const std::size_t row_samples = std::size_t(size.width) * ch;
   tbb::parallel_for(0, size.height, [&](int y) {
-    float* dst = &out.pixels[std::size_t(y) * row_samples];
-    for (std::size_t t = rows.first[std::size_t(y)]; t < rows.first[std::size_t(y) + 1]; ++t) {
-      const float* src = &across[std::size_t(rows.taps[t].index) * row_samples];
-      const float w = rows.taps[t].weight;
-      for (std::size_t i = 0; i < row_samples; ++i) dst[i] += w * src[i];
+    const float* row = &down[std::size_t(y) * source_row];
+    float* dst = &out.pixels[std::size_t(y) * std::size_t(size.width) * ch];
+    for (int x = 0; x < size.width; ++x) {
+      for (std::size_t t = columns.first[std::size_t(x)]; t < columns.first[std::size_t(x) + 1]; ++t) {
+        const float* texel = row + std::size_t(columns.taps[t].index) * ch;
+        for (std::size_t c = 0; c < ch; ++c) dst[std::size_t(x) * ch + c] += columns.taps[t].weight * texel[c];
+      }
     }
   });
   return out;
@@ -192,18 +195,44 @@ std::vector<image::Image> mip_chain(const image::Image& source, Size base, const
   return mip_levels(source, whole_chain ? mip_sizes(base) : std::vector<Size>{base}, request);
 }
 
-std::vector<image::Image> mip_levels(const image::Image& source, const std::vector<Size>& sizes, const MipRequest& request) {
+namespace {
+
+// The levels of `sizes`, each from the source; a level of the source's own size is the source
+// itself (moved when `source` is an rvalue), renormalised like the others.
+template <class Source>
+std::vector<image::Image> make_levels(Source&& source, const std::vector<Size>& sizes, const MipRequest& request) {
   const float cutoff = request.alpha_cutoff.value_or(0.0f);
   const double coverage = request.alpha_cutoff ? alpha_coverage(source, cutoff) : 1.0;
-  std::vector<image::Image> levels;
-  for (const Size& size : sizes) {
-    image::Image level = resample(source, size, request.sampling);
+  const auto finish = [&](image::Image& level, bool resized) {
     if (request.texture_class == TextureClass::normal && level.channels >= 3) renormalise_normals(level);
-    const bool resized = size.width != source.width || size.height != source.height;
     if (request.alpha_cutoff && resized) keep_coverage(level, cutoff, coverage);
-    levels.push_back(std::move(level));
+  };
+  const Size own{source.width, source.height};
+  std::vector<image::Image> levels(sizes.size());
+  std::optional<std::size_t> same;
+  for (std::size_t i = 0; i < sizes.size(); ++i) {
+    if (sizes[i] == own && !same) {
+      same = i;  // made last: the others still read the source
+      continue;
+    }
+    levels[i] = resample(source, sizes[i], request.sampling);
+    finish(levels[i], true);
+  }
+  if (same) {
+    levels[*same] = std::forward<Source>(source);
+    finish(levels[*same], false);
   }
   return levels;
+}
+
+}  // namespace
+
+std::vector<image::Image> mip_levels(const image::Image& source, const std::vector<Size>& sizes, const MipRequest& request) {
+  return make_levels(source, sizes, request);
+}
+
+std::vector<image::Image> mip_levels(image::Image&& source, const std::vector<Size>& sizes, const MipRequest& request) {
+  return make_levels(std::move(source), sizes, request);
 }
 
 }  // namespace matbake::delivery

@@ -109,7 +109,9 @@ PngEncoder::PngEncoder(const ImageLayout& layout, int bits, int level, std::stri
 void PngEncoder::filter_row(const std::uint8_t* row) {
   std::uint64_t best_sum = UINT64_MAX;
   int best = kNone;
-  for (int f = 0; f < kFilterCount; ++f) {
+  // Stored (level 0): a filter cannot make stored bytes smaller, so none is tried.
+  const int tried = level_ == 0 ? kNone + 1 : kFilterCount;
+  for (int f = kNone; f < tried; ++f) {
     std::uint8_t* out = candidate_.data() + std::size_t(f) * row_bytes_;
     apply_filter(Filter(f), row, previous_.data(), row_bytes_, pixel_bytes_, out);
     const std::uint64_t sum = signed_byte_sum(out, row_bytes_);
