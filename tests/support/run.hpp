@@ -17,7 +17,7 @@ RunResult run(const std::string& program, const std::vector<std::string>& args,
               const std::vector<std::string>& env = {});
 
 // run, in a process group of its own (killed as one), its memory and its descendants' summed every
-// millisecond as proportional set sizes (tree_memory_bytes in run.cpp), as a cluster's cgroup
+// 5 ms as proportional set sizes (tree_memory_bytes in run.cpp), as a cluster's cgroup
 // counts a job and the encoders it starts: the peak of the sums, or the largest single process's
 // own peak (the kernel's, between samples) when that is higher.
 RunResult run_measured(const std::string& program, const std::vector<std::string>& args,

@@ -136,8 +136,10 @@ image::Image rows_of(const image::Image& level, int first, int rows) {
 
 // A chain's levels as pieces, in order: a level of more than `max_blocks` blocks in strips of whole
 // block rows (where it splits depends on its size alone, never on the thread count), the others whole.
+// With `finish`, each piece is made a level of its own size first (what mip_levels does at the
+// source's size is texel by texel, so a strip's equals the level's strip).
 Result<std::vector<Piece>> pieces_of(const std::vector<const image::Image*>& levels, const EncodeRequest& request,
-                                     std::uint64_t max_blocks) {
+                                     std::uint64_t max_blocks, const MipRequest* finish = nullptr) {
   struct Cut {
     std::size_t level;
     int first_row, rows;
@@ -153,8 +155,14 @@ Result<std::vector<Piece>> pieces_of(const std::vector<const image::Image*>& lev
   std::vector<Status> made(cuts.size(), success());
   tbb::parallel_for(std::size_t(0), cuts.size(), [&](std::size_t i) {
     const image::Image& level = *levels[cuts[i].level];
-    const bool whole = cuts[i].rows == level.height;
-    auto png = png_bytes(whole ? level : rows_of(level, cuts[i].first_row, cuts[i].rows), request);
+    const bool as_is = cuts[i].rows == level.height && finish == nullptr;
+    image::Image piece;
+    if (!as_is) {
+      piece = rows_of(level, cuts[i].first_row, cuts[i].rows);
+      const Size size{piece.width, piece.height};
+      if (finish) piece = std::move(mip_levels(std::move(piece), {size}, *finish)[0]);
+    }
+    auto png = png_bytes(as_is ? level : piece, request);
     if (!png) {
       made[i] = png.error();
       return;
@@ -252,13 +260,11 @@ Result<std::vector<ktx2::Level>> uastc_chain(const Encoder& encoder, image::Imag
   const std::vector<std::string> args = encoder_arguments(request);
   std::deque<Batch> batches;  // a batch keeps its place while its runs read it
   tbb::task_group encoding;
-  const auto add_batch = [&](const std::vector<image::Image>& levels, std::size_t first_level) -> Status {
-    std::vector<const image::Image*> chain;
-    for (const image::Image& l : levels) {
-      chain.push_back(&l);
-      if (mips.alpha_cutoff) coverage.push_back(alpha_coverage(l, *mips.alpha_cutoff));
+  const auto add_batch = [&](const std::vector<const image::Image*>& chain, std::size_t first_level, const MipRequest* finish) -> Status {
+    for (const image::Image* l : chain) {
+      if (mips.alpha_cutoff) coverage.push_back(alpha_coverage(*l, *mips.alpha_cutoff));
     }
-    auto pieces = pieces_of(chain, request, kStripBlocks);
+    auto pieces = pieces_of(chain, request, kStripBlocks, finish);
     if (!pieces) return pieces.error();
     for (Piece& p : *pieces) p.level += first_level;
     Batch& batch = batches.emplace_back();
@@ -266,8 +272,20 @@ Result<std::vector<ktx2::Level>> uastc_chain(const Encoder& encoder, image::Imag
     start_runs(encoding, batch, encoder, one_thread, args);
     return success();
   };
-  Status status = add_batch(mip_levels(source, {sizes[0]}, mips), 0);
-  if (status && sizes.size() > 1) status = add_batch(mip_levels(std::move(source), {sizes.begin() + 1, sizes.end()}, mips), 1);
+  Status status = success();
+  if (sizes[0] == Size{source.width, source.height}) {
+    status = add_batch({&source}, 0, &mips);  // level 0 made strip by strip from the source, not copied whole
+  } else {
+    const std::vector<image::Image> level0 = mip_levels(source, {sizes[0]}, mips);
+    status = add_batch({&level0[0]}, 0, nullptr);
+  }
+  if (status && sizes.size() > 1) {
+    // The source goes with this statement.
+    const std::vector<image::Image> rest = mip_levels(image::Image(std::move(source)), {sizes.begin() + 1, sizes.end()}, mips);
+    std::vector<const image::Image*> chain;
+    for (const image::Image& l : rest) chain.push_back(&l);
+    status = add_batch(chain, 1, nullptr);
+  }
   encoding.wait();
   if (!status) return status.error();
   return join_levels(batches, sizes.size(), request.options.zstd);

@@ -1,6 +1,7 @@
 // Resampling and mip chains. A separable filter: per output column (then row) the source texels it
 // reads and their weights, computed once per axis; rows in parallel, each written by one task, so the
 // result does not depend on the thread count.
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -150,31 +151,31 @@ image::Image resample(const image::Image& in, Size size, const Sampling& samplin
   const Axis columns = axis_taps(in.width, size.width, sampling.filter, sampling.wrap_s);
   const Axis rows = axis_taps(in.height, size.height, sampling.filter, sampling.wrap_t);
   const std::size_t ch = std::size_t(in.channels);
-  // Rows first, over whole source rows: the pass that reads every source texel (6 per output texel
-  // and tap span) is then a sum of contiguous rows, which the compiler vectorises; the columns'
-  // pass reads only the rows made.
   const std::size_t source_row = std::size_t(in.width) * ch;
-  std::vector<float> down(std::size_t(size.height) * source_row);
-  tbb::parallel_for(0, size.height, [&](int y) {
-    float* dst = &down[std::size_t(y) * source_row];
-    for (std::size_t t = rows.first[std::size_t(y)]; t < rows.first[std::size_t(y) + 1]; ++t) {
-      const float* src = &in.pixels[std::size_t(rows.taps[t].index) * source_row];
-      const float w = rows.taps[t].weight;
-      for (std::size_t i = 0; i < source_row; ++i) dst[i] += w * src[i];
-    }
-  });
   image::Image out;
   static_cast<image::ImageLayout&>(out) = in;
   out.width = size.width, out.height = size.height;
   image::reserve_pixels(out.pixels, out.sample_count());
   out.pixels.assign(out.sample_count(), 0.0f);
-  tbb::parallel_for(0, size.height, [&](int y) {
-    const float* row = &down[std::size_t(y) * source_row];
-    float* dst = &out.pixels[std::size_t(y) * std::size_t(size.width) * ch];
-    for (int x = 0; x < size.width; ++x) {
-      for (std::size_t t = columns.first[std::size_t(x)]; t < columns.first[std::size_t(x) + 1]; ++t) {
-        const float* texel = row + std::size_t(columns.taps[t].index) * ch;
-        for (std::size_t c = 0; c < ch; ++c) dst[std::size_t(x) * ch + c] += columns.taps[t].weight * texel[c];
+  // Each output row through one source row's worth of buffer, not a second image. Rows first, over
+  // whole source rows: the pass that reads every source texel (6 per output texel and tap span) is
+  // then a sum of contiguous rows, which the compiler vectorises; the columns' pass reads only the
+  // row made.
+  tbb::parallel_for(tbb::blocked_range<int>(0, size.height, 16), [&](const tbb::blocked_range<int>& band) {
+    std::vector<float> down(source_row);
+    for (int y = band.begin(); y < band.end(); ++y) {
+      std::fill(down.begin(), down.end(), 0.0f);
+      for (std::size_t t = rows.first[std::size_t(y)]; t < rows.first[std::size_t(y) + 1]; ++t) {
+        const float* src = &in.pixels[std::size_t(rows.taps[t].index) * source_row];
+        const float w = rows.taps[t].weight;
+        for (std::size_t i = 0; i < source_row; ++i) down[i] += w * src[i];
+      }
+      float* texels = &out.pixels[std::size_t(y) * std::size_t(size.width) * ch];
+      for (int x = 0; x < size.width; ++x) {
+        for (std::size_t t = columns.first[std::size_t(x)]; t < columns.first[std::size_t(x) + 1]; ++t) {
+          const float* texel = &down[std::size_t(columns.taps[t].index) * ch];
+          for (std::size_t c = 0; c < ch; ++c) texels[std::size_t(x) * ch + c] += columns.taps[t].weight * texel[c];
+        }
       }
     }
   });
