@@ -346,9 +346,9 @@ Result<std::vector<TextureReport>> deliver_textures(gltf::Document& doc, gltf::I
     found = std::move(*e);
     encoder = &*found;
   }
-  // Textures in parallel; an encoder run gets the threads the textures leave, never more in all.
-  const int jobs = tbb::this_task_arena::max_concurrency();
-  const int threads = std::max(1, jobs / std::max(1, std::min<int>(jobs, int(work.size()))));
+  // Textures in parallel. UASTC runs are single-threaded, as many at once as --jobs; an ETC1S run
+  // (one at a time, encode.cpp) gets every thread.
+  const int threads = tbb::this_task_arena::max_concurrency();
   tbb::parallel_for(std::size_t(0), work.size(), [&](std::size_t i) {
     Work& w = work[i];
     if (w.codec == Codec::png && w.size == w.source_size) return;  // unchanged

@@ -7,6 +7,7 @@
 #include <atomic>
 #include <deque>
 #include <limits>
+#include <mutex>
 #include <fstream>
 
 #include "matbake/atomic_file.hpp"
@@ -352,7 +353,13 @@ Result<Encoded> encode_texture(const Encoder& encoder, image::Image source, Size
   auto pieces = pieces_of({&level0[0]}, request, std::numeric_limits<std::uint64_t>::max());
   if (!pieces) return pieces.error();
   level0.clear();
+  // One ETC1S run at a time, with the request's threads: basisu threads ETC1S itself (its bytes do
+  // not depend on the thread count), and a run holds ~200 MB at 2048², so two at once doubled the
+  // peak (docs/delivery.md#against-gltfpack-with-basisu). A thread waiting here holds no lock of tbb.
+  static std::mutex one_run;
+  std::unique_lock lock(one_run);
   auto file = run_on(encoder, {&pieces->front()}, request, encoder_arguments(request));
+  lock.unlock();
   if (!file) return file.error();
   out.file = std::move((*file)[0]);
   auto read = ktx2::read(out.file, request.scratch.string());  // basisu's own chain

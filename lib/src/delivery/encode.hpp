@@ -20,7 +20,7 @@ struct EncodeRequest {
   bool alpha = false;           // RGBA, else RGB (has_alpha)
   std::filesystem::path scratch;  // a file name in the output folder: scratch files go beside it,
                                   // in the process's temporary folder (removed on an interrupt)
-  int threads = 1;              // encoder threads (basisu -max_threads)
+  int threads = 1;              // threads of an ETC1S run (basisu -max_threads); a UASTC run has one
 };
 
 // Whether a texture needs its alpha: it has an alpha channel with a texel below 1 in 8 bits.
