@@ -313,14 +313,14 @@ Result<std::vector<TextureReport>> deliver_textures(gltf::Document& doc, gltf::I
       continue;
     }
     const color::Transfer transfer = use.texture_class == TextureClass::colour ? color::Transfer::srgb : color::Transfer::linear;
-    // Decoded here for its size and so that a bad image fails the pass before any encode; decoded
-    // again when its turn comes (a decode is milliseconds next to an encode), so that only the
-    // textures being worked on are held.
+    // Its size as the cache's check noted it (else decoded here, so that a bad image fails the pass
+    // before any encode); decoded when its turn comes, so that only the textures being worked on are
+    // held.
     Size source_size;
-    if (auto decoded = cache.decode(texture, transfer); decoded) {
-      source_size = {decoded->width, decoded->height};
+    if (auto size = cache.size_of(texture); size) {
+      source_size = {size->first, size->second};
     } else {
-      return decoded.error();
+      return size.error();
     }
     Work w{.texture = texture, .image = image, .use = use, .sampling = sampling_of(doc.json, t, options.filter),
            .transfer = transfer, .source_size = source_size};

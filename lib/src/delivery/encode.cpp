@@ -353,13 +353,15 @@ Result<Encoded> encode_texture(const Encoder& encoder, image::Image source, Size
   auto pieces = pieces_of({&level0[0]}, request, std::numeric_limits<std::uint64_t>::max());
   if (!pieces) return pieces.error();
   level0.clear();
-  // One ETC1S run at a time, with the request's threads: basisu threads ETC1S itself (its bytes do
-  // not depend on the thread count), and a run holds ~200 MB at 2048², so two at once doubled the
-  // peak (docs/delivery.md#against-gltfpack-with-basisu). A thread waiting here holds no lock of tbb.
-  static std::mutex one_run;
-  std::unique_lock lock(one_run);
+  // A large ETC1S run (a megatexel or more) one at a time, each with the request's threads: basisu
+  // threads ETC1S itself (its bytes do not depend on the thread count), and a run holds ~200 MB at
+  // 2048², so two at once doubled the peak (docs/delivery.md#against-gltfpack-with-basisu). Small
+  // runs, mostly the process's start, go in parallel. A thread waiting here holds no lock of tbb.
+  static std::mutex one_large_run;
+  std::unique_lock lock(one_large_run, std::defer_lock);
+  if (std::uint64_t(base.width) * std::uint64_t(base.height) >= (1u << 20)) lock.lock();
   auto file = run_on(encoder, {&pieces->front()}, request, encoder_arguments(request));
-  lock.unlock();
+  if (lock.owns_lock()) lock.unlock();
   if (!file) return file.error();
   out.file = std::move((*file)[0]);
   auto read = ktx2::read(out.file, request.scratch.string());  // basisu's own chain

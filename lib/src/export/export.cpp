@@ -468,9 +468,7 @@ Result<Report> export_scene(const fs::path& input, const fs::path& output, const
     }
 
     gltf::ImageCache cache(*doc, options.encoding, delivery::made_format(options.delivery));
-    for (std::size_t i = 0; doc->json.contains("images") && i < doc->json["images"].size(); ++i) {
-      if (Status s = cache.check(i); !s) return s.error();
-    }
+    if (Status s = cache.check_all(); !s) return s.error();
     Exporter exporter{*doc, cache, options, output.stem().string(), report, {}, {}};
     const std::size_t materials = doc->json.contains("materials") ? doc->json["materials"].size() : 0;
     for (std::size_t i = 0; i < materials; ++i) {

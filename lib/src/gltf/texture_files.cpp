@@ -110,17 +110,31 @@ Result<image::Image> ImageCache::decode(int texture, color::Transfer colour) con
   return decode_source(*source, colour);
 }
 
-Status ImageCache::check(std::size_t index) {
-  auto bytes = gltf::image_bytes(doc_, index);
-  if (!bytes) return bytes.error();
-  const std::string what = "image " + std::to_string(index);
-  if (bytes->rfind("\xabKTX 20\xbb", 0) == 0) return success();
-  const char* extension = extension_of(*bytes);
-  if (!*extension) return Error{doc_.file, what + " is not PNG, JPEG, WebP or KTX2"};
-  // Decoded in full: a header that reads over truncated or corrupt pixels must not pass.
-  auto decoded = image::decode_image(as_bytes(*bytes), std::string("image") + extension, color::Transfer::linear);
-  if (!decoded) return Error{doc_.file, what + ": " + decoded.error().message};
+Status ImageCache::check_all() {
+  const std::size_t count = array_in(doc_.json, "images").size();
+  // One at a time: a decoded image is up to 16 bytes a texel.
+  for (std::size_t index = 0; index < count; ++index) {
+    auto bytes = gltf::image_bytes(doc_, index);
+    if (!bytes) return bytes.error();
+    const std::string what = "image " + std::to_string(index);
+    if (bytes->rfind("\xabKTX 20\xbb", 0) == 0) continue;  // passed through
+    const char* extension = extension_of(*bytes);
+    if (!*extension) return Error{doc_.file, what + " is not PNG, JPEG, WebP or KTX2"};
+    // Decoded in full: a header that reads over truncated or corrupt pixels must not pass.
+    auto decoded = image::decode_image(as_bytes(*bytes), std::string("image") + extension, color::Transfer::linear);
+    if (!decoded) return Error{doc_.file, what + ": " + decoded.error().message};
+    sizes_[int(index)] = {decoded->width, decoded->height};
+  }
   return success();
+}
+
+Result<std::pair<int, int>> ImageCache::size_of(int texture) const {
+  auto source = source_of(texture);
+  if (!source) return source.error();
+  if (const auto found = sizes_.find(*source); found != sizes_.end()) return found->second;
+  auto decoded = decode_source(*source, color::Transfer::linear);
+  if (!decoded) return decoded.error();
+  return std::pair{decoded->width, decoded->height};
 }
 
 Result<ImageCache::Made> ImageCache::add_image(Document& doc, const image::Image& img, color::Transfer colour,

@@ -50,8 +50,11 @@ class ImageCache {
   // Drops every decoded image kept (texture() decodes again when asked).
   void forget_decoded() { images_.clear(); }
 
-  // Image `index` is a PNG, JPEG or WebP whose header reads, or a KTX2 file (passed through).
-  Status check(std::size_t index);
+  // Every image of the document is a PNG, JPEG or WebP that decodes in full, or a KTX2 file (passed
+  // through); each dropped once its size is noted. The first bad one's error.
+  Status check_all();
+  // The width and height of texture `texture`'s image: as check_all noted it, else decoded.
+  Result<std::pair<int, int>> size_of(int texture) const;
 
   // A new image of `doc` (the cache's document) holding `img`, its colour channels encoded with
   // `colour`, in the cache's format: a new file `<name>.png`, or `<name>.webp` (lossless,
@@ -76,6 +79,7 @@ class ImageCache {
   image::Encoding encoding_;
   MadeFormat made_;
   std::map<std::pair<int, color::Transfer>, image::Image> images_;  // by (image index, transfer)
+  std::map<int, std::pair<int, int>> sizes_;                         // by image index, from check_all
 };
 
 }  // namespace matbake::gltf
