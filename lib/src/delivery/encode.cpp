@@ -251,9 +251,10 @@ Result<std::vector<ktx2::Level>> join_levels(std::deque<Batch>& batches, std::si
   return out;
 }
 
-// The chain of `source` as UASTC levels: level 0 made and its runs (the largest) started first, the
-// other levels made from the source meanwhile, then theirs. Levels are held as basisu reads them
-// (8-bit PNG, a quarter of the floats) from when they are made; the source goes with the last.
+// The chain of `source` as UASTC levels. A level 0 in strips: made and its runs (the largest)
+// started first, the other levels made from the source meanwhile, then theirs. Levels are held as
+// basisu reads them (8-bit PNG, a quarter of the floats) from when they are made; the source goes
+// with the last.
 Result<std::vector<ktx2::Level>> uastc_chain(const Encoder& encoder, image::Image source, const std::vector<Size>& sizes,
                                              const MipRequest& mips, const EncodeRequest& request, std::vector<double>& coverage) {
   EncodeRequest one_thread = request;
@@ -273,19 +274,25 @@ Result<std::vector<ktx2::Level>> uastc_chain(const Encoder& encoder, image::Imag
     start_runs(encoding, batch, encoder, one_thread, args);
     return success();
   };
+  const auto pointers = [](const std::vector<image::Image>& levels) {
+    std::vector<const image::Image*> out;
+    for (const image::Image& l : levels) out.push_back(&l);
+    return out;
+  };
   Status status = success();
-  if (sizes[0] == Size{source.width, source.height}) {
-    status = add_batch({&source}, 0, &mips);  // level 0 made strip by strip from the source, not copied whole
+  if (blocks_of(sizes[0]) <= kStripBlocks) {
+    // Level 0 is one piece: the chain made whole first goes in as few runs as its size allows.
+    status = add_batch(pointers(mip_levels(std::move(source), sizes, mips)), 0, nullptr);
   } else {
-    const std::vector<image::Image> level0 = mip_levels(source, {sizes[0]}, mips);
-    status = add_batch({&level0[0]}, 0, nullptr);
-  }
-  if (status && sizes.size() > 1) {
-    // The source goes with this statement.
-    const std::vector<image::Image> rest = mip_levels(image::Image(std::move(source)), {sizes.begin() + 1, sizes.end()}, mips);
-    std::vector<const image::Image*> chain;
-    for (const image::Image& l : rest) chain.push_back(&l);
-    status = add_batch(chain, 1, nullptr);
+    if (sizes[0] == Size{source.width, source.height}) {
+      status = add_batch({&source}, 0, &mips);  // level 0 made strip by strip from the source, not copied whole
+    } else {
+      status = add_batch(pointers(mip_levels(source, {sizes[0]}, mips)), 0, nullptr);
+    }
+    if (status && sizes.size() > 1) {
+      // The source goes with this statement.
+      status = add_batch(pointers(mip_levels(image::Image(std::move(source)), {sizes.begin() + 1, sizes.end()}, mips)), 1, nullptr);
+    }
   }
   encoding.wait();
   if (!status) return status.error();
