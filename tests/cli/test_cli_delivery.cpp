@@ -266,25 +266,32 @@ TEST(CliDelivery, UastcColourKeepsCoverageAtEveryLevelAndJobsDoNotChangeBytes) {
   }
 }
 
-// An ETC1S run gets --jobs threads (one run at a time): basisu's threaded ETC1S must give the same
-// bytes for any count, on a texture large enough for its threads to split (512², a pattern).
-TEST(CliDelivery, Etc1sBytesDoNotDependOnJobs) {
-  MATBAKE_BASISU_OR_SKIP(basisu);
-  TempDir dir;
-  const int side = 512;
+// quad.gltf in `dir` whose material's baseColor is colour.png, width × height: ramps in red and
+// green, a wave in blue (every block differs). Returns its samples, row by row.
+std::vector<double> write_patterned_quad(const fs::path& dir, int width, int height) {
   GltfBuilder b = quad_with_material_0();
   b.doc["materials"] = {{{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}}};
   b.doc["textures"] = {{{"source", 0}}};
   b.doc["images"] = {{{"uri", "colour.png"}}};
   b.write(dir / "quad.gltf", {0});
   std::vector<double> colour;
-  for (int y = 0; y < side; ++y) {
-    for (int x = 0; x < side; ++x) {
-      colour.insert(colour.end(), {std::round(255.0 * x / (side - 1)), std::round(127.5 + 120 * std::sin(0.09 * x + 0.05 * y)),
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      colour.insert(colour.end(), {std::round(255.0 * x / (width - 1)), std::round(255.0 * y / (height - 1)),
                                    std::round(127.5 + 100 * std::sin(0.05 * x) * std::cos(0.07 * y))});
     }
   }
-  write_raw(dir / "colour.png", side, side, 3, "uint8", colour);
+  write_raw(dir / "colour.png", width, height, 3, "uint8", colour);
+  return colour;
+}
+
+// An ETC1S run gets --jobs threads (one run at a time): basisu's threaded ETC1S must give the same
+// bytes for any count, on a texture large enough for its threads to split (512², a pattern).
+TEST(CliDelivery, Etc1sBytesDoNotDependOnJobs) {
+  MATBAKE_BASISU_OR_SKIP(basisu);
+  TempDir dir;
+  const int side = 512;
+  write_patterned_quad(dir.path(), side, side);
   const std::vector<std::string> env = {"MATBAKE_BASISU=" + basisu};
   std::string first;
   for (const char* jobs : {"1", "2", "3"}) {
@@ -307,19 +314,7 @@ TEST(CliDelivery, LargeLevelsEncodeInStripsInPlaceWithBytesIndependentOfJobs) {
   MATBAKE_BASISU_OR_SKIP(basisu);
   TempDir dir;
   const int width = 1024, height = 1088;
-  GltfBuilder b = quad_with_material_0();
-  b.doc["materials"] = {{{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}}};
-  b.doc["textures"] = {{{"source", 0}}};
-  b.doc["images"] = {{{"uri", "colour.png"}}};
-  b.write(dir / "quad.gltf", {0});
-  std::vector<double> colour;
-  for (int y = 0; y < height; ++y) {
-    for (int x = 0; x < width; ++x) {
-      colour.insert(colour.end(), {std::round(255.0 * x / (width - 1)), std::round(255.0 * y / (height - 1)),
-                                   std::round(127.5 + 100 * std::sin(0.05 * x) * std::cos(0.07 * y))});
-    }
-  }
-  write_raw(dir / "colour.png", width, height, 3, "uint8", colour);
+  const std::vector<double> colour = write_patterned_quad(dir.path(), width, height);
   const std::vector<std::string> env = {"MATBAKE_BASISU=" + basisu};
   std::string first;
   for (const char* jobs : {"1", "2", "3"}) {
