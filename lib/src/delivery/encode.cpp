@@ -318,7 +318,7 @@ std::vector<std::string> encoder_arguments(const EncodeRequest& request) {
   if (o.codec == Codec::uastc) {
     args.insert(args.end(), {"-uastc", "-uastc_level", std::to_string(o.uastc_level), "-ktx2_no_zstandard"});
     // basisu's own threaded RDO splits a level by its thread count (and the machine's): matbake splits
-    // it by size (uastc_levels) and runs each piece single-threaded.
+    // it by size (pieces_of) and runs each piece single-threaded.
     if (o.uastc_rdo > 0) {
       args.insert(args.end(), {"-uastc_rdo_l", std::to_string(o.uastc_rdo), "-uastc_rdo_d", std::to_string(o.uastc_rdo_dictionary), "-uastc_rdo_m"});
     }
