@@ -306,6 +306,63 @@ TEST(CliDelivery, Etc1sBytesDoNotDependOnJobs) {
   }
 }
 
+// The patterned quad (64²) whose material reads colour.png twice, as base colour through a sampler
+// wrapping (wrapS, wrapT) and as emissive through one wrapping (emissive_s, emissive_t).
+void write_quad_reading_one_image_twice(const fs::path& dir, int wrap_s, int wrap_t, int emissive_s, int emissive_t) {
+  fs::create_directories(dir);
+  write_patterned_quad(dir, 64, 64);
+  json quad = json::parse(read_bytes(dir / "quad.gltf"));
+  quad["materials"][0]["emissiveTexture"] = {{"index", 1}};
+  quad["materials"][0]["emissiveFactor"] = {1, 1, 1};
+  quad["samplers"] = {{{"wrapS", wrap_s}, {"wrapT", wrap_t}}, {{"wrapS", emissive_s}, {"wrapT", emissive_t}}};
+  quad["textures"] = {{{"source", 0}, {"sampler", 0}}, {{"source", 0}, {"sampler", 1}}};
+  write_bytes(dir / "quad.gltf", quad.dump());
+}
+
+// One image under two samplers is one file, as gltfpack writes it, KTX2 or resized PNG: its chain is
+// made once, its edges clamped on the axis where the samplers differ and wrapped as they agree on the
+// other — byte for byte the file of the same image read through that sampler alone. The textures
+// keep their own samplers, and their reports say why the edges are clamped.
+TEST(CliDelivery, OneImageUnderTwoSamplersIsMadeOnceWithTheEdgesTheyAgreeOn) {
+  MATBAKE_BASISU_OR_SKIP(basisu);
+  constexpr int kRepeat = 10497, kClamp = 33071, kMirror = 33648;
+  const std::vector<std::string> env = {"MATBAKE_BASISU=" + basisu};
+  const auto files = [](const fs::path& folder, const std::string& extension) {
+    std::vector<std::string> out;
+    for (const std::string& f : list_folder(folder)) {
+      if (f.ends_with(extension)) out.push_back(f);
+    }
+    return out;
+  };
+  for (const std::vector<std::string>& format :
+       {std::vector<std::string>{"--texture-format", "ktx2"}, std::vector<std::string>{"--colour-max-size", "32"}}) {
+    const std::string extension = format[0] == "--texture-format" ? ".ktx2" : ".png";
+    TempDir dir;
+    write_quad_reading_one_image_twice(dir / "shared", kRepeat, kMirror, kRepeat, kClamp);
+    write_quad_reading_one_image_twice(dir / "alone", kRepeat, kClamp, kRepeat, kClamp);
+    std::vector<std::string> args = {"export", (dir / "shared" / "quad.gltf").string(), "-o", (dir / "shared" / "out" / "quad.gltf").string()};
+    args.insert(args.end(), format.begin(), format.end());
+    const json report = run_json(args, env);
+    args[1] = (dir / "alone" / "quad.gltf").string();
+    args[3] = (dir / "alone" / "out" / "quad.gltf").string();
+    run_json(args, env);
+
+    const std::vector<std::string> shared = files(dir / "shared" / "out", extension), alone = files(dir / "alone" / "out", extension);
+    ASSERT_EQ(shared.size(), 1u) << extension;
+    ASSERT_EQ(alone.size(), 1u) << extension;
+    EXPECT_EQ(read_bytes(dir / "shared" / "out" / shared[0]), read_bytes(dir / "alone" / "out" / alone[0])) << extension;
+    const gltf::Document doc = read_output(dir / "shared" / "out" / "quad.gltf");
+    ASSERT_EQ(doc.json["textures"].size(), 2u);
+    EXPECT_NE(doc.json["textures"][0]["sampler"], doc.json["textures"][1]["sampler"]);
+    EXPECT_EQ(doc.json["images"].size(), 1u);
+    const json& textures = report["textures"];
+    ASSERT_EQ(textures.size(), 2u) << report.dump();
+    for (const json& t : textures) EXPECT_NE(t.value("note", "").find("clamp to edge"), std::string::npos) << t.dump();
+    MATBAKE_VALIDATE_OR_SKIP(validated, dir / "shared" / "out" / "quad.gltf");
+    EXPECT_EQ(validated->errors, 0) << validated->summary;
+  }
+}
+
 // Level 0 of a 1024 × 1088 UASTC texture is larger than one encoder run's strip (65 536 blocks): it is
 // encoded in two strips in parallel, RDO on. The bytes are the same for any --jobs, and the strips
 // land where they belong: level 0 transcoded (basisu -unpack, BC7) is within UASTC's error of the

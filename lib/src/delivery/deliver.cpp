@@ -181,6 +181,8 @@ struct Work {
   std::optional<int> needed;
   Codec codec = Codec::png;
   std::string name;
+  int made_by = -1;  // the index in the work list of the alike texture that makes this one's file
+  std::string shared_note;  // set when textures made once had differing wrap modes
   // Made:
   std::vector<unsigned char> ktx2;
   image::Image level0;  // png: the resized texture
@@ -212,6 +214,35 @@ Status make(Work& w, image::Image source, const Options& options, const Encoder*
   w.levels = made->levels;
   w.coverage = std::move(made->coverage);
   return success();
+}
+
+// Textures made alike (one image, class, size, codec, alpha cutoff and mip filter) are made once, as
+// gltfpack and glTF-Transform store an image once whatever samplers read it: each later one is
+// marked made by the first. The first's mip edges follow the wrap mode all of them agree on per axis,
+// clamp to edge where they differ (which reads no texel of the opposite edge, wrong for none of
+// them by more than an edge texel's filter footprint); the textures' reports say so.
+void make_alike_once(std::vector<Work>& work) {
+  for (std::size_t i = 0; i < work.size(); ++i) {
+    Work& w = work[i];
+    for (std::size_t first = 0; first < i; ++first) {
+      Work& f = work[first];
+      if (f.made_by >= 0 || f.image != w.image || f.use.texture_class != w.use.texture_class || f.size != w.size ||
+          f.codec != w.codec || f.use.alpha_cutoff != w.use.alpha_cutoff || f.sampling.filter != w.sampling.filter) {
+        continue;
+      }
+      w.made_by = int(first);
+      if (f.sampling.wrap_s != w.sampling.wrap_s || f.sampling.wrap_t != w.sampling.wrap_t) {
+        if (f.sampling.wrap_s != w.sampling.wrap_s) f.sampling.wrap_s = Wrap::clamp_to_edge;
+        if (f.sampling.wrap_t != w.sampling.wrap_t) f.sampling.wrap_t = Wrap::clamp_to_edge;
+        f.shared_note = "one file with the other textures of image '" + f.name + "': their samplers' wrap modes differ, so "
+                        "its mip levels' edges are filtered as clamp to edge";
+      }
+      break;
+    }
+  }
+  for (Work& w : work) {
+    if (w.made_by >= 0) w.shared_note = work[std::size_t(w.made_by)].shared_note;
+  }
 }
 
 // The texture's sources replaced: KTX2 through KHR_texture_basisu (its PNG or WebP source kept only
@@ -337,6 +368,7 @@ Result<std::vector<TextureReport>> deliver_textures(gltf::Document& doc, gltf::I
     }
     work.push_back(std::move(w));
   }
+  make_alike_once(work);
   cache.forget_decoded();  // the earlier passes' images: delivery decodes each texture in its turn
   const Encoder* encoder = nullptr;
   std::optional<Encoder> found;
@@ -351,7 +383,7 @@ Result<std::vector<TextureReport>> deliver_textures(gltf::Document& doc, gltf::I
   const int threads = tbb::this_task_arena::max_concurrency();
   tbb::parallel_for(std::size_t(0), work.size(), [&](std::size_t i) {
     Work& w = work[i];
-    if (w.codec == Codec::png && w.size == w.source_size) return;  // unchanged
+    if (w.made_by >= 0 || (w.codec == Codec::png && w.size == w.source_size)) return;  // made by another, or unchanged
     // Decoded in its turn and dropped when made. Not isolated: a thread waiting inside one texture's
     // encode may start another (isolating cost 15% of the wall time on SpecGlossVsMetalRough for the
     // same peak), so a few more than --jobs textures can be held at once.
@@ -365,39 +397,51 @@ Result<std::vector<TextureReport>> deliver_textures(gltf::Document& doc, gltf::I
     if (!w.status) return w.status.error();
   }
 
-  for (Work& w : work) {
+  std::vector<int> written(work.size(), -1);  // the image each made file was added as
+  for (std::size_t i = 0; i < work.size(); ++i) {
+    const Work& w = work[i];
+    const Work& made = w.made_by >= 0 ? work[std::size_t(w.made_by)] : w;
+    int& image = written[w.made_by >= 0 ? std::size_t(w.made_by) : i];
     TextureReport report{.texture = w.texture, .texture_class = w.use.texture_class, .codec = w.codec,
                          .source = w.source_size, .delivered = w.size, .needed = w.needed,
-                         .materials = materials_of(w.use), .levels = w.levels,
-                         .alpha_cutoff = w.use.alpha_cutoff, .coverage = w.coverage, .reused = w.reused};
+                         .materials = materials_of(w.use), .levels = made.levels,
+                         .alpha_cutoff = w.use.alpha_cutoff, .coverage = made.coverage, .note = w.shared_note,
+                         .reused = made.reused};
     auto source_bytes = gltf::image_bytes(doc, std::size_t(w.image));
     if (!source_bytes) return source_bytes.error();
     report.source_bytes = source_bytes->size();
     report.bytes = report.source_bytes;
-    if (!w.ktx2.empty()) {
-      report.uri = gltf::free_uri(doc, w.name, ".ktx2");
-      report.bytes = w.ktx2.size();
-      doc.new_files[report.uri] = std::string(w.ktx2.begin(), w.ktx2.end());
-      const std::string name = fs::path(report.uri).stem().string();
-      doc.json["images"].push_back({{"uri", report.uri}, {"mimeType", "image/ktx2"}, {"name", name}});
-      point_texture(doc, w, int(doc.json["images"].size()) - 1, options.png_fallback);
-      doc.json["textures"][std::size_t(w.texture)]["name"] = name;
+    if (!made.ktx2.empty()) {
+      if (image < 0) {
+        const std::string uri = gltf::free_uri(doc, w.name, ".ktx2");
+        doc.new_files[uri] = std::string(made.ktx2.begin(), made.ktx2.end());
+        doc.json["images"].push_back({{"uri", uri}, {"mimeType", "image/ktx2"}, {"name", fs::path(uri).stem().string()}});
+        image = int(doc.json["images"].size()) - 1;
+      }
+      report.bytes = made.ktx2.size();
+      point_texture(doc, w, image, options.png_fallback);
       if (!options.mipmaps) sample_one_level(doc, w.texture);
       gltf::require_extension(doc, kBasisu, !options.png_fallback);
-    } else if (!w.level0.pixels.empty()) {
-      const color::Transfer transfer = w.use.texture_class == TextureClass::colour ? color::Transfer::srgb : color::Transfer::linear;
-      const std::string extension = cache.webp() ? ".webp" : ".png";
-      const std::string uri =
-          gltf::free_uri(doc, w.name + "_" + std::to_string(w.size.width) + "x" + std::to_string(w.size.height), extension);
-      auto made = cache.add_image(doc, w.level0, transfer, uri.substr(0, uri.size() - extension.size()));
-      if (!made) return made.error();
-      report.uri = made->uri;
-      report.bytes = doc.new_files[made->uri].size();
-      point_texture(doc, w, made->index, options.png_fallback);
-      doc.json["textures"][std::size_t(w.texture)]["name"] = doc.json["images"][std::size_t(made->index)]["name"];
+    } else if (!made.level0.pixels.empty()) {
+      if (image < 0) {
+        const color::Transfer transfer = w.use.texture_class == TextureClass::colour ? color::Transfer::srgb : color::Transfer::linear;
+        const std::string extension = cache.webp() ? ".webp" : ".png";
+        const std::string uri =
+            gltf::free_uri(doc, w.name + "_" + std::to_string(w.size.width) + "x" + std::to_string(w.size.height), extension);
+        auto added = cache.add_image(doc, made.level0, transfer, uri.substr(0, uri.size() - extension.size()));
+        if (!added) return added.error();
+        image = added->index;
+      }
+      point_texture(doc, w, image, options.png_fallback);
     } else {
       report.note = "kept as it is (its size and format are what was asked)";
+      reports.push_back(std::move(report));
+      continue;
     }
+    const Json& written_image = doc.json["images"][std::size_t(image)];
+    report.uri = written_image["uri"].get<std::string>();
+    if (made.ktx2.empty()) report.bytes = doc.new_files[report.uri].size();
+    doc.json["textures"][std::size_t(w.texture)]["name"] = written_image["name"];
     reports.push_back(std::move(report));
   }
   drop_unused_webp(doc);
