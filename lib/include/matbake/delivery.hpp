@@ -174,6 +174,10 @@ std::vector<image::Image> mip_levels(const image::Image& source, const std::vect
 // The source consumed: a level of its own size is the source itself, not a copy.
 std::vector<image::Image> mip_levels(image::Image&& source, const std::vector<Size>& sizes, const MipRequest& request);
 
+// A normal map's texel (x, y, z in [0, 1] as glTF stores them) made unit length, as every level is;
+// a zero vector becomes +Z.
+void renormalise_normal(float* xyz);
+
 // The fraction of texels whose alpha, stored in 8 bits, is at least `cutoff` (what a MASK material
 // renders). 1 when the image has no alpha.
 double alpha_coverage(const image::Image& im, float cutoff);

@@ -127,6 +127,12 @@ Status write_image(const Image& image, const std::filesystem::path& path, const 
 // The bytes of `image` in the format of `name`'s extension (as write_image would write the file).
 Result<std::string> encode_image(const Image& image, const std::filesystem::path& name, const WriteOptions& options);
 
+// The bytes of an image of `layout` that is never held whole: `fill(y, rows, samples)` writes rows
+// [y, y + rows) into `samples` (layout.channels a texel, row by row), for several bands at once.
+using BandFill = std::function<void(int y, int rows, std::span<float> samples)>;
+Result<std::string> encode_bands(const ImageLayout& layout, const BandFill& fill, const std::filesystem::path& name,
+                                 const WriteOptions& options);
+
 // Reads `input` and writes `output` band by band (rows), `transform` applied to each decoded band
 // in between: reading, transforming and writing overlap on the cores, and memory stays a few bands
 // whatever the image size. Same checks and guarantees as read_image and write_image.

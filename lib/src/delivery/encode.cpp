@@ -18,27 +18,33 @@ namespace matbake::delivery {
 namespace fs = std::filesystem;
 namespace {
 
-// The level as 8-bit RGB or RGBA, grey spread to RGB, colour channels encoded as the class stores
-// them (sRGB for colour), alpha linear; deflate level 0 (stored): read once, then removed.
-Result<std::string> png_bytes(const image::Image& level, const EncodeRequest& request) {
-  image::Image rgb;
-  static_cast<image::ImageLayout&>(rgb) = level;
+// Rows [first, first + rows) of `level` as 8-bit RGB or RGBA PNG: grey spread to RGB, colour channels
+// encoded as the class stores them (sRGB for colour), alpha linear, a normal map's texels made unit
+// length when `renormalise` (what mip_levels does at the source's own size); deflate level 0
+// (stored): read once, then removed. Written band by band, never copied whole.
+Result<std::string> png_bytes(const image::Image& level, int first, int rows, const EncodeRequest& request, bool renormalise) {
+  image::ImageLayout rgb = level;
+  rgb.height = rows;
   rgb.channels = request.alpha ? 4 : 3;
   rgb.channel_names = request.alpha ? std::vector<std::string>{"R", "G", "B", "A"} : std::vector<std::string>{"R", "G", "B"};
   rgb.alpha_channel = request.alpha ? 3 : -1;
-  const std::size_t pixels = std::size_t(level.width) * std::size_t(level.height), ch = std::size_t(level.channels);
-  rgb.pixels.resize(pixels * std::size_t(rgb.channels));
-  for (std::size_t p = 0; p < pixels; ++p) {
-    const float* in = &level.pixels[p * ch];
-    float* out = &rgb.pixels[p * std::size_t(rgb.channels)];
-    for (int c = 0; c < 3; ++c) out[c] = ch >= 3 ? in[c] : in[0];
-    if (request.alpha) out[3] = level.alpha_channel >= 0 ? in[level.alpha_channel] : 1.0f;
-  }
+  const std::size_t ch = std::size_t(level.channels), out_ch = std::size_t(rgb.channels);
+  const auto fill = [&](int y, int band_rows, std::span<float> samples) {
+    const std::size_t texels = std::size_t(level.width) * std::size_t(band_rows);
+    const float* in_band = &level.pixels[std::size_t(first + y) * std::size_t(level.width) * ch];
+    for (std::size_t p = 0; p < texels; ++p) {
+      const float* in = in_band + p * ch;
+      float* out = &samples[p * out_ch];
+      for (std::size_t c = 0; c < 3; ++c) out[c] = ch >= 3 ? in[c] : in[0];
+      if (renormalise) renormalise_normal(out);
+      if (request.alpha) out[3] = level.alpha_channel >= 0 ? in[level.alpha_channel] : 1.0f;
+    }
+  };
   image::WriteOptions options;
   options.type = image::SampleType::u8;
   options.colour = request.texture_class == TextureClass::colour ? color::Transfer::srgb : color::Transfer::linear;
   options.png_level = 0;
-  return image::encode_image(rgb, "level.png", options);
+  return image::encode_bands(rgb, fill, "level.png", options);
 }
 
 // The encoder's output, its size checked before it is read: at most `limit` bytes.
@@ -124,23 +130,12 @@ Result<std::vector<unsigned char>> uastc_blocks(const Encoder& encoder, const st
   return ktx2::level_data(*texture, 0, name);
 }
 
-// Rows `first` to `first + rows` of `level`.
-image::Image rows_of(const image::Image& level, int first, int rows) {
-  image::Image strip;
-  static_cast<image::ImageLayout&>(strip) = level;
-  strip.height = rows;
-  const std::size_t row = std::size_t(level.width) * std::size_t(level.channels);
-  strip.pixels.assign(level.pixels.begin() + std::ptrdiff_t(row * std::size_t(first)),
-                      level.pixels.begin() + std::ptrdiff_t(row * std::size_t(first + rows)));
-  return strip;
-}
-
 // A chain's levels as pieces, in order: a level of more than `max_blocks` blocks in strips of whole
 // block rows (where it splits depends on its size alone, never on the thread count), the others whole.
-// With `finish`, each piece is made a level of its own size first (what mip_levels does at the
-// source's size is texel by texel, so a strip's equals the level's strip).
+// With `renormalise`, a normal map's texels are made unit length on the way (the source, level 0 at its
+// own size, is cut as it is).
 Result<std::vector<Piece>> pieces_of(const std::vector<const image::Image*>& levels, const EncodeRequest& request,
-                                     std::uint64_t max_blocks, const MipRequest* finish = nullptr) {
+                                     std::uint64_t max_blocks, bool renormalise = false) {
   struct Cut {
     std::size_t level;
     int first_row, rows;
@@ -156,14 +151,7 @@ Result<std::vector<Piece>> pieces_of(const std::vector<const image::Image*>& lev
   std::vector<Status> made(cuts.size(), success());
   tbb::parallel_for(std::size_t(0), cuts.size(), [&](std::size_t i) {
     const image::Image& level = *levels[cuts[i].level];
-    const bool as_is = cuts[i].rows == level.height && finish == nullptr;
-    image::Image piece;
-    if (!as_is) {
-      piece = rows_of(level, cuts[i].first_row, cuts[i].rows);
-      const Size size{piece.width, piece.height};
-      if (finish) piece = std::move(mip_levels(std::move(piece), {size}, *finish)[0]);
-    }
-    auto png = png_bytes(as_is ? level : piece, request);
+    auto png = png_bytes(level, cuts[i].first_row, cuts[i].rows, request, renormalise && level.channels >= 3);
     if (!png) {
       made[i] = png.error();
       return;
@@ -262,11 +250,11 @@ Result<std::vector<ktx2::Level>> uastc_chain(const Encoder& encoder, image::Imag
   const std::vector<std::string> args = encoder_arguments(request);
   std::deque<Batch> batches;  // a batch keeps its place while its runs read it
   tbb::task_group encoding;
-  const auto add_batch = [&](const std::vector<const image::Image*>& chain, std::size_t first_level, const MipRequest* finish) -> Status {
+  const auto add_batch = [&](const std::vector<const image::Image*>& chain, std::size_t first_level, bool renormalise) -> Status {
     for (const image::Image* l : chain) {
       if (mips.alpha_cutoff) coverage.push_back(alpha_coverage(*l, *mips.alpha_cutoff));
     }
-    auto pieces = pieces_of(chain, request, kStripBlocks, finish);
+    auto pieces = pieces_of(chain, request, kStripBlocks, renormalise);
     if (!pieces) return pieces.error();
     for (Piece& p : *pieces) p.level += first_level;
     Batch& batch = batches.emplace_back();
@@ -282,16 +270,17 @@ Result<std::vector<ktx2::Level>> uastc_chain(const Encoder& encoder, image::Imag
   Status status = success();
   if (blocks_of(sizes[0]) <= kStripBlocks) {
     // Level 0 is one piece: the chain made whole first goes in as few runs as its size allows.
-    status = add_batch(pointers(mip_levels(std::move(source), sizes, mips)), 0, nullptr);
+    status = add_batch(pointers(mip_levels(std::move(source), sizes, mips)), 0, false);
   } else {
     if (sizes[0] == Size{source.width, source.height}) {
-      status = add_batch({&source}, 0, &mips);  // level 0 made strip by strip from the source, not copied whole
+      // Level 0 cut from the source, not copied: at its own size a level is the source renormalised.
+      status = add_batch({&source}, 0, mips.texture_class == TextureClass::normal);
     } else {
-      status = add_batch(pointers(mip_levels(source, {sizes[0]}, mips)), 0, nullptr);
+      status = add_batch(pointers(mip_levels(source, {sizes[0]}, mips)), 0, false);
     }
     if (status && sizes.size() > 1) {
       // The source goes with this statement.
-      status = add_batch(pointers(mip_levels(image::Image(std::move(source)), {sizes.begin() + 1, sizes.end()}, mips)), 1, nullptr);
+      status = add_batch(pointers(mip_levels(image::Image(std::move(source)), {sizes.begin() + 1, sizes.end()}, mips)), 1, false);
     }
   }
   encoding.wait();

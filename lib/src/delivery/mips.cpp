@@ -89,14 +89,7 @@ int opaque_code(float cutoff) { return int(std::ceil(double(cutoff) * 255.0 - 1e
 
 void renormalise_normals(image::Image& im) {
   const std::size_t pixels = std::size_t(im.width) * std::size_t(im.height), ch = std::size_t(im.channels);
-  for (std::size_t p = 0; p < pixels; ++p) {
-    float* t = &im.pixels[p * ch];
-    double v[3] = {2.0 * t[0] - 1, 2.0 * t[1] - 1, 2.0 * t[2] - 1};
-    const double length = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-    if (length < 1e-12) v[0] = 0, v[1] = 0, v[2] = 1;
-    else for (double& c : v) c /= length;
-    for (int c = 0; c < 3; ++c) t[c] = float(0.5 * v[c] + 0.5);
-  }
+  for (std::size_t p = 0; p < pixels; ++p) renormalise_normal(&im.pixels[p * ch]);
 }
 
 // Scales the level's alpha so that as many texels as `target` × texels render opaque: the
@@ -194,6 +187,14 @@ double alpha_coverage(const image::Image& im, float cutoff) {
 
 std::vector<image::Image> mip_chain(const image::Image& source, Size base, const MipRequest& request, bool whole_chain) {
   return mip_levels(source, whole_chain ? mip_sizes(base) : std::vector<Size>{base}, request);
+}
+
+void renormalise_normal(float* t) {
+  double v[3] = {2.0 * t[0] - 1, 2.0 * t[1] - 1, 2.0 * t[2] - 1};
+  const double length = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+  if (length < 1e-12) v[0] = 0, v[1] = 0, v[2] = 1;
+  else for (double& c : v) c /= length;
+  for (int c = 0; c < 3; ++c) t[c] = float(0.5 * v[c] + 0.5);
 }
 
 namespace {

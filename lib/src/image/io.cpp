@@ -587,6 +587,36 @@ Result<std::string> encode_image(const Image& image, const fs::path& name, const
   });
 }
 
+Result<std::string> encode_bands(const ImageLayout& layout, const BandFill& fill, const fs::path& name, const WriteOptions& options) {
+  return guarded(name.string(), [&]() -> Result<std::string> {
+    if (layout.channels < 1 || layout.channels > 4 || layout.width < 1 || layout.height < 1) {
+      return Error{name.string(), "internal: inconsistent image"};
+    }
+    std::vector<unsigned char> bytes;
+    {
+      auto writer = RowWriter::open_memory(bytes, name, layout, options);
+      if (!writer) return writer.error();
+      const std::size_t row_samples = std::size_t(layout.width) * std::size_t(layout.channels);
+      const int band_rows = aligned_band_rows(*writer, std::max<std::size_t>(kBandRows, (std::size_t{1} << 18) / row_samples));
+      int next_row = 0;
+      std::atomic<bool> stop{false};
+      const auto next = [&](Band& band) {
+        if (next_row >= layout.height) return false;
+        band.y = next_row;
+        band.rows = std::min(band_rows, layout.height - next_row);
+        band.pixels.resize(row_samples * std::size_t(band.rows));
+        band.view = band.pixels;
+        next_row += band.rows;
+        return true;
+      };
+      const auto prepare = [&](Band& band) { fill(band.y, band.rows, band.pixels); };
+      if (Status s = write_bands(*writer, next, prepare, stop); !s) return s.error();
+      if (Status s = writer->commit(); !s) return s.error();
+    }
+    return std::string(bytes.begin(), bytes.end());
+  });
+}
+
 Status write_image(const Image& image, const fs::path& path, const WriteOptions& options) {
   return guarded(path.string(), [&]() -> Status {
     if (image.channels < 1 || image.channels > 4 || image.pixels.size() != image.sample_count()) {
