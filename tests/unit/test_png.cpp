@@ -9,6 +9,8 @@
 #include <cstring>
 #include <fstream>
 #include <memory>
+#include <mutex>
+#include <span>
 #include <random>
 #include <string>
 #include <vector>
@@ -98,6 +100,30 @@ std::vector<std::uint16_t> test_codes(int width, int height, int channels, int m
     }
   }
   return codes;
+}
+
+// An image given band by band (encode_bands) is the same file as the image given whole, for sizes
+// of one band, several and a last partial one; each row filled once, with its own rows.
+TEST(Png, BandsFilledByTheCallerGiveTheBytesOfTheWholeImage) {
+  for (auto [w, h] : {std::pair{5, 3}, std::pair{300, 1000}, std::pair{64, 4097}}) {
+    const auto codes = test_codes(w, h, 3, 255, unsigned(w + h));
+    const Image image = image_of_codes(w, h, 3, codes, 255);
+    WriteOptions options;
+    options.type = SampleType::u8;
+    options.colour = Transfer::srgb;
+    std::vector<int> filled(std::size_t(h), 0);
+    std::mutex guard;
+    const auto fill = [&](int y, int rows, std::span<float> samples) {
+      ASSERT_EQ(samples.size(), std::size_t(w) * std::size_t(rows) * 3u);
+      std::copy_n(image.pixels.begin() + std::ptrdiff_t(std::size_t(y) * std::size_t(w) * 3u), samples.size(), samples.begin());
+      std::lock_guard lock(guard);
+      for (int r = y; r < y + rows; ++r) ++filled[std::size_t(r)];
+    };
+    auto banded = encode_bands(image, fill, "x.png", options);
+    ASSERT_TRUE(banded) << banded.error().to_string();
+    EXPECT_EQ(*banded, encode_image(image, "x.png", options).value()) << w << "x" << h;
+    EXPECT_EQ(filled, std::vector<int>(std::size_t(h), 1)) << w << "x" << h;
+  }
 }
 
 TEST(Png, EveryLayoutDepthLevelAndOddSizeReadsBackCodeForCodeInLibpngAndOurReader) {
