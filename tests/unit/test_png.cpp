@@ -121,7 +121,7 @@ TEST(Png, BandsFilledByTheCallerGiveTheBytesOfTheWholeImage) {
     };
     auto banded = encode_bands(image, fill, "x.png", options);
     ASSERT_TRUE(banded) << banded.error().to_string();
-    EXPECT_EQ(*banded, encode_image(image, "x.png", options).value()) << w << "x" << h;
+    EXPECT_TRUE(*banded == encode_image(image, "x.png", options).value()) << w << "x" << h;  // not printed: bytes
     EXPECT_EQ(filled, std::vector<int>(std::size_t(h), 1)) << w << "x" << h;
   }
 }
