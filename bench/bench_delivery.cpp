@@ -196,7 +196,7 @@ int main(int argc, char** argv) {
   EncodeRequest request{.texture_class = cls, .options = options, .alpha = channels == 4, .scratch = work / (name + ".ktx2"),
                         .threads = 2};
   auto start = std::chrono::steady_clock::now();
-  auto encoded = encode_texture(*encoder, *source, base, {cls, {}, cutoff > 0 ? std::optional(cutoff) : std::nullopt}, request, "bench");
+  auto encoded = encode_texture(*encoder, *source, base, {cls, {}, cutoff > 0 ? std::optional(cutoff) : std::nullopt, cutoff > 0}, request, "bench");
   if (!encoded) {
     std::fprintf(stderr, "%s\n", encoded.error().to_string().c_str());
     return 1;

@@ -197,17 +197,19 @@ TEST(DeliveryMips, AlphaCoverageOfAMaskMaterialIsKeptAtEveryLevel) {
   const float cutoff = 0.5f;
   const double source = alpha_coverage(leaves, cutoff);
   EXPECT_NEAR(source, 0.25, 1e-12);
-  const auto plain = mip_chain(leaves, {64, 64}, {TextureClass::colour, {}, {}});
-  EXPECT_LT(alpha_coverage(plain[1], cutoff), 0.05);
+  for (const std::optional<float> measured : {std::optional<float>{}, std::optional<float>{cutoff}}) {
+    const auto plain = mip_chain(leaves, {64, 64}, {TextureClass::colour, {}, measured});  // kept only when asked
+    EXPECT_LT(alpha_coverage(plain[1], cutoff), 0.05);
+  }
   for (Filter f : {Filter::kaiser, Filter::box}) {
-    const auto kept = mip_chain(leaves, {64, 64}, {TextureClass::colour, {f, Wrap::repeat, Wrap::repeat}, cutoff});
+    const auto kept = mip_chain(leaves, {64, 64}, {TextureClass::colour, {f, Wrap::repeat, Wrap::repeat}, cutoff, true});
     for (const image::Image& l : kept) {
       const double texels = double(l.width) * l.height;
       EXPECT_NEAR(alpha_coverage(l, cutoff), source, std::max(0.01, 0.5 / texels) + 1e-12) << l.width;
     }
   }
   // A level of fewer texels than the coverage can split: 1×1 renders all or nothing, the nearer.
-  const auto tiny = mip_chain(leaves, {64, 64}, {TextureClass::colour, {}, 0.5f});
+  const auto tiny = mip_chain(leaves, {64, 64}, {TextureClass::colour, {}, 0.5f, true});
   EXPECT_EQ(alpha_coverage(tiny.back(), cutoff), 0.0);
 }
 
@@ -400,6 +402,7 @@ TEST(EncodeCache, TheKeyFollowsWhatTheBytesDependOn) {
   keys.insert(encode_key(source, {8, 8}, {TextureClass::data, {.filter = Filter::box}}, request, writer));
   keys.insert(encode_key(source, {8, 8}, {TextureClass::data, {.wrap_s = Wrap::clamp_to_edge}}, request, writer));
   keys.insert(encode_key(source, {8, 8}, {TextureClass::data, {}, 0.5f}, request, writer));
+  keys.insert(encode_key(source, {8, 8}, {TextureClass::data, {}, 0.5f, true}, request, writer));
   for (auto change : std::vector<std::function<void(EncodeRequest&)>>{
            [](EncodeRequest& r) { r.options.uastc_level = 3; }, [](EncodeRequest& r) { r.options.uastc_rdo = 0.5; },
            [](EncodeRequest& r) {
@@ -414,7 +417,7 @@ TEST(EncodeCache, TheKeyFollowsWhatTheBytesDependOn) {
     keys.insert(encode_key(source, {8, 8}, mips, changed, writer));
   }
   keys.insert(encode_key(source, {8, 8}, mips, request, "matbake 0.2.0 / basisu 1.16.5"));
-  EXPECT_EQ(keys.size(), 15u);  // each of the 14 changes a key of its own
+  EXPECT_EQ(keys.size(), 16u);  // each of the 15 changes a key of its own
 }
 
 // Eviction removes the least recently used entries until the rest fit, and nothing that is not an

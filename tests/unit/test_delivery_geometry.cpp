@@ -12,11 +12,13 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <numeric>
 
 #include "lib/src/delivery/geometry.hpp"
 #include "lib/src/gltf/document.hpp"
 #include "lib/src/gltf/texture_transform.hpp"
 #include "matbake/scene.hpp"
+#include "support/files.hpp"
 #include "support/gltf_files.hpp"
 #include "support/gltf_validator.hpp"
 #include "support/run.hpp"
@@ -194,6 +196,90 @@ TEST(DeliveryGeometry, QuantizedAndCompressedReadsBackWithinTheStatedBoundsWithE
     EXPECT_EQ(report->errors, 0) << report->summary;
     EXPECT_EQ(report->warnings, 0) << report->summary;
   }
+}
+
+// The grid scene rearranged for joining: its mesh copied (the same accessors) into meshes placed by a
+// rotated, scaled node, its mirrored child, two instances, and a node an animation moves.
+void write_join_scene(const fs::path& file) {
+  write_grid_scene(file);
+  json scene = json::parse(test::read_bytes(file));
+  const json mesh = scene["meshes"][0];
+  scene["meshes"] = {mesh, mesh, mesh, mesh};
+  scene["nodes"] = {{{"mesh", 0}, {"rotation", {0.0, 0.3826834, 0.0, 0.9238795}}, {"scale", {2.0, 2.0, 2.0}},
+                     {"translation", {5.0, -1.0, 0.5}}, {"children", {1}}, {"name", "static"}},
+                    {{"mesh", 1}, {"translation", {0.0, 0.0, 2.0}}, {"scale", {-1.5, 1.5, 1.5}}, {"name", "mirrored"}},
+                    {{"mesh", 2}, {"translation", {-4.0, 0.0, 0.0}}, {"name", "instance"}},
+                    {{"mesh", 2}, {"translation", {-4.0, 3.0, 0.0}}, {"name", "instance"}},
+                    {{"mesh", 3}, {"translation", {0.0, -4.0, 0.0}}, {"name", "animated"}}};
+  scene["scenes"][0]["nodes"] = {0, 2, 3, 4};
+  // The animation's keys: times 0 and 1, two translations, in a buffer of their own.
+  const std::vector<float> keys = {0, 1, 0, -4, 0, 1, -4, 0};
+  const std::string bytes(reinterpret_cast<const char*>(keys.data()), keys.size() * sizeof(float));
+  test::write_bytes(file.parent_path() / "keys.bin", bytes);
+  scene["buffers"].push_back({{"uri", "keys.bin"}, {"byteLength", bytes.size()}});
+  const std::size_t buffer = scene["buffers"].size() - 1, views = scene["bufferViews"].size(), accessors = scene["accessors"].size();
+  scene["bufferViews"].push_back({{"buffer", buffer}, {"byteOffset", 0}, {"byteLength", 8}});
+  scene["bufferViews"].push_back({{"buffer", buffer}, {"byteOffset", 8}, {"byteLength", 24}});
+  scene["accessors"].push_back({{"bufferView", views}, {"componentType", 5126}, {"count", 2}, {"type", "SCALAR"}, {"min", {0}}, {"max", {1}}});
+  scene["accessors"].push_back({{"bufferView", views + 1}, {"componentType", 5126}, {"count", 2}, {"type", "VEC3"}});
+  scene["animations"] = {{{"samplers", {{{"input", accessors}, {"output", accessors + 1}}}},
+                          {"channels", {{{"sampler", 0}, {"target", {{"node", 4}, {"path", "translation"}}}}}}}};
+  test::write_bytes(file, scene.dump());
+}
+
+// Every instance of a scene as one, in world space (the loader flips a mirrored instance's triangles).
+scene::Instance all_in_one(const scene::Scene& s) {
+  scene::Instance out;
+  for (const scene::Instance& i : s.instances) {
+    const auto base = std::uint32_t(out.positions.size());
+    out.positions.insert(out.positions.end(), i.positions.begin(), i.positions.end());
+    out.normals.insert(out.normals.end(), i.normals.begin(), i.normals.end());
+    for (auto t : i.triangles) out.triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
+  }
+  return out;
+}
+
+// Joined, the two static meshes become one primitive in world space — the same triangles facing the
+// same way (the mirrored one's winding flipped), normals within float rounding — under one new node,
+// their emptied nodes gone; the instanced mesh and the animated node stay as they were. With
+// quantization and meshopt on top: one grid, validator-clean.
+TEST(DeliveryGeometry, JoinedMeshesAreTheSameTrianglesInWorldSpaceAndInstancesAndAnimationsStay) {
+  test::TempDir dir;
+  const fs::path scene = dir / "join.gltf";
+  write_join_scene(scene);
+  const fs::path out = dir / "joined.gltf";
+  export_ok(scene, out, {"--join-meshes"});
+  const gltf::Document doc = test::read_output(out);
+  ASSERT_EQ(doc.json["meshes"].size(), 3u);  // the two kept, then the joined one
+  EXPECT_EQ(doc.json["meshes"][2]["primitives"].size(), 1u);
+  std::vector<std::string> names;
+  for (const gltf::Json& n : doc.json["nodes"]) names.push_back(n.value("name", ""));
+  EXPECT_EQ(names, (std::vector<std::string>{"instance", "instance", "animated", "joined"}));
+  EXPECT_EQ(doc.json["animations"][0]["channels"][0]["target"]["node"], 2);
+  EXPECT_EQ(doc.json["nodes"][0]["mesh"], doc.json["nodes"][1]["mesh"]);
+
+  const scene::Scene before = load(scene), after = load(out);
+  EXPECT_EQ(after.instances.size(), 4u);
+  const scene::Instance a = all_in_one(before), b = all_in_one(after);
+  ASSERT_EQ(a.positions.size(), b.positions.size());
+  const std::vector<std::size_t> to_a = nearest_vertices(a, b);
+  std::vector<std::size_t> identity(a.positions.size());
+  std::iota(identity.begin(), identity.end(), std::size_t(0));
+  EXPECT_EQ(triangles_in(b, to_a), triangles_in(a, identity));
+  double position = 0, normal = 0;
+  for (std::size_t v = 0; v < b.positions.size(); ++v) {
+    position = std::max(position, double(glm::length(b.positions[v] - a.positions[to_a[v]])));
+    normal = std::max(normal, double(glm::length(b.normals[v] - a.normals[to_a[v]])));
+  }
+  EXPECT_LT(position, 1e-5);
+  EXPECT_LT(normal, 1e-5);
+
+  const fs::path packed = dir / "packed.glb";
+  export_ok(scene, packed, {"--join-meshes", "--mesh-quantization", "--mesh-compression", "meshopt"});
+  EXPECT_EQ(load(packed).instances.size(), 4u);
+  MATBAKE_VALIDATE_OR_SKIP(report, packed);
+  EXPECT_EQ(report->errors, 0) << report->summary;
+  EXPECT_EQ(report->warnings, 0) << report->summary;
 }
 
 TEST(DeliveryGeometry, CompressionAloneIsLosslessAndSmaller) {

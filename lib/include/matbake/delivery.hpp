@@ -72,12 +72,13 @@ enum class MeshCompression { none, meshopt };
 inline constexpr NameTable<MeshCompression, 2> kMeshCompressionNames{{{MeshCompression::none, "none"}, {MeshCompression::meshopt, "meshopt"}}};
 
 struct GeometryOptions {
+  bool join = false;  // static meshes into world space, one primitive per material (join.hpp)
   bool quantize = false;
   int position_bits = 14;  // 8–16
   int texcoord_bits = 12;  // 8–16
   MeshCompression compression = MeshCompression::none;
 
-  bool any() const { return quantize || compression != MeshCompression::none; }
+  bool any() const { return join || quantize || compression != MeshCompression::none; }
 };
 
 struct Options {
@@ -88,6 +89,7 @@ struct Options {
   Rounding rounding = Rounding::multiple_of_4;
   Filter filter = Filter::kaiser;
   bool mipmaps = true;          // a full chain down to 1×1
+  bool keep_alpha_coverage = false;  // MASK materials' levels keep the source's alpha coverage (MipRequest)
   bool png_fallback = false;    // keep the PNG as the texture's core source (the extension then optional)
   double texel_density = 0;     // texels per scene unit the textures are sized for; 0: their own sizes
   GeometryOptions geometry;
@@ -158,15 +160,16 @@ image::Image resample(const image::Image& in, Size size, const Sampling& samplin
 struct MipRequest {
   TextureClass texture_class = TextureClass::colour;
   Sampling sampling;
-  std::optional<float> alpha_cutoff;  // a MASK material's: each level keeps the base's coverage
+  std::optional<float> alpha_cutoff;  // a MASK material's: each level's coverage is reported
+  bool keep_coverage = false;         // with alpha_cutoff: each resized level keeps the source's coverage
 };
 
 // The chain of `source` (decoded linear: colour channels as linear light, alpha and data as stored,
 // a normal map's channels as glTF stores them, in [0, 1]) with level 0 at `base`, level 0 first
 // (only level 0 unless whole_chain), each level resampled from the source, never from the level
 // before. Normal maps: filtered, then renormalised at every level (level 0 included; a zero vector
-// becomes +Z). With alpha_cutoff: each resized level's alpha scaled so that its coverage equals the
-// source's as closely as its texel count allows.
+// becomes +Z). With alpha_cutoff and keep_coverage: each resized level's alpha scaled so that its coverage
+// equals the source's as closely as its texel count allows.
 std::vector<image::Image> mip_chain(const image::Image& source, Size base, const MipRequest& request,
                                     bool whole_chain = true);
 // The same for the levels of `sizes` alone (of a chain whose other levels are made elsewhere).

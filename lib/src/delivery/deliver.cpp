@@ -198,7 +198,7 @@ Size ktx2_size(Size s) { return {std::max(s.width, 4), std::max(s.height, 4)}; }
 bool sides_fit_ktx2(Size s) { return s.width % 4 == 0 && s.height % 4 == 0; }
 
 Status make(Work& w, image::Image source, const Options& options, const Encoder* encoder, const fs::path& output, int threads) {
-  const MipRequest request{w.use.texture_class, w.sampling, w.use.alpha_cutoff};
+  const MipRequest request{w.use.texture_class, w.sampling, w.use.alpha_cutoff, options.keep_alpha_coverage};
   if (w.codec == Codec::png) {
     w.level0 = std::move(mip_chain(source, w.size, request, false)[0]);
     if (w.use.alpha_cutoff) w.coverage = {alpha_coverage(source, *w.use.alpha_cutoff), alpha_coverage(w.level0, *w.use.alpha_cutoff)};
@@ -407,6 +407,10 @@ Result<std::vector<TextureReport>> deliver_textures(gltf::Document& doc, gltf::I
                          .materials = materials_of(w.use), .levels = made.levels,
                          .alpha_cutoff = w.use.alpha_cutoff, .coverage = made.coverage, .note = w.shared_note,
                          .reused = made.reused};
+    if (options.keep_alpha_coverage && options.mipmaps && w.use.alpha_cutoff && w.codec == Codec::etc1s) {
+      report.note += std::string(report.note.empty() ? "" : "; ") +
+                     "ETC1S levels are basisu's own: keep_alpha_coverage does not act on them (UASTC does)";
+    }
     auto source_bytes = gltf::image_bytes(doc, std::size_t(w.image));
     if (!source_bytes) return source_bytes.error();
     report.source_bytes = source_bytes->size();

@@ -184,7 +184,7 @@ std::string encode_key(const image::Image& source, Size base, const MipRequest& 
   for (const double v : {double(o.codec), double(o.quality), double(o.uastc_level), o.uastc_rdo, double(o.zstd)}) hash_value(s, v);
   for (const int v : {source.width, source.height, source.channels, source.alpha_channel, base.width, base.height,
                       int(mips.texture_class), int(mips.sampling.filter), int(mips.sampling.wrap_s), int(mips.sampling.wrap_t),
-                      int(request.texture_class), int(request.mipmaps), int(request.alpha), int(mips.alpha_cutoff.has_value())}) {
+                      int(request.texture_class), int(request.mipmaps), int(request.alpha), int(mips.alpha_cutoff.has_value()), int(mips.keep_coverage)}) {
     hash_value(s, v);
   }
   hash_value(s, mips.alpha_cutoff.value_or(0.0f));

@@ -203,11 +203,12 @@ namespace {
 // itself (moved when `source` is an rvalue), renormalised like the others.
 template <class Source>
 std::vector<image::Image> make_levels(Source&& source, const std::vector<Size>& sizes, const MipRequest& request) {
+  const bool keep = request.alpha_cutoff && request.keep_coverage;
   const float cutoff = request.alpha_cutoff.value_or(0.0f);
-  const double coverage = request.alpha_cutoff ? alpha_coverage(source, cutoff) : 1.0;
+  const double coverage = keep ? alpha_coverage(source, cutoff) : 1.0;
   const auto finish = [&](image::Image& level, bool resized) {
     if (request.texture_class == TextureClass::normal && level.channels >= 3) renormalise_normals(level);
-    if (request.alpha_cutoff && resized) keep_coverage(level, cutoff, coverage);
+    if (keep && resized) keep_coverage(level, cutoff, coverage);
   };
   const Size own{source.width, source.height};
   std::vector<image::Image> levels(sizes.size());

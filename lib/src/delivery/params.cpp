@@ -87,6 +87,12 @@ Param<Options> profile_param() {
 
 void add_geometry(std::vector<Param<Options>>& out) {
   const params::Condition quantized{"mesh_quantization", "true"};
+  out.push_back(params::flag<Options>(Spec{.name = "join_meshes",
+                                           .help = "Move meshes that one node places and nothing animates into world space and "
+                                                   "join primitives of one material into one (as gltfpack does); their nodes' "
+                                                   "names go",
+                                           .example = "true"},
+                                      [](auto& o) -> auto& { return o.geometry.join; }));
   out.push_back(params::flag<Options>(Spec{.name = "mesh_quantization",
                                            .help = "Store vertex attributes as integers (KHR_mesh_quantization): positions "
                                                    "of position_bits per mesh, normals and tangents in bytes, UVs of "
@@ -138,6 +144,13 @@ const params::Group<Options>& options_params() {
                                                   .example = "false",
                                                   .needs = {{"texture_format", "ktx2"}}},
                                              [](auto& o) -> auto& { return o.mipmaps; }));
+    g.params.push_back(params::flag<Options>(Spec{.name = "keep_alpha_coverage",
+                                                  .help = "Scale the alpha of each resized level of a MASK material's textures so that "
+                                                          "as many texels pass its alphaCutoff as in the source (foliage and "
+                                                          "lettering keep their thickness far away; UASTC, PNG and WebP: an ETC1S "
+                                                          "chain is basisu's own)",
+                                                  .example = "true"},
+                                             [](auto& o) -> auto& { return o.keep_alpha_coverage; }));
     g.params.push_back(params::flag<Options>(Spec{.name = "png_fallback",
                                                   .help = "Keep each KTX2 texture's PNG as its core source, so that "
                                                           "KHR_texture_basisu is used but not required",

@@ -75,6 +75,7 @@ float component_value(const unsigned char* p, int component_type, bool normalize
 // One index at `p` (unsigned byte, short or int).
 std::uint32_t index_value(const unsigned char* p, int component_type);
 
+constexpr int kTriangles = 4;              // primitive.mode of triangle lists (the default)
 constexpr int kArrayBuffer = 34962;         // bufferView.target of vertex attributes
 constexpr int kElementArrayBuffer = 34963;  // and of indices
 

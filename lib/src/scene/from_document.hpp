@@ -8,4 +8,7 @@ namespace matbake::scene {
 
 Result<Scene> scene_from_document(const gltf::Document& doc, const SceneContent& content = {});
 
+// A node's own transform: its matrix, else translation · rotation · scale (identity where absent).
+glm::dmat4 local_matrix(const gltf::Json& node);
+
 }  // namespace matbake::scene

@@ -105,14 +105,6 @@ std::optional<std::vector<double>> numbers(const Json& json, const char* key, st
   return out;
 }
 
-glm::dmat4 local_matrix(const Json& node) {
-  if (auto m = numbers(node, "matrix", 16)) return glm::make_mat4(m->data());  // column-major, as glm
-  glm::dmat4 m(1.0);
-  if (auto t = numbers(node, "translation", 3)) m = glm::translate(m, glm::dvec3((*t)[0], (*t)[1], (*t)[2]));
-  if (auto r = numbers(node, "rotation", 4)) m *= glm::mat4_cast(glm::dquat((*r)[3], (*r)[0], (*r)[1], (*r)[2]));
-  if (auto s = numbers(node, "scale", 3)) m = glm::scale(m, glm::dvec3((*s)[0], (*s)[1], (*s)[2]));
-  return m;
-}
 
 const Json& object_in(const Json& json, const char* key) {
   static const Json empty = Json::object();
@@ -208,6 +200,16 @@ Result<Instance> place_primitive(const Reader& read, const Json& primitive, int 
 }
 
 }  // namespace
+
+// The node's own transform: its matrix, else T · R · S.
+glm::dmat4 local_matrix(const Json& node) {
+  if (auto m = numbers(node, "matrix", 16)) return glm::make_mat4(m->data());  // column-major, as glm
+  glm::dmat4 m(1.0);
+  if (auto t = numbers(node, "translation", 3)) m = glm::translate(m, glm::dvec3((*t)[0], (*t)[1], (*t)[2]));
+  if (auto r = numbers(node, "rotation", 4)) m *= glm::mat4_cast(glm::dquat((*r)[3], (*r)[0], (*r)[1], (*r)[2]));
+  if (auto s = numbers(node, "scale", 3)) m = glm::scale(m, glm::dvec3((*s)[0], (*s)[1], (*s)[2]));
+  return m;
+}
 
 float Scene::radius() const { return 0.5f * glm::length(bounds_max - bounds_min); }
 
