@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Geometry for delivery against gltfpack: each model written by matbake export (--mesh-quantization
+# Geometry for delivery against gltfpack: each model written by matbake export (--join-meshes --mesh-quantization
 # --mesh-compression meshopt, textures as they are) and by Debian's gltfpack -c (the same
 # quantization: 14-bit positions, 12-bit UVs, 8-bit normals and colours), and, for scale, both
 # without compression. Per model and tool: the geometry's bytes (the GLB's binary chunk without its
@@ -50,9 +50,9 @@ for model in "${models[@]}"; do
   name=$(basename "${model%.*}")
   "$matbake" -q export "$model" -o "$work/$name-plain.glb"
   plain=$(geometry_bytes "$work/$name-plain.glb")
-  "$matbake" -q export "$model" -o "$work/$name-q.glb" --mesh-quantization
+  "$matbake" -q export "$model" -o "$work/$name-q.glb" --join-meshes --mesh-quantization
   gltfpack -i "$model" -o "$work/$name-gq.glb" >/dev/null
-  ours=$(measure "$work/$name-mq.glb" "$matbake" -q export "$model" -o "$work/$name-mq.glb" --mesh-quantization --mesh-compression meshopt)
+  ours=$(measure "$work/$name-mq.glb" "$matbake" -q export "$model" -o "$work/$name-mq.glb" --join-meshes --mesh-quantization --mesh-compression meshopt)
   theirs=$(measure "$work/$name-gp.glb" gltfpack -i "$model" -o "$work/$name-gp.glb" -c)
   ratio=$(echo "scale=3; ${ours%% *} / ${theirs%% *}" | bc)
   echo "| $name | $plain | $(geometry_bytes "$work/$name-q.glb") | $(geometry_bytes "$work/$name-gq.glb") | $ours | $theirs | $ratio |"

@@ -187,7 +187,7 @@ const char* const kGeometryOnlyModels[] = {
     "MultiUVTest/glTF-Embedded/MultiUVTest.gltf",
     "VertexColorTest/glTF-Embedded/VertexColorTest.gltf",
 };
-const std::vector<std::string> kGeometryFlags = {"--mesh-quantization", "--mesh-compression", "meshopt"};
+const std::vector<std::string> kGeometryFlags = {"--join-meshes", "--mesh-quantization", "--mesh-compression", "meshopt"};
 
 TEST(Runtime, KhronosModelsDeliveredByMatbakeLookAsTheOriginalsInThreeJs) {
   SKIP_UNDER_SANITIZERS();
@@ -315,7 +315,7 @@ TEST(Runtime, DISABLED_AgainstGltfpack) {
     std::string name;
     std::vector<std::string> gltfpack_args, matbake_args;
   };
-  const std::vector<std::string> geometry = {"--mesh-quantization", "--mesh-compression", "meshopt"};
+  const std::vector<std::string> geometry = {"--join-meshes", "--mesh-quantization", "--mesh-compression", "meshopt"};
   // gltfpack 0.17 runs basisu with "-uastc -uastc_level 1 -uastc_rdo_l 0.29 -uastc_rdo_d 1024
   // -ktx2_zstandard_level 9" and "-comp_level 1 -q 192" (its arguments, logged): matbake is given
   // the same codec settings per class.

@@ -198,20 +198,26 @@ TEST(DeliveryGeometry, QuantizedAndCompressedReadsBackWithinTheStatedBoundsWithE
   }
 }
 
-// The grid scene rearranged for joining: its mesh copied (the same accessors) into meshes placed by a
-// rotated, scaled node, its mirrored child, two instances, and a node an animation moves.
+// The grid scene rearranged for joining: its mesh copied into meshes placed by a rotated, scaled node
+// and its mirrored child (each with positions of its own), two instances of one mesh, a node an
+// animation moves, and a node whose mesh shares its positions with those two.
 void write_join_scene(const fs::path& file) {
   write_grid_scene(file);
   json scene = json::parse(test::read_bytes(file));
   const json mesh = scene["meshes"][0];
-  scene["meshes"] = {mesh, mesh, mesh, mesh};
+  scene["meshes"] = {mesh, mesh, mesh, mesh, mesh};
+  for (int own : {0, 1}) {
+    scene["accessors"].push_back(scene["accessors"][mesh["primitives"][0]["attributes"]["POSITION"].get<std::size_t>()]);
+    scene["meshes"][own]["primitives"][0]["attributes"]["POSITION"] = scene["accessors"].size() - 1;
+  }
   scene["nodes"] = {{{"mesh", 0}, {"rotation", {0.0, 0.3826834, 0.0, 0.9238795}}, {"scale", {2.0, 2.0, 2.0}},
                      {"translation", {5.0, -1.0, 0.5}}, {"children", {1}}, {"name", "static"}},
                     {{"mesh", 1}, {"translation", {0.0, 0.0, 2.0}}, {"scale", {-1.5, 1.5, 1.5}}, {"name", "mirrored"}},
                     {{"mesh", 2}, {"translation", {-4.0, 0.0, 0.0}}, {"name", "instance"}},
                     {{"mesh", 2}, {"translation", {-4.0, 3.0, 0.0}}, {"name", "instance"}},
-                    {{"mesh", 3}, {"translation", {0.0, -4.0, 0.0}}, {"name", "animated"}}};
-  scene["scenes"][0]["nodes"] = {0, 2, 3, 4};
+                    {{"mesh", 3}, {"translation", {0.0, -4.0, 0.0}}, {"name", "animated"}},
+                    {{"mesh", 4}, {"translation", {0.0, 8.0, 0.0}}, {"name", "shared"}}};
+  scene["scenes"][0]["nodes"] = {0, 2, 3, 4, 5};
   // The animation's keys: times 0 and 1, two translations, in a buffer of their own.
   const std::vector<float> keys = {0, 1, 0, -4, 0, 1, -4, 0};
   const std::string bytes(reinterpret_cast<const char*>(keys.data()), keys.size() * sizeof(float));
@@ -241,7 +247,8 @@ scene::Instance all_in_one(const scene::Scene& s) {
 
 // Joined, the two static meshes become one primitive in world space — the same triangles facing the
 // same way (the mirrored one's winding flipped), normals within float rounding — under one new node,
-// their emptied nodes gone; the instanced mesh and the animated node stay as they were. With
+// their emptied nodes gone; the instanced mesh, the animated node and the mesh sharing the instances'
+// positions stay as they were (joined, each would be a copy). With
 // quantization and meshopt on top: one grid, validator-clean.
 TEST(DeliveryGeometry, JoinedMeshesAreTheSameTrianglesInWorldSpaceAndInstancesAndAnimationsStay) {
   test::TempDir dir;
@@ -250,16 +257,16 @@ TEST(DeliveryGeometry, JoinedMeshesAreTheSameTrianglesInWorldSpaceAndInstancesAn
   const fs::path out = dir / "joined.gltf";
   export_ok(scene, out, {"--join-meshes"});
   const gltf::Document doc = test::read_output(out);
-  ASSERT_EQ(doc.json["meshes"].size(), 3u);  // the two kept, then the joined one
-  EXPECT_EQ(doc.json["meshes"][2]["primitives"].size(), 1u);
+  ASSERT_EQ(doc.json["meshes"].size(), 4u);  // the three kept, then the joined one
+  EXPECT_EQ(doc.json["meshes"][3]["primitives"].size(), 1u);
   std::vector<std::string> names;
   for (const gltf::Json& n : doc.json["nodes"]) names.push_back(n.value("name", ""));
-  EXPECT_EQ(names, (std::vector<std::string>{"instance", "instance", "animated", "joined"}));
+  EXPECT_EQ(names, (std::vector<std::string>{"instance", "instance", "animated", "shared", "joined"}));
   EXPECT_EQ(doc.json["animations"][0]["channels"][0]["target"]["node"], 2);
   EXPECT_EQ(doc.json["nodes"][0]["mesh"], doc.json["nodes"][1]["mesh"]);
 
   const scene::Scene before = load(scene), after = load(out);
-  EXPECT_EQ(after.instances.size(), 4u);
+  EXPECT_EQ(after.instances.size(), 5u);
   const scene::Instance a = all_in_one(before), b = all_in_one(after);
   ASSERT_EQ(a.positions.size(), b.positions.size());
   const std::vector<std::size_t> to_a = nearest_vertices(a, b);
@@ -276,7 +283,7 @@ TEST(DeliveryGeometry, JoinedMeshesAreTheSameTrianglesInWorldSpaceAndInstancesAn
 
   const fs::path packed = dir / "packed.glb";
   export_ok(scene, packed, {"--join-meshes", "--mesh-quantization", "--mesh-compression", "meshopt"});
-  EXPECT_EQ(load(packed).instances.size(), 4u);
+  EXPECT_EQ(load(packed).instances.size(), 5u);
   MATBAKE_VALIDATE_OR_SKIP(report, packed);
   EXPECT_EQ(report->errors, 0) << report->summary;
   EXPECT_EQ(report->warnings, 0) << report->summary;

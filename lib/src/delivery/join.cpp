@@ -77,6 +77,15 @@ std::vector<std::pair<std::size_t, glm::dmat4>> static_placements(const gltf::Do
   for (const Json& node : nodes) {
     if (node.contains("mesh")) ++placements[gltf::size_in(node, "mesh", SIZE_MAX)];
   }
+  // Meshes whose primitives share their vertices are instances too (MetalRoughSpheresNoTextures: 98
+  // meshes over one sphere's accessors): joined, each would become a copy.
+  std::map<std::size_t, int> position_uses;  // POSITION accessor → primitives reading it
+  for (const Json& mesh : meshes) {
+    for (const Json& p : array_in(mesh, "primitives")) {
+      if (p.is_object() && p.contains("attributes")) ++position_uses[gltf::size_in(p["attributes"], "POSITION", SIZE_MAX)];
+    }
+  }
+  const auto own_vertices = [&](const Json& p) { return position_uses[gltf::size_in(p["attributes"], "POSITION", SIZE_MAX)] == 1; };
   const std::set<std::size_t> moving = moving_nodes(doc.json);
   std::vector<std::pair<std::size_t, glm::dmat4>> out;
   std::vector<std::pair<std::size_t, glm::dmat4>> stack;
@@ -95,7 +104,7 @@ std::vector<std::pair<std::size_t, glm::dmat4>> static_placements(const gltf::Do
       continue;
     }
     const Json& primitives = array_in(meshes[m], "primitives");
-    if (!primitives.empty() && std::all_of(primitives.begin(), primitives.end(), [&](const Json& p) { return joinable(doc, p); })) {
+    if (!primitives.empty() && std::all_of(primitives.begin(), primitives.end(), [&](const Json& p) { return joinable(doc, p) && own_vertices(p); })) {
       out.emplace_back(n, world);
     }
   }

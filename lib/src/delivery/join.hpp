@@ -3,8 +3,8 @@
 // default and glTF-Transform's flatten + join: each mesh placed by one node that nothing moves goes
 // into world space, and its primitives join those of the same material and attributes, in one mesh
 // placed by one new root node; nodes left empty are removed. Fewer and longer streams: fewer draw
-// calls, less JSON, better meshopt compression. Kept as placed: meshes placed by several nodes
-// (instances stay instances, not copies), skinned and morphed meshes, nodes an animation moves and
+// calls, less JSON, better meshopt compression. Kept as placed: meshes placed by several nodes or
+// sharing their vertices with another mesh (instances stay instances, not copies), skinned and morphed meshes, nodes an animation moves and
 // what is below them, nodes with extensions, primitives that are not triangles or not floats.
 #include <string>
 #include <vector>
