@@ -174,14 +174,18 @@ const char* const kKhronosModels[] = {
 };
 
 // Models whose geometry is the point — UVs beyond [0, 1] and wrap modes, mirrored tangents, two UV
-// sets, vertex colours — delivered (PNG) with quantized, meshopt-compressed geometry; render PSNR
-// against the original as measured on 2026-11-27 (as kKtx2RenderPsnr), the test failing 3 dB below.
+// sets, vertex colours — delivered (PNG) with joined, quantized, meshopt-compressed geometry; render
+// PSNR against the original as measured on 2026-11-27 (as kKtx2RenderPsnr), the test failing 3 dB
+// below. Joined alone, every model renders as the original to the pixel but NormalTangentMirrorTest
+// (55.4 dB fit); quantized, a joined scene has one grid over its extent, so TextureCoordinateTest's
+// quad edges move by up to 7e-5 units (per mesh: 3e-5) and flip edge pixels: 86.5 / 69.0 / 40.2 dB
+// where each mesh on its own grid gave 96.5 / 92.7 / identical (gltfpack -c: 40.1 / 43.7 / 39.2).
 const std::map<std::string, Measured> kGeometryRenderPsnr = {
     {"NormalTangentMirrorTest", {40.0, 41.5, 40.1}},
-    {"TextureCoordinateTest", {90.0, 90.0, 90.0}},  // 96.5, 92.7 and identical pixels
-    {"TextureSettingsTest", {41.3, 38.3, 44.8}},
+    {"TextureCoordinateTest", {86.5, 69.0, 40.2}},
+    {"TextureSettingsTest", {41.9, 37.9, 44.8}},
     {"MultiUVTest", {64.9, 79.7, 66.4}},
-    {"VertexColorTest", {46.0, 47.0, 59.6}},
+    {"VertexColorTest", {44.7, 43.8, 59.6}},
 };
 const char* const kGeometryOnlyModels[] = {
     "MultiUVTest/glTF-Embedded/MultiUVTest.gltf",
