@@ -270,7 +270,12 @@ Result<std::vector<std::string>> join_meshes(gltf::Document& doc) {
     return std::vector<std::string>{"meshes not joined: KHR_animation_pointer may animate any node"};
   }
   const auto placements = static_placements(doc, scenes[0]);
-  if (placements.size() < 2) return std::vector<std::string>{};
+  // One mesh on a root node gains nothing; one below other nodes sheds them (BoxTextured: 3 → 1).
+  const Json& roots = array_in(scenes[0], "nodes");
+  if (placements.empty() ||
+      (placements.size() == 1 && std::find(roots.begin(), roots.end(), placements[0].first) != roots.end())) {
+    return std::vector<std::string>{};
+  }
   std::map<JoinKey, std::vector<Placed>> groups;  // in material order, then layout
   for (const auto& [n, world] : placements) {
     const std::size_t m = gltf::size_in(doc.json["nodes"][n], "mesh", SIZE_MAX);
