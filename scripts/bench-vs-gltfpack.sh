@@ -22,4 +22,5 @@ if [ -z "${GLTFPACK:-}" ]; then
 fi
 export GLTFPACK
 export BASISU_PATH=${BASISU_PATH:-$root/scripts/basisu/bin/basisu}
+cd "$work"  # gltfpack writes its temporary images into the current folder
 "$root/build/tests/matbake_tests" --gtest_also_run_disabled_tests --gtest_filter='Runtime.DISABLED_AgainstGltfpack' | grep '^|'
