@@ -131,6 +131,11 @@ RunResult run(const std::string& program, const std::vector<std::string>& args, 
   return run_program(program, args, env, false);
 }
 
+std::string tool_path(const std::string& tool) {
+  const RunResult r = run("/bin/sh", {"-c", "command -v " + tool});
+  return r.exit_code == 0 ? r.out.substr(0, r.out.find('\n')) : std::string();
+}
+
 RunResult run_measured(const std::string& program, const std::vector<std::string>& args, const std::vector<std::string>& env) {
   return run_program(program, args, env, true);
 }

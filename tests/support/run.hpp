@@ -13,6 +13,9 @@ struct RunResult {
 
 // Runs `program args...` with stdout and stderr captured; `env` entries ("NAME=value") are added
 // to (or override) the environment; an entry "NAME=" removes NAME.
+// Where `tool` is on PATH; empty when it is not.
+std::string tool_path(const std::string& tool);
+
 RunResult run(const std::string& program, const std::vector<std::string>& args,
               const std::vector<std::string>& env = {});
 

@@ -211,12 +211,6 @@ struct Variant {
   double position_step;           // the largest distance quantization may move a vertex, in scene units
 };
 
-// Where `tool` is on PATH; empty when it is not.
-std::string tool_path(const std::string& tool) {
-  const test::RunResult r = test::run("/bin/sh", {"-c", "command -v " + tool});
-  return r.exit_code == 0 ? r.out.substr(0, r.out.find('\n')) : std::string();
-}
-
 double mean_ao(const std::vector<std::string>& args) {
   const test::RunResult r = test::matbake(args);
   EXPECT_EQ(r.exit_code, 0) << r.err;
@@ -240,7 +234,7 @@ double farthest_vertex(const scene::Scene& a, const scene::Scene& b) {
 
 TEST(GltfInput, DracoAndMeshoptVariantsBakeAndExportLikeThePlainScene) {
   for (const char* tool : {"draco_transcoder", "gltfpack"}) {
-    if (tool_path(tool).empty()) GTEST_SKIP() << tool << " is not installed (Debian packages draco and gltfpack; scripts/deps.sh)";
+    if (test::tool_path(tool).empty()) GTEST_SKIP() << tool << " is not installed (Debian packages draco and gltfpack; scripts/deps.sh)";
   }
   TempDir dir;
   for (const char* f : {"showroom.gltf", "showroom.bin"}) fs::copy_file(fs::path(MATBAKE_SOURCE_DIR) / "examples" / f, dir / f);
@@ -269,7 +263,7 @@ TEST(GltfInput, DracoAndMeshoptVariantsBakeAndExportLikeThePlainScene) {
     std::vector<std::string> args = {"-i", plain.string()};
     args = with(args, v.args);
     args = with(args, {"-o", file.string()});
-    const test::RunResult made = test::run(tool_path(v.tool), args);
+    const test::RunResult made = test::run(test::tool_path(v.tool), args);
     ASSERT_EQ(made.exit_code, 0) << v.tool << ": " << made.err;
     auto decoded = scene::load_scene(file);
     ASSERT_TRUE(decoded) << decoded.error().to_string();
@@ -288,10 +282,11 @@ TEST(GltfInput, DracoAndMeshoptVariantsBakeAndExportLikeThePlainScene) {
     }
     const test::RunResult e = test::matbake({"export", file.string(), "-o", exported.string(), "--ao-samples", "16"});
     ASSERT_EQ(e.exit_code, 0) << e.err;
-    // Delivered again with quantized, compressed geometry (Draco made plain, meshopt and quantized
-    // input re-quantized under its own dequantizing nodes): within one more 14-bit step of the scene.
+    // Delivered again with joined, quantized, compressed geometry (Draco made plain, meshopt and
+    // quantized input joined in world space and quantized again): within one more 14-bit step of the scene.
     const fs::path redelivered = dir / ("geometry_" + v.name);
-    const test::RunResult g = test::matbake({"export", file.string(), "-o", redelivered.string(), "--mesh-quantization", "--mesh-compression", "meshopt"});
+    const test::RunResult g = test::matbake({"export", file.string(), "-o", redelivered.string(), "--join-meshes", "--mesh-quantization",
+                                             "--mesh-compression", "meshopt"});
     ASSERT_EQ(g.exit_code, 0) << g.err;
     auto requantized = scene::load_scene(redelivered);
     ASSERT_TRUE(requantized) << requantized.error().to_string();

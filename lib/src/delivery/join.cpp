@@ -32,8 +32,9 @@ using JoinKey = std::pair<int, std::vector<std::pair<std::string, std::size_t>>>
 bool starts_with(const std::string& s, const char* prefix) { return s.rfind(prefix, 0) == 0; }
 
 // Whether a primitive can be read into floats and merged: triangles, no morph targets, no
-// extension (Draco is decoded on reading and dropped with the primitive), attributes that are floats
-// or normalized integers (an integer attribute such as a custom ID keeps its type where it is).
+// extension (Draco is decoded on reading and dropped with the primitive), no skinning attributes. A
+// quantized attribute's integers become the floats they stand for (its node's dequantizing transform
+// goes into world space with the rest); a custom integer attribute (an ID) keeps its type where it is.
 bool joinable(const gltf::Document& doc, const Json& primitive) {
   if (!primitive.is_object() || primitive.contains("targets") || gltf::integer_in<int>(primitive, "mode", kTriangles, -1) != kTriangles) {
     return false;
@@ -48,7 +49,7 @@ bool joinable(const gltf::Document& doc, const Json& primitive) {
   for (const auto& [name, index] : attributes.items()) {
     if (starts_with(name, "JOINTS_") || starts_with(name, "WEIGHTS_")) return false;
     auto bytes = gltf::accessor_bytes(doc, gltf::size_in(attributes, name.c_str(), SIZE_MAX));
-    if (!bytes || (bytes->component_type != gltf::kFloat && !bytes->normalized)) return false;
+    if (!bytes || (starts_with(name, "_") && bytes->component_type != gltf::kFloat && !bytes->normalized)) return false;
   }
   return true;
 }
