@@ -284,6 +284,23 @@ void sample_one_level(gltf::Document& doc, int texture_index) {
   texture["sampler"] = int(samplers.size()) - 1;
 }
 
+// The file `made` made, as a new image of `doc` (KTX2, or the resized texture as PNG or WebP); its index.
+Result<int> add_made_image(gltf::Document& doc, const gltf::ImageCache& cache, const Work& made) {
+  if (!made.ktx2.empty()) {
+    const std::string uri = gltf::free_uri(doc, made.name, ".ktx2");
+    doc.new_files[uri] = std::string(made.ktx2.begin(), made.ktx2.end());
+    doc.json["images"].push_back({{"uri", uri}, {"mimeType", "image/ktx2"}, {"name", fs::path(uri).stem().string()}});
+    return int(doc.json["images"].size()) - 1;
+  }
+  const color::Transfer transfer = made.use.texture_class == TextureClass::colour ? color::Transfer::srgb : color::Transfer::linear;
+  const std::string extension = cache.webp() ? ".webp" : ".png";
+  const std::string uri =
+      gltf::free_uri(doc, made.name + "_" + std::to_string(made.size.width) + "x" + std::to_string(made.size.height), extension);
+  auto added = cache.add_image(doc, made.level0, transfer, uri.substr(0, uri.size() - extension.size()));
+  if (!added) return added.error();
+  return added->index;
+}
+
 // EXT_texture_webp named only while a texture still uses it.
 void drop_unused_webp(gltf::Document& doc) {
   for (const Json& t : gltf::array_in(doc.json, "textures")) {
@@ -415,32 +432,21 @@ Result<std::vector<TextureReport>> deliver_textures(gltf::Document& doc, gltf::I
     if (!source_bytes) return source_bytes.error();
     report.source_bytes = source_bytes->size();
     report.bytes = report.source_bytes;
-    if (!made.ktx2.empty()) {
-      if (image < 0) {
-        const std::string uri = gltf::free_uri(doc, w.name, ".ktx2");
-        doc.new_files[uri] = std::string(made.ktx2.begin(), made.ktx2.end());
-        doc.json["images"].push_back({{"uri", uri}, {"mimeType", "image/ktx2"}, {"name", fs::path(uri).stem().string()}});
-        image = int(doc.json["images"].size()) - 1;
-      }
-      report.bytes = made.ktx2.size();
-      point_texture(doc, w, image, options.png_fallback);
-      if (!options.mipmaps) sample_one_level(doc, w.texture);
-      gltf::require_extension(doc, kBasisu, !options.png_fallback);
-    } else if (!made.level0.pixels.empty()) {
-      if (image < 0) {
-        const color::Transfer transfer = w.use.texture_class == TextureClass::colour ? color::Transfer::srgb : color::Transfer::linear;
-        const std::string extension = cache.webp() ? ".webp" : ".png";
-        const std::string uri =
-            gltf::free_uri(doc, w.name + "_" + std::to_string(w.size.width) + "x" + std::to_string(w.size.height), extension);
-        auto added = cache.add_image(doc, made.level0, transfer, uri.substr(0, uri.size() - extension.size()));
-        if (!added) return added.error();
-        image = added->index;
-      }
-      point_texture(doc, w, image, options.png_fallback);
-    } else {
+    if (made.ktx2.empty() && made.level0.pixels.empty()) {
       report.note = "kept as it is (its size and format are what was asked)";
       reports.push_back(std::move(report));
       continue;
+    }
+    if (image < 0) {
+      auto added = add_made_image(doc, cache, made);
+      if (!added) return added.error();
+      image = *added;
+    }
+    point_texture(doc, w, image, options.png_fallback);
+    if (!made.ktx2.empty()) {
+      report.bytes = made.ktx2.size();
+      if (!options.mipmaps) sample_one_level(doc, w.texture);
+      gltf::require_extension(doc, kBasisu, !options.png_fallback);
     }
     const Json& written_image = doc.json["images"][std::size_t(image)];
     report.uri = written_image["uri"].get<std::string>();

@@ -440,6 +440,16 @@ int aligned_band_rows(const RowWriter& writer, std::size_t rows) {
   return int((rows + alignment - 1) / alignment * alignment);
 }
 
+// The next band of at most `band_rows` rows from `next_row` of an image `height` rows tall, advancing
+// `next_row`; false past the last row.
+bool cut_band(Band& band, int& next_row, int height, int band_rows) {
+  if (next_row >= height) return false;
+  band.y = next_row;
+  band.rows = std::min(band_rows, height - next_row);
+  next_row += band.rows;
+  return true;
+}
+
 Status write_whole(RowWriter& writer, const Image& image) {
   if (image.channels < 1 || image.channels > 4 || image.pixels.size() != image.sample_count()) {
     return Error{"", "internal: inconsistent image"};
@@ -450,11 +460,8 @@ Status write_whole(RowWriter& writer, const Image& image) {
   int next_row = 0;
   std::atomic<bool> stop{false};
   const auto next = [&](Band& band) {
-    if (next_row >= image.height) return false;
-    band.y = next_row;
-    band.rows = std::min(band_rows, image.height - next_row);
+    if (!cut_band(band, next_row, image.height, band_rows)) return false;
     band.view = {image.pixels.data() + row_samples * std::size_t(band.y), row_samples * std::size_t(band.rows)};
-    next_row += band.rows;
     return true;
   };
   if (Status s = write_bands(writer, next, {}, stop); !s) return s;
@@ -601,12 +608,9 @@ Result<std::string> encode_bands(const ImageLayout& layout, const BandFill& fill
       int next_row = 0;
       std::atomic<bool> stop{false};
       const auto next = [&](Band& band) {
-        if (next_row >= layout.height) return false;
-        band.y = next_row;
-        band.rows = std::min(band_rows, layout.height - next_row);
+        if (!cut_band(band, next_row, layout.height, band_rows)) return false;
         band.pixels.resize(row_samples * std::size_t(band.rows));
         band.view = band.pixels;
-        next_row += band.rows;
         return true;
       };
       const auto prepare = [&](Band& band) { fill(band.y, band.rows, band.pixels); };
