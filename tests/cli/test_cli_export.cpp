@@ -20,6 +20,7 @@
 #include "support/files.hpp"
 #include "support/gltf_files.hpp"
 #include "support/gltf_validator.hpp"
+#include "support/png_chunks.hpp"
 #include "support/run.hpp"
 #include "support/temp_dir.hpp"
 
@@ -441,6 +442,12 @@ TEST(CliExport, BadInputIsRefusedAndNothingIsWritten) {
     b.doc["images"] = {{{"uri", "data:image/png;base64," + base64(std::vector<unsigned char>(
                                                                {0x89, 'P', 'N', 'G', 0, 0, 0, 0}))}}};
     b.write(dir / "broken-data.gltf", {0});
+    // A header of 200 rows over the pixels of 2: every image is decoded to its last row before export.
+    std::string rows;
+    for (int y = 0; y < 2; ++y) rows += std::string(1, '\0') + std::string(9, char(40 * y));
+    const std::string short_png = kPngSignature + png_ihdr(3, 200, 8, 2) + png_chunk("IDAT", deflated(rows)) + png_chunk("IEND", "");
+    b.doc["images"] = {{{"uri", "data:image/png;base64," + base64(std::vector<unsigned char>(short_png.begin(), short_png.end()))}}};
+    b.write(dir / "truncated.gltf", {0});
   }
   {
     GltfBuilder b = quad_scene(json::array({json::object(), json::object()}));
@@ -461,7 +468,7 @@ TEST(CliExport, BadInputIsRefusedAndNothingIsWritten) {
        {Case{"malformed.gltf", "not a valid glTF"}, Case{"missing.gltf", "image 0: 'missing.png' cannot be read"},
         Case{"escape.gltf", "URI '../../etc/passwd' is outside the glTF's folder"},
         Case{"absolute.gltf", "URI '/etc/passwd' is outside the glTF's folder"},
-        Case{"broken-data.gltf", "image 0: "}, Case{"range.gltf", "accessor 0 reaches beyond its buffer"},
+        Case{"broken-data.gltf", "image 0: "}, Case{"truncated.gltf", "image 0: cannot read pixels"}, Case{"range.gltf", "accessor 0 reaches beyond its buffer"},
         Case{"chunks.glb", "not a valid glTF"},
         Case{"factor.gltf", "material 0 KHR_materials_pbrSpecularGlossiness.diffuseFactor must be 4 numbers"}}) {
     const RunResult r = matbake({"export", (dir / file).string(), "-o", out});

@@ -245,6 +245,25 @@ TEST(ImageIo, ExrHeaderDeclaringMoreThanTheFileHoldsIsRefused) {
   EXPECT_EQ(read->pixels, first);
 }
 
+// check_image_bytes gives the layout decode_image gives (its refusals: PngDecode's damaged files).
+TEST(ImageIo, CheckingBytesGivesTheDecodedLayout) {
+  Image noise;
+  noise.width = 300, noise.height = 200, noise.channels = 4, noise.alpha_channel = 3;
+  noise.channel_names = {"R", "G", "B", "A"};
+  for (std::size_t i = 0; i < noise.sample_count(); ++i) noise.pixels.push_back(float((i * 2654435761u) % 251) / 250.0f);
+  auto png = encode_image(noise, "noise.png", {.type = SampleType::u8});
+  ASSERT_TRUE(png) << png.error().to_string();
+  const std::span bytes(reinterpret_cast<const unsigned char*>(png->data()), png->size());
+  auto checked = check_image_bytes(bytes, "noise.png");
+  auto decoded = decode_image(bytes, "noise.png", Transfer::linear);
+  ASSERT_TRUE(checked && decoded);
+  EXPECT_EQ(checked->width, 300);
+  EXPECT_EQ(checked->height, 200);
+  EXPECT_EQ(checked->channels, 4);
+  EXPECT_EQ(checked->alpha_channel, decoded->alpha_channel);
+  EXPECT_EQ(checked->channel_names, decoded->channel_names);
+}
+
 // Inputs found by tests/fuzz/fuzz_image that made OIIO 2.4 read out of bounds (oiio_icc_override.cpp,
 // oiio/checked_mem_reader.cpp; the PNG is read by libspng now, which ignores the profile):
 // a PNG whose ICC profile's text tags point past it (SIGSEGV in release) and an EXR decoded from

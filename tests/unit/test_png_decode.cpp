@@ -12,6 +12,7 @@
 
 #include "matbake/image.hpp"
 #include "support/files.hpp"
+#include "support/png_chunks.hpp"
 #include "support/run.hpp"
 #include "support/temp_dir.hpp"
 
@@ -20,6 +21,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using color::Transfer;
+using test::be32, test::deflated, test::kPngSignature, test::png_chunk, test::png_ihdr;
 
 const fs::path kTestdata = MATBAKE_TESTDATA_DIR;
 
@@ -117,25 +119,6 @@ TEST(PngDecode, LibpngCrashersAreReadOrRefusedAsLibpngDoes) {
 }
 
 // A valid 3×2 RGB PNG written by hand, so each damage below is exact.
-std::string be32(std::uint32_t v) {
-  return {char(v >> 24), char(v >> 16), char(v >> 8), char(v)};
-}
-std::string chunk(const std::string& type, const std::string& data) {
-  const std::string body = type + data;
-  return be32(std::uint32_t(data.size())) + body +
-         be32(std::uint32_t(crc32(0, reinterpret_cast<const Bytef*>(body.data()), uInt(body.size()))));
-}
-std::string ihdr(std::uint32_t w, std::uint32_t h, int depth, int colour_type, int interlace = 0) {
-  return chunk("IHDR", be32(w) + be32(h) + std::string{char(depth), char(colour_type), 0, 0, char(interlace)});
-}
-std::string deflated(const std::string& raw) {
-  uLongf size = compressBound(uLong(raw.size()));
-  std::string out(size, '\0');
-  compress(reinterpret_cast<Bytef*>(out.data()), &size, reinterpret_cast<const Bytef*>(raw.data()), uLong(raw.size()));
-  out.resize(size);
-  return out;
-}
-const std::string kSignature("\x89PNG\r\n\x1a\n", 8);
 std::string rgb_rows() {  // filter byte 0, then 3 RGB pixels; two rows
   std::string raw;
   for (int y = 0; y < 2; ++y) {
@@ -145,7 +128,7 @@ std::string rgb_rows() {  // filter byte 0, then 3 RGB pixels; two rows
   return raw;
 }
 std::string valid_png() {
-  return kSignature + ihdr(3, 2, 8, 2) + chunk("IDAT", deflated(rgb_rows())) + chunk("IEND", "");
+  return kPngSignature + png_ihdr(3, 2, 8, 2) + png_chunk("IDAT", deflated(rgb_rows())) + png_chunk("IEND", "");
 }
 
 TEST(PngDecode, HandWrittenPngDecodesAndEveryTruncationIsAnError) {
@@ -173,7 +156,7 @@ TEST(PngDecode, HandWrittenPngDecodesAndEveryTruncationIsAnError) {
 
 TEST(PngDecode, DamagedAndHostileHeadersAreOneLineErrors) {
   test::TempDir dir;
-  const std::string idat = chunk("IDAT", deflated(rgb_rows())), iend = chunk("IEND", "");
+  const std::string idat = png_chunk("IDAT", deflated(rgb_rows())), iend = png_chunk("IEND", "");
   std::string bad_crc = valid_png();
   bad_crc[8 + 8 + 4] ^= 1;  // a bit of IHDR's width: its CRC no longer matches
   std::string bad_data = valid_png();
@@ -192,24 +175,24 @@ TEST(PngDecode, DamagedAndHostileHeadersAreOneLineErrors) {
       {"signature-byte", signature_byte},
       {"signature-lf", lf_mangled},
       {"signature-cr", cr_mangled},
-      {"colour-type-1", kSignature + ihdr(3, 2, 8, 1) + idat + iend},
-      {"colour-type-9", kSignature + ihdr(3, 2, 8, 9) + idat + iend},
-      {"depth-0", kSignature + ihdr(3, 2, 0, 2) + idat + iend},
-      {"depth-3", kSignature + ihdr(3, 2, 3, 2) + idat + iend},
-      {"depth-99", kSignature + ihdr(3, 2, 99, 2) + idat + iend},
+      {"colour-type-1", kPngSignature + png_ihdr(3, 2, 8, 1) + idat + iend},
+      {"colour-type-9", kPngSignature + png_ihdr(3, 2, 8, 9) + idat + iend},
+      {"depth-0", kPngSignature + png_ihdr(3, 2, 0, 2) + idat + iend},
+      {"depth-3", kPngSignature + png_ihdr(3, 2, 3, 2) + idat + iend},
+      {"depth-99", kPngSignature + png_ihdr(3, 2, 99, 2) + idat + iend},
       {"bad-idat-crc", bad_idat_crc},
       {"bad-ihdr-crc", bad_crc},
-      {"huge-size", kSignature + ihdr(100000, 100000, 8, 2) + idat + iend},
-      {"zero-width", kSignature + ihdr(0, 2, 8, 2) + idat + iend},
-      {"bad-depth", kSignature + ihdr(3, 2, 7, 2) + idat + iend},
-      {"bad-colour-type", kSignature + ihdr(3, 2, 8, 5) + idat + iend},
-      {"palette-without-plte", kSignature + ihdr(3, 2, 8, 3) + idat + iend},
-      {"no-idat", kSignature + ihdr(3, 2, 8, 2) + iend},
+      {"huge-size", kPngSignature + png_ihdr(100000, 100000, 8, 2) + idat + iend},
+      {"zero-width", kPngSignature + png_ihdr(0, 2, 8, 2) + idat + iend},
+      {"bad-depth", kPngSignature + png_ihdr(3, 2, 7, 2) + idat + iend},
+      {"bad-colour-type", kPngSignature + png_ihdr(3, 2, 8, 5) + idat + iend},
+      {"palette-without-plte", kPngSignature + png_ihdr(3, 2, 8, 3) + idat + iend},
+      {"no-idat", kPngSignature + png_ihdr(3, 2, 8, 2) + iend},
       {"damaged-deflate", bad_data},
-      {"bad-filter", kSignature + ihdr(3, 2, 8, 2) + chunk("IDAT", deflated(bad_filter_raw)) + iend},
-      {"rows-missing", kSignature + ihdr(3, 200, 8, 2) + idat + iend},
-      {"huge-text-chunk", kSignature + ihdr(3, 2, 8, 2) + be32(0x7ffffff0u) + "tEXt" + std::string(64, 'a')},
-      {"signature-only", kSignature},
+      {"bad-filter", kPngSignature + png_ihdr(3, 2, 8, 2) + png_chunk("IDAT", deflated(bad_filter_raw)) + iend},
+      {"rows-missing", kPngSignature + png_ihdr(3, 200, 8, 2) + idat + iend},
+      {"huge-text-chunk", kPngSignature + png_ihdr(3, 2, 8, 2) + be32(0x7ffffff0u) + "tEXt" + std::string(64, 'a')},
+      {"signature-only", kPngSignature},
   };
   for (const auto& [name, bytes] : cases) {
     SCOPED_TRACE(name);
@@ -219,6 +202,8 @@ TEST(PngDecode, DamagedAndHostileHeadersAreOneLineErrors) {
     expect_one_line_error(
         status_of(decode_image({reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size()}, name, Transfer::srgb)),
         name);
+    // Checked without keeping the pixels (a glTF's images before export): the same refusal.
+    expect_one_line_error(status_of(check_image_bytes({reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size()}, name)), name);
     // The command: exit 1, one line, nothing written.
     const auto r = test::matbake({"convert", f.string(), "-o", (dir / "out.exr").string()});
     EXPECT_EQ(r.exit_code, 1) << r.err;

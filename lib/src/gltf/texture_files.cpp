@@ -1,5 +1,7 @@
 #include "texture_files.hpp"
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cctype>
 #include <set>
@@ -112,18 +114,27 @@ Result<image::Image> ImageCache::decode(int texture, color::Transfer colour) con
 
 Status ImageCache::check_all() {
   const std::size_t count = array_in(doc_.json, "images").size();
-  // One at a time: a decoded image is up to 16 bytes a texel.
-  for (std::size_t index = 0; index < count; ++index) {
+  // Decoded in full, band by band (a header that reads over truncated or corrupt pixels must not
+  // pass), several at once: the pixels are not kept.
+  std::vector<Result<image::ImageLayout>> checked(count, image::ImageLayout{});
+  tbb::parallel_for(std::size_t(0), count, [&](std::size_t index) {
     auto bytes = gltf::image_bytes(doc_, index);
-    if (!bytes) return bytes.error();
     const std::string what = "image " + std::to_string(index);
-    if (bytes->rfind("\xabKTX 20\xbb", 0) == 0) continue;  // passed through
-    const char* extension = extension_of(*bytes);
-    if (!*extension) return Error{doc_.file, what + " is not PNG, JPEG, WebP or KTX2"};
-    // Decoded in full: a header that reads over truncated or corrupt pixels must not pass.
-    auto decoded = image::decode_image(as_bytes(*bytes), std::string("image") + extension, color::Transfer::linear);
-    if (!decoded) return Error{doc_.file, what + ": " + decoded.error().message};
-    sizes_[int(index)] = {decoded->width, decoded->height};
+    if (!bytes) {
+      checked[index] = bytes.error();
+    } else if (bytes->rfind("\xabKTX 20\xbb", 0) == 0) {
+      checked[index] = image::ImageLayout{};  // passed through
+    } else if (const char* extension = extension_of(*bytes); !*extension) {
+      checked[index] = Error{doc_.file, what + " is not PNG, JPEG, WebP or KTX2"};
+    } else if (auto layout = image::check_image_bytes(as_bytes(*bytes), std::string("image") + extension); !layout) {
+      checked[index] = Error{doc_.file, what + ": " + layout.error().message};
+    } else {
+      checked[index] = *layout;
+    }
+  }, tbb::simple_partitioner());
+  for (std::size_t index = 0; index < count; ++index) {
+    if (!checked[index]) return checked[index].error();
+    if (checked[index]->width > 0) sizes_[int(index)] = {checked[index]->width, checked[index]->height};
   }
   return success();
 }
