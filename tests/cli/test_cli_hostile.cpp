@@ -168,6 +168,7 @@ TEST(Hostile, GltfCountsFoldersAndLinks) {
     b.doc["textures"] = {{{"source", 0}}};
     b.doc["materials"] = {{{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}}};
     b.doc["meshes"][0]["primitives"][0]["material"] = 0;
+    b.doc["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_0"] = b.add_floats({0, 0, 1, 0, 0, 1}, "VEC2", 2);
     b.write(dir / "dot.gltf", {0});
     const std::string file = (dir / "dot.gltf").string();
     expect_refused({"export", file, "-o", out}, kFailed, file, "image 0: '.' cannot be read", dir / "out");

@@ -93,6 +93,10 @@ Status check_image_file(const std::filesystem::path& path);
 Result<Image> decode_image(std::span<const unsigned char> bytes, const std::filesystem::path& name,
                            color::Transfer colour, ReadInfo* info = nullptr);
 
+// The layout of an image held in memory, from its header (and, for PNG, the chunks up to its first
+// pixels): what decode_image would return, without decoding.
+Result<ImageLayout> probe_image_bytes(std::span<const unsigned char> bytes, const std::filesystem::path& name);
+
 // decode_image's checks without keeping the pixels: every row decoded through one band's buffer, so
 // a header that reads over truncated or corrupt pixels fails here too. Its layout when it decodes.
 Result<ImageLayout> check_image_bytes(std::span<const unsigned char> bytes, const std::filesystem::path& name);

@@ -361,9 +361,8 @@ Result<std::vector<TextureReport>> deliver_textures(gltf::Document& doc, gltf::I
       continue;
     }
     const color::Transfer transfer = use.texture_class == TextureClass::colour ? color::Transfer::srgb : color::Transfer::linear;
-    // Its size as the cache's check noted it (else decoded here, so that a bad image fails the pass
-    // before any encode); decoded when its turn comes, so that only the textures being worked on are
-    // held.
+    // Its size from the image's header (a header that does not read fails the pass before any
+    // encode); decoded when its turn comes, so that only the textures being worked on are held.
     Size source_size;
     if (auto size = cache.size_of(texture); size) {
       source_size = {size->first, size->second};

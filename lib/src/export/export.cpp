@@ -468,7 +468,7 @@ Result<Report> export_scene(const fs::path& input, const fs::path& output, const
     }
 
     gltf::ImageCache cache(*doc, options.encoding, delivery::made_format(options.delivery));
-    if (Status s = cache.check_all(); !s) return s.error();
+    const std::size_t images_read = gltf::array_in(doc->json, "images").size();
     Exporter exporter{*doc, cache, options, output.stem().string(), report, {}, {}};
     const std::size_t materials = doc->json.contains("materials") ? doc->json["materials"].size() : 0;
     for (std::size_t i = 0; i < materials; ++i) {
@@ -519,6 +519,8 @@ Result<Report> export_scene(const fs::path& input, const fs::path& output, const
     }
     auto delivered = delivery::deliver_textures(*doc, cache, options.delivery, output);
     if (!delivered) return delivered.error();
+    // The input's images that nothing decoded (passed through as they are) decode in full too.
+    if (Status s = cache.check_undecoded(images_read); !s) return s.error();
     report.textures = std::move(*delivered);
     // What the conversions replaced (spec-gloss textures, separate occlusion maps, old colours) and
     // what delivery did (resized or KTX2 images).

@@ -94,6 +94,8 @@ Result<image::Image> ImageCache::decode_source(int source, color::Transfer colou
   if (!*extension) return Error{doc_.file, "image " + std::to_string(source) + " is not PNG, JPEG or WebP"};
   auto decoded = image::decode_image(as_bytes(*bytes), std::string("image") + extension, colour);
   if (!decoded) return Error{doc_.file, "image " + std::to_string(source) + ": " + decoded.error().message};
+  std::lock_guard lock(decoded_mutex_);
+  decoded_sources_.insert(source);
   return decoded;
 }
 
@@ -112,29 +114,28 @@ Result<image::Image> ImageCache::decode(int texture, color::Transfer colour) con
   return decode_source(*source, colour);
 }
 
-Status ImageCache::check_all() {
-  const std::size_t count = array_in(doc_.json, "images").size();
-  // Decoded in full, band by band (a header that reads over truncated or corrupt pixels must not
-  // pass), several at once: the pixels are not kept.
-  std::vector<Result<image::ImageLayout>> checked(count, image::ImageLayout{});
+Status ImageCache::check_undecoded(std::size_t count) const {
+  count = std::min(count, array_in(doc_.json, "images").size());
+  std::vector<Status> checked(count, success());
   tbb::parallel_for(std::size_t(0), count, [&](std::size_t index) {
+    {
+      std::lock_guard lock(decoded_mutex_);
+      if (decoded_sources_.count(int(index))) return;
+    }
     auto bytes = gltf::image_bytes(doc_, index);
     const std::string what = "image " + std::to_string(index);
     if (!bytes) {
       checked[index] = bytes.error();
     } else if (bytes->rfind("\xabKTX 20\xbb", 0) == 0) {
-      checked[index] = image::ImageLayout{};  // passed through
+      return;  // passed through
     } else if (const char* extension = extension_of(*bytes); !*extension) {
       checked[index] = Error{doc_.file, what + " is not PNG, JPEG, WebP or KTX2"};
     } else if (auto layout = image::check_image_bytes(as_bytes(*bytes), std::string("image") + extension); !layout) {
       checked[index] = Error{doc_.file, what + ": " + layout.error().message};
-    } else {
-      checked[index] = *layout;
     }
   }, tbb::simple_partitioner());
-  for (std::size_t index = 0; index < count; ++index) {
-    if (!checked[index]) return checked[index].error();
-    if (checked[index]->width > 0) sizes_[int(index)] = {checked[index]->width, checked[index]->height};
+  for (Status& s : checked) {
+    if (!s) return s.error();
   }
   return success();
 }
@@ -142,10 +143,13 @@ Status ImageCache::check_all() {
 Result<std::pair<int, int>> ImageCache::size_of(int texture) const {
   auto source = source_of(texture);
   if (!source) return source.error();
-  if (const auto found = sizes_.find(*source); found != sizes_.end()) return found->second;
-  auto decoded = decode_source(*source, color::Transfer::linear);
-  if (!decoded) return decoded.error();
-  return std::pair{decoded->width, decoded->height};
+  auto bytes = gltf::image_bytes(doc_, std::size_t(*source));
+  if (!bytes) return bytes.error();
+  const char* extension = extension_of(*bytes);
+  if (!*extension) return Error{doc_.file, "image " + std::to_string(*source) + " is not PNG, JPEG or WebP"};
+  auto layout = image::probe_image_bytes(as_bytes(*bytes), std::string("image") + extension);
+  if (!layout) return Error{doc_.file, "image " + std::to_string(*source) + ": " + layout.error().message};
+  return std::pair{layout->width, layout->height};
 }
 
 Result<ImageCache::Made> ImageCache::add_image(Document& doc, const image::Image& img, color::Transfer colour,

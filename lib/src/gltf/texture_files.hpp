@@ -2,6 +2,8 @@
 // A glTF document's images decoded in memory through OIIO (each once per transfer), and images
 // encoded as PNG bytes for the document's new files. No file is written outside the output.
 #include <map>
+#include <mutex>
+#include <set>
 #include <string>
 #include <utility>
 
@@ -50,10 +52,12 @@ class ImageCache {
   // Drops every decoded image kept (texture() decodes again when asked).
   void forget_decoded() { images_.clear(); }
 
-  // Every image of the document is a PNG, JPEG or WebP that decodes in full, or a KTX2 file (passed
-  // through); each dropped once its size is noted. The first bad one's error.
-  Status check_all();
-  // The width and height of texture `texture`'s image: as check_all noted it, else decoded.
+  // Images [0, `count`) of the document that no decode of this cache has read: each a PNG, JPEG or
+  // WebP that decodes in full (band by band, several at once, pixels not kept), or a KTX2 file
+  // (passed through). The first bad one's error. Called once the work that decodes is done, so
+  // that no image is decoded only to be checked.
+  Status check_undecoded(std::size_t count) const;
+  // The width and height of texture `texture`'s image, from its header.
   Result<std::pair<int, int>> size_of(int texture) const;
 
   // A new image of `doc` (the cache's document) holding `img`, its colour channels encoded with
@@ -79,7 +83,8 @@ class ImageCache {
   image::Encoding encoding_;
   MadeFormat made_;
   std::map<std::pair<int, color::Transfer>, image::Image> images_;  // by (image index, transfer)
-  std::map<int, std::pair<int, int>> sizes_;                         // by image index, from check_all
+  mutable std::mutex decoded_mutex_;
+  mutable std::set<int> decoded_sources_;  // images a decode has read in full
 };
 
 }  // namespace matbake::gltf

@@ -584,6 +584,14 @@ Result<Image> decode_image(std::span<const unsigned char> bytes, const fs::path&
   });
 }
 
+Result<ImageLayout> probe_image_bytes(std::span<const unsigned char> bytes, const fs::path& name) {
+  return guarded(name.string(), [&]() -> Result<ImageLayout> {
+    auto reader = RowReader::open_memory(bytes, name, color::Transfer::linear);
+    if (!reader) return reader.error();
+    return reader->layout();
+  });
+}
+
 Result<ImageLayout> check_image_bytes(std::span<const unsigned char> bytes, const fs::path& name) {
   return guarded(name.string(), [&]() -> Result<ImageLayout> {
     auto reader = RowReader::open_memory(bytes, name, color::Transfer::linear);
