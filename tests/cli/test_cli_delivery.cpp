@@ -196,6 +196,9 @@ TEST(CliDelivery, TinyTexturesAreRaisedToFourTexelsInKtx2) {
   write_raw(dir / "normal.png", 3, 3, 3, "uint8", std::vector<double>(27, 128));
   json quad = json::parse(read_bytes(dir / "quad.gltf"));
   quad["textures"][0]["name"] = "ToyCar_clearcoat.png";  // a name the KTX2 texture must not keep
+  // An embedded image without a name: named from the material and slot that read it.
+  const std::string orm = read_bytes(dir / "orm.png");
+  quad["images"][1] = {{"uri", "data:image/png;base64," + base64(std::vector<unsigned char>(orm.begin(), orm.end()))}};
   write_bytes(dir / "quad.gltf", quad.dump());
   const fs::path out = dir / "tiny.glb";
   const RunResult r = matbake({"export", (dir / "quad.gltf").string(), "-o", out.string(), "--texture-format", "ktx2"},
@@ -209,12 +212,13 @@ TEST(CliDelivery, TinyTexturesAreRaisedToFourTexelsInKtx2) {
     EXPECT_EQ(k->width, 4u) << "texture " << t;
     EXPECT_EQ(k->height, 4u) << "texture " << t;
     EXPECT_EQ(k->levels.size(), 3u) << "texture " << t;  // 4, 2, 1
-    // Named as its KTX2 image is (from the file it replaced: colour, orm, normal).
+    // Named as its KTX2 image is (from the file it replaced: colour, normal; the embedded one from its slot).
     const json& texture = doc.json["textures"][std::size_t(t)];
     const json& image = doc.json["images"][texture["extensions"]["KHR_texture_basisu"]["source"].get<std::size_t>()];
     EXPECT_EQ(texture["name"], image["name"]) << "texture " << t;
   }
   EXPECT_EQ(doc.json["images"][0]["name"], "colour");
+  EXPECT_EQ(doc.json["images"][1]["name"], "leaves_metallicRoughness");
 }
 
 // --no-mipmaps: one level per KTX2 file, and samplers that do not ask for more: each texture's own

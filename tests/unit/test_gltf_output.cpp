@@ -6,6 +6,7 @@
 #include <fstream>
 
 #include "lib/src/gltf/document.hpp"
+#include "lib/src/gltf/json_text.hpp"
 #include "lib/src/gltf/prune.hpp"
 #include "lib/src/gltf/vertex_occlusion.hpp"
 #include "matbake/ao.hpp"
@@ -40,6 +41,27 @@ fs::path write_external_scene(const fs::path& folder) {
   fs::create_directories(folder / "tex");
   test::write_raw(folder / "tex" / "a b.png", 1, 1, 3, "uint8", {10, 20, 30});
   return folder / "scene.gltf";
+}
+
+// The written text is nlohmann's but for floating-point numbers: those that are float32 values in
+// their shortest float32 form, the others in their shortest double form, whole ones without ".0";
+// each reads back as the value written (a float32 one as that float32).
+TEST(GltfJsonText, NumbersAreShortAndReadBackAsThemselves) {
+  const gltf::Json no_floats = gltf::Json::parse(R"({"asset":{"version":"2.0","generator":"x\u0001\"y"},"nodes":[{"children":[1,2]},{},{"name":"é"}],"e":[],"o":{},"b":[true,false,null],"n":-7})");
+  EXPECT_EQ(gltf::json_text(no_floats), no_floats.dump());
+  EXPECT_EQ(gltf::json_text(no_floats, 2), no_floats.dump(2));
+  const double step = 1.0 / 16383;  // not a float32: its double's shortest form
+  const gltf::Json numbers = {{"f", {0.0, 1.0, -0.5, 16383.0, double(float(step)), double(0.1f), 1e30, double(1e-30f)}},
+                              {"d", {step, 0.1, 1e300}},
+                              {"nan", std::nan("")}};
+  EXPECT_EQ(gltf::json_text(numbers),
+            R"({"f":[0,1,-0.5,16383,6.103888e-05,0.1,1e+30,1e-30],"d":[6.103888176768602e-05,0.1,1e+300],"nan":null})");
+  const gltf::Json back = gltf::Json::parse(gltf::json_text(numbers, 2));
+  for (std::size_t i = 0; i < numbers["f"].size(); ++i) {
+    EXPECT_EQ(float(back["f"][i].get<double>()), float(numbers["f"][i].get<double>())) << i;
+  }
+  for (std::size_t i = 0; i < numbers["d"].size(); ++i) EXPECT_EQ(back["d"][i].get<double>(), numbers["d"][i].get<double>()) << i;
+  EXPECT_TRUE(back["nan"].is_null());
 }
 
 TEST(GltfDocument, GltfToAnotherFolderMergesBuffersAndCopiesImages) {

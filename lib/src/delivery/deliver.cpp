@@ -43,6 +43,8 @@ struct Use {
   std::optional<float> alpha_cutoff;
   std::string conflict;  // "used as colour and data": kept as it is
   std::set<Placement> placements;  // every slot that reads it
+  int first_material = -1;          // the first slot that reads it, which names it when its image has no name
+  std::string first_slot;           // "baseColorTexture"
 };
 
 // The class of a material slot, by its name, for core and extension slots alike: normal maps
@@ -54,8 +56,9 @@ TextureClass class_of_slot(const std::string& key) {
   return TextureClass::data;
 }
 
-void record(std::map<int, Use>& uses, int texture, TextureClass c, std::optional<float> cutoff, Placement placement) {
-  auto [it, fresh] = uses.try_emplace(texture, Use{c, cutoff, "", {}});
+void record(std::map<int, Use>& uses, int texture, TextureClass c, std::optional<float> cutoff, Placement placement,
+            const std::string& slot) {
+  auto [it, fresh] = uses.try_emplace(texture, Use{c, cutoff, "", {}, placement.material, slot});
   Use& use = it->second;
   use.placements.insert(placement);
   if (fresh) return;
@@ -85,7 +88,7 @@ void collect(const Json& node, int material, std::optional<float> cutoff, std::m
     if (key.ends_with("Texture") && value.contains("index")) {
       const int index = gltf::integer_in<int>(value, "index", -1, -1);
       const bool mask_alpha = key == "baseColorTexture";
-      if (index >= 0) record(uses, index, class_of_slot(key), mask_alpha ? cutoff : std::nullopt, placement_of(value, material));
+      if (index >= 0) record(uses, index, class_of_slot(key), mask_alpha ? cutoff : std::nullopt, placement_of(value, material), key);
     } else {
       collect(value, material, cutoff, uses);
     }
@@ -129,9 +132,9 @@ Sampling sampling_of(const Json& json, const Json& texture, Filter filter) {
   return s;
 }
 
-// A file name for what replaces image `image`: its file's stem, else its name, else "<stem>_image<N>";
-// only characters safe in a URI.
-std::string base_name(const Json& json, int image, const std::string& stem) {
+// A file name for what replaces image `image`: its file's stem, else its name, else its first
+// material's and slot's ("Paint_baseColor"); only characters safe in a URI.
+std::string base_name(const Json& json, int image, const Use& use) {
   const Json& img = gltf::array_in(json, "images")[std::size_t(image)];
   std::string name;
   if (img.contains("uri") && img["uri"].is_string() && img["uri"].get<std::string>().rfind("data:", 0) != 0) {
@@ -140,7 +143,9 @@ std::string base_name(const Json& json, int image, const std::string& stem) {
     name = gltf::name_in(img, "");
   }
   name = gltf::uri_safe(name);
-  return name.empty() ? stem + "_image" + std::to_string(image) : name;
+  if (!name.empty()) return name;
+  const std::string slot = use.first_slot.substr(0, use.first_slot.rfind("Texture"));
+  return gltf::material_file_name(gltf::array_in(json, "materials")[std::size_t(use.first_material)], use.first_material) + "_" + slot;
 }
 
 double triangle_area(glm::dvec3 a, glm::dvec3 b, glm::dvec3 c) { return 0.5 * glm::length(glm::cross(b - a, c - a)); }
@@ -340,7 +345,6 @@ Result<std::vector<TextureReport>> deliver_textures(gltf::Document& doc, gltf::I
                                                     const fs::path& output) {
   if (!changes_textures(options)) return std::vector<TextureReport>{};
   const bool ktx2_out = options.texture_format == TextureFormat::ktx2;
-  const std::string stem = output.stem().string();
   std::vector<Work> work;
   std::vector<TextureReport> reports;
   const std::map<int, Use> uses = texture_uses(doc.json);
@@ -375,7 +379,7 @@ Result<std::vector<TextureReport>> deliver_textures(gltf::Document& doc, gltf::I
     if (options.texel_density > 0) w.needed = needed_side(mapped[texture], source_size, options.texel_density);
     w.size = delivered_size(source_size, o, options.rounding, w.needed);
     w.codec = ktx2_out ? o.codec : Codec::png;
-    w.name = base_name(doc.json, image, stem);
+    w.name = base_name(doc.json, image, use);
     if (w.codec != Codec::png) w.size = ktx2_size(w.size);
     if (w.codec != Codec::png && !sides_fit_ktx2(w.size)) {
       return Error{doc.file, "texture " + std::to_string(texture) + " (" + w.name + ") would be " + std::to_string(w.size.width) +

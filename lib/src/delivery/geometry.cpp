@@ -478,8 +478,10 @@ void place_on_grids(gltf::Document& doc, const Plan& plan, const GeometryOptions
     const std::size_t m = gltf::size_in(doc.json["nodes"][n], "mesh", SIZE_MAX);
     if (m >= plan.meshes.size() || !plan.meshes[m].quantize) continue;
     const MeshGrid& g = plan.meshes[m];
-    const double step = g.step(options.position_bits);
-    doc.json["nodes"].push_back({{"mesh", m}, {"translation", {g.lo.x, g.lo.y, g.lo.z}}, {"scale", {step, step, step}}});
+    // As float32, which runtimes apply them in (and the file's text is then short).
+    const float step = float(g.step(options.position_bits));
+    const glm::vec3 lo(g.lo);
+    doc.json["nodes"].push_back({{"mesh", m}, {"translation", {lo.x, lo.y, lo.z}}, {"scale", {step, step, step}}});
     Json& node = doc.json["nodes"][n];
     node.erase("mesh");
     node["children"].push_back(doc.json["nodes"].size() - 1);
@@ -510,8 +512,8 @@ Status undo_uv_grids(gltf::Document& doc, const Plan& plan, const GeometryOption
       const glm::dvec2 s = uv->second.range() * (65535.0 / double((1 << options.texcoord_bits) - 1));
       const glm::dvec2 offset = t->apply(uv->second.lo), scale = t->scale * s;
       Json& ext = info["extensions"][kTransform];
-      ext["offset"] = {offset.x, offset.y};
-      ext["scale"] = {scale.x, scale.y};
+      ext["offset"] = {float(offset.x), float(offset.y)};  // float32, as runtimes apply them
+      ext["scale"] = {float(scale.x), float(scale.y)};
       added = true;
     });
     if (!status) return status;

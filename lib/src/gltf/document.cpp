@@ -8,6 +8,7 @@
 #include <iterator>
 
 #include "decode.hpp"
+#include "json_text.hpp"
 #include "load_model.hpp"
 #include "references.hpp"
 #include "matbake/output_check.hpp"
@@ -533,12 +534,12 @@ Result<std::vector<fs::path>> write_document(const Document& doc, const fs::path
       written.push_back(target);
     }
     if (!glb) {
-      if (Status s = write_file_atomically(output, json.dump(2) + "\n"); !s) return s.error();
+      if (Status s = write_file_atomically(output, json_text(json, 2) + "\n"); !s) return s.error();
       written.push_back(output);
       return written;
     }
 
-    std::string text = json.dump();
+    std::string text = json_text(json);
     pad(text, 4, ' ');
     bin.pad();
     std::string header;  // the GLB header and the JSON chunk; the BIN chunk is written from `bin` as it is
