@@ -54,15 +54,16 @@ void add_output_dir_option(CLI::App& cmd, std::string& output_dir) {
 }
 
 // `build --status`: each job that is not up to date, with why; the counts; exit 1 when any failed.
-// ", KTX2: 10 encoded, 5 from the encode cache" for a scene that delivered KTX2 textures, else "".
-std::string ktx2_counts(const nlohmann::json& details) {
+// ", textures: 10 encoded, 5 from the encode cache" for a scene that made textures (KTX2, or resized
+// PNG or WebP), else "".
+std::string texture_counts(const nlohmann::json& details) {
   if (!details.is_object() || !details.contains("textures")) return "";
   int encoded = 0, reused = 0;
   for (const nlohmann::json& t : details["textures"]) {
     if (t.contains("reused")) ++(t["reused"].get<bool>() ? reused : encoded);
   }
   if (encoded + reused == 0) return "";
-  return ", KTX2: " + std::to_string(encoded) + " encoded, " + std::to_string(reused) + " from the encode cache";
+  return ", textures: " + std::to_string(encoded) + " encoded, " + std::to_string(reused) + " from the encode cache";
 }
 
 int run_status(const BuildSettings& s, const GlobalOptions& global, const pipeline::Manifest& manifest,
@@ -230,7 +231,7 @@ int run_build(const BuildSettings& s, const GlobalOptions& global) {
     } else if (!global.quiet && !terminal) {
       char line[64];
       std::snprintf(line, sizeof line, "[%zu/%zu] ", done, total);
-      bar.print_above(line + r.job->name + " built (" + std::to_string(int(r.seconds * 1000)) + " ms" + ktx2_counts(r.details) + ")");
+      bar.print_above(line + r.job->name + " built (" + std::to_string(int(r.seconds * 1000)) + " ms" + texture_counts(r.details) + ")");
     }
     bar.update(done, total);
   };

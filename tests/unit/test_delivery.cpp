@@ -455,5 +455,45 @@ TEST(EncodeCache, EvictionRemovesTheLeastRecentlyUsedEntriesAndOnlyEntries) {
   EXPECT_TRUE(fs::exists(newest));
 }
 
+// PNG and WebP files (resized textures) go through the cache as KTX2 files do: kept, read back the
+// same, and ignored (made again) where the entry is not a file of the asked size or is damaged.
+TEST(EncodeCache, PngAndWebpEntriesAreKeptAndCheckedOnTheWayBack) {
+  test::TempDir dir;
+  const EncodeCache cache{dir / "encode-cache", 1 << 20};
+  const image::Image texture = make_image(12, 8, 3, [](int x, int y, int c) { return float((x * 7 + y * 3 + c) % 11) / 10.0f; });
+  for (const std::string format : {"png", "webp"}) {
+    SCOPED_TRACE(format);
+    int made = 0;
+    const auto encode = [&]() -> Result<Encoded> {
+      ++made;
+      auto bytes = image::encode_image(texture, "t." + format, {.type = image::SampleType::u8, .compression = "lossless"});
+      if (!bytes) return bytes.error();
+      return Encoded{{bytes->begin(), bytes->end()}, 1, {0.25, 0.5}};
+    };
+    const std::string key = made_file_key(texture, {12, 8}, {TextureClass::colour}, format, 6, "matbake test");
+    bool reused = true;
+    auto first = through_cache(cache, key, {12, 8}, encode, reused);
+    ASSERT_TRUE(first) << first.error().to_string();
+    EXPECT_FALSE(reused);
+    auto second = through_cache(cache, key, {12, 8}, encode, reused);
+    ASSERT_TRUE(second) << second.error().to_string();
+    EXPECT_TRUE(reused);
+    EXPECT_EQ(made, 1);
+    EXPECT_TRUE(second->file == first->file);
+    EXPECT_EQ(second->coverage, first->coverage);
+    EXPECT_TRUE(through_cache(cache, key, {12, 12}, encode, reused));  // not of the asked size: made again
+    EXPECT_FALSE(reused);
+    const fs::path entry = cache.folder / (key + ".ktx2e");
+    fs::resize_file(entry, fs::file_size(entry) - 8);  // its pixels cut short
+    EXPECT_TRUE(through_cache(cache, key, {12, 8}, encode, reused));
+    EXPECT_FALSE(reused);
+    EXPECT_EQ(made, 3);
+  }
+  EXPECT_NE(made_file_key(texture, {12, 8}, {TextureClass::colour}, "png", 6, "w"),
+            made_file_key(texture, {12, 8}, {TextureClass::colour}, "webp", 6, "w"));
+  EXPECT_NE(made_file_key(texture, {12, 8}, {TextureClass::colour}, "png", 6, "w"),
+            made_file_key(texture, {12, 8}, {TextureClass::colour}, "png", 9, "w"));
+}
+
 }  // namespace
 }  // namespace matbake::delivery

@@ -189,8 +189,7 @@ struct Work {
   int made_by = -1;  // the index in the work list of the alike texture that makes this one's file
   std::string shared_note;  // set when textures made once had differing wrap modes
   // Made:
-  std::vector<unsigned char> ktx2;
-  image::Image level0;  // png: the resized texture
+  std::vector<unsigned char> file;  // the KTX2 file, or (codec png) the resized texture's PNG or WebP
   int levels = 1;
   std::vector<double> coverage;
   bool reused = false;  // from the encode cache
@@ -202,20 +201,37 @@ struct Work {
 Size ktx2_size(Size s) { return {std::max(s.width, 4), std::max(s.height, 4)}; }
 bool sides_fit_ktx2(Size s) { return s.width % 4 == 0 && s.height % 4 == 0; }
 
-Status make(Work& w, image::Image source, const Options& options, const Encoder* encoder, const fs::path& output, int threads) {
+// The resized texture of `source` as the cache's format (PNG or WebP) makes it.
+Result<Encoded> resized_file(const Work& w, const image::Image& source, const MipRequest& request, const gltf::ImageCache& cache) {
+  const image::Image level0 = std::move(mip_chain(source, w.size, request, false)[0]);
+  Encoded made{.levels = 1};
+  if (w.use.alpha_cutoff) made.coverage = {alpha_coverage(source, *w.use.alpha_cutoff), alpha_coverage(level0, *w.use.alpha_cutoff)};
+  auto bytes = cache.encode(level0, w.transfer, w.name);
+  if (!bytes) return bytes.error();
+  made.file.assign(bytes->begin(), bytes->end());
+  return made;
+}
+
+Status make(Work& w, image::Image source, const Options& options, const gltf::ImageCache& cache, const Encoder* encoder,
+            const fs::path& output, int threads) {
   const MipRequest request{w.use.texture_class, w.sampling, w.use.alpha_cutoff, options.keep_alpha_coverage};
+  const EncodeCache kept{options.encode_cache, options.encode_cache_bytes};
+  Result<Encoded> made = Error{"", "not made"};
   if (w.codec == Codec::png) {
-    w.level0 = std::move(mip_chain(source, w.size, request, false)[0]);
-    if (w.use.alpha_cutoff) w.coverage = {alpha_coverage(source, *w.use.alpha_cutoff), alpha_coverage(w.level0, *w.use.alpha_cutoff)};
-    return success();
+    const bool keeps = !kept.folder.empty() && kept.limit_bytes > 0;
+    const std::string key =
+        keeps ? made_file_key(source, w.size, request, cache.webp() ? "webp" : "png", cache.png_level(), "matbake " + std::string(matbake::version))
+              : std::string();
+    made = through_cache(kept, key, w.size, [&] { return resized_file(w, source, request, cache); }, w.reused);
+  } else {
+    EncodeRequest encode{.texture_class = w.use.texture_class, .options = options.of(w.use.texture_class), .sampling = w.sampling,
+                         .mipmaps = options.mipmaps, .alpha = has_alpha(source),
+                         .scratch = output.parent_path() / (w.name + ".ktx2"), .threads = threads};
+    made = encode_with_cache(kept, *encoder, std::move(source), w.size, request, encode,
+                             "matbake " + std::string(matbake::version) + " / basisu " + encoder->version, w.reused);
   }
-  EncodeRequest encode{.texture_class = w.use.texture_class, .options = options.of(w.use.texture_class), .sampling = w.sampling,
-                       .mipmaps = options.mipmaps, .alpha = has_alpha(source),
-                       .scratch = output.parent_path() / (w.name + ".ktx2"), .threads = threads};
-  auto made = encode_with_cache({options.encode_cache, options.encode_cache_bytes}, *encoder, std::move(source), w.size, request, encode,
-                                 "matbake " + std::string(matbake::version) + " / basisu " + encoder->version, w.reused);
   if (!made) return made.error();
-  w.ktx2 = std::move(made->file);
+  w.file = std::move(made->file);
   w.levels = made->levels;
   w.coverage = std::move(made->coverage);
   return success();
@@ -290,20 +306,16 @@ void sample_one_level(gltf::Document& doc, int texture_index) {
 }
 
 // The file `made` made, as a new image of `doc` (KTX2, or the resized texture as PNG or WebP); its index.
-Result<int> add_made_image(gltf::Document& doc, const gltf::ImageCache& cache, const Work& made) {
-  if (!made.ktx2.empty()) {
+int add_made_image(gltf::Document& doc, const gltf::ImageCache& cache, const Work& made) {
+  std::string bytes(made.file.begin(), made.file.end());
+  if (made.codec != Codec::png) {
     const std::string uri = gltf::free_uri(doc, made.name, ".ktx2");
-    doc.new_files[uri] = std::string(made.ktx2.begin(), made.ktx2.end());
+    doc.new_files[uri] = std::move(bytes);
     doc.json["images"].push_back({{"uri", uri}, {"mimeType", "image/ktx2"}, {"name", fs::path(uri).stem().string()}});
     return int(doc.json["images"].size()) - 1;
   }
-  const color::Transfer transfer = made.use.texture_class == TextureClass::colour ? color::Transfer::srgb : color::Transfer::linear;
-  const std::string extension = cache.webp() ? ".webp" : ".png";
-  const std::string uri =
-      gltf::free_uri(doc, made.name + "_" + std::to_string(made.size.width) + "x" + std::to_string(made.size.height), extension);
-  auto added = cache.add_image(doc, made.level0, transfer, uri.substr(0, uri.size() - extension.size()));
-  if (!added) return added.error();
-  return added->index;
+  const std::string size = std::to_string(made.size.width) + "x" + std::to_string(made.size.height);
+  return cache.add_encoded(doc, std::move(bytes), made.name + "_" + size).index;
 }
 
 // EXT_texture_webp named only while a texture still uses it.
@@ -410,7 +422,7 @@ Result<std::vector<TextureReport>> deliver_textures(gltf::Document& doc, gltf::I
     w.status = guarded(doc.file, [&]() -> Status {
       auto source = cache.decode(w.texture, w.transfer);
       if (!source) return source.error();
-      return make(w, std::move(*source), options, encoder, output, threads);
+      return make(w, std::move(*source), options, cache, encoder, output, threads);
     });
   }, tbb::simple_partitioner());
   for (Work& w : work) {
@@ -435,25 +447,20 @@ Result<std::vector<TextureReport>> deliver_textures(gltf::Document& doc, gltf::I
     if (!source_bytes) return source_bytes.error();
     report.source_bytes = source_bytes->size();
     report.bytes = report.source_bytes;
-    if (made.ktx2.empty() && made.level0.pixels.empty()) {
+    if (made.file.empty()) {
       report.note = "kept as it is (its size and format are what was asked)";
       reports.push_back(std::move(report));
       continue;
     }
-    if (image < 0) {
-      auto added = add_made_image(doc, cache, made);
-      if (!added) return added.error();
-      image = *added;
-    }
+    if (image < 0) image = add_made_image(doc, cache, made);
     point_texture(doc, w, image, options.png_fallback);
-    if (!made.ktx2.empty()) {
-      report.bytes = made.ktx2.size();
+    report.bytes = made.file.size();
+    if (made.codec != Codec::png) {
       if (!options.mipmaps) sample_one_level(doc, w.texture);
       gltf::require_extension(doc, kBasisu, !options.png_fallback);
     }
     const Json& written_image = doc.json["images"][std::size_t(image)];
     report.uri = written_image["uri"].get<std::string>();
-    if (made.ktx2.empty()) report.bytes = doc.new_files[report.uri].size();
     doc.json["textures"][std::size_t(w.texture)]["name"] = written_image["name"];
     reports.push_back(std::move(report));
   }

@@ -27,7 +27,7 @@ struct EncodeRequest {
 bool has_alpha(const image::Image& im);
 
 struct Encoded {
-  std::vector<unsigned char> file;  // the KTX2 file
+  std::vector<unsigned char> file;  // the KTX2 file (or a PNG or WebP one, through_cache)
   int levels = 0;
   std::vector<double> coverage;     // with an alpha cutoff: the source's, then each level made here
 };

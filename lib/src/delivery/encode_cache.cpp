@@ -15,6 +15,7 @@
 #include <optional>
 
 #include "matbake/atomic_file.hpp"
+#include "matbake/image.hpp"
 #include "matbake/ktx2.hpp"
 #include "../io/unique_fd.hpp"
 
@@ -34,10 +35,11 @@ bool is_entry_name(const std::string& name) {
          std::all_of(name.begin(), name.begin() + kKeyDigits, [](char c) { return (c >= '0' && c <= '9') || (c >= 'a' && c <= 'f'); });
 }
 
-// The most bytes an entry of level 0 at `base` can hold: what read_output allows the encoder, plus
-// the header.
+// The most bytes an entry of level 0 at `base` can hold: a KTX2 file as read_output allows the
+// encoder, or a PNG or WebP file of 8-bit RGBA stored uncompressed (4 bytes a texel, a filter byte a
+// row, chunks), plus the header.
 std::uint64_t entry_limit(Size base) {
-  return 2 * std::uint64_t(base.width) * std::uint64_t(base.height) + (1u << 20) + kMagic.size() + 8 + 8 * (kMostLevels + 1);
+  return 5 * std::uint64_t(base.width) * std::uint64_t(base.height) + (1u << 20) + kMagic.size() + 8 + 8 * (kMostLevels + 1);
 }
 
 template <typename T>
@@ -73,10 +75,16 @@ std::optional<Encoded> parse_entry(const std::vector<unsigned char>& bytes, Size
     std::memcpy(e.coverage.data(), bytes.data() + kMagic.size() + sizeof counts, counts[1] * sizeof(double));
   }
   e.file.assign(bytes.begin() + std::ptrdiff_t(file_at), bytes.end());
-  auto read = ktx2::read(e.file, name);
-  if (!read || read->width != unsigned(base.width) || read->height != unsigned(base.height) || read->levels.size() != counts[0]) {
-    return std::nullopt;
+  if (e.file.size() >= 8 && std::memcmp(e.file.data(), "\xabKTX 20\xbb", 8) == 0) {
+    auto read = ktx2::read(e.file, name);
+    if (!read || read->width != unsigned(base.width) || read->height != unsigned(base.height) || read->levels.size() != counts[0]) {
+      return std::nullopt;
+    }
+    return e;
   }
+  // A PNG or WebP file: one level of the asked size whose pixels decode.
+  auto layout = image::check_image_bytes(e.file, name);
+  if (!layout || counts[0] != 1 || layout->width != base.width || layout->height != base.height) return std::nullopt;
   return e;
 }
 
@@ -173,18 +181,25 @@ Result<std::uint64_t> encode_cache_limit() {
   return std::uint64_t(std::stoull(text)) << 20;
 }
 
-std::string encode_key(const image::Image& source, Size base, const MipRequest& mips, const EncodeRequest& request,
-                       const std::string& writer) {
-  const std::unique_ptr<XXH3_state_t, decltype(&XXH3_freeState)> state(XXH3_createState(), XXH3_freeState);
+namespace {
+
+using HashState = std::unique_ptr<XXH3_state_t, decltype(&XXH3_freeState)>;
+
+// A key's hash begun: the format of entries, `writer`, and what the file is made for, `what`.
+HashState start_key(const std::string& writer, const std::vector<std::string>& what) {
+  HashState state(XXH3_createState(), XXH3_freeState);
   XXH3_128bits_reset(state.get());
-  XXH3_state_t* s = state.get();
-  hash_text(s, std::string(kMagic) + writer);
-  for (const std::string& arg : encoder_arguments(request)) hash_text(s, arg);
-  const ClassOptions& o = request.options;
-  for (const double v : {double(o.codec), double(o.quality), double(o.uastc_level), o.uastc_rdo, double(o.zstd)}) hash_value(s, v);
+  hash_text(state.get(), std::string(kMagic) + writer);
+  for (const std::string& w : what) hash_text(state.get(), w);
+  return state;
+}
+
+// A key finished by what every made file depends on: the source's layout and pixels, the size of
+// level 0 and the mip request; 32 hex digits.
+std::string finish_key(XXH3_state_t* s, const image::Image& source, Size base, const MipRequest& mips) {
   for (const int v : {source.width, source.height, source.channels, source.alpha_channel, base.width, base.height,
                       int(mips.texture_class), int(mips.sampling.filter), int(mips.sampling.wrap_s), int(mips.sampling.wrap_t),
-                      int(request.texture_class), int(request.mipmaps), int(request.alpha), int(mips.alpha_cutoff.has_value()), int(mips.keep_coverage)}) {
+                      int(mips.alpha_cutoff.has_value()), int(mips.keep_coverage)}) {
     hash_value(s, v);
   }
   hash_value(s, mips.alpha_cutoff.value_or(0.0f));
@@ -198,18 +213,35 @@ std::string encode_key(const image::Image& source, Size base, const MipRequest& 
   return key;
 }
 
-Result<Encoded> encode_with_cache(const EncodeCache& cache, const Encoder& encoder, image::Image source, Size base,
-                                  const MipRequest& mips, const EncodeRequest& request, const std::string& writer, bool& reused) {
+}  // namespace
+
+std::string encode_key(const image::Image& source, Size base, const MipRequest& mips, const EncodeRequest& request,
+                       const std::string& writer) {
+  const HashState state = start_key(writer, encoder_arguments(request));
+  XXH3_state_t* s = state.get();
+  const ClassOptions& o = request.options;
+  for (const double v : {double(o.codec), double(o.quality), double(o.uastc_level), o.uastc_rdo, double(o.zstd)}) hash_value(s, v);
+  for (const int v : {int(request.texture_class), int(request.mipmaps), int(request.alpha)}) hash_value(s, v);
+  return finish_key(s, source, base, mips);
+}
+
+std::string made_file_key(const image::Image& source, Size base, const MipRequest& mips, const std::string& format, int png_level,
+                          const std::string& writer) {
+  const HashState state = start_key(writer, {format, std::to_string(png_level)});
+  return finish_key(state.get(), source, base, mips);
+}
+
+Result<Encoded> through_cache(const EncodeCache& cache, const std::string& key, Size base, const std::function<Result<Encoded>()>& encode,
+                              bool& reused) {
   reused = false;
-  if (cache.folder.empty() || cache.limit_bytes == 0) return encode_texture(encoder, std::move(source), base, mips, request, writer);
-  const std::string key = encode_key(source, base, mips, request, writer);
+  if (cache.folder.empty() || cache.limit_bytes == 0) return encode();
   if (auto hit = read_entry(cache.folder, key, base)) {
     reused = true;
     return std::move(*hit);
   }
   std::optional<Result<Encoded>> made;
   tbb::collaborative_call_once(in_flight(key)->once, [&] {
-    made = encode_texture(encoder, std::move(source), base, mips, request, writer);
+    made = encode();
     if (*made) keep_entry(cache, key, **made);
   });
   if (made) return std::move(*made);
@@ -217,8 +249,14 @@ Result<Encoded> encode_with_cache(const EncodeCache& cache, const Encoder& encod
     reused = true;
     return std::move(*hit);
   }
-  // It failed there, or was not kept; this call's own source is still whole (its function did not run).
-  return encode_texture(encoder, std::move(source), base, mips, request, writer);
+  // It failed there, or was not kept; this call's own inputs are still whole (its function did not run).
+  return encode();
+}
+
+Result<Encoded> encode_with_cache(const EncodeCache& cache, const Encoder& encoder, image::Image source, Size base,
+                                  const MipRequest& mips, const EncodeRequest& request, const std::string& writer, bool& reused) {
+  const std::string key = cache.folder.empty() || cache.limit_bytes == 0 ? std::string() : encode_key(source, base, mips, request, writer);
+  return through_cache(cache, key, base, [&] { return encode_texture(encoder, std::move(source), base, mips, request, writer); }, reused);
 }
 
 }  // namespace matbake::delivery

@@ -1,12 +1,14 @@
 #pragma once
-// Encoded textures kept between runs, so that a scene rebuilt for another reason (an AO setting, a
-// material that changed one texture) encodes only the textures whose pixels or settings changed, and
-// two scenes of one build sharing a texture encode it once. A build keeps them in its output folder's
+// Encoded textures (KTX2 files, and the PNG or WebP files of resized textures) kept between runs, so
+// that a scene rebuilt for another reason (an AO setting, a material that changed one texture)
+// encodes only the textures whose pixels or settings changed, and two scenes of one build sharing a
+// texture encode it once. A build keeps them in its output folder's
 // state (OUT/.matbake/encode-cache/), one file per encode named by its key; least recently used
 // entries are removed past a size limit. Entries are outside input: read through O_NOFOLLOW, size-
-// limited and parsed as a KTX2 file of the asked size, or ignored (encoded again).
+// limited and parsed as a file of the asked size, or ignored (encoded again).
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 
 #include "encode.hpp"
 
@@ -32,9 +34,19 @@ void evict_encoded(const std::filesystem::path& folder, std::uint64_t limit);
 std::string encode_key(const image::Image& source, Size base, const MipRequest& mips, const EncodeRequest& request,
                        const std::string& writer);
 
-// encode_texture through the cache: an entry found is used (and marked recently used), else the
-// texture is encoded and kept. `reused` says which. Within a process one key is encoded once: a
-// second caller waits for the first (its thread working on other tasks meanwhile) and reads its entry.
+// The key of a PNG or WebP file that delivery makes of `source` (level 0 alone, at `base`): as
+// encode_key, with the file's format ("png", "webp") and deflate effort for the encoder's settings.
+std::string made_file_key(const image::Image& source, Size base, const MipRequest& mips, const std::string& format, int png_level,
+                          const std::string& writer);
+
+// `encode` through the cache under `key`: an entry found (a KTX2 file of level 0 at `base`, or a
+// PNG or WebP file of that size) is used and marked recently used, else encode() runs and its result
+// is kept. `reused` says which. Within a process one key is encoded once: a second caller waits for
+// the first (its thread working on other tasks meanwhile) and reads its entry.
+Result<Encoded> through_cache(const EncodeCache& cache, const std::string& key, Size base, const std::function<Result<Encoded>()>& encode,
+                              bool& reused);
+
+// encode_texture through the cache, under encode_key.
 Result<Encoded> encode_with_cache(const EncodeCache& cache, const Encoder& encoder, image::Image source, Size base,
                                   const MipRequest& mips, const EncodeRequest& request, const std::string& writer, bool& reused);
 

@@ -152,27 +152,36 @@ Result<std::pair<int, int>> ImageCache::size_of(int texture) const {
   return std::pair{layout->width, layout->height};
 }
 
-Result<ImageCache::Made> ImageCache::add_image(Document& doc, const image::Image& img, color::Transfer colour,
-                                               const std::string& name, image::SampleType type) const {
+Result<std::string> ImageCache::encode(const image::Image& img, color::Transfer colour, const std::string& name,
+                                       image::SampleType type) const {
   if (webp() && type != image::SampleType::u8) {
-    return Error{doc.file, name + ": WebP holds 8 bits per channel; write 16-bit textures as PNG (" + mention("texture_format", "png") + ")"};
+    return Error{doc_.file, name + ": WebP holds 8 bits per channel; write 16-bit textures as PNG (" + mention("texture_format", "png") + ")"};
   }
   image::WriteOptions options;
   options.colour = colour;
   options.type = type;
   options.png_level = encoding_.png_level;
   if (webp()) options.compression = "lossless";  // data (occlusion, roughness) survives as written
+  return image::encode_image(webp() && img.channels < 3 ? as_rgb(img) : img, name + (webp() ? ".webp" : ".png"), options);
+}
+
+ImageCache::Made ImageCache::add_encoded(Document& doc, std::string bytes, const std::string& name) const {
   Made made;
   made.uri = free_uri(doc, name, webp() ? ".webp" : ".png");
-  auto bytes = image::encode_image(webp() && img.channels < 3 ? as_rgb(img) : img, made.uri, options);
-  if (!bytes) return bytes.error();
-  doc.new_files[made.uri] = std::move(*bytes);
+  doc.new_files[made.uri] = std::move(bytes);
   doc.json["images"].push_back({{"uri", made.uri},
                                 {"mimeType", webp() ? "image/webp" : "image/png"},
                                 {"name", made.uri.substr(0, made.uri.rfind('.'))}});
   made.index = int(doc.json["images"].size()) - 1;
   if (webp()) require_extension(doc, "EXT_texture_webp", true);
   return made;
+}
+
+Result<ImageCache::Made> ImageCache::add_image(Document& doc, const image::Image& img, color::Transfer colour,
+                                               const std::string& name, image::SampleType type) const {
+  auto bytes = encode(img, colour, name, type);
+  if (!bytes) return bytes.error();
+  return add_encoded(doc, std::move(*bytes), name);
 }
 
 Result<ImageCache::Made> ImageCache::add_texture(Document& doc, const image::Image& img, color::Transfer colour,

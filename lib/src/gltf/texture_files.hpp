@@ -69,6 +69,12 @@ class ImageCache {
   };
   Result<Made> add_image(Document& doc, const image::Image& img, color::Transfer colour, const std::string& name,
                          image::SampleType type = image::SampleType::u8) const;
+  // add_image's two steps: `img` as the cache's format's bytes (`name` names it in errors), and
+  // those bytes as a new image of `doc`.
+  Result<std::string> encode(const image::Image& img, color::Transfer colour, const std::string& name,
+                             image::SampleType type = image::SampleType::u8) const;
+  Made add_encoded(Document& doc, std::string bytes, const std::string& name) const;
+  int png_level() const { return encoding_.png_level; }
   // A new texture over a new image (add_image), through EXT_texture_webp when WebP, with the
   // sampler of texture `sampler_from` (none when −1). Returns the texture's index and the image's URI.
   Result<Made> add_texture(Document& doc, const image::Image& img, color::Transfer colour, const std::string& name,

@@ -95,7 +95,7 @@ nlohmann::json to_json(const delivery::TextureReport& t) {
                       {"levels", t.levels},
                       {"source_bytes", t.source_bytes},
                       {"bytes", t.bytes}};
-  if (t.codec != delivery::Codec::png && !t.uri.empty()) j["reused"] = t.reused;
+  if (!t.uri.empty()) j["reused"] = t.reused;  // a file made (KTX2, or a resized PNG or WebP)
   if (t.needed) j["needed_side"] = *t.needed;
   if (t.alpha_cutoff) j["alpha_cutoff"] = *t.alpha_cutoff, j["coverage"] = t.coverage;
   if (!t.note.empty()) j["note"] = t.note;
