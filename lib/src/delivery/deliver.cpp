@@ -218,9 +218,8 @@ Status make(Work& w, image::Image source, const Options& options, const gltf::Im
   const EncodeCache kept{options.encode_cache, options.encode_cache_bytes};
   Result<Encoded> made = Error{"", "not made"};
   if (w.codec == Codec::png) {
-    const bool keeps = !kept.folder.empty() && kept.limit_bytes > 0;
     const std::string key =
-        keeps ? made_file_key(source, w.size, request, cache.webp() ? "webp" : "png", cache.png_level(), "matbake " + std::string(matbake::version))
+        kept.on() ? made_file_key(source, w.size, request, cache.webp() ? "webp" : "png", cache.png_level(), "matbake " + std::string(matbake::version))
               : std::string();
     made = through_cache(kept, key, w.size, [&] { return resized_file(w, source, request, cache); }, w.reused);
   } else {

@@ -234,7 +234,7 @@ std::string made_file_key(const image::Image& source, Size base, const MipReques
 Result<Encoded> through_cache(const EncodeCache& cache, const std::string& key, Size base, const std::function<Result<Encoded>()>& encode,
                               bool& reused) {
   reused = false;
-  if (cache.folder.empty() || cache.limit_bytes == 0) return encode();
+  if (!cache.on()) return encode();
   if (auto hit = read_entry(cache.folder, key, base)) {
     reused = true;
     return std::move(*hit);
@@ -255,7 +255,7 @@ Result<Encoded> through_cache(const EncodeCache& cache, const std::string& key, 
 
 Result<Encoded> encode_with_cache(const EncodeCache& cache, const Encoder& encoder, image::Image source, Size base,
                                   const MipRequest& mips, const EncodeRequest& request, const std::string& writer, bool& reused) {
-  const std::string key = cache.folder.empty() || cache.limit_bytes == 0 ? std::string() : encode_key(source, base, mips, request, writer);
+  const std::string key = cache.on() ? encode_key(source, base, mips, request, writer) : std::string();
   return through_cache(cache, key, base, [&] { return encode_texture(encoder, std::move(source), base, mips, request, writer); }, reused);
 }
 

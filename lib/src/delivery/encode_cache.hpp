@@ -21,6 +21,7 @@ Result<std::uint64_t> encode_cache_limit();
 struct EncodeCache {
   std::filesystem::path folder;  // empty: no cache
   std::uint64_t limit_bytes = 0;
+  bool on() const { return !folder.empty() && limit_bytes > 0; }
 };
 
 // Least recently used entries (by modification time: a read marks it) removed from `folder` until its
