@@ -191,12 +191,15 @@ int main(int argc, char** argv) {
   const int channels = source->alpha_channel >= 0 && has_alpha(*source) ? 4 : 3;
   const std::string name = file.stem().string() + "-" + argv[3];
 
-  // matbake: the chain, then UASTC level by level (assembled here), or ETC1S through basisu's mips.
+  // matbake: the chain, then UASTC level by level (assembled here), or ETC1S through basisu's mips;
+  // with the Kaiser filter, which the float64 reference and basisu's -mipmap both use.
   const ClassOptions options{.codec = codec};
-  EncodeRequest request{.texture_class = cls, .options = options, .alpha = channels == 4, .scratch = work / (name + ".ktx2"),
-                        .threads = 2};
+  const Sampling kaiser{.filter = Filter::kaiser};
+  EncodeRequest request{.texture_class = cls, .options = options, .sampling = kaiser, .alpha = channels == 4,
+                        .scratch = work / (name + ".ktx2"), .threads = 2};
   auto start = std::chrono::steady_clock::now();
-  auto encoded = encode_texture(*encoder, *source, base, {cls, {}, cutoff > 0 ? std::optional(cutoff) : std::nullopt, cutoff > 0}, request, "bench");
+  auto encoded = encode_texture(*encoder, *source, base, {cls, kaiser, cutoff > 0 ? std::optional(cutoff) : std::nullopt, cutoff > 0},
+                                request, "bench");
   if (!encoded) {
     std::fprintf(stderr, "%s\n", encoded.error().to_string().c_str());
     return 1;

@@ -399,7 +399,7 @@ TEST(EncodeCache, TheKeyFollowsWhatTheBytesDependOn) {
   copy.pixels[17] += 1.0f / 255;
   keys.insert(encode_key(copy, {8, 8}, mips, request, writer));
   keys.insert(encode_key(source, {4, 4}, mips, request, writer));
-  keys.insert(encode_key(source, {8, 8}, {TextureClass::data, {.filter = Filter::box}}, request, writer));
+  keys.insert(encode_key(source, {8, 8}, {TextureClass::data, {.filter = Filter::kaiser}}, request, writer));
   keys.insert(encode_key(source, {8, 8}, {TextureClass::data, {.wrap_s = Wrap::clamp_to_edge}}, request, writer));
   keys.insert(encode_key(source, {8, 8}, {TextureClass::data, {}, 0.5f}, request, writer));
   keys.insert(encode_key(source, {8, 8}, {TextureClass::data, {}, 0.5f, true}, request, writer));

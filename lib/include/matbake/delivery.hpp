@@ -87,7 +87,7 @@ struct Options {
   ClassOptions data{.codec = Codec::uastc};
   ClassOptions normal{.codec = Codec::uastc};
   Rounding rounding = Rounding::multiple_of_4;
-  Filter filter = Filter::kaiser;
+  Filter filter = Filter::box;
   bool mipmaps = true;          // a full chain down to 1×1
   bool keep_alpha_coverage = false;  // MASK materials' levels keep the source's alpha coverage (MipRequest)
   bool png_fallback = false;    // keep the PNG as the texture's core source (the extension then optional)
@@ -148,7 +148,7 @@ std::vector<Size> mip_sizes(Size base);
 double kaiser_weight(double x);
 
 struct Sampling {
-  Filter filter = Filter::kaiser;
+  Filter filter = Filter::box;
   Wrap wrap_s = Wrap::repeat, wrap_t = Wrap::repeat;
 };
 

@@ -136,8 +136,8 @@ const params::Group<Options>& options_params() {
                                                     .example = "power-of-two"},
                                                [](auto& o) -> auto& { return o.rounding; }, kRoundingNames));
     g.params.push_back(params::choice<Options>(Spec{.name = "mip_filter",
-                                                    .help = "Filter of resizes and mip levels: kaiser (windowed sinc) or box",
-                                                    .example = "box"},
+                                                    .help = "Filter of resizes and mip levels: box (area mean, as runtimes make mips) or kaiser (windowed sinc)",
+                                                    .example = "kaiser"},
                                                [](auto& o) -> auto& { return o.filter; }, kFilterNames));
     g.params.push_back(params::flag<Options>(Spec{.name = "mipmaps",
                                                   .help = "Give KTX2 textures a full mip chain (false: level 0 only, sampled without mipmap filtering)",
