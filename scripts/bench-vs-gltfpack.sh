@@ -3,8 +3,9 @@
 # at equal codec settings (ETC1S colour with UASTC data and normals; all UASTC; all ETC1S; matbake
 # given the basisu settings gltfpack 0.17 passes: UASTC level 1, RDO 0.29 over 1024 bytes, zstd 9;
 # ETC1S q 192) with quantized, meshopt-compressed geometry, rendered in three.js (headless Chromium)
-# against the originals; bytes, wall time, peak memory and render PSNR per model, each tool run three
-# times interleaved (MATBAKE_BENCH_RUNS) and the median time and memory kept. Markdown on stdout.
+# against the originals; bytes, wall time, peak memory and render PSNR per model, each tool timed
+# MATBAKE_BENCH_RUNS times (default 5) interleaved with the other and the median kept, then run once
+# more, watched, for its peak memory. Markdown on stdout.
 # gltfpack: GLTFPACK=/path/to/gltfpack (a native build with BasisU), else npm's gltfpack 0.17.0
 # (pinned in bench/gltfpack/), the last release that encodes KTX2 through an external basisu, run
 # with the basisu matbake installs. Needs ../shared/testdata. Usage: scripts/bench-vs-gltfpack.sh

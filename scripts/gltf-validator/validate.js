@@ -1,9 +1,10 @@
 #!/usr/bin/env node
 // Runs the Khronos glTF-Validator (pinned in package.json beside this file) on one .gltf or .glb.
-//   node validate.js FILE [--json]
+//   node validate.js FILE [--json | --brief]
 // Resolves external buffers and images next to FILE. Prints a one-line summary and every error
-// and warning (with --json: the validator's whole report). Exit 0 with no errors, 1 with errors,
-// 2 when the file cannot be read or the validator cannot run.
+// and warning (with --json: the validator's whole report; with --brief: the summary alone, the
+// warnings it raises only because it does not know KHR_texture_basisu counted apart). Exit 0 with
+// no errors, 1 with errors, 2 when the file cannot be read or the validator cannot run.
 'use strict';
 const fs = require('fs');
 const path = require('path');
@@ -18,7 +19,8 @@ try {
 
 const args = process.argv.slice(2);
 const json = args.includes('--json');
-const file = args.find((a) => a !== '--json');
+const brief = args.includes('--brief');
+const file = args.find((a) => a !== '--json' && a !== '--brief');
 if (!file) {
   console.error('usage: node validate.js FILE.gltf|FILE.glb [--json]');
   process.exit(2);
@@ -33,6 +35,22 @@ try {
 }
 
 const severities = ['error', 'warning', 'info', 'hint'];
+
+// The validator (2.0.0-dev.3.10) does not know KHR_texture_basisu (its issue #177): each KTX2 image
+// gets a warning that 'image/ktx2' is not a mimeType it knows and one that its format is not
+// recognised. Those are counted apart.
+function briefSummary(report) {
+  const messages = report.issues.messages;
+  const ktx2Images = new Set(messages
+    .filter((m) => m.code === 'VALUE_NOT_IN_LIST' && /'image\/ktx2'/.test(m.message) && /^\/images\/\d+\/mimeType$/.test(m.pointer || ''))
+    .map((m) => m.pointer.split('/')[2]));
+  const onKtx2 = (m) => m.severity === 1 && ktx2Images.has((/^\/images\/(\d+)(\/mimeType)?$/.exec(m.pointer || '') || [])[1]) &&
+                        (m.code === 'VALUE_NOT_IN_LIST' || m.code === 'IMAGE_UNRECOGNIZED_FORMAT');
+  const ktx2 = messages.filter(onKtx2).length;
+  let text = `${report.issues.numErrors} errors, ${report.issues.numWarnings - ktx2} warnings`;
+  if (ktx2 > 0) text += ` (and ${ktx2} on KTX2 images only because the validator does not know KHR_texture_basisu yet, its issue #177)`;
+  return text;
+}
 validator
   .validateBytes(bytes, {
     uri: path.basename(full),
@@ -48,6 +66,8 @@ validator
       const issues = report.issues;
       if (json) {
         console.log(JSON.stringify(report, null, 1));
+      } else if (brief) {
+        console.log(briefSummary(report));
       } else {
         console.log(`${file}: ${issues.numErrors} errors, ${issues.numWarnings} warnings, ` +
                     `${issues.numInfos} infos, ${issues.numHints} hints (validator ${report.validatorVersion})`);

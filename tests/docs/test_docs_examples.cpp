@@ -7,10 +7,13 @@
 #include <toml++/toml.h>
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <set>
 #include <sstream>
 
 #include "support/files.hpp"
@@ -112,8 +115,35 @@ TEST(DocsExamples, EveryManifestBlockLoads) {
   EXPECT_GE(manifests, 1);
 }
 
-// Links such as [build](build.md) or [x](../README.md#anchor): the file they name exists.
+// The anchors GitHub gives a Markdown file's headings (outside code blocks): the heading's text in
+// lower case, every character but letters, digits, '-', '_' and spaces dropped (non-ASCII kept, as
+// the letters they mostly are here), spaces made '-'; a repeated anchor gets -1, -2, ...
+std::set<std::string> heading_anchors(const fs::path& file) {
+  std::ifstream in(file);
+  std::set<std::string> anchors;
+  std::map<std::string, int> seen;
+  bool code = false;
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind("```", 0) == 0) code = !code;
+    if (code || line.empty() || line[0] != '#') continue;
+    const std::size_t text = line.find_first_not_of('#');
+    if (text == std::string::npos || line[text] != ' ') continue;
+    std::string anchor;
+    for (char c : line.substr(text + 1)) {
+      const auto u = static_cast<unsigned char>(c);
+      if (std::isalnum(u) || c == '-' || c == '_' || u >= 0x80) anchor += char(std::tolower(u));
+      else if (c == ' ') anchor += '-';
+    }
+    const int repeat = seen[anchor]++;
+    anchors.insert(repeat == 0 ? anchor : anchor + "-" + std::to_string(repeat));
+  }
+  return anchors;
+}
+
+// Links such as [build](build.md), [x](../README.md#anchor) or [y](#anchor): the file they name
+// exists, and so does the heading an anchor names in a Markdown file.
 TEST(DocsExamples, EveryRelativeLinkResolves) {
+  int anchors = 0;
   for (const fs::path& file : markdown_files()) {
     std::ifstream in(file);
     std::stringstream text;
@@ -122,15 +152,39 @@ TEST(DocsExamples, EveryRelativeLinkResolves) {
     for (std::size_t at = s.find("]("); at != std::string::npos; at = s.find("](", at + 2)) {
       const std::size_t end = s.find(')', at + 2);
       if (end == std::string::npos) break;
-      std::string target = s.substr(at + 2, end - at - 2);
-      if (target.find("://") != std::string::npos || target.rfind("mailto:", 0) == 0 || target.empty() ||
-          target[0] == '#') {
-        continue;
-      }
-      target = target.substr(0, target.find('#'));
-      EXPECT_TRUE(fs::exists(file.parent_path() / target)) << file.filename().string() << " links to " << target;
+      const std::string target = s.substr(at + 2, end - at - 2);
+      if (target.find("://") != std::string::npos || target.rfind("mailto:", 0) == 0 || target.empty()) continue;
+      const std::size_t hash = target.find('#');
+      const fs::path named = hash == 0 ? file : file.parent_path() / target.substr(0, hash);
+      EXPECT_TRUE(fs::exists(named)) << file.filename().string() << " links to " << target;
+      if (hash == std::string::npos || named.extension() != ".md" || !fs::exists(named)) continue;
+      ++anchors;
+      EXPECT_TRUE(heading_anchors(named).contains(target.substr(hash + 1)))
+          << file.filename().string() << " links to " << target << ", a heading " << named.filename().string() << " does not have";
     }
   }
+  EXPECT_GT(anchors, 0);  // the check ran
+}
+
+// The README is a landing page: the two commands first (README command 1 and 2, the same words
+// CI's .ci/run and the scripts' comments use), at most 150 lines; details live in docs/.
+TEST(DocsExamples, TheReadmeIsALandingPageThatOpensWithTheTwoCommands) {
+  const fs::path readme = fs::path(MATBAKE_SOURCE_DIR) / "README.md";
+  std::ifstream in(readme);
+  int lines = 0;
+  for (std::string line; std::getline(in, line);) ++lines;
+  EXPECT_LE(lines, 150);
+  const std::vector<Block> blocks = fenced_blocks(readme);
+  ASSERT_FALSE(blocks.empty());
+  EXPECT_EQ(blocks[0].language, "sh");
+  std::istringstream commands(blocks[0].text);
+  std::vector<std::string> words;
+  for (std::string line; std::getline(commands, line);) {
+    line.resize(line.find(" #") == std::string::npos ? line.size() : line.find(" #"));
+    words.push_back(line.substr(0, line.find_last_not_of(' ') + 1));
+  }
+  const std::vector<std::string> expected = {"bash scripts/example.sh", "bash scripts/test.sh"};
+  EXPECT_EQ(words, expected);
 }
 
 // The examples' scene.gltf: three quads on a floor, materials Brick, Steel and Rubber, each quad's
