@@ -111,6 +111,7 @@ int run_slurm_plan(const PlanSettings& s, const GlobalOptions& global, pipeline:
   if (s.dry_run) {
     if (!global.json) {
       for (const std::string& line : *lines) std::printf("%s\n", line.c_str());
+      if (lines->empty()) std::printf("nothing to submit: %s\n", pipeline::submission_counts(submission).c_str());
     }
   } else if (Status st = pipeline::write_slurm_scripts(manifest, plan, *scripts, target.folder); !st) {
     return report_error(st.error(), key_mention);

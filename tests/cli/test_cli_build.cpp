@@ -667,6 +667,8 @@ TEST(CliPlan, SlurmSubmissionBuildsWhatALocalBuildBuilds) {
   EXPECT_EQ(r.out, (slurm / "submit.sh").string() + ": 0 material jobs (one array), 0 scene jobs; 6 up to date\n");
   EXPECT_EQ(submit().out, "matbake: nothing to submit: 0 material jobs (one array), 0 scene jobs; 6 up to date\n");
   EXPECT_EQ(sbatch_calls(dir.path()).size(), 2u);
+  r = matbake({"plan", manifest, "--format", "slurm", "-o", slurm.string(), "--dry-run"});  // says so, writes nothing
+  EXPECT_EQ(r.out, "nothing to submit: 0 material jobs (one array), 0 scene jobs; 6 up to date\n");
 
   fs::copy_file(dir / "cluster/textures/painted_metal_albedo.png", dir / "cluster/textures/rubber_albedo.png",
                 fs::copy_options::overwrite_existing);
