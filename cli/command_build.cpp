@@ -214,11 +214,15 @@ int run_build(const BuildSettings& s, const GlobalOptions& global) {
     for (const std::string& w : plan->warnings) std::cerr << "matbake: warning: " << w << "\n";
   }
 
-  // Progress: a bar on a terminal; elsewhere (build logs) one line per finished job.
+  // Progress: a bar on a terminal; elsewhere (build logs) a line per job started and finished, and
+  // one at least every 10 s while one runs.
   const bool terminal = isatty(STDERR_FILENO) != 0;
   SilencedStderr quiet;  // the image libraries' own messages: each job's error line says it
-  ProgressBar bar(terminal && !global.quiet, quiet.original_fd());
+  pipeline::BuildProgress tracker;
+  using Mode = ProgressBar::Mode;
+  ProgressBar bar(tracker, global.quiet || s.dry_run ? Mode::quiet : terminal ? Mode::terminal : Mode::log, quiet.original_fd());
   pipeline::RunOptions options;
+  options.tracker = &tracker;
   options.force = s.force;
   options.dry_run = s.dry_run;
   options.only = s.only;
@@ -234,7 +238,6 @@ int run_build(const BuildSettings& s, const GlobalOptions& global) {
       std::snprintf(line, sizeof line, "[%zu/%zu] ", done, total);
       bar.print_above(line + r.job->name + " built (" + std::to_string(int(r.seconds * 1000)) + " ms" + texture_counts(r.details) + ")");
     }
-    bar.update(done, total);
   };
   auto report = pipeline::run(manifest, *plan, options);
   bar.finish();

@@ -3,6 +3,8 @@
 // across job counts, what makes a job out of date, failing jobs beside finished ones, validation
 // rules, depfiles, JSON, dry runs, Ninja, and interrupts that leave no temporary file.
 #include <gtest/gtest.h>
+
+#include <regex>
 #include <nlohmann/json.hpp>
 
 #include <signal.h>
@@ -338,14 +340,16 @@ layout = "gltf-orm"
 )");
   const RunResult r = matbake({"build", (dir / "m.toml").string()});
   EXPECT_EQ(r.exit_code, 1);
-  // One line per failed job naming the file and the job, then the summary; the finished job's
-  // progress line (stderr is not a terminal); no library noise.
+  // One line per failed job naming the file and the job, then the summary; the progress lines of
+  // a log (stderr is not a terminal): each job's start, the finished job's end; no library noise.
   std::vector<std::string> lines;
   for (std::size_t at = 0; at < r.err.size();) {
     const std::size_t end = r.err.find('\n', at);
     const std::string line = r.err.substr(at, end - at);
     if (line.rfind("[", 0) == 0) {
       EXPECT_NE(line.find("/4] material:good built ("), std::string::npos) << line;
+    } else if (line.find(" started (") != std::string::npos) {
+      EXPECT_TRUE(std::regex_match(line, std::regex("material:[a-z_]+ started \\([1-4] of 4\\)"))) << line;
     } else {
       lines.push_back(line);
     }
@@ -429,7 +433,9 @@ TEST(CliBuild, AFailingSceneNamesItsInputsLine) {
   write_bytes(dir / "m.toml", "[scenes.s]\ninput = \"s.gltf\"\n");
   const RunResult r = matbake({"build", (dir / "m.toml").string()});
   EXPECT_EQ(r.exit_code, 1);
-  const std::string first = r.err.substr(0, r.err.find('\n'));
+  ASSERT_EQ(r.err.rfind("scene:s started (1 of 1)\n", 0), 0u) << r.err;  // the log's progress line, then the error
+  const std::size_t error_line = r.err.find('\n') + 1;
+  const std::string first = r.err.substr(error_line, r.err.find('\n', error_line) - error_line);
   EXPECT_EQ(first.rfind("matbake: error: " + (dir / "m.toml").string() + ":2:9: scenes.s: ", 0), 0u) << r.err;
   EXPECT_NE(first.find("gone.bin"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir / "out/s.glb"));
@@ -550,17 +556,18 @@ TEST(CliBuild, DepfileStampAndJson) {
   EXPECT_FALSE(job["details"].contains("conversion"));  // the schuler layout takes spec-gloss as given
 
   // Without --stamp the targets are the outputs; --quiet prints nothing; not on a terminal, each
-  // finished job is one line.
+  // job's start and end is one line.
   const RunResult quiet = matbake({"build", (folder / "m.toml").string(), "--force", "--quiet", "--depfile", depfile.string()});
   EXPECT_EQ(quiet.out + quiet.err, "");
   std::string first_output = (folder / "out/materials/brick_a.png").string();
   first_output.replace(first_output.find(' '), 1, "\\ ");
   EXPECT_EQ(read_bytes(depfile).rfind(first_output + " ", 0), 0u) << read_bytes(depfile);
   const RunResult plain = matbake({"build", (folder / "m.toml").string(), "--force"});
-  EXPECT_EQ(plain.err.rfind("[1/1] material:brick built (", 0), 0u) << plain.err;
+  EXPECT_EQ(plain.err.rfind("material:brick started (1 of 1)\n[1/1] material:brick built (", 0), 0u) << plain.err;
 }
 
-// On a terminal (script(1) gives the build one), stderr shows the bar with done/total and ETA.
+// On a terminal (script(1) gives the build one), stderr shows the bar with done/total, the share of
+// work, the ETA and the running job with its stage.
 TEST(CliBuild, ProgressBarOnATerminal) {
   const RunResult which = run("/bin/sh", {"-c", "command -v script"});
   if (which.exit_code != 0) GTEST_SKIP() << "script(1) is not installed";
@@ -575,8 +582,9 @@ TEST(CliBuild, ProgressBarOnATerminal) {
   const std::string command = std::string(MATBAKE_EXE) + " build '" + (dir / "m.toml").string() + "' --jobs 1";
   const RunResult r = run(which.out.substr(0, which.out.find('\n')), {"-qec", command, "/dev/null"});
   ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
-  EXPECT_NE(r.out.find("/40  ETA "), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("] 40/40"), std::string::npos) << r.out;
+  EXPECT_TRUE(std::regex_search(r.out, std::regex("\\] [0-9]+/40 +[0-9]+% ETA [0-9]+:[0-9]{2}  material:m[0-9]+ \\((decoding "
+                                                  "sources|validating|writing textures), [0-9]+ s\\)")))
+      << r.out;
   EXPECT_EQ(r.out.find("material:m1 built"), std::string::npos);  // no per-job lines on a terminal
   EXPECT_NE(r.out.find("built 40, up to date 0, failed 0"), std::string::npos) << r.out;
 }

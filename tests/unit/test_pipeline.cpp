@@ -11,6 +11,7 @@
 
 #include "cli/progress_bar.hpp"
 #include "matbake/cluster.hpp"
+#include "matbake/build_progress.hpp"
 #include "matbake/pipeline.hpp"
 #include "matbake/script_text.hpp"
 #include "support/files.hpp"
@@ -388,31 +389,104 @@ TEST(BuildDepfile, MakeSyntaxWithEscapes) {
             "/o/a\\ b.png /o/c.json: \\\n  /in/x\\#1.png \\\n  /in/$$y.png \\\n  /in/z.png\n");
 }
 
-// The bar is drawn only after half a second, with done/total and an ETA, and cleared at the end.
+// A job's work done at a phase: the phases before it whole, its own by the fraction.
+TEST(BuildProgress, WorkDoneByPhase) {
+  const pipeline::JobWork w{.read = 1, .ao = 2, .textures = 3, .write = 4};
+  EXPECT_DOUBLE_EQ(w.total(), 10);
+  EXPECT_DOUBLE_EQ(w.done_at(Phase::read, 0), 0);
+  EXPECT_DOUBLE_EQ(w.done_at(Phase::textures, 0.5), 4.5);
+  EXPECT_DOUBLE_EQ(w.done_at(Phase::write, 2), 10);  // clamped
+}
+
+pipeline::Job named_job(const std::string& name) {
+  pipeline::Job job;
+  job.name = name;
+  return job;
+}
+
+// The ETA weights each job by its work: with jobs of work 1 and 3, the first done at 2 s is a
+// quarter of the build (6 s left), not half (a count of jobs would say 2 s); the second's stage
+// counts by its phase.
+TEST(BuildProgress, EtaWeightsJobsByTheirWork) {
+  using Clock = pipeline::BuildProgress::Clock;
+  const Clock::time_point t0{};
+  const pipeline::Job a = named_job("material:a"), b = named_job("scene:b");
+  pipeline::BuildProgress progress;
+  progress.planned({{&a, {.read = 1}}, {&b, {.read = 0.5, .textures = 2.5}}}, t0);
+  EXPECT_FALSE(progress.seconds_left(t0).has_value());
+  progress.started(a, t0);
+  progress.started(b, t0);
+  progress.finished(a);
+  EXPECT_DOUBLE_EQ(progress.fraction_done(), 0.25);
+  EXPECT_DOUBLE_EQ(progress.seconds_left(t0 + std::chrono::seconds(2)).value(), 6);
+  progress.stage(b, Phase::textures, "encoding textures 3 of 12", 0.25);
+  EXPECT_DOUBLE_EQ(progress.fraction_done(), (1 + 0.5 + 2.5 * 0.25) / 4);
+  const std::string line = progress.status_line(t0 + std::chrono::seconds(4), 200);
+  EXPECT_EQ(line, "[##########..........] 1/2  53% ETA 0:04  scene:b (encoding textures 3 of 12, 4 s)");
+  EXPECT_EQ(progress.status_line(t0 + std::chrono::seconds(4), 40), line.substr(0, 37) + "...");
+}
+
+// In a log: a line when each job starts (also one that ended before the log was read), and one at
+// least every interval while a job runs, saying its stage and the build's share and ETA.
+TEST(BuildProgress, LogSaysWhenAJobStartsAndEveryIntervalWhileItRuns) {
+  using Clock = pipeline::BuildProgress::Clock;
+  using std::chrono::seconds;
+  const Clock::time_point t0{};
+  const pipeline::Job a = named_job("material:a"), b = named_job("scene:b");
+  pipeline::BuildProgress progress;
+  progress.planned({{&a, {.read = 1}}, {&b, {.textures = 3}}}, t0);
+  progress.started(a, t0);
+  progress.finished(a);
+  progress.started(b, t0);
+  progress.stage(b, Phase::ao, "AO: 2 textures, 64 rays a texel", 0);
+  EXPECT_EQ(progress.log_lines(t0, seconds(10)),
+            (std::vector<std::string>{"material:a started (1 of 2)", "scene:b started (2 of 2)"}));
+  EXPECT_TRUE(progress.log_lines(t0 + seconds(9), seconds(10)).empty());
+  EXPECT_EQ(progress.log_lines(t0 + seconds(10), seconds(10)),
+            (std::vector<std::string>{"scene:b running: AO: 2 textures, 64 rays a texel, 10 s; build 25% done, ETA 0:30"}));
+  EXPECT_TRUE(progress.log_lines(t0 + seconds(19), seconds(10)).empty());
+  EXPECT_EQ(progress.log_lines(t0 + seconds(20), seconds(10)).size(), 1u);
+  progress.finished(b);
+  EXPECT_TRUE(progress.log_lines(t0 + seconds(40), seconds(10)).empty());
+}
+
+std::string read_pipe(int fd) {
+  std::string text, chunk(4096, '\0');
+  for (ssize_t n; (n = read(fd, chunk.data(), chunk.size())) > 0;) text.append(chunk, 0, std::size_t(n));
+  return text;
+}
+
+// On a terminal the line is drawn only after half a second and cleared at the end; in a log each
+// job's start is a line; quiet draws nothing but messages.
 TEST(ProgressBar, DrawsAfterAMomentAndClears) {
-  int fds[2];
-  ASSERT_EQ(pipe(fds), 0);
-  {
-    cli::ProgressBar bar(true, fds[1]);
-    bar.update(1, 4);  // quick: nothing yet
-    std::this_thread::sleep_for(std::chrono::milliseconds(600));
-    bar.update(2, 4);
-    bar.print_above("a message");
-    bar.finish();
-    cli::ProgressBar off(false, fds[1]);
-    std::this_thread::sleep_for(std::chrono::milliseconds(600));
-    off.update(3, 4);  // disabled (not a terminal, or --quiet): no bar ...
-    off.print_above("still printed");  // ... but messages
+  const pipeline::Job a = named_job("material:a");
+  for (const auto mode : {cli::ProgressBar::Mode::terminal, cli::ProgressBar::Mode::log, cli::ProgressBar::Mode::quiet}) {
+    int fds[2];
+    ASSERT_EQ(pipe(fds), 0);
+    {
+      pipeline::BuildProgress progress;
+      progress.planned({{&a, {.read = 1}}}, pipeline::BuildProgress::Clock::now());
+      cli::ProgressBar bar(progress, mode, fds[1]);
+      progress.started(a, pipeline::BuildProgress::Clock::now());
+      progress.stage(a, Phase::read, "decoding sources", 0.5);
+      std::this_thread::sleep_for(std::chrono::milliseconds(800));
+      bar.print_above("a message");
+      bar.finish();
+    }
+    close(fds[1]);
+    const std::string text = read_pipe(fds[0]);
+    close(fds[0]);
+    if (mode == cli::ProgressBar::Mode::terminal) {
+      EXPECT_NE(text.find("\r\033[K[##########..........] 0/1  50% ETA 0:0"), std::string::npos) << text;
+      EXPECT_NE(text.find("material:a (decoding sources, 0 s)"), std::string::npos) << text;
+      EXPECT_NE(text.find("\r\033[Ka message\n"), std::string::npos) << text;
+      EXPECT_EQ(text.substr(text.size() - 4), "\r\033[K");
+    } else if (mode == cli::ProgressBar::Mode::log) {
+      EXPECT_EQ(text, "material:a started (1 of 1)\na message\n");
+    } else {
+      EXPECT_EQ(text, "a message\n");
+    }
   }
-  close(fds[1]);
-  std::string text(4096, '\0');
-  text.resize(std::size_t(read(fds[0], text.data(), text.size())));
-  close(fds[0]);
-  EXPECT_EQ(text.find("1/4"), std::string::npos);
-  EXPECT_NE(text.find("[###############...............] 2/4  ETA 0:0"), std::string::npos) << text;
-  EXPECT_NE(text.find("\r\033[Ka message\n"), std::string::npos);
-  EXPECT_EQ(text.find("3/4"), std::string::npos);
-  EXPECT_EQ(text.substr(text.size() - 14), "still printed\n");
 }
 
 // The memory model's closed form (docs/cluster.md): 4 bytes a channel a texel of the largest

@@ -16,6 +16,7 @@
 #include "matbake/enum_names.hpp"
 #include "matbake/result.hpp"
 #include "matbake/scene.hpp"
+#include "matbake/stage.hpp"
 #include "matbake/wrap.hpp"
 
 namespace matbake::ao {
@@ -150,8 +151,10 @@ struct TextureBakes {
 
 // Deterministic for a given seed whatever the thread count. options.targets is ignored (every
 // instance occludes; the targets say what is baked).
+// `stage` is told as each texture starts.
 Result<TextureBakes> bake_textures(const scene::Scene& scene, const Options& options,
-                                   const std::vector<TextureTarget>& targets, const TextureOptions& texture);
+                                   const std::vector<TextureTarget>& targets, const TextureOptions& texture,
+                                   const StageReport& stage = {});
 
 // Texture bakes for a written glTF: one occlusion texture per material the default scene reaches.
 struct TextureRequest {

@@ -20,6 +20,7 @@
 #include "matbake/delivery.hpp"
 #include "matbake/pack.hpp"
 #include "matbake/result.hpp"
+#include "matbake/stage.hpp"
 #include "matbake/workflow_maps.hpp"
 
 namespace matbake::exporter {
@@ -48,6 +49,7 @@ struct Options {
   delivery::Options delivery;     // sizes and KTX2 of every texture the scene uses
   std::optional<ao::Request> ao;  // bake AO when set: per vertex, or with ao->texture into each
                                   // material's ORM texture (red), or its own occlusion texture
+  StageReport stage;  // not a parameter: told what the export is doing (a build's progress)
 };
 
 struct MaterialReport {

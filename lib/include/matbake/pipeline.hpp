@@ -203,6 +203,8 @@ struct StaleOutputs {
 inline constexpr double kPruneShare = 0.5;
 inline constexpr std::size_t kPruneMinimum = 8;
 
+class BuildProgress;
+
 struct RunOptions {
   bool force = false;
   bool dry_run = false;
@@ -214,6 +216,9 @@ struct RunOptions {
   bool prune = false;
   // Called as each job finishes (from worker threads, one call at a time).
   std::function<void(const JobReport&, std::size_t done, std::size_t total)> progress;
+  // Told the jobs to run with their work, each job's start and stage, each job's end (from worker
+  // threads); a display reads it (build_progress.hpp). Null: none.
+  BuildProgress* tracker = nullptr;
   // Called when a job has written its outputs and before its stamp is (tests change a source here).
   std::function<void(const Job&)> before_stamp;
 };

@@ -86,7 +86,8 @@ Status check(const TextureRequest& request, const Options& estimator) {
 }
 
 Result<TextureBakes> bake_textures(const scene::Scene& scene, const Options& options,
-                                   const std::vector<TextureTarget>& targets, const TextureOptions& texture) {
+                                   const std::vector<TextureTarget>& targets, const TextureOptions& texture,
+                                   const StageReport& stage) {
   if (Status s = check(options); !s) return s.error();
   if (Status s = check(texture, options); !s) return s.error();
   for (const TextureTarget& target : targets) {
@@ -107,6 +108,8 @@ Result<TextureBakes> bake_textures(const scene::Scene& scene, const Options& opt
   const int padding = padding_for(texture);
   for (std::size_t index = 0; index < targets.size(); ++index) {
     const TextureTarget& target = targets[index];
+    report_stage(stage, Phase::ao, "AO texture " + std::to_string(index + 1) + " of " + std::to_string(targets.size()) + ", " +
+                                       std::to_string(options.samples) + " rays a texel", double(index) / double(targets.size()));
     auto texel_start = Clock::now();
     auto coverage = texels::cover(scene, target, texture.width, texture.height);
     if (!coverage) {

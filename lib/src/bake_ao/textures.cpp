@@ -175,9 +175,9 @@ Result<std::vector<TextureReport>> bake_occlusion_textures(gltf::Document& doc, 
                                                            gltf::ImageCache& cache, const ao::Request& request,
                                                            const OcclusionTargets& targets,
                                                            const std::string& stem, OcclusionInto into,
-                                                           ao::TextureBakes& timing) {
+                                                           ao::TextureBakes& timing, const StageReport& stage) {
   const ao::TextureRequest& texture = *request.texture;
-  auto baked = ao::bake_textures(scene, request.options, targets.targets, texture.size);
+  auto baked = ao::bake_textures(scene, request.options, targets.targets, texture.size, stage);
   if (!baked) {
     Error error = baked.error();  // about the scene: named after its file (a usage error stays one)
     if (error.path.empty() && !error.usage) error.path = doc.file;

@@ -43,6 +43,6 @@ Result<std::vector<TextureReport>> bake_occlusion_textures(gltf::Document& doc, 
                                                            gltf::ImageCache& cache, const ao::Request& request,
                                                            const OcclusionTargets& targets,
                                                            const std::string& stem, OcclusionInto into,
-                                                           ao::TextureBakes& timing);
+                                                           ao::TextureBakes& timing, const StageReport& stage = {});
 
 }  // namespace matbake::bake_ao

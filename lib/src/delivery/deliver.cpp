@@ -9,6 +9,7 @@
 #include <glm/geometric.hpp>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <map>
 #include <set>
@@ -198,6 +199,9 @@ struct Work {
 
 // KHR_texture_basisu: "pixelWidth and pixelHeight MUST be multiples of 4". A side below 4 (a 1 × 1
 // constant, a 2 × 2 swatch) is raised to 4, the one case where a delivered side exceeds its source.
+// Whether the texture's file is made by its own work (not an alike one's, and not kept as it is).
+bool makes(const Work& w) { return w.made_by < 0 && !(w.codec == Codec::png && w.size == w.source_size); }
+
 Size ktx2_size(Size s) { return {std::max(s.width, 4), std::max(s.height, 4)}; }
 bool sides_fit_ktx2(Size s) { return s.width % 4 == 0 && s.height % 4 == 0; }
 
@@ -353,7 +357,7 @@ gltf::MadeFormat made_format(const Options& options) {
 }
 
 Result<std::vector<TextureReport>> deliver_textures(gltf::Document& doc, gltf::ImageCache& cache, const Options& options,
-                                                    const fs::path& output) {
+                                                    const fs::path& output, const StageReport& stage) {
   if (!changes_textures(options)) return std::vector<TextureReport>{};
   const bool ktx2_out = options.texture_format == TextureFormat::ktx2;
   std::vector<Work> work;
@@ -412,9 +416,16 @@ Result<std::vector<TextureReport>> deliver_textures(gltf::Document& doc, gltf::I
   // Textures in parallel. UASTC runs are single-threaded, as many at once as --jobs; an ETC1S run
   // (one at a time, encode.cpp) gets every thread.
   const int threads = tbb::this_task_arena::max_concurrency();
+  const std::size_t to_make = std::size_t(std::count_if(work.begin(), work.end(), [](const Work& w) { return makes(w); }));
+  std::atomic<std::size_t> textures_made{0};
+  const auto tell = [&](std::size_t n) {
+    report_stage(stage, Phase::textures, (ktx2_out ? "encoding textures " : "resizing textures ") + std::to_string(n) + " of " +
+                                             std::to_string(to_make), to_make ? double(n) / double(to_make) : 1.0);
+  };
+  tell(0);
   tbb::parallel_for(std::size_t(0), work.size(), [&](std::size_t i) {
     Work& w = work[i];
-    if (w.made_by >= 0 || (w.codec == Codec::png && w.size == w.source_size)) return;  // made by another, or unchanged
+    if (!makes(w)) return;  // made by another, or unchanged
     // Decoded in its turn and dropped when made. Not isolated: a thread waiting inside one texture's
     // encode may start another (isolating cost 15% of the wall time on SpecGlossVsMetalRough for the
     // same peak), so a few more than --jobs textures can be held at once.
@@ -423,6 +434,7 @@ Result<std::vector<TextureReport>> deliver_textures(gltf::Document& doc, gltf::I
       if (!source) return source.error();
       return make(w, std::move(*source), options, cache, encoder, output, threads);
     });
+    tell(++textures_made);
   }, tbb::simple_partitioner());
   for (Work& w : work) {
     if (!w.status) return w.status.error();

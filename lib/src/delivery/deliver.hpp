@@ -6,6 +6,7 @@
 
 #include "../gltf/texture_files.hpp"
 #include "matbake/delivery.hpp"
+#include "matbake/stage.hpp"
 
 namespace matbake::delivery {
 
@@ -19,8 +20,9 @@ gltf::MadeFormat made_format(const Options& options);
 // ktx2 and the class's codec is not png, else resized PNG/WebP when the sizes say so. Scratch files go
 // beside `output`. Textures already KTX2 are kept. Call store_once afterwards: replaced images are
 // left unreferenced. The cache's decoded images are dropped; each texture is decoded in its turn.
+// `stage` is told how many textures are made.
 Result<std::vector<TextureReport>> deliver_textures(gltf::Document& doc, gltf::ImageCache& cache, const Options& options,
-                                                    const std::filesystem::path& output);
+                                                    const std::filesystem::path& output, const StageReport& stage = {});
 
 // The document as it will be written: identical images stored once (and textures that then match
 // merged), what nothing reaches removed (gltf::prune_unreachable; its lines returned), and `reports`

@@ -432,6 +432,7 @@ Result<Report> export_scene(const fs::path& input, const fs::path& output, const
   return guarded(input.string(), [&]() -> Result<Report> {
     const std::string ext = output.extension().string();
     if (ext != ".gltf" && ext != ".glb") return Error{output.string(), "the output is .gltf or .glb", true};
+    report_stage(options.stage, Phase::read, "reading the glTF");
     auto doc = gltf::read_document(input);
     if (!doc) return doc.error();
     if (options.ao && options.ao->texture) {
@@ -471,6 +472,7 @@ Result<Report> export_scene(const fs::path& input, const fs::path& output, const
     const std::size_t images_read = gltf::array_in(doc->json, "images").size();
     Exporter exporter{*doc, cache, options, output.stem().string(), report, {}, {}};
     const std::size_t materials = doc->json.contains("materials") ? doc->json["materials"].size() : 0;
+    report_stage(options.stage, Phase::read, "converting " + std::to_string(materials) + " materials", 0.5);
     for (std::size_t i = 0; i < materials; ++i) {
       Json& material = doc->json["materials"][i];
       MaterialReport out;
@@ -507,17 +509,18 @@ Result<Report> export_scene(const fs::path& input, const fs::path& output, const
     if (occlusion) {
       ao::TextureBakes timing;
       auto textures = bake_ao::bake_occlusion_textures(*doc, *scene, cache, *options.ao, *occlusion, output.stem().string(),
-                                              bake_ao::OcclusionInto::orm, timing);
+                                              bake_ao::OcclusionInto::orm, timing, options.stage);
       if (!textures) return textures.error();
       report.ao_textures = std::move(*textures);
       report.ao_notes = occlusion->notes;
       report.ao_rays = timing.rays;
     } else if (options.ao) {
+      report_stage(options.stage, Phase::ao, "AO per vertex, " + std::to_string(options.ao->options.samples) + " rays a vertex");
       auto baked = bake_ao::bake_into(*doc, *scene, *options.ao);
       if (!baked) return baked.error();
       report.ao_rays = baked->rays;
     }
-    auto delivered = delivery::deliver_textures(*doc, cache, options.delivery, output);
+    auto delivered = delivery::deliver_textures(*doc, cache, options.delivery, output, options.stage);
     if (!delivered) return delivered.error();
     // The input's images that nothing decoded (passed through as they are) decode in full too.
     if (Status s = cache.check_undecoded(images_read); !s) return s.error();
@@ -534,6 +537,7 @@ Result<Report> export_scene(const fs::path& input, const fs::path& output, const
       report.geometry = gltf::geometry_notes(*doc);
     }
 
+    report_stage(options.stage, Phase::write, "writing " + output.filename().string());
     auto written = gltf::write_document(*doc, output);
     if (!written) return written.error();
     for (const fs::path& p : *written) report.written.push_back(p.string());

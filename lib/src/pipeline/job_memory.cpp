@@ -1,11 +1,13 @@
-// The memory a job asks a cluster for, from what it holds at its peak: every image is float
-// samples, so a job's images cost 4 bytes a channel a texel, counted by what the job decodes, makes
-// and writes (docs/cluster.md, "Memory model"; scripts/bench-cluster.sh measures it against peaks).
+// What a job holds and does, from what it decodes, makes and writes. The memory a cluster is asked
+// for, from what it holds at its peak: every image is float samples, so a job's images cost 4 bytes
+// a channel a texel (docs/cluster.md, "Memory model"; scripts/bench-cluster.sh measures it against
+// peaks). Its work, for a progress display's ETA: texels decoded and written, rays, textures encoded.
 #include <algorithm>
 #include <cmath>
 #include <set>
 
 #include "../gltf/document.hpp"
+#include "matbake/build_progress.hpp"
 #include "matbake/cluster.hpp"
 #include "matbake/image.hpp"
 #include "matbake/workflow_maps.hpp"
@@ -39,6 +41,16 @@ constexpr int kGltfMaterialTextures = 4;
 // basisu's own (ETC1S at 2048² peaked at 64.5 bytes a texel, UASTC with RDO at 21).
 constexpr double kKtx2ParentBytesPerTexel = 80;
 constexpr double kBasisuBytesPerTexel = 72;
+
+// Work rates (seconds on the 2-core reference machine, measured on the example's jobs): only their
+// ratios matter, a display scales them by the run's own pace.
+constexpr double kDecodeSecondsPerTexel = 8e-9;     // a PNG source, decoded
+constexpr double kValidateSecondsPerTexel = 30e-9;  // F0 classes and flags
+constexpr double kConvertSecondsPerTexel = 4e-6;    // spec-gloss ⇄ metal-rough (least squares)
+constexpr double kWriteSecondsPerSample = 6e-9;     // a channel of a PNG written
+constexpr double kRaySeconds = 5e-8;                // an AO ray (20 M rays/s)
+constexpr double kKtx2SecondsPerTexel = 1e-6;       // basisu's chain, UASTC and ETC1S alike
+constexpr double kGeometrySecondsPerByte = 2e-9;    // a scene's buffers read, written
 
 constexpr double kHeadroom = 1.25;
 constexpr std::int64_t kMemoryStepMb = 64;
@@ -109,15 +121,37 @@ bool uses_extension(const gltf::Json& json, const std::string& name) {
   return false;
 }
 
-double geometry_bytes(const gltf::Json& json) {
+double buffer_bytes(const gltf::Json& json) {
   double bytes = 0;
   if (json.contains("buffers") && json["buffers"].is_array()) {
     for (const auto& b : json["buffers"]) {
       if (b.is_object() && b.contains("byteLength") && b["byteLength"].is_number()) bytes += std::max(0.0, b["byteLength"].get<double>());
     }
   }
+  return bytes;
+}
+
+double geometry_bytes(const gltf::Json& json) {
   const bool compressed = uses_extension(json, "KHR_draco_mesh_compression") || uses_extension(json, "EXT_meshopt_compression");
-  return bytes * (compressed ? kCompressedGeometryPerBufferByte : kGeometryPerBufferByte);
+  return buffer_bytes(json) * (compressed ? kCompressedGeometryPerBufferByte : kGeometryPerBufferByte);
+}
+
+// The vertices of the meshes (each mesh once, however often it is placed): per-vertex AO's rays.
+double mesh_vertices(const gltf::Json& json) {
+  if (!json.contains("meshes") || !json["meshes"].is_array() || !json.contains("accessors") || !json["accessors"].is_array()) return 0;
+  const gltf::Json& accessors = json["accessors"];
+  double vertices = 0;
+  for (const auto& mesh : json["meshes"]) {
+    if (!mesh.is_object() || !mesh.contains("primitives") || !mesh["primitives"].is_array()) continue;
+    for (const auto& p : mesh["primitives"]) {
+      if (!p.is_object() || !p.contains("attributes") || !p["attributes"].is_object()) continue;
+      const auto position = p["attributes"].find("POSITION");
+      if (position == p["attributes"].end() || !position->is_number_unsigned() || position->get<std::size_t>() >= accessors.size()) continue;
+      const gltf::Json& a = accessors[position->get<std::size_t>()];
+      if (a.is_object() && a.contains("count") && a["count"].is_number()) vertices += std::max(0.0, a["count"].get<double>());
+    }
+  }
+  return vertices;
 }
 
 JobFootprint material_footprint(const MaterialSpec& m) {
@@ -127,45 +161,104 @@ JobFootprint material_footprint(const MaterialSpec& m) {
   return f;
 }
 
-JobFootprint scene_footprint(const Job& job, const Manifest& manifest, int cpus) {
-  const SceneSpec& s = manifest.scenes[job.spec];
-  JobFootprint f;
-  f.program = kProgramBytes;
-  double largest_texture = 0, delivered_texels = 0;
+// What a scene job reads: its manifest materials (each source's header read once) and its glTF's
+// own images, and the glTF's JSON.
+struct SceneInputs {
+  double material_images = 0;    // the materials' images at their peak (material_bytes)
+  double own_images = 0;         // the glTF's own images, decoded, converted and written
+  double decoded_texels = 0;     // of every file decoded
+  double largest_texture = 0;
+  double delivered_texels = 0;   // of the textures the scene writes
+  double converted_texels = 0;   // of materials converted to metal-rough (their maps are spec-gloss)
+  std::optional<gltf::Json> json;
+};
+
+SceneInputs scene_inputs(const Job& job, const Manifest& manifest) {
+  SceneInputs in;
   std::set<std::size_t> materials;
   std::set<fs::path> material_files;
   for (const auto& [gltf_name, m] : job.materials) materials.insert(m);
   for (std::size_t m : materials) {
     const MaterialSpec& spec = manifest.materials[m];
     const int written = spec.layout ? std::max(kGltfMaterialChannels, texture_channels(spec.layout->layout)) : kGltfMaterialChannels;
-    const MaterialShape shape = material_shape(spec);  // each source's header read once
-    f.images += material_bytes(spec, shape, written);
-    largest_texture = std::max(largest_texture, shape.texels);
-    delivered_texels += kGltfMaterialTextures * shape.texels;
+    const MaterialShape shape = material_shape(spec);
+    in.material_images += material_bytes(spec, shape, written);
+    in.largest_texture = std::max(in.largest_texture, shape.texels);
+    in.delivered_texels += kGltfMaterialTextures * shape.texels;
+    in.decoded_texels += shape.texels * double(std::max<std::size_t>(1, decoded_files(spec).size()));
+    const material::MapNames names = source_map_names(spec);  // spec-gloss maps: a scene converts them
+    if (names.count(material::kKd) && names.count(material::kGloss)) in.converted_texels += shape.texels;
     for (const fs::path& file : decoded_files(spec)) material_files.insert(file);
   }
-  for (const fs::path& in : job.inputs) {
-    if (material_files.count(fs::absolute(in).lexically_normal())) continue;
-    const ImageSize size = probe(in);
-    f.images += size.texels * kOwnImageBytesPerTexel;
-    largest_texture = std::max(largest_texture, size.texels);
-    delivered_texels += size.texels;
+  for (const fs::path& file : job.inputs) {
+    if (material_files.count(fs::absolute(file).lexically_normal())) continue;
+    const ImageSize size = probe(file);
+    in.own_images += size.texels * kOwnImageBytesPerTexel;
+    in.largest_texture = std::max(in.largest_texture, size.texels);
+    in.delivered_texels += size.texels;
+    in.decoded_texels += size.texels;
   }
-  auto json = gltf::read_json(s.input);
-  if (json) f.geometry = geometry_bytes(*json);
+  if (auto json = gltf::read_json(manifest.scenes[job.spec].input)) in.json = std::move(*json);
+  return in;
+}
+
+// One AO texture per material, and per placement of a mesh when each gets its own.
+double ao_textures(const ao::TextureRequest& t, const std::optional<gltf::Json>& json) {
+  double textures = double(std::max<std::size_t>(1, json ? array_size(*json, "materials") : 1));
+  if (t.per_instance && json) textures += double(array_size(*json, "nodes"));
+  return textures;
+}
+
+JobFootprint scene_footprint(const Job& job, const Manifest& manifest, int cpus) {
+  const SceneSpec& s = manifest.scenes[job.spec];
+  const SceneInputs in = scene_inputs(job, manifest);
+  JobFootprint f;
+  f.program = kProgramBytes;
+  f.images = in.material_images + in.own_images;
+  if (in.json) f.geometry = geometry_bytes(*in.json);
   if (s.options.ao && s.options.ao->texture) {
     const ao::TextureRequest& t = *s.options.ao->texture;
-    // One texture per material, and per placement of a mesh when each gets its own.
-    double textures = double(std::max<std::size_t>(1, json ? array_size(*json, "materials") : 1));
-    if (t.per_instance && json) textures += double(array_size(*json, "nodes"));
-    f.ao = textures * double(t.size.width) * double(t.size.height) * kAoBytesPerTexel;
+    f.ao = ao_textures(t, in.json) * double(t.size.width) * double(t.size.height) * kAoBytesPerTexel;
   }
   if (s.options.delivery.texture_format == delivery::TextureFormat::ktx2) {
     // Every texture decoded, then encoded in parallel, one per core: the largest, that many at once.
-    f.encoder = delivered_texels * kDecodedTextureBytesPerTexel +
-                double(std::max(1, cpus)) * largest_texture * (kKtx2ParentBytesPerTexel + kBasisuBytesPerTexel);
+    f.encoder = in.delivered_texels * kDecodedTextureBytesPerTexel +
+                double(std::max(1, cpus)) * in.largest_texture * (kKtx2ParentBytesPerTexel + kBasisuBytesPerTexel);
   }
   return f;
+}
+
+JobWork material_work(const MaterialSpec& m) {
+  const MaterialShape shape = material_shape(m);
+  JobWork w;
+  w.read = shape.texels * double(std::max<std::size_t>(1, decoded_files(m).size())) * kDecodeSecondsPerTexel;
+  if (m.validation.enabled) w.textures += shape.texels * kValidateSecondsPerTexel;
+  if (m.layout) {
+    w.textures += shape.texels * texture_channels(m.layout->layout) * kWriteSecondsPerSample;
+    if (workflow::layout_direction(source_map_names(m), m.layout->layout)) w.textures += shape.texels * kConvertSecondsPerTexel;
+  }
+  return w;
+}
+
+JobWork scene_work(const Job& job, const Manifest& manifest) {
+  const SceneSpec& s = manifest.scenes[job.spec];
+  const SceneInputs in = scene_inputs(job, manifest);
+  const double geometry = in.json ? buffer_bytes(*in.json) : 0;
+  JobWork w;
+  w.read = in.decoded_texels * kDecodeSecondsPerTexel + in.converted_texels * kConvertSecondsPerTexel +
+           geometry * kGeometrySecondsPerByte;
+  if (s.options.ao) {
+    const double samples = double(s.options.ao->options.samples);
+    if (const auto& t = s.options.ao->texture) {
+      w.ao = ao_textures(*t, in.json) * double(t->size.width) * double(t->size.height) * samples * kRaySeconds;
+    } else if (in.json) {
+      w.ao = mesh_vertices(*in.json) * samples * kRaySeconds;
+    }
+  }
+  const bool ktx2 = s.options.delivery.texture_format == delivery::TextureFormat::ktx2;
+  w.textures = in.delivered_texels * (ktx2 ? kKtx2SecondsPerTexel : 4 * kWriteSecondsPerSample);
+  w.write = geometry * kGeometrySecondsPerByte;
+  return w;
 }
 
 }  // namespace
@@ -173,6 +266,11 @@ JobFootprint scene_footprint(const Job& job, const Manifest& manifest, int cpus)
 JobFootprint job_footprint(const Job& job, const Manifest& manifest, int cpus) {
   if (job.kind == JobKind::material) return material_footprint(manifest.materials[job.spec]);
   return scene_footprint(job, manifest, cpus);
+}
+
+JobWork job_work(const Job& job, const Manifest& manifest) {
+  if (job.kind == JobKind::material) return material_work(manifest.materials[job.spec]);
+  return scene_work(job, manifest);
 }
 
 std::int64_t memory_request_mb(const JobFootprint& footprint) {

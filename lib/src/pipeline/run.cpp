@@ -10,6 +10,7 @@
 #include <mutex>
 #include <set>
 
+#include "matbake/build_progress.hpp"
 #include "matbake/join.hpp"
 #include "matbake/near_names.hpp"
 #include "matbake/atomic_file.hpp"
@@ -213,26 +214,31 @@ Status write_layout(const Job& job, const JobContext& ctx, const MaterialSpec& m
 }
 
 // Validated first: a gate that fails writes no textures (a failed job's outputs are not fresh ones).
-Status run_material(const Job& job, const JobContext& ctx, JobReport& report) {
+Status run_material(const Job& job, const JobContext& ctx, const StageReport& stage, JobReport& report) {
   return guarded(ctx.manifest.materials[job.spec].name, [&]() -> Status {
     const MaterialSpec& m = ctx.manifest.materials[job.spec];
+    report_stage(stage, Phase::read, "decoding sources");
     auto maps = load_material(m, ctx.cache);
     if (!maps) return maps.error();
     for (std::string& note : pack::decode_overrides(m.sources, m.options)) report.warnings.push_back(std::move(note));
     report.details["size"] = {maps->width, maps->height};
     if (Status s = ensure_folder(ctx.manifest.output / "materials"); !s) return s;
     if (m.validation.enabled) {
+      report_stage(stage, Phase::textures, "validating");
       if (Status s = validate_material(m, *maps, ctx, job.outputs, report); !s) return s;
     }
+    report_stage(stage, Phase::textures, "writing textures", m.validation.enabled ? 0.5 : 0);
     if (m.layout) return write_layout(job, ctx, m, std::move(*maps), report);
     return success();
   });
 }
 
-Result<std::vector<fs::path>> run_scene(const Job& job, const JobContext& ctx, JobReport& report) {
+Result<std::vector<fs::path>> run_scene(const Job& job, const JobContext& ctx, const StageReport& stage, JobReport& report) {
   return guarded(ctx.manifest.scenes[job.spec].input.string(), [&]() -> Result<std::vector<fs::path>> {
     const SceneSpec& s = ctx.manifest.scenes[job.spec];
     exporter::Options options = s.options;
+    options.stage = stage;
+    report_stage(stage, Phase::read, "decoding materials");
     // Content-keyed, so shared by every manifest that builds into the folder.
     options.delivery.encode_cache = ctx.manifest.output / ".matbake" / "encode-cache";
     options.delivery.encode_cache_bytes = ctx.encode_cache_bytes;
@@ -280,6 +286,11 @@ std::vector<StampedFile> inputs_as_read(std::vector<StampedFile> read, const std
 void run_job(const Job& job, const JobContext& ctx, const RunOptions& run_options, const StampRoots& roots,
              JobReport& report) {
   const auto start = std::chrono::steady_clock::now();
+  StageReport stage;
+  if (BuildProgress* tracker = run_options.tracker) {
+    tracker->started(job, start);
+    stage = [tracker, &job](Phase phase, std::string_view what, double fraction) { tracker->stage(job, phase, what, fraction); };
+  }
   remove_stamp(job.name, roots);  // from here until it succeeds, the job is not up to date
   remove_failure(job.name, roots);  // nor failed: running (or, if it is killed, not built)
   const std::vector<fs::path> decoded = decoded_files(job, ctx.manifest);
@@ -289,8 +300,8 @@ void run_job(const Job& job, const JobContext& ctx, const RunOptions& run_option
   if (job.problem) {
     status = *job.problem;
   } else if (job.kind == JobKind::material) {
-    status = run_material(job, ctx, report);
-  } else if (auto files = run_scene(job, ctx, report); files) {
+    status = run_material(job, ctx, stage, report);
+  } else if (auto files = run_scene(job, ctx, stage, report); files) {
     written = *files;
   } else {
     status = files.error();
@@ -452,6 +463,14 @@ Result<Report> run(const Manifest& manifest, const Plan& plan, const RunOptions&
     }
     return {};
   };
+  if (options.tracker) {
+    std::vector<std::pair<const Job*, JobWork>> work(to_run.size());
+    tbb::parallel_for(std::size_t(0), to_run.size(), [&](std::size_t i) {
+      const Job& job = *report.jobs[to_run[i]].job;
+      work[i] = {&job, job_work(job, manifest)};
+    });
+    options.tracker->planned(work, std::chrono::steady_clock::now());
+  }
   std::vector<std::size_t> waves[2];
   for (std::size_t i : to_run) waves[report.jobs[i].job->depends_on.empty() ? 0 : 1].push_back(i);
   std::mutex progress_mutex;
@@ -468,6 +487,7 @@ Result<Report> run(const Manifest& manifest, const Plan& plan, const RunOptions&
         tbb::this_task_arena::isolate([&] { run_job(*r.job, ctx, options, roots, r); });
       }
       for (const fs::path& f : decoded_files(*r.job, manifest)) cache.release(f);
+      if (options.tracker) options.tracker->finished(*r.job);
       std::lock_guard lock(progress_mutex);
       ++done;
       if (options.progress) options.progress(r, done, to_run.size());
