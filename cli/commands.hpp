@@ -164,4 +164,10 @@ struct PlanSettings {
 CLI::App* setup_plan(CLI::App& app, PlanSettings& settings);
 int run_plan(const PlanSettings& settings, const GlobalOptions& global);
 
+struct InspectSettings {
+  std::string path;
+};
+CLI::App* setup_inspect(CLI::App& app, InspectSettings& settings);
+int run_inspect(const InspectSettings& settings, const GlobalOptions& global);
+
 }  // namespace matbake::cli

@@ -12,6 +12,7 @@ packages=(
   libgtest-dev libbenchmark-dev zlib1g-dev libdeflate-dev libspng-dev libxxhash-dev time
   libdraco-dev libmeshoptimizer-dev libwebp-dev libzstd-dev draco gltfpack
   clang-14 libclang-rt-14-dev llvm-14
+  python3-jsonschema
 )
 # `deps.sh cluster`: also Slurm and munge, for scripts/test-cluster.sh.
 [ "${1:-}" = cluster ] && packages+=(slurm-wlm munge)

@@ -16,6 +16,7 @@
 #include <set>
 #include <sstream>
 
+#include "matbake/ktx2.hpp"
 #include "support/files.hpp"
 #include "support/gltf_files.hpp"
 #include "support/run.hpp"
@@ -229,6 +230,10 @@ void write_example_files(const fs::path& dir) {
   write_small_scene(dir / "scene.gltf");
   fs::create_directory_symlink(fs::path(MATBAKE_SOURCE_DIR) / "presets", dir / "presets");
   ASSERT_EQ(matbake({"export", (dir / "scene.gltf").string(), "-o", (dir / "scene.glb").string()}).exit_code, 0);
+  // texture.ktx2: UASTC 4×4, one level (inspect reads it; no encoder needed).
+  const auto ktx2_file = ktx2::write_uastc({.width = 4, .height = 4, .levels = {*ktx2::uastc_level(std::vector<unsigned char>(16), 0)}});
+  ASSERT_TRUE(ktx2_file);
+  write_bytes(dir / "texture.ktx2", std::string(ktx2_file->begin(), ktx2_file->end()));
 }
 
 // A shell line's commands (split at &&), comments cut.

@@ -22,6 +22,11 @@ enum class TextureClass { colour, data, normal };
 inline constexpr NameTable<TextureClass, 3> kTextureClassNames{
     {{TextureClass::colour, "colour"}, {TextureClass::data, "data"}, {TextureClass::normal, "normal"}}};
 
+// The class of a material slot, by its key, for core and extension slots alike: normal maps
+// (normalTexture, clearcoatNormalTexture), colour (baseColor, emissive, *ColorTexture: specular
+// colour, sheen colour), data otherwise (metallic-roughness, occlusion, clearcoat, transmission...).
+TextureClass class_of_slot(const std::string& key);
+
 // How a class's textures are stored: Basis Universal ETC1S (small, BasisLZ), UASTC (high quality,
 // optionally zstd-supercompressed), or PNG (kept, resized when the sizes say so).
 enum class Codec { etc1s, uastc, png };

@@ -48,15 +48,6 @@ struct Use {
   std::string first_slot;           // "baseColorTexture"
 };
 
-// The class of a material slot, by its name, for core and extension slots alike: normal maps
-// (normalTexture, clearcoatNormalTexture), colour (baseColor, emissive, *ColorTexture: specular
-// colour, sheen colour), data otherwise (metallic-roughness, occlusion, clearcoat, transmission...).
-TextureClass class_of_slot(const std::string& key) {
-  if (key.find("ormalTexture") != std::string::npos) return TextureClass::normal;
-  if (key == "baseColorTexture" || key == "emissiveTexture" || key.ends_with("ColorTexture")) return TextureClass::colour;
-  return TextureClass::data;
-}
-
 void record(std::map<int, Use>& uses, int texture, TextureClass c, std::optional<float> cutoff, Placement placement,
             const std::string& slot) {
   auto [it, fresh] = uses.try_emplace(texture, Use{c, cutoff, "", {}, placement.material, slot});
@@ -343,6 +334,13 @@ std::vector<int> materials_of(const Use& use) {
 }
 
 }  // namespace
+
+TextureClass class_of_slot(const std::string& key) {
+  if (key.find("ormalTexture") != std::string::npos) return TextureClass::normal;
+  if (key == "baseColorTexture" || key == "emissiveTexture" || key.ends_with("ColorTexture")) return TextureClass::colour;
+  return TextureClass::data;
+}
+
 
 bool changes_textures(const Options& options) {
   if (options.texture_format == TextureFormat::ktx2 || options.texel_density > 0) return true;
