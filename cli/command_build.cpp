@@ -48,6 +48,14 @@ void print_stale(const pipeline::StaleOutputs& stale, bool dry_run) {
   }
 }
 
+// The page --report (or the manifest's `report = true`) asks for: a relative FILE is the output
+// folder's; "" when none is asked.
+fs::path report_page(const BuildSettings& s, const pipeline::Manifest& manifest) {
+  if (s.report.empty() && !manifest.report) return {};
+  const fs::path file = s.report.empty() ? fs::path("report.html") : fs::path(s.report);
+  return (file.is_absolute() ? file : manifest.output / file).lexically_normal();
+}
+
 void add_output_dir_option(CLI::App& cmd, std::string& output_dir) {
   cmd.add_option("--output-dir", output_dir,
                  "Write the outputs here instead of the manifest's `output` (e.g. inside a build tree)");
@@ -151,8 +159,12 @@ CLI::App* setup_build(CLI::App& app, BuildSettings& s) {
                   "Write a Make depfile of every input read, for CMake add_custom_command(DEPFILE) and Ninja");
   CLI::Option* stamp = cmd->add_option("--stamp", s.stamp,
                   "Write this file after a successful run; the depfile's target is then this file rather than the outputs");
+  CLI::Option* report = cmd->add_flag("--report{report.html}", s.report,
+                "Write one HTML page of the build (--report=FILE: that file, inside the output folder; default\n"
+                "OUT/report.html; also `report = true` in the manifest): every job, each material's textures and\n"
+                "checks, each scene's AO and delivered textures (docs/build.md#the-report-page)");
   // --status builds nothing: a flag about building beside it would be silently ignored.
-  for (CLI::Option* building : {force, dry_run, keep_stale, prune, only, depfile, stamp}) status->excludes(building);
+  for (CLI::Option* building : {force, dry_run, keep_stale, prune, only, depfile, stamp, report}) status->excludes(building);
   return cmd;
 }
 
@@ -210,6 +222,10 @@ int run_build(const BuildSettings& s, const GlobalOptions& global) {
   if (!s.depfile.empty()) {
     if (Status st = pipeline::check_depfile_paths(manifest, *plan); !st) return report_error(st.error(), key_mention);
   }
+  const fs::path page = s.dry_run ? fs::path() : report_page(s, manifest);
+  if (!page.empty()) {
+    if (Status st = pipeline::check_report_page(manifest, *plan, page); !st) return report_error(st.error(), key_mention);
+  }
   if (!global.quiet) {
     for (const std::string& w : plan->warnings) std::cerr << "matbake: warning: " << w << "\n";
   }
@@ -249,6 +265,10 @@ int run_build(const BuildSettings& s, const GlobalOptions& global) {
   if (!s.dry_run) {
     if (Status st = pipeline::write_build_tool_files(manifest, *report, s.depfile, s.stamp); !st) {
       return report_error(st.error(), key_mention);
+    }
+    if (!page.empty()) {
+      if (Status st = pipeline::write_report_page(manifest, *plan, *report, page); !st) return report_error(st.error(), key_mention);
+      if (!global.json && !global.quiet) std::printf("report: %s\n", page.c_str());
     }
   }
   if (global.json) {

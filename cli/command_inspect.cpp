@@ -22,7 +22,7 @@ int run_inspect(const InspectSettings& s, const GlobalOptions& global) {
   quiet.restore();
   if (!inspected) return report_error(inspected.error(), key_mention);
   if (global.json) {
-    std::cout << nlohmann::json{{"command", "inspect"}, {"inspected", *inspected}}.dump(2) << "\n";
+    std::cout << nlohmann::json{{"command", "inspect"}, {"inspected", *inspected}}.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
   } else if (!global.quiet) {
     std::cout << inspect::text(*inspected);
   }

@@ -147,6 +147,7 @@ struct BuildSettings {
   std::vector<std::string> only;
   std::string depfile;
   std::string stamp;
+  std::string report;  // the report page; "" unless --report was given (or the manifest asks)
 };
 CLI::App* setup_build(CLI::App& app, BuildSettings& settings);
 int run_build(const BuildSettings& settings, const GlobalOptions& global);

@@ -19,7 +19,7 @@ count() { find "$@" -type f | wc -l; }
 bash "$root/scripts/build.sh" --cli-only "$root/build"
 built=$SECONDS
 matbake=$root/build/cli/matbake
-"$matbake" build "$root/examples/showroom.toml"
+"$matbake" build "$root/examples/showroom.toml" --report
 mkdir -p "$out"
 log=$out/example.log
 : >"$log"
@@ -63,5 +63,6 @@ else
 fi
 echo "  AO         $(rel "$out")/ao/: $(count "$out/ao" -name '*.png') occlusion textures, 256², 256 rays a texel"
 echo "  preview    $(rel "$out")/materials-preview.png"
+echo "  report     $(rel "$out")/report.html: the build on one page (every job, material, scene and texture)"
 echo "  picture    $picture"
 echo "  log        $(rel "$log"); what each file is: docs/build.md#the-bundled-example"

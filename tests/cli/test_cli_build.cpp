@@ -886,3 +886,32 @@ TEST(ExampleScene, GeneratorWritesTheCommittedFiles) {
 
 }  // namespace
 }  // namespace matbake::test
+
+namespace matbake::test {
+namespace {
+
+// The report page is written inside the output folder only (--report=FILE elsewhere is refused,
+// nothing built); `report = true` in the manifest writes OUT/report.html on every build.
+TEST(CliBuild, TheReportPageGoesInsideTheOutputFolder) {
+  TempDir dir;
+  write_raw(dir / "a.png", 4, 4, 3, "uint8", std::vector<double>(48, 120));
+  const std::string material = "[materials.a]\nsources = { base_color = \"a.png\", metallic = 0.0, roughness = 0.5 }\n"
+                               "layout = \"gltf-orm\"\n";
+  write_bytes(dir / "m.toml", material);
+  RunResult r = matbake({"build", (dir / "m.toml").string(), "--report=" + (dir / "elsewhere.html").string()});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_EQ(r.err, "matbake: error: " + (dir / "elsewhere.html").string() + ": the report page goes inside the output folder (" +
+                       (dir / "out").string() + ")\n");
+  EXPECT_FALSE(fs::exists(dir / "elsewhere.html"));
+  write_bytes(dir / "m.toml", "report = true\n" + material);
+  r = matbake({"build", (dir / "m.toml").string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string page = read_bytes(dir / "out/report.html");
+  EXPECT_NE(page.find("<section id=\"material:a\"><h3>a</h3>"), std::string::npos) << page;
+  EXPECT_NE(page.find("<img src=\"materials/a_base_color.png\""), std::string::npos) << page;
+  EXPECT_NE(page.find("validation: 0 of 16 texels flagged"), std::string::npos) << page;
+  EXPECT_EQ(page.find("<script"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace matbake::test

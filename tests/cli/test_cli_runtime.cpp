@@ -117,6 +117,40 @@ int swap_transfers(const fs::path& folder) {
   return changed;
 }
 
+// The example build's report page in Chromium: no console message or failed request, every image
+// loads, a section per job of the manifest, no script; then the up-to-date build's page (written
+// from the stamps' summaries) the same, with each material's validation line.
+TEST(Runtime, TheExampleBuildsReportPageOpensInChromium) {
+  SKIP_UNDER_SANITIZERS();
+  TempDir dir;
+  copy_example(dir.path(), true);
+  const std::string manifest = (dir / "showroom.toml").string();
+  const fs::path page = dir / "out/report.html";
+  for (const char* run : {"built", "up to date"}) {
+    const RunResult built = matbake({"build", manifest, "--report"});
+    ASSERT_EQ(built.exit_code, 0) << built.err;
+    EXPECT_NE(built.out.find("report: " + page.string() + "\n"), std::string::npos) << built.out;
+    MATBAKE_CHECK_PAGE_OR_SKIP(seen, page, fs::path());
+    EXPECT_EQ((*seen)["console"], json::array()) << run;
+    EXPECT_EQ((*seen)["scripts"], 0) << run;
+    EXPECT_GE((*seen)["images"].size(), 10u + 15u) << run;  // 5 materials × 2 textures, the scene's 15 images
+    for (const json& image : (*seen)["images"]) {
+      EXPECT_GT(image["naturalWidth"].get<int>(), 0) << run << ": " << image["src"];
+      EXPECT_EQ(image["src"].get<std::string>().find(':'), std::string::npos) << "a relative path, no URL: " << image["src"];
+    }
+    std::vector<std::string> sections = (*seen)["sections"];
+    std::sort(sections.begin(), sections.end());
+    EXPECT_EQ(sections, (std::vector<std::string>{"material:glass", "material:gold_trim", "material:painted_metal",
+                                                  "material:rubber", "material:wood", "scene:showroom"}))
+        << run;
+    const std::string text = read_bytes(page);
+    std::size_t validation_lines = 0;
+    for (std::size_t at = 0; (at = text.find("texels flagged", at)) != std::string::npos; ++at) ++validation_lines;
+    EXPECT_EQ(validation_lines, 5u) << run;
+    EXPECT_NE(text.find("AO rays"), std::string::npos) << run;
+  }
+}
+
 TEST(Runtime, TheExamplesKtx2SceneLooksAsItsPngSceneInThreeJs) {
   SKIP_UNDER_SANITIZERS();
   MATBAKE_BASISU_OR_SKIP(basisu);

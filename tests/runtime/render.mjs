@@ -9,10 +9,9 @@
 // The whole run is bounded by --timeout seconds (default 120); Chromium dies with this process.
 import http from 'node:http';
 import fs from 'node:fs';
-import os from 'node:os';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
-import puppeteer from 'puppeteer-core';
+import { close, deadline, launch, watchConsole } from './chromium.mjs';
 
 const here = path.dirname(fileURLToPath(import.meta.url));
 const threeRoot = path.join(here, 'node_modules', 'three');
@@ -73,31 +72,10 @@ function threeVersion() {
   return JSON.parse(fs.readFileSync(path.join(threeRoot, 'package.json'), 'utf8')).version;
 }
 
-async function launch() {
-  const executablePath = process.env.CHROMIUM || '/usr/bin/chromium';
-  if (!fs.existsSync(executablePath)) return { why: `no Chromium at ${executablePath} (bash scripts/install-runtime.sh)` };
-  const userDataDir = fs.mkdtempSync(path.join(os.tmpdir(), 'matbake-chromium-'));
-  try {
-    const browser = await puppeteer.launch({
-      executablePath, userDataDir, headless: true, timeout: 30000,
-      // WebGL on the CPU (SwiftShader through ANGLE); no network beyond 127.0.0.1.
-      args: ['--no-sandbox', '--use-angle=swiftshader', '--enable-unsafe-swiftshader', '--disable-quic',
-        '--no-first-run', '--disable-background-networking', '--disable-component-update', '--disable-sync'],
-    });
-    return { browser, userDataDir };
-  } catch (error) {
-    fs.rmSync(userDataDir, { recursive: true, force: true });
-    return { why: `Chromium at ${executablePath} did not start: ${String(error.message).split('\n')[0]}` };
-  }
-}
-
 async function renderAll(browser, server, options) {
   const page = await browser.newPage();
   const messages = [];
-  page.on('console', (m) => { if (m.type() === 'warn' || m.type() === 'error') messages.push(`${m.type()}: ${m.text()}`); });
-  page.on('pageerror', (e) => messages.push(`pageerror: ${e.message}`));
-  page.on('requestfailed', (r) => messages.push(`requestfailed: ${r.url()}`));
-  page.on('response', (r) => { if (r.status() >= 400) messages.push(`http ${r.status()}: ${r.url()}`); });
+  watchConsole(page, messages);
   await page.goto(`http://127.0.0.1:${server.address().port}/`);
   await page.waitForFunction('window.matbakeReady === true', { timeout: 30000 });
   const report = {};
@@ -121,11 +99,7 @@ async function main() {
     console.error(`render.mjs: ${started.why}`);
     process.exit(77);
   }
-  const timer = setTimeout(() => {
-    console.error(`render.mjs: no result within ${options.timeout} s`);
-    started.browser.process()?.kill('SIGKILL');
-    process.exit(1);
-  }, options.timeout * 1000);
+  const timer = deadline(started, options.timeout, 'render.mjs');
   const server = await serve(options.models);
   try {
     const models = await renderAll(started.browser, server, options);
@@ -134,8 +108,7 @@ async function main() {
   } finally {
     clearTimeout(timer);
     server.close();
-    await started.browser.close();
-    fs.rmSync(started.userDataDir, { recursive: true, force: true });
+    await close(started);
   }
 }
 

@@ -37,14 +37,38 @@ RuntimeTexture texture_from(const json& t) {
 
 }  // namespace
 
-std::optional<std::map<std::string, RuntimeModel>> render_in_three(
-    const fs::path& folder, const std::vector<std::pair<std::string, fs::path>>& models, std::string& why_not) {
+// The harness's npm packages, or why they are missing.
+bool harness_installed(std::string& why_not) {
   for (const char* package : {"three", "puppeteer-core"}) {
     if (!fs::exists(kHarness / "node_modules" / package / "package.json")) {
       why_not = std::string("the runtime harness is not installed (no ") + package + "; bash scripts/install-runtime.sh)";
-      return std::nullopt;
+      return false;
     }
   }
+  return true;
+}
+
+std::optional<nlohmann::json> check_page_in_chromium(const fs::path& page, const fs::path& screenshot, std::string& why_not) {
+  if (!harness_installed(why_not)) return std::nullopt;
+  SubprocessRequest request;
+  request.program = "/usr/bin/env";
+  const fs::path result_file = page.parent_path() / (page.stem().string() + ".chromium.json");
+  request.args = {"node", (kHarness / "check_page.mjs").string(), page.string(), "--out", result_file.string(), "--timeout", "60"};
+  if (!screenshot.empty()) request.args.insert(request.args.end(), {"--screenshot", screenshot.string()});
+  request.time_limit = std::chrono::seconds(90);
+  const SubprocessResult result = run_supervised(request);
+  if (result.status == kSkipExit) {
+    why_not = "no runtime here: " + result.error_line();
+    return std::nullopt;
+  }
+  if (result.status != 0) throw std::runtime_error("the page harness failed: " + result.output_tail);
+  std::ifstream in(result_file);
+  return json::parse(in);
+}
+
+std::optional<std::map<std::string, RuntimeModel>> render_in_three(
+    const fs::path& folder, const std::vector<std::pair<std::string, fs::path>>& models, std::string& why_not) {
+  if (!harness_installed(why_not)) return std::nullopt;
   SubprocessRequest request;
   request.program = "/usr/bin/env";
   request.args = {"node", (kHarness / "render.mjs").string(), "--out", folder.string(), "--timeout", "150"};

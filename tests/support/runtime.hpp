@@ -3,6 +3,8 @@
 // SwiftShader (tests/runtime/render.mjs, installed by scripts/install-runtime.sh). Each model is
 // rendered from three fixed views under a fixed light; what three.js made of each texture is read
 // back. Tests skip, saying why, only where the harness or Chromium is missing.
+#include <nlohmann/json.hpp>
+
 #include <filesystem>
 #include <map>
 #include <optional>
@@ -43,10 +45,22 @@ std::optional<std::map<std::string, RuntimeModel>> render_in_three(
 // background (the top-left pixel of the reference): 8-bit RGB, peak 255. Infinity when equal.
 double render_psnr(const std::filesystem::path& reference, const std::filesystem::path& test);
 
+// What Chromium shows of an HTML page (tests/runtime/check_page.mjs): console messages, each image's
+// src and natural size, section ids, headings, script count (also left beside the page as
+// PAGE.chromium.json); with `screenshot`, the whole page as PNG. Empty with `why_not` when the harness cannot run here; a harness failure throws.
+std::optional<nlohmann::json> check_page_in_chromium(const std::filesystem::path& page, const std::filesystem::path& screenshot,
+                                                      std::string& why_not);
+
 // The colour space three.js must give a texture read for `slot`: "srgb" for colour, "" for data.
 std::string color_space_of_slot(const std::string& slot);
 
 }  // namespace matbake::test
+
+// In a test: what Chromium shows of `page`, or skip the test when it cannot run here.
+#define MATBAKE_CHECK_PAGE_OR_SKIP(seen, page, screenshot)                                    \
+  std::string seen##_why_not;                                                                  \
+  const auto seen = ::matbake::test::check_page_in_chromium(page, screenshot, seen##_why_not); \
+  if (!seen) GTEST_SKIP() << seen##_why_not
 
 // In a test: `renders` for `models`, or skip the test when the runtime cannot run here.
 #define MATBAKE_RENDER_OR_SKIP(renders, folder, models)                               \

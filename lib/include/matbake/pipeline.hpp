@@ -116,6 +116,7 @@ struct Manifest {
   // it the folder belongs to the manifest that built it first (OUT/.matbake/owner.json).
   bool shared_output = false;
   bool prune = false;  // `prune = true`: as --prune on every run (RunOptions::prune)
+  bool report = false;  // `report = true`: every build writes OUT/report.html (write_report_page)
   // `max_pixels = N`: the largest image its jobs read or make (image::set_max_pixels), wherever they
   // run (a build, Ninja's or Slurm's jobs); 0: the run's own limit.
   std::int64_t max_pixels = 0;
@@ -271,6 +272,15 @@ Status check_side_outputs(const Manifest& manifest, const Plan& plan, std::span<
 // be empty; a dry run should write neither.
 Status write_build_tool_files(const Manifest& manifest, const Report& report, const std::filesystem::path& depfile,
                               const std::filesystem::path& stamp);
+
+// `build --report`: one HTML page of the run at `page` (inside the output folder; a usage error
+// otherwise), with each job (this run's outcome, or an up-to-date job's recorded summary), each
+// material's textures, heatmap, validation and conversion error, each scene's AO textures and
+// delivered textures (docs/build.md#the-report-page). Images are the output folder's files, linked
+// relative to the page; a scene's PNG, JPEG and WebP images are copied into report/ beside it.
+Status write_report_page(const Manifest& manifest, const Plan& plan, const Report& report, const std::filesystem::path& page);
+// The page's place, checked before a build runs: inside the output folder, none of its files.
+Status check_report_page(const Manifest& manifest, const Plan& plan, const std::filesystem::path& page);
 
 // Make syntax: `targets: inputs`, spaces escaped, one prerequisite per line; an error (usage) for
 // a path no depfile can hold (a line break).

@@ -549,7 +549,7 @@ Result<Manifest> parse_manifest(std::string_view toml_text, const fs::path& file
                    "not valid TOML: " + std::string(e.description())};
     }
     const std::vector<std::string> own_keys{"output", "table", "materials", "material_rules", "scenes", "cluster",
-                                            "shared_output", "prune", "max_pixels"};
+                                            "shared_output", "prune", "max_pixels", "report"};
     if (Status s = r.known_keys(doc, "the manifest", keys_of_tree(material_tree(), keys_of_tree(scene_tree(), own_keys))); !s) {
       return s.error();
     }
@@ -562,6 +562,7 @@ Result<Manifest> parse_manifest(std::string_view toml_text, const fs::path& file
     if (Status s = r.get(doc, "table", "manifest", table); !s) return s.error();
     if (Status s = r.get(doc, "shared_output", "manifest", m.shared_output); !s) return s.error();
     if (Status s = r.get(doc, "prune", "manifest", m.prune); !s) return s.error();
+    if (Status s = r.get(doc, "report", "manifest", m.report); !s) return s.error();
     if (Status s = r.get(doc, "max_pixels", "manifest", m.max_pixels); !s) return s.error();
     if (m.max_pixels < 0 || (doc.get("max_pixels") && m.max_pixels == 0)) {
       return r.at(*doc.get("max_pixels"), "manifest.max_pixels: a count of pixels, 1 or more");

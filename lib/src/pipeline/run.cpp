@@ -310,7 +310,11 @@ void run_job(const Job& job, const JobContext& ctx, const RunOptions& run_option
     if (run_options.before_stamp) run_options.before_stamp(job);
     read = inputs_as_read(std::move(read), decoded, ctx.cache, report.moved);
     auto made = identify_all(written);
-    status = made ? write_stamp(job, read, *made, roots) : Status(made.error());
+    const nlohmann::json summary = {
+        {"seconds", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()},
+        {"details", report.details},
+        {"warnings", report.warnings}};
+    status = made ? write_stamp(job, read, *made, summary, roots) : Status(made.error());
     if (made) {
       for (const StampedFile& f : *made) report.written[f.path] = f.identity.hash;
     }

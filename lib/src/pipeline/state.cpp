@@ -258,15 +258,34 @@ std::string out_of_date_reason(const Job& job, const StampRoots& roots, bool ref
 }
 
 Status write_stamp(const Job& job, const std::vector<StampedFile>& read, const std::vector<StampedFile>& written,
-                   const StampRoots& roots) {
+                   const nlohmann::json& summary, const StampRoots& roots) {
   nlohmann::json inputs = nlohmann::json::array(), outputs = nlohmann::json::array();
   for (const StampedFile& f : read) inputs.push_back(stamped_file_json(f.identity, stamped_path(f.path, roots.inputs)));
   for (const StampedFile& f : written) outputs.push_back(stamped_file_json(f.identity, stamped_path(f.path, roots.outputs)));
-  const nlohmann::json stamp = {{"form", kStampForm}, {"matbake", version}, {"job", job.name},
-                                {"options", job.options}, {"inputs", inputs},   {"outputs", outputs}};
+  const nlohmann::json stamp = {{"form", kStampForm}, {"matbake", version}, {"job", job.name},   {"options", job.options},
+                                {"inputs", inputs},    {"outputs", outputs},  {"summary", summary}};
   std::error_code ec;
   fs::create_directories(roots.state_folder, ec);
-  return write_file_atomically(stamp_path(job.name, roots), stamp.dump(1) + "\n");
+  // The summary's texts (warnings, file names in the details) are for reading: bytes that are not
+  // UTF-8 (a path of another encoding) are replaced there; the stamp's own paths are encoded.
+  return write_file_atomically(stamp_path(job.name, roots), stamp.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
+}
+
+std::optional<JobSummary> recorded_summary(const std::string& job_name, const StampRoots& roots) {
+  const StateText read = read_state_file(stamp_path(job_name, roots), kStampLimit);
+  if (!read.problem.empty() || read.absent) return std::nullopt;
+  const nlohmann::json stamp = nlohmann::json::parse(read.text, nullptr, false);
+  if (!stamp.is_object() || !stamp.contains("summary") || !stamp["summary"].is_object()) return std::nullopt;
+  const nlohmann::json& s = stamp["summary"];
+  if (!s.contains("seconds") || !s["seconds"].is_number() || !s.contains("details") || !s.contains("warnings") ||
+      !s["warnings"].is_array()) {
+    return std::nullopt;
+  }
+  JobSummary out{s["seconds"].get<double>(), s["details"], {}};
+  for (const nlohmann::json& w : s["warnings"]) {
+    if (w.is_string()) out.warnings.push_back(w.get<std::string>());
+  }
+  return out;
 }
 
 void remove_stamp(const std::string& job_name, const StampRoots& roots) {

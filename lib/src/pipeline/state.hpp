@@ -85,8 +85,17 @@ std::string out_of_date_reason(const Job& job, const StampRoots& roots, bool ref
 Result<std::vector<StampedFile>> identify_all(const std::vector<std::filesystem::path>& files);
 
 // Records a successful run: the inputs as they were read, the outputs as they were written.
+// `summary`: what its run reported (time, details, warnings), for a report page of a later run
+// that finds the job up to date.
 Status write_stamp(const Job& job, const std::vector<StampedFile>& read, const std::vector<StampedFile>& written,
-                   const StampRoots& roots);
+                   const nlohmann::json& summary, const StampRoots& roots);
+struct JobSummary {
+  double seconds = 0;
+  nlohmann::json details;
+  std::vector<std::string> warnings;
+};
+// The summary its stamp records (type-checked), or none.
+std::optional<JobSummary> recorded_summary(const std::string& job_name, const StampRoots& roots);
 
 // Removes the stamp, so that a failed job runs again next time.
 void remove_stamp(const std::string& job_name, const StampRoots& roots);
