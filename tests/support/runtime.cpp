@@ -48,38 +48,38 @@ bool harness_installed(std::string& why_not) {
   return true;
 }
 
-std::optional<nlohmann::json> check_page_in_chromium(const fs::path& page, const fs::path& screenshot, std::string& why_not) {
-  if (!harness_installed(why_not)) return std::nullopt;
+// Runs `node SCRIPT ARGS...` of the harness within `limit`: true when it ran; false with `why_not`
+// when the harness or Chromium is missing here; a failure throws.
+bool run_harness(const std::string& script, std::vector<std::string> args, std::chrono::seconds limit, std::string& why_not) {
+  if (!harness_installed(why_not)) return false;
   SubprocessRequest request;
   request.program = "/usr/bin/env";
-  const fs::path result_file = page.parent_path() / (page.stem().string() + ".chromium.json");
-  request.args = {"node", (kHarness / "check_page.mjs").string(), page.string(), "--out", result_file.string(), "--timeout", "60"};
-  if (!screenshot.empty()) request.args.insert(request.args.end(), {"--screenshot", screenshot.string()});
-  request.time_limit = std::chrono::seconds(90);
+  request.args = {"node", (kHarness / script).string()};
+  request.args.insert(request.args.end(), args.begin(), args.end());
+  request.time_limit = limit;
   const SubprocessResult result = run_supervised(request);
   if (result.status == kSkipExit) {
     why_not = "no runtime here: " + result.error_line();
-    return std::nullopt;
+    return false;
   }
-  if (result.status != 0) throw std::runtime_error("the page harness failed: " + result.output_tail);
+  if (result.status != 0) throw std::runtime_error(script + " failed: " + result.output_tail);
+  return true;
+}
+
+std::optional<nlohmann::json> check_page_in_chromium(const fs::path& page, const fs::path& screenshot, std::string& why_not) {
+  const fs::path result_file = page.parent_path() / (page.stem().string() + ".chromium.json");
+  std::vector<std::string> args{page.string(), "--out", result_file.string(), "--timeout", "60"};
+  if (!screenshot.empty()) args.insert(args.end(), {"--screenshot", screenshot.string()});
+  if (!run_harness("check_page.mjs", args, std::chrono::seconds(90), why_not)) return std::nullopt;
   std::ifstream in(result_file);
   return json::parse(in);
 }
 
 std::optional<std::map<std::string, RuntimeModel>> render_in_three(
     const fs::path& folder, const std::vector<std::pair<std::string, fs::path>>& models, std::string& why_not) {
-  if (!harness_installed(why_not)) return std::nullopt;
-  SubprocessRequest request;
-  request.program = "/usr/bin/env";
-  request.args = {"node", (kHarness / "render.mjs").string(), "--out", folder.string(), "--timeout", "150"};
-  for (const auto& [name, file] : models) request.args.push_back(name + "=" + file.string());
-  request.time_limit = std::chrono::seconds(180);
-  const SubprocessResult result = run_supervised(request);
-  if (result.status == kSkipExit) {
-    why_not = "no runtime here: " + result.error_line();
-    return std::nullopt;
-  }
-  if (result.status != 0) throw std::runtime_error("the runtime harness failed: " + result.output_tail);
+  std::vector<std::string> args{"--out", folder.string(), "--timeout", "150"};
+  for (const auto& [name, file] : models) args.push_back(name + "=" + file.string());
+  if (!run_harness("render.mjs", args, std::chrono::seconds(180), why_not)) return std::nullopt;
 
   std::ifstream in(folder / "report.json");
   const json report = json::parse(in);

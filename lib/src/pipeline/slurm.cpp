@@ -59,7 +59,9 @@ std::vector<Word> scene_command(const SlurmJob& scene, const ClusterOptions& opt
     for (std::size_t task : scene.after) {
       dependency.push_back({":"});
       dependency.push_back({"", true});
-      dependency.push_back({"_" + std::to_string(task)});
+      std::string part = "_";  // appended, not `"_" + to_string(...)`: GCC 12 at -O3 warns falsely on that
+      part += std::to_string(task);
+      dependency.push_back({std::move(part)});
     }
     args.push_back(std::move(dependency));
     // A failed material cancels the scenes that wait for it (else they would wait for ever).
