@@ -49,9 +49,10 @@ void print_stale(const pipeline::StaleOutputs& stale, bool dry_run) {
 }
 
 // The page --report (or the manifest's `report = true`) asks for: a relative FILE is the output
-// folder's; "" when none is asked.
+// folder's; "" when none is asked. A build tool's `--only JOB` runs (Ninja's edges, Slurm's tasks)
+// see one job each: the manifest's key writes no page there (`build --report` afterwards does).
 fs::path report_page(const BuildSettings& s, const pipeline::Manifest& manifest) {
-  if (s.report.empty() && !manifest.report) return {};
+  if (s.report.empty() && (!manifest.report || !s.only.empty())) return {};
   const fs::path file = s.report.empty() ? fs::path("report.html") : fs::path(s.report);
   return (file.is_absolute() ? file : manifest.output / file).lexically_normal();
 }
@@ -165,6 +166,7 @@ CLI::App* setup_build(CLI::App& app, BuildSettings& s) {
                 "checks, each scene's AO and delivered textures (docs/build.md#the-report-page)");
   // --status builds nothing: a flag about building beside it would be silently ignored.
   for (CLI::Option* building : {force, dry_run, keep_stale, prune, only, depfile, stamp, report}) status->excludes(building);
+  report->excludes(only);  // the page is the whole build's; an --only run knows one job
   return cmd;
 }
 

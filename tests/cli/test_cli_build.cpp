@@ -911,6 +911,14 @@ TEST(CliBuild, TheReportPageGoesInsideTheOutputFolder) {
   EXPECT_NE(page.find("<img src=\"materials/a_base_color.png\""), std::string::npos) << page;
   EXPECT_NE(page.find("validation: 0 of 16 texels flagged"), std::string::npos) << page;
   EXPECT_EQ(page.find("<script"), std::string::npos);
+  // A build tool's one-job runs leave the whole build's page alone; --report with --only is refused.
+  const std::string before = read_bytes(dir / "out/report.html");
+  r = matbake({"build", (dir / "m.toml").string(), "--only", "material:a", "--force"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(read_bytes(dir / "out/report.html"), before);
+  r = matbake({"build", (dir / "m.toml").string(), "--only", "material:a", "--report"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_EQ(r.err, "matbake: error: --only excludes --report (see matbake --help)\n");
 }
 
 }  // namespace
