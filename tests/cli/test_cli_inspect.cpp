@@ -242,6 +242,66 @@ TEST(Inspect, AManifestsJobsAsTheStampsHaveThem) {
   }
 }
 
+// The scene job of a `build --json` or of `inspect --json` on a manifest.
+json scene_job(const json& jobs) {
+  for (const json& job : jobs) {
+    if (job["name"] == "scene:showroom") return job;
+  }
+  ADD_FAILURE() << "no scene:showroom in " << jobs.dump();
+  return json::object();
+}
+
+// What inspect plans for the example's scene, delivered with `settings`, is what the build then
+// delivers: every texture's number, class, codec, materials, needed side, size and levels. Bytes:
+// a colour PNG kept at its size is its source's, exactly (the ORM textures hold AO, which a plan
+// bakes with one ray a texel, so their PNG bytes differ); uncompressed UASTC counts 16 bytes a block of
+// every level exactly, so only the header's key/value data (the writer's name, allowed 96 bytes)
+// and each level's 16-byte alignment can differ.
+void expect_planned_as_built(const std::string& settings, bool ktx2) {
+  TempDir dir;
+  copy_example(dir.path(), true);
+  const fs::path manifest = dir / "showroom.toml";
+  write_bytes(manifest, read_bytes(manifest) + settings);
+  const json inspected = inspect_json(manifest);
+  const json planned = scene_job(inspected["inspected"]["jobs"])["delivery"];
+  EXPECT_FALSE(fs::exists(dir / "out")) << "a plan writes nothing";
+  write_bytes(dir / "plan.json", inspected.dump());
+  if (const auto problems = schema_problems({dir / "plan.json"})) {
+    EXPECT_EQ(*problems, "");
+  }
+  const RunResult built = matbake({"--json", "build", manifest.string(), "--quiet"});
+  ASSERT_EQ(built.exit_code, 0) << built.err;
+  const json delivered = scene_job(json::parse(built.out)["jobs"])["details"]["textures"];
+  ASSERT_EQ(planned["textures"].size(), delivered.size()) << planned.dump();
+  ASSERT_EQ(delivered.size(), 15u) << "the example's scene has 15 textures";
+  std::uint64_t total = 0;
+  for (std::size_t i = 0; i < delivered.size(); ++i) {
+    const json& p = planned["textures"][i];
+    const json& d = delivered[i];
+    for (const char* key : {"texture", "class", "codec", "materials", "source_size", "size", "levels", "needed_side"}) {
+      EXPECT_EQ(p.value(key, json()), d.value(key, json())) << key << " of texture " << i;
+    }
+    const std::uint64_t estimated = p["estimated_bytes"], bytes = d["bytes"];
+    if (d["codec"] == "uastc") {
+      EXPECT_LE(std::max(estimated, bytes) - std::min(estimated, bytes), 96u + 16u * d["levels"].get<std::uint64_t>()) << i;
+    } else if (d["codec"] == "png" && d["size"] == d["source_size"] && d["class"] == "colour") {
+      EXPECT_EQ(estimated, bytes) << i;
+    }
+    total += estimated;
+    EXPECT_EQ(d["codec"] != "png", ktx2) << i;
+  }
+  EXPECT_EQ(planned["estimated_bytes"]["total"], total);
+}
+
+TEST(Inspect, AScenesPlannedDeliveryIsWhatTheBuildDeliversPng) {
+  expect_planned_as_built("texel_density = 64\n", false);
+}
+
+TEST(Inspect, AScenesPlannedDeliveryIsWhatTheBuildDeliversKtx2) {
+  MATBAKE_BASISU_OR_SKIP(basisu);
+  expect_planned_as_built("texture_format = \"ktx2\"\ntexel_density = 64\ndata_zstd = 0\n", true);
+}
+
 // Every Khronos model of the shared test data: figures against the files, --json against the schema.
 TEST(Inspect, EveryTestdataModelAgainstItsFilesAndTheSchema) {
   if (!fs::is_directory(kInspectTestdata)) GTEST_SKIP() << kInspectTestdata << " is absent (it comes with the project's shared folder, not with a clone)";

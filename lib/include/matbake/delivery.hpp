@@ -208,4 +208,15 @@ struct TextureReport {
   bool reused = false;                       // KTX2: read from the encode cache, not encoded
 };
 
+// ---- Estimates (a plan: docs/inspect.md#estimated-bytes) -----------------------------------------
+
+// What a delivered texture's file is expected to take, from its class options, codec, size and
+// levels: PNG the source's bytes scaled by the texel count; UASTC 16 bytes a 4 × 4 block of every
+// level (exact without zstd) times kUastcZstdShare under zstd; ETC1S kEtc1sBitsPerTexel over the
+// chain's texels; each KTX2 file its header, level index and descriptors more. The shares are means measured on the Khronos
+// models (docs/inspect.md), so a texture's own figure may differ by the spread given there.
+inline constexpr double kUastcZstdShare = 0.35;
+inline constexpr double kEtc1sBitsPerTexel = 0.6;
+std::uint64_t estimated_bytes(const TextureReport& planned, const ClassOptions& options);
+
 }  // namespace matbake::delivery

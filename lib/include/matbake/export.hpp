@@ -50,6 +50,10 @@ struct Options {
   std::optional<ao::Request> ao;  // bake AO when set: per vertex, or with ao->texture into each
                                   // material's ORM texture (red), or its own occlusion texture
   StageReport stage;  // not a parameter: told what the export is doing (a build's progress)
+  // Not a parameter: only plan (`matbake inspect MANIFEST`): materials converted and AO textures
+  // made at their sizes with one ray a texel, then Report::textures is delivery's plan
+  // (delivery::plan_textures: sizes, codecs, estimated bytes); nothing is encoded or written.
+  bool plan_only = false;
 };
 
 struct MaterialReport {

@@ -237,6 +237,11 @@ struct Report {
 // Runs the out-of-date jobs of the plan (all jobs with force). Errors are per job, in the report.
 Result<Report> run(const Manifest& manifest, const Plan& plan, const RunOptions& options);
 
+// What a scene job would deliver, without building (`matbake inspect MANIFEST`): its materials
+// decoded and converted as the build would, AO textures made at their sizes (one ray a texel), then
+// delivery's plan of every texture (exporter::Options::plan_only). Nothing is written.
+Result<std::vector<delivery::TextureReport>> plan_scene(const Manifest& manifest, const Job& job);
+
 // How each job stands after runs elsewhere (a cluster's jobs, each its own `build --only`), read
 // from the stamps and the failures recorded beside them: up to date, failed (the error line of its
 // last run) or not built (never run, running, cancelled, or out of date since it ran).

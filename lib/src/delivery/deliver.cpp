@@ -333,33 +333,12 @@ std::vector<int> materials_of(const Use& use) {
   return out;
 }
 
-}  // namespace
-
-TextureClass class_of_slot(const std::string& key) {
-  if (key.find("ormalTexture") != std::string::npos) return TextureClass::normal;
-  if (key == "baseColorTexture" || key == "emissiveTexture" || key.ends_with("ColorTexture")) return TextureClass::colour;
-  return TextureClass::data;
-}
-
-
-bool changes_textures(const Options& options) {
-  if (options.texture_format == TextureFormat::ktx2 || options.texel_density > 0) return true;
-  for (TextureClass c : {TextureClass::colour, TextureClass::data, TextureClass::normal}) {
-    if (options.of(c).max_size > 0 || options.of(c).scale != 1) return true;
-  }
-  return false;
-}
-
-gltf::MadeFormat made_format(const Options& options) {
-  return options.texture_format == TextureFormat::webp ? gltf::MadeFormat::webp : gltf::MadeFormat::png;
-}
-
-Result<std::vector<TextureReport>> deliver_textures(gltf::Document& doc, gltf::ImageCache& cache, const Options& options,
-                                                    const fs::path& output, const StageReport& stage) {
-  if (!changes_textures(options)) return std::vector<TextureReport>{};
+// Each used texture's work (class, sizes, codec, name), before any texel is decoded; a texture kept
+// as it is (already KTX2, used as two classes) goes to `kept` with the reason.
+Result<std::vector<Work>> planned_work(const gltf::Document& doc, const gltf::ImageCache& cache, const Options& options,
+                                       std::vector<TextureReport>& kept) {
   const bool ktx2_out = options.texture_format == TextureFormat::ktx2;
   std::vector<Work> work;
-  std::vector<TextureReport> reports;
   const std::map<int, Use> uses = texture_uses(doc.json);
   std::map<int, std::vector<MappedTriangle>> mapped;
   if (options.texel_density > 0) {
@@ -369,12 +348,11 @@ Result<std::vector<TextureReport>> deliver_textures(gltf::Document& doc, gltf::I
   }
   for (const auto& [texture, use] : uses) {
     const Json& t = doc.json["textures"][std::size_t(texture)];
-    TextureReport report{.texture = texture, .texture_class = use.texture_class, .materials = materials_of(use),
-                         .alpha_cutoff = use.alpha_cutoff};
     const int image = decodable_image(t);
     if (image < 0 || !use.conflict.empty()) {
-      report.note = !use.conflict.empty() ? use.conflict : "no PNG, JPEG or WebP source (already KTX2): kept as it is";
-      reports.push_back(std::move(report));
+      kept.push_back({.texture = texture, .texture_class = use.texture_class, .materials = materials_of(use),
+                      .alpha_cutoff = use.alpha_cutoff,
+                      .note = !use.conflict.empty() ? use.conflict : "no PNG, JPEG or WebP source (already KTX2): kept as it is"});
       continue;
     }
     const color::Transfer transfer = use.texture_class == TextureClass::colour ? color::Transfer::srgb : color::Transfer::linear;
@@ -402,6 +380,38 @@ Result<std::vector<TextureReport>> deliver_textures(gltf::Document& doc, gltf::I
     work.push_back(std::move(w));
   }
   make_alike_once(work);
+  return work;
+}
+
+}  // namespace
+
+TextureClass class_of_slot(const std::string& key) {
+  if (key.find("ormalTexture") != std::string::npos) return TextureClass::normal;
+  if (key == "baseColorTexture" || key == "emissiveTexture" || key.ends_with("ColorTexture")) return TextureClass::colour;
+  return TextureClass::data;
+}
+
+
+bool changes_textures(const Options& options) {
+  if (options.texture_format == TextureFormat::ktx2 || options.texel_density > 0) return true;
+  for (TextureClass c : {TextureClass::colour, TextureClass::data, TextureClass::normal}) {
+    if (options.of(c).max_size > 0 || options.of(c).scale != 1) return true;
+  }
+  return false;
+}
+
+gltf::MadeFormat made_format(const Options& options) {
+  return options.texture_format == TextureFormat::webp ? gltf::MadeFormat::webp : gltf::MadeFormat::png;
+}
+
+Result<std::vector<TextureReport>> deliver_textures(gltf::Document& doc, gltf::ImageCache& cache, const Options& options,
+                                                    const fs::path& output, const StageReport& stage) {
+  if (!changes_textures(options)) return std::vector<TextureReport>{};
+  const bool ktx2_out = options.texture_format == TextureFormat::ktx2;
+  std::vector<TextureReport> reports;
+  auto planned = planned_work(doc, cache, options, reports);
+  if (!planned) return planned.error();
+  std::vector<Work> work = std::move(*planned);
   cache.forget_decoded();  // the earlier passes' images: delivery decodes each texture in its turn
   const Encoder* encoder = nullptr;
   std::optional<Encoder> found;
@@ -474,6 +484,26 @@ Result<std::vector<TextureReport>> deliver_textures(gltf::Document& doc, gltf::I
     reports.push_back(std::move(report));
   }
   drop_unused_webp(doc);
+  std::sort(reports.begin(), reports.end(), [](const TextureReport& a, const TextureReport& b) { return a.texture < b.texture; });
+  return reports;
+}
+
+Result<std::vector<TextureReport>> plan_textures(const gltf::Document& doc, const gltf::ImageCache& cache, const Options& options) {
+  std::vector<TextureReport> reports;
+  auto planned = planned_work(doc, cache, options, reports);
+  if (!planned) return planned.error();
+  for (const Work& w : *planned) {
+    TextureReport report{.texture = w.texture, .texture_class = w.use.texture_class, .codec = w.codec, .source = w.source_size,
+                         .delivered = w.size, .needed = w.needed, .materials = materials_of(w.use),
+                         .levels = w.codec != Codec::png && options.mipmaps ? int(mip_sizes(w.size).size()) : 1,
+                         .alpha_cutoff = w.use.alpha_cutoff, .note = w.shared_note};
+    auto source_bytes = gltf::image_bytes(doc, std::size_t(w.image));
+    if (!source_bytes) return source_bytes.error();
+    report.source_bytes = source_bytes->size();
+    if (w.made_by >= 0) report.note = "one file with texture " + std::to_string((*planned)[std::size_t(w.made_by)].texture);
+    report.bytes = w.made_by >= 0 ? 0 : estimated_bytes(report, options.of(w.use.texture_class));
+    reports.push_back(std::move(report));
+  }
   std::sort(reports.begin(), reports.end(), [](const TextureReport& a, const TextureReport& b) { return a.texture < b.texture; });
   return reports;
 }

@@ -24,6 +24,12 @@ gltf::MadeFormat made_format(const Options& options);
 Result<std::vector<TextureReport>> deliver_textures(gltf::Document& doc, gltf::ImageCache& cache, const Options& options,
                                                     const std::filesystem::path& output, const StageReport& stage = {});
 
+// What deliver_textures would make of each used texture, with nothing decoded or encoded: class,
+// source, needed and delivered sizes, codec and levels as it would choose them, the source image's
+// bytes, and `bytes` estimated (estimated_bytes; 0 for a texture made as one file with another).
+// Textures it would keep have their note. The same choices as deliver_textures, made by the same code.
+Result<std::vector<TextureReport>> plan_textures(const gltf::Document& doc, const gltf::ImageCache& cache, const Options& options);
+
 // The document as it will be written: identical images stored once (and textures that then match
 // merged), what nothing reaches removed (gltf::prune_unreachable; its lines returned), and `reports`
 // renumbered to the written textures (a texture delivered twice under two indices is one report,

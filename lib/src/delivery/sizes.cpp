@@ -31,6 +31,10 @@ int rounded_side(double side, int limit, Rounding rounding) {
   return std::clamp(int(std::lround(side)), 1, limit);
 }
 
+// A KTX2 file's bytes besides its levels: the 80-byte header, 24 bytes of level index a level, a
+// one-sample data format descriptor (44 bytes) and the key/value data (the writer's name: ~96 bytes).
+std::uint64_t ktx2_overhead(int levels) { return 80 + 24 * std::uint64_t(levels) + 44 + 96; }
+
 }  // namespace
 
 Size delivered_size(Size source, const ClassOptions& options, Rounding rounding, std::optional<int> needed) {
@@ -63,6 +67,26 @@ std::optional<int> needed_side(const std::vector<MappedTriangle>& triangles, Siz
     if (below >= kDensityPercentile * total) return int(std::min(1e9, std::ceil(side - 1e-9)));
   }
   return int(std::min(1e9, std::ceil(sides.back().first - 1e-9)));
+}
+
+std::uint64_t estimated_bytes(const TextureReport& planned, const ClassOptions& options) {
+  const double base_texels = double(planned.delivered.width) * double(planned.delivered.height);
+  const double source_texels = double(planned.source.width) * double(planned.source.height);
+  if (planned.codec == Codec::png) {
+    if (planned.delivered == planned.source || !(source_texels > 0)) return planned.source_bytes;
+    return std::uint64_t(std::llround(double(planned.source_bytes) * base_texels / source_texels));
+  }
+  if (planned.codec == Codec::etc1s) {
+    const double chain = planned.levels > 1 ? 4.0 / 3.0 : 1.0;
+    return ktx2_overhead(planned.levels) + std::uint64_t(std::llround(base_texels * chain * kEtc1sBitsPerTexel / 8));
+  }
+  std::uint64_t blocks = 0;
+  const std::vector<Size> sizes = mip_sizes(planned.delivered);
+  for (std::size_t l = 0; l < std::size_t(planned.levels) && l < sizes.size(); ++l) {
+    blocks += std::uint64_t((sizes[l].width + 3) / 4) * std::uint64_t((sizes[l].height + 3) / 4);
+  }
+  const double share = options.zstd > 0 ? kUastcZstdShare : 1.0;
+  return ktx2_overhead(planned.levels) + std::uint64_t(std::llround(double(blocks) * 16 * share));
 }
 
 }  // namespace matbake::delivery

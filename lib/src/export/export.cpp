@@ -435,8 +435,13 @@ Result<Report> export_scene(const fs::path& input, const fs::path& output, const
     report_stage(options.stage, Phase::read, "reading the glTF");
     auto doc = gltf::read_document(input);
     if (!doc) return doc.error();
-    if (options.ao && options.ao->texture) {
-      if (Status s = ao::check(*options.ao->texture, options.ao->options); !s) return s.error();
+    std::optional<ao::Request> ao_request = options.ao;
+    if (ao_request && options.plan_only) {
+      ao_request->options.samples = 1;  // a plan needs the textures' sizes and places, not their values
+      if (ao_request->texture) ao_request->texture->dump.clear();
+    }
+    if (ao_request && ao_request->texture) {
+      if (Status s = ao::check(*ao_request->texture, ao_request->options); !s) return s.error();
     }
     Report report;
     report.skipped = gltf::prune_unreachable(*doc);  // from here on, everything in doc is reachable
@@ -445,15 +450,15 @@ Result<Report> export_scene(const fs::path& input, const fs::path& output, const
     // after pruning, so that its mesh and material indices are the written file's.
     std::optional<scene::Scene> scene;
     std::optional<bake_ao::OcclusionTargets> occlusion;
-    if (options.ao) {
-      auto flattened = scene::scene_from_document(*doc, {.texcoords = options.ao->texture.has_value()});
+    if (ao_request) {
+      auto flattened = scene::scene_from_document(*doc, {.texcoords = ao_request->texture.has_value()});
       if (!flattened) return flattened.error();
       scene = std::move(*flattened);
-      if (options.ao->texture) {
-        auto targets = bake_ao::occlusion_targets(*doc, *scene, *options.ao->texture);
+      if (ao_request->texture) {
+        auto targets = bake_ao::occlusion_targets(*doc, *scene, *ao_request->texture);
         if (!targets) return targets.error();
         occlusion = std::move(*targets);
-        if (const fs::path& dump = options.ao->texture->dump; !dump.empty()) {
+        if (const fs::path& dump = ao_request->texture->dump; !dump.empty()) {
           std::vector<NamedOutput> dumped;
           for (int m : occlusion->materials) dumped.push_back({bake_ao::dumped_texture(dump, output.stem().string(), m), "texture dump"});
           if (Status s = check_outputs(dumped, gltf::source_files(doc->file, doc->json)); !s) return s.error();
@@ -508,17 +513,24 @@ Result<Report> export_scene(const fs::path& input, const fs::path& output, const
 
     if (occlusion) {
       ao::TextureBakes timing;
-      auto textures = bake_ao::bake_occlusion_textures(*doc, *scene, cache, *options.ao, *occlusion, output.stem().string(),
+      auto textures = bake_ao::bake_occlusion_textures(*doc, *scene, cache, *ao_request, *occlusion, output.stem().string(),
                                               bake_ao::OcclusionInto::orm, timing, options.stage);
       if (!textures) return textures.error();
       report.ao_textures = std::move(*textures);
       report.ao_notes = occlusion->notes;
       report.ao_rays = timing.rays;
-    } else if (options.ao) {
-      report_stage(options.stage, Phase::ao, "AO per vertex, " + std::to_string(options.ao->options.samples) + " rays a vertex");
-      auto baked = bake_ao::bake_into(*doc, *scene, *options.ao);
+    } else if (ao_request && !options.plan_only) {  // per vertex: no texture to plan
+      report_stage(options.stage, Phase::ao, "AO per vertex, " + std::to_string(ao_request->options.samples) + " rays a vertex");
+      auto baked = bake_ao::bake_into(*doc, *scene, *ao_request);
       if (!baked) return baked.error();
       report.ao_rays = baked->rays;
+    }
+    if (options.plan_only) {
+      auto planned = delivery::plan_textures(*doc, cache, options.delivery);
+      if (!planned) return planned.error();
+      report.textures = std::move(*planned);
+      (void)delivery::store_once(*doc, report.textures);  // numbered as the written file's textures
+      return report;
     }
     auto delivered = delivery::deliver_textures(*doc, cache, options.delivery, output, options.stage);
     if (!delivered) return delivered.error();

@@ -2,6 +2,7 @@
 // recorded beside it), what it reads and would write. Nothing is built or written.
 #include "matbake/inspect.hpp"
 #include "matbake/pipeline.hpp"
+#include "matbake/report_json.hpp"
 
 namespace matbake::inspect {
 namespace fs = std::filesystem;
@@ -22,6 +23,25 @@ nlohmann::json state_of(const pipeline::JobReport& r, const pipeline::JobStatus*
   nlohmann::json out = {{"state", "out_of_date"}, {"reason", r.reason}};
   if (!r.changed.is_null()) out["changed"] = r.changed;
   return out;
+}
+
+// A scene's delivery as planned: each texture's class, sizes (the texel density's needed side when
+// set), codec, levels and estimated bytes, and the estimated bytes per class; or why it cannot be planned.
+nlohmann::json planned_delivery(const pipeline::Manifest& manifest, const pipeline::Job& job) {
+  auto planned = pipeline::plan_scene(manifest, job);
+  if (!planned) return {{"error", planned.error().to_string()}};
+  nlohmann::json textures = nlohmann::json::array();
+  std::map<std::string, std::uint64_t> by_class{{"colour", 0}, {"data", 0}, {"normal", 0}, {"total", 0}};
+  for (const delivery::TextureReport& t : *planned) {
+    nlohmann::json entry = to_json(t);
+    entry.erase("file");
+    entry.erase("bytes");
+    entry["estimated_bytes"] = t.bytes;
+    textures.push_back(std::move(entry));
+    by_class[std::string(name_in(delivery::kTextureClassNames, t.texture_class))] += t.bytes;
+    by_class["total"] += t.bytes;
+  }
+  return {{"textures", textures}, {"estimated_bytes", by_class}};
 }
 
 }  // namespace
@@ -54,6 +74,7 @@ Result<nlohmann::json> inspect_manifest(const fs::path& path) {
       nlohmann::json materials = nlohmann::json::object();
       for (const auto& [gltf_name, m] : job.materials) materials[gltf_name] = manifest->materials[m].name;
       entry["materials"] = materials;
+      entry["delivery"] = planned_delivery(*manifest, job);
     }
     jobs.push_back(std::move(entry));
   }

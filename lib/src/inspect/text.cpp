@@ -124,6 +124,23 @@ std::string ktx2_text(const Json& j) {
   return out + table("levels", levels) + table("key/value data", kv);
 }
 
+// A scene's planned delivery: each texture's sizes, codec and estimated bytes, then the bytes per class.
+std::string delivery_text(const Json& job) {
+  const Json& d = job["delivery"];
+  if (d.contains("error")) return str(job["name"]) + " cannot be planned: " + str(d["error"]) + "\n";
+  Rows textures{{"#", "class", "materials", "source", "needed", "delivered", "codec", "levels", "estimated bytes"}};
+  const auto size = [](const Json& s) { return str(s[0]) + "x" + str(s[1]); };
+  for (const Json& t : d["textures"]) {
+    textures.push_back({str(t["texture"]), str(t["class"]), list(t["materials"]), size(t["source_size"]),
+                        t.contains("needed_side") ? str(t["needed_side"]) : "-", size(t["size"]), str(t["codec"]), str(t["levels"]),
+                        bytes_text(t["estimated_bytes"].get<std::uint64_t>()) + (t.contains("note") ? " (" + str(t["note"]) + ")" : "")});
+  }
+  const Json& e = d["estimated_bytes"];
+  return table(str(job["name"]) + ": textures as it would deliver them (estimated, docs/inspect.md)", textures) +
+         "  estimated: colour " + bytes_text(e["colour"].get<std::uint64_t>()) + ", data " + bytes_text(e["data"].get<std::uint64_t>()) +
+         ", normal " + bytes_text(e["normal"].get<std::uint64_t>()) + ", total " + bytes_text(e["total"].get<std::uint64_t>()) + "\n";
+}
+
 std::string manifest_text(const Json& j) {
   std::string out = j["file"].get<std::string>() + " (manifest; output " + str(j["output"]) + ")\n";
   Rows jobs{{"job", "state", "why", "writes"}};
@@ -133,8 +150,12 @@ std::string manifest_text(const Json& j) {
     jobs.push_back({str(job["name"]), state, why, std::to_string(job["outputs"].size()) + " files"});
   }
   const Json& c = j["counts"];
-  return out + table("jobs", jobs) + "up to date " + str(c["up_to_date"]) + ", out of date " + str(c["out_of_date"]) + ", failed " +
+  out += table("jobs", jobs) + "up to date " + str(c["up_to_date"]) + ", out of date " + str(c["out_of_date"]) + ", failed " +
          str(c["failed"]) + "\n";
+  for (const Json& job : j["jobs"]) {
+    if (job.contains("delivery")) out += delivery_text(job);
+  }
+  return out;
 }
 
 }  // namespace

@@ -233,21 +233,29 @@ Status run_material(const Job& job, const JobContext& ctx, const StageReport& st
   });
 }
 
+// The export's options of a scene job: the scene's, with the maps of the manifest's materials it uses.
+Result<exporter::Options> scene_options(const Job& job, const Manifest& manifest, DecodeCache& cache) {
+  exporter::Options options = manifest.scenes[job.spec].options;
+  for (const auto& [gltf_name, m] : job.materials) {
+    const MaterialSpec& spec = manifest.materials[m];
+    auto maps = load_material(spec, cache);
+    if (!maps) return maps.error();
+    options.materials.push_back({gltf_name, std::move(*maps), spec.options.mapping});
+  }
+  return options;
+}
+
 Result<std::vector<fs::path>> run_scene(const Job& job, const JobContext& ctx, const StageReport& stage, JobReport& report) {
   return guarded(ctx.manifest.scenes[job.spec].input.string(), [&]() -> Result<std::vector<fs::path>> {
     const SceneSpec& s = ctx.manifest.scenes[job.spec];
-    exporter::Options options = s.options;
-    options.stage = stage;
     report_stage(stage, Phase::read, "decoding materials");
+    auto found = scene_options(job, ctx.manifest, ctx.cache);
+    if (!found) return found.error();
+    exporter::Options& options = *found;
+    options.stage = stage;
     // Content-keyed, so shared by every manifest that builds into the folder.
     options.delivery.encode_cache = ctx.manifest.output / ".matbake" / "encode-cache";
     options.delivery.encode_cache_bytes = ctx.encode_cache_bytes;
-    for (const auto& [gltf_name, m] : job.materials) {
-      const MaterialSpec& spec = ctx.manifest.materials[m];
-      auto maps = load_material(spec, ctx.cache);
-      if (!maps) return maps.error();
-      options.materials.push_back({gltf_name, std::move(*maps), spec.options.mapping});
-    }
     const fs::path& output = job.outputs.scene;
     if (Status st = ensure_folder(output.parent_path()); !st) return st.error();
     auto exported = exporter::export_scene(s.input, output, options);
@@ -504,6 +512,19 @@ Result<Report> run(const Manifest& manifest, const Plan& plan, const RunOptions&
     report.warnings.push_back("the log of files made was not updated: " + s.error().to_string());
   }
   return report;
+}
+
+Result<std::vector<delivery::TextureReport>> plan_scene(const Manifest& manifest, const Job& job) {
+  const SceneSpec& s = manifest.scenes[job.spec];
+  return guarded(s.input.string(), [&]() -> Result<std::vector<delivery::TextureReport>> {
+    DecodeCache cache({});
+    auto options = scene_options(job, manifest, cache);
+    if (!options) return options.error();
+    options->plan_only = true;
+    auto planned = exporter::export_scene(s.input, job.outputs.scene, *options);
+    if (!planned) return Error{s.origins.of("input"), "scenes." + s.name + ": " + planned.error().to_string()};
+    return std::move(planned->textures);
+  });
 }
 
 }  // namespace matbake::pipeline
