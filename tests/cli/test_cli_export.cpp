@@ -325,6 +325,29 @@ TEST(CliExport, IdenticalImagesAreStoredOnceAndTheReportUsesTheFilesIndices) {
   }
 }
 
+// Textures delivery makes alike from images of other bytes (one colour as an 8-bit and a 16-bit
+// PNG, as TextureEncodingTest has it) are stored once, and the report names that texture with every
+// material that uses it (it named the first material's alone).
+TEST(CliExport, TexturesMadeAlikeAreOneReportWithEveryMaterial) {
+  TempDir dir;
+  std::vector<double> colour, deep;
+  for (int i = 0; i < 64; ++i) colour.insert(colour.end(), {double(i * 3), double(255 - i * 2), 40});
+  for (double v : colour) deep.push_back(v * 257);
+  write_raw(dir / "a8.png", 8, 8, 3, "uint8", colour);
+  write_raw(dir / "a16.png", 8, 8, 3, "uint16", deep);
+  GltfBuilder b = quad_scene(json::array({{{"name", "A"}, {"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}},
+                                          {{"name", "B"}, {"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 1}}}}}}}));
+  b.doc["textures"] = {{{"source", 0}}, {{"source", 1}}};
+  b.doc["images"] = {{{"uri", "a8.png"}}, {{"uri", "a16.png"}}};
+  b.write(dir / "in.gltf", {0, 1});
+  const json report = export_json({(dir / "in.gltf").string(), "-o", (dir / "out.gltf").string(), "--colour-max-size", "4"});
+  ASSERT_FALSE(report.is_null());
+  const gltf::Document doc = read_output(dir / "out.gltf");
+  EXPECT_EQ(doc.json["textures"].size(), 1u);
+  ASSERT_EQ(report["textures"].size(), 1u) << report["textures"].dump();
+  EXPECT_EQ(report["textures"][0]["materials"], json::array({0, 1}));
+}
+
 // Made textures are named from their material and slot (its name made safe for a file — "Lamp
 // Shade!" is Lamp_Shade — not its index), files, images and textures alike; a texture delivery rewrites loses its stale name.
 TEST(CliExport, MadeTexturesAreNamedFromTheirMaterialAndSlot) {

@@ -509,11 +509,13 @@ Result<std::vector<TextureReport>> plan_textures(const gltf::Document& doc, cons
 }
 
 std::vector<std::string> store_once(gltf::Document& doc, std::vector<TextureReport>& reports) {
-  gltf::merge_identical_images(doc);
+  const std::vector<int> same_as = gltf::merge_identical_images(doc);
   std::vector<int> remap;
   std::vector<std::string> removed = gltf::prune_unreachable(doc, &remap);
   std::vector<TextureReport> written;
   for (TextureReport& r : reports) {
+    // A texture merged into another is reported as that one, its materials with it.
+    if (r.texture >= 0 && std::size_t(r.texture) < same_as.size()) r.texture = same_as[std::size_t(r.texture)];
     if (r.texture < 0 || std::size_t(r.texture) >= remap.size() || remap[std::size_t(r.texture)] < 0) continue;
     r.texture = remap[std::size_t(r.texture)];
     const auto same = std::find_if(written.begin(), written.end(), [&](const TextureReport& w) { return w.texture == r.texture; });

@@ -310,12 +310,11 @@ std::vector<std::string> prune_unreachable(Document& doc, std::vector<int>* text
   return removed;
 }
 
-int merge_identical_images(Document& doc) {
+std::vector<int> merge_identical_images(Document& doc) {
   Json& json = doc.json;
   // Image i → the first image with the same bytes.
   std::vector<int> first(count_of(json, "images"));
   std::unordered_map<std::size_t, std::vector<std::pair<int, std::string>>> by_hash;
-  int merged = 0;
   for (std::size_t i = 0; i < first.size(); ++i) {
     first[i] = int(i);
     auto bytes = image_bytes(doc, i);
@@ -324,7 +323,6 @@ int merge_identical_images(Document& doc) {
     const auto same = std::find_if(same_hash.begin(), same_hash.end(), [&](const auto& e) { return e.second == *bytes; });
     if (same != same_hash.end()) {
       first[i] = same->first;
-      ++merged;
     } else {
       same_hash.emplace_back(int(i), std::move(*bytes));
     }
@@ -349,7 +347,7 @@ int merge_identical_images(Document& doc) {
       }
     });
   });
-  return merged;
+  return texture_first;
 }
 
 }  // namespace matbake::gltf

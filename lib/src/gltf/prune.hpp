@@ -18,8 +18,9 @@ std::vector<std::string> prune_unreachable(Document& doc, std::vector<int>* text
 
 // Images with the same bytes become one: every texture's reference moves to the first of them; then
 // textures that are the same (name aside) become one likewise, for every material. What is left
-// unused goes with the next prune_unreachable. Returns how many images were merged.
-int merge_identical_images(Document& doc);
+// unused goes with the next prune_unreachable. Returns each texture's index → the texture that
+// now stands for it (itself when none does).
+std::vector<int> merge_identical_images(Document& doc);
 
 // Calls f(info) for every textureInfo of a material (an object under a key ending in "Texture" with
 // an index), core and extensions alike.
