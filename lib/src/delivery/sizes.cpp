@@ -72,21 +72,26 @@ std::optional<int> needed_side(const std::vector<MappedTriangle>& triangles, Siz
 std::uint64_t estimated_bytes(const TextureReport& planned, const ClassOptions& options) {
   const double base_texels = double(planned.delivered.width) * double(planned.delivered.height);
   const double source_texels = double(planned.source.width) * double(planned.source.height);
+  if (!(source_texels > 0)) return planned.source_bytes;
   if (planned.codec == Codec::png) {
-    if (planned.delivered == planned.source || !(source_texels > 0)) return planned.source_bytes;
+    if (planned.delivered == planned.source) return planned.source_bytes;
     return std::uint64_t(std::llround(double(planned.source_bytes) * base_texels / source_texels));
   }
+  // The rates below are of the whole chain per texel of level 0; one level is 3/4 of a chain.
+  const double one_level = planned.levels > 1 ? 1.0 : 0.75;
+  const double source_bits = 8.0 * double(planned.source_bytes) / source_texels;
   if (planned.codec == Codec::etc1s) {
-    const double chain = planned.levels > 1 ? 4.0 / 3.0 : 1.0;
-    return ktx2_overhead(planned.levels) + std::uint64_t(std::llround(base_texels * chain * kEtc1sBitsPerTexel / 8));
+    const double bits = std::min(kEtc1sMaxBits, kEtc1sSourceShare * source_bits) * one_level;
+    return ktx2_overhead(planned.levels) + std::uint64_t(std::llround(base_texels * bits / 8));
   }
   std::uint64_t blocks = 0;
   const std::vector<Size> sizes = mip_sizes(planned.delivered);
   for (std::size_t l = 0; l < std::size_t(planned.levels) && l < sizes.size(); ++l) {
     blocks += std::uint64_t((sizes[l].width + 3) / 4) * std::uint64_t((sizes[l].height + 3) / 4);
   }
-  const double share = options.zstd > 0 ? kUastcZstdShare : 1.0;
-  return ktx2_overhead(planned.levels) + std::uint64_t(std::llround(double(blocks) * 16 * share));
+  double bytes = double(blocks) * 16;  // UASTC: 16 bytes a 4 × 4 block
+  if (options.zstd > 0) bytes = std::min(bytes, base_texels * (kUastcZstdFloorBits + source_bits) * one_level / 8);
+  return ktx2_overhead(planned.levels) + std::uint64_t(std::llround(bytes));
 }
 
 }  // namespace matbake::delivery
