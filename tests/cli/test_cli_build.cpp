@@ -21,6 +21,7 @@
 #include "lib/src/gltf/document.hpp"
 #include "matbake/cluster.hpp"
 #include "matbake/params.hpp"
+#include "matbake/preview.hpp"
 #include "support/files.hpp"
 #include "support/gltf_validator.hpp"
 #include "support/run.hpp"
@@ -159,12 +160,40 @@ TEST(CliBuild, AValidationSettingRebuildsTheMaterialsOnly) {
   EXPECT_EQ(read_bytes(dir / "out/.matbake/scene-showroom.json"), stamp);
 }
 
+// A job whose last run did not write an output it now has (its stamp from a matbake that wrote no
+// ball) is out of date, saying so, and the build writes it: it was up to date without it.
+TEST(CliBuild, AnOutputTheLastRunDidNotWriteRebuildsItsJob) {
+  TempDir dir;
+  copy_example(dir.path(), true);
+  const std::string manifest = (dir / "showroom.toml").string();
+  ASSERT_EQ(matbake({"build", manifest, "--quiet"}).exit_code, 0);
+  const fs::path stamp_file = dir / "out/.matbake/material-wood.json", ball = dir / "out/materials/wood_preview.png";
+  json stamp = json::parse(read_bytes(stamp_file));
+  json kept = json::array();
+  for (const json& f : stamp["outputs"]) {
+    if (!f["path"].get<std::string>().ends_with("_preview.png")) kept.push_back(f);
+  }
+  ASSERT_EQ(kept.size() + 1, stamp["outputs"].size());
+  stamp["outputs"] = kept;
+  write_bytes(stamp_file, stamp.dump(1) + "\n");
+  fs::remove(ball);
+  const json dry = run_json({"build", manifest, "-n"});
+  for (const json& job : dry["jobs"]) {
+    EXPECT_EQ(job["outcome"], job["name"] == "material:wood" ? "out_of_date" : "up_to_date") << job.dump();
+    if (job["name"] == "material:wood") {
+      EXPECT_EQ(job["reason"], "new output: " + ball.string());
+    }
+  }
+  ASSERT_EQ(matbake({"build", manifest, "--quiet"}).exit_code, 0);
+  EXPECT_TRUE(fs::exists(ball));
+}
+
 TEST(CliBuild, SameBytesWhateverTheJobCount) {
   TempDir dir;
   copy_example(dir.path(), true);
   ASSERT_EQ(matbake({"build", (dir / "showroom.toml").string(), "--jobs", "1"}).exit_code, 0);
   const auto one = outputs_under(dir / "out");
-  EXPECT_EQ(one.size(), 16u);  // 5 × (2 textures + report) + the .glb
+  EXPECT_EQ(one.size(), 21u);  // 5 × (2 textures + report + ball) + the .glb
   const RunResult again = matbake({"build", (dir / "showroom.toml").string(), "--jobs", "2", "--force"});
   ASSERT_EQ(again.exit_code, 0) << again.err;
   EXPECT_EQ(outputs_under(dir / "out"), one);
@@ -309,6 +338,7 @@ TEST(CliBuild, StaleOutputsAreRemovedAndOnlyThose) {
   std::sort(gone.begin(), gone.end());
   EXPECT_EQ(gone, (std::vector<std::string>{(dir / "out/materials/gold_trim.validation.json").string(),
                                             (dir / "out/materials/gold_trim_base_color.png").string(),
+                                            (dir / "out/materials/gold_trim_preview.png").string(),
                                             (dir / "out/materials/wood.validation.json").string()}));
   EXPECT_EQ(cleaned["stale"]["changed"], json::array({(dir / "out/materials/gold_trim_orm.png").string()}));
   EXPECT_EQ(read_bytes(dir / "out/materials/gold_trim_orm.png"), "changed by hand");
@@ -375,7 +405,8 @@ layout = "gltf-orm"
   const RawImage good = read_raw(dir / "out/materials/good_base_color.png");
   EXPECT_EQ(good.width, 1);
   EXPECT_EQ(list_folder(dir / "out/materials"),
-            (std::vector<std::string>{"below_real.validation.json", "good.validation.json", "good_base_color.png", "good_orm.png"}));
+            (std::vector<std::string>{"below_real.validation.json", "good.validation.json", "good_base_color.png", "good_orm.png",
+                                      "good_preview.png"}));
   // Failed jobs run again next time; the finished one does not.
   const json dry = run_json({"build", (dir / "m.toml").string(), "-n"}, 1);  // exit 1: a job would fail
   EXPECT_EQ(outcome_of(dry, "material:good"), "up_to_date");
@@ -548,7 +579,8 @@ TEST(CliBuild, DepfileStampAndJson) {
   EXPECT_EQ(job["reason"], "no earlier build");
   EXPECT_EQ(job["inputs"], json::array({(folder / "k d.png").string()}));
   EXPECT_EQ(job["outputs"], json::array({(folder / "out/materials/brick_a.png").string(), (folder / "out/materials/brick_b.png").string(),
-                                         (folder / "out/materials/brick.validation.json").string()}));
+                                         (folder / "out/materials/brick.validation.json").string(),
+                                         (folder / "out/materials/brick_preview.png").string()}));
   EXPECT_GE(job["seconds"].get<double>(), 0);
   EXPECT_EQ(job["details"]["size"], json::array({2, 2}));
   EXPECT_EQ(job["details"]["validation"]["checked"], 4);
@@ -819,8 +851,9 @@ TEST(CliBuild, InterruptKeepsFinishedOutputsAndNoTemporaryFiles) {
       ++finished;
       const json stamp = json::parse(read_bytes(e.path()));
       for (const json& out : stamp["outputs"]) {
-        const RawImage image = read_raw(dir / "out" / out["path"].get<std::string>());  // relative to the output folder
-        EXPECT_EQ(image.width, kSize);
+        const std::string path = out["path"];  // relative to the output folder
+        const RawImage image = read_raw(dir / "out" / path);
+        EXPECT_EQ(image.width, path.ends_with("_preview.png") ? preview::Options{}.cell_size : kSize) << path;
       }
     }
     EXPECT_GE(finished, 1u);
@@ -870,7 +903,7 @@ TEST(CliBuild, RunsAtOnceKeepEveryJobInTheLogOfFilesMade) {
     for (const json& out : stamp["outputs"]) {
       written[out["path"].get<std::string>()] = out["hash"];
     }
-    EXPECT_EQ(written.size(), 2u);
+    EXPECT_EQ(written.size(), 3u);  // its texture, its validation report, its ball
     EXPECT_EQ(log["jobs"][job], written) << job;
   }
 }

@@ -266,6 +266,23 @@ TEST_F(Parity, ValidateWritesTheManifestsReportAndHeatmap) {
   }
 }
 
+// A material job's ball is `matbake preview` of the same sources, byte for byte: Schüler maps and
+// metal-rough ones (converted per texel by the same code).
+TEST_F(Parity, PreviewGivesTheManifestsBall) {
+  build("\n[materials.schuler]\nsources = { kd = \"kd.png\", ks = \"ks.png\", gloss = 0.5 }\nlayout = \"schuler\"\n"
+        "\n[materials.metal_rough]\nsources = { base_color = \"kd.png\", metallic = 0.0, roughness = 0.5 }\nlayout = \"gltf-orm\"\n");
+  const std::vector<std::pair<std::string, std::vector<std::string>>> cases = {
+      {"schuler", {"--kd", (dir / "kd.png").string(), "--ks", (dir / "ks.png").string(), "--gloss", "0.5"}},
+      {"metal_rough", {"--base-color", (dir / "kd.png").string(), "--metallic", "0", "--roughness", "0.5"}}};
+  for (const auto& [name, sources] : cases) {
+    std::vector<std::string> args = {"preview", "-o", (dir / "cli" / (name + "_preview.png")).string()};
+    args.insert(args.end(), sources.begin(), sources.end());
+    const RunResult r = matbake(args);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    expect_same_files({dir / "cli" / (name + "_preview.png")}, {dir / "out" / "materials" / (name + "_preview.png")}, name);
+  }
+}
+
 TEST_F(Parity, ExportAndAoGiveTheManifestsScene) {
   for (const char* f : {"showroom.gltf", "showroom.bin"}) fs::copy_file(kExamples / f, dir / f);
   // One Schüler pair for painted_metal, packed from the test's noise; the other materials as in the file.

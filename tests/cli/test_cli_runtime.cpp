@@ -133,10 +133,17 @@ TEST(Runtime, TheExampleBuildsReportPageOpensInChromium) {
     MATBAKE_CHECK_PAGE_OR_SKIP(seen, page, fs::path());
     EXPECT_EQ((*seen)["console"], json::array()) << run;
     EXPECT_EQ((*seen)["scripts"], 0) << run;
-    EXPECT_GE((*seen)["images"].size(), 10u + 15u) << run;  // 5 materials × 2 textures, the scene's 15 images
+    EXPECT_GE((*seen)["images"].size(), 15u + 15u) << run;  // 5 materials × (ball + 2 textures), the scene's 15 images
     for (const json& image : (*seen)["images"]) {
       EXPECT_GT(image["naturalWidth"].get<int>(), 0) << run << ": " << image["src"];
       EXPECT_EQ(image["src"].get<std::string>().find(':'), std::string::npos) << "a relative path, no URL: " << image["src"];
+    }
+    for (const char* material : {"glass", "gold_trim", "painted_metal", "rubber", "wood"}) {  // each ball, loaded
+      const std::string ball = "materials/" + std::string(material) + "_preview.png";
+      const auto shown = std::find_if((*seen)["images"].begin(), (*seen)["images"].end(),
+                                      [&](const json& image) { return image["src"].get<std::string>().ends_with(ball); });
+      ASSERT_NE(shown, (*seen)["images"].end()) << run << ": no " << ball;
+      EXPECT_EQ((*shown)["naturalWidth"], 128) << run << ": " << ball;
     }
     std::vector<std::string> sections = (*seen)["sections"];
     std::sort(sections.begin(), sections.end());

@@ -271,14 +271,14 @@ materials = { "other" = "scene_only" }
   ASSERT_TRUE(m) << m.error().to_string();
   auto plan = pipeline::make_plan(*m);
   ASSERT_TRUE(plan) << plan.error().to_string();
-  // paint: textures + report; unused: no layout, no validation, no scene (a warning); scene_only:
-  // nothing of its own.
+  // paint: textures + report + ball; unused: no layout, no validation, no scene (a warning);
+  // scene_only: nothing of its own (no ball either).
   ASSERT_EQ(plan->jobs.size(), 2u);
   const pipeline::Job& paint = plan->jobs[0];
   EXPECT_EQ(paint.name, "material:paint");
   const fs::path out = dir.path() / "out";
   EXPECT_EQ(paint.outputs.all(), (std::vector<fs::path>{out / "materials/paint_base_color.png", out / "materials/paint_orm.png",
-                                                 out / "materials/paint.validation.json"}));
+                                                 out / "materials/paint.validation.json", out / "materials/paint_preview.png"}));
   EXPECT_EQ(paint.inputs, std::vector<fs::path>{dir.path() / "paint.png"});
   const pipeline::Job& room = plan->jobs[1];
   EXPECT_EQ(room.name, "scene:room");
@@ -302,8 +302,8 @@ materials = { "other" = "scene_only" }
   // The scene's edge waits for its material's (a failed material stops it, as in a build).
   EXPECT_EQ(room.depends_on, std::vector<std::string>{"material:paint"});
   EXPECT_NE(ninja.find((dir.path() / "paint.png").string() + " " + (out / "materials/paint_base_color.png").string() + " " +
-                       (out / "materials/paint_orm.png").string() + " " + (out / "materials/paint.validation.json").string() +
-                       "\n  job = scene:room"),
+                       (out / "materials/paint_orm.png").string() + " " + (out / "materials/paint.validation.json").string() + " " +
+                       (out / "materials/paint_preview.png").string() + "\n  job = scene:room"),
             std::string::npos)
       << ninja;
   EXPECT_NE(ninja.find("build build.ninja: matbake_plan " + m->file.string() + "\n"), std::string::npos);

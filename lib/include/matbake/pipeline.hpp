@@ -133,6 +133,7 @@ struct JobOutputs {
   std::vector<std::filesystem::path> textures;  // a material's layout textures, in the layout's order
   std::filesystem::path validation_report;      // <name>.validation.json
   std::filesystem::path heatmap;                // <name>_validation.png
+  std::filesystem::path preview;                // a material's ball: <name>_preview.png (the report page's)
   std::filesystem::path scene;                  // a scene's .gltf or .glb
   std::filesystem::path buffer;                 // a .gltf scene's .bin
   std::vector<std::filesystem::path> all() const;  // every one, in that order

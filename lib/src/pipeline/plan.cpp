@@ -151,6 +151,8 @@ Result<Job> material_job(const Manifest& manifest, std::size_t i, const Result<s
     job.outputs.validation_report = materials_folder / (m.name + ".validation.json");
     if (m.validation.heatmap) job.outputs.heatmap = materials_folder / (m.name + "_validation.png");
   }
+  // Its ball beside what it writes; a material only scenes use has no job, and no ball.
+  if (!job.outputs.all().empty()) job.outputs.preview = materials_folder / (m.name + "_preview.png");
   return job;
 }
 
@@ -182,7 +184,7 @@ fs::path material_texture_pattern(const Manifest& manifest, const MaterialSpec& 
 
 std::vector<fs::path> JobOutputs::all() const {
   std::vector<fs::path> files = textures;
-  for (const fs::path* f : {&validation_report, &heatmap, &scene, &buffer}) {
+  for (const fs::path* f : {&validation_report, &heatmap, &preview, &scene, &buffer}) {
     if (!f->empty()) files.push_back(*f);
   }
   return files;

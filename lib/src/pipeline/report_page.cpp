@@ -119,6 +119,9 @@ std::string conversion_table(const json& conversion) {
 std::string material_section(const JobView& v, const fs::path& page_folder) {
   const std::string name = v.job->name.substr(v.job->name.find(':') + 1);
   std::string out = "<section id=\"" + html(v.job->name) + "\"><h3>" + html(name) + "</h3><div class=\"figures\">";
+  if (!v.job->outputs.preview.empty() && fs::exists(v.job->outputs.preview)) {
+    out += figure(href(v.job->outputs.preview, page_folder), "preview");
+  }
   for (const fs::path& t : v.job->outputs.textures) {
     if (fs::exists(t)) out += figure(href(t, page_folder), t.filename().string());
   }

@@ -16,6 +16,7 @@
 #include "matbake/atomic_file.hpp"
 #include "matbake/read_file.hpp"
 #include "matbake/pipeline.hpp"
+#include "matbake/preview.hpp"
 #include "matbake/material_table.hpp"
 #include "matbake/report_json.hpp"
 #include "matbake/validate.hpp"
@@ -213,6 +214,17 @@ Status write_layout(const Job& job, const JobContext& ctx, const MaterialSpec& m
   return success();
 }
 
+// The material's ball as the preview command renders it (one cell, its maps over the ball, the
+// default light rig and model) as an sRGB PNG: what the report page shows for it.
+Status write_preview(const MaterialSpec& m, const material::Maps& maps, const fs::path& path) {
+  auto material = preview::material_from_maps(m.name, maps);
+  if (!material) return material.error();
+  auto rendered = preview::render({*material}, preview::Options{});
+  if (!rendered) return rendered.error();
+  const image::WriteOptions png{color::Transfer::srgb, image::SampleType::u8, "", "sRGB", m.encoding.png_level};
+  return image::write_image(rendered->image, path, png);
+}
+
 // Validated first: a gate that fails writes no textures (a failed job's outputs are not fresh ones).
 Status run_material(const Job& job, const JobContext& ctx, const StageReport& stage, JobReport& report) {
   return guarded(ctx.manifest.materials[job.spec].name, [&]() -> Status {
@@ -228,6 +240,7 @@ Status run_material(const Job& job, const JobContext& ctx, const StageReport& st
       if (Status s = validate_material(m, *maps, ctx, job.outputs, report); !s) return s;
     }
     report_stage(stage, Phase::textures, "writing textures", m.validation.enabled ? 0.5 : 0);
+    if (Status s = write_preview(m, *maps, job.outputs.preview); !s) return s;
     if (m.layout) return write_layout(job, ctx, m, std::move(*maps), report);
     return success();
   });

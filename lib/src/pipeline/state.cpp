@@ -242,10 +242,16 @@ std::string out_of_date_reason(const Job& job, const StampRoots& roots, bool ref
     std::string why = check_recorded(stamp["inputs"][i], recorded[i], "input missing: ", "input changed: ", touched);
     if (!why.empty()) return why;
   }
+  std::vector<fs::path> made;
   for (nlohmann::json& f : stamp["outputs"]) {
     const fs::path p = resolved_path(f["path"].get<std::string>(), roots.outputs);
     std::string why = check_recorded(f, p, "output missing: ", "output changed since it was built: ", touched);
     if (!why.empty()) return why;
+    made.push_back(p);
+  }
+  // An output its last run did not write (a matbake that writes more, such as a material's ball).
+  for (const fs::path& p : job.outputs.all()) {
+    if (std::find(made.begin(), made.end(), p) == made.end()) return "new output: " + p.string();
   }
   // Best effort: a stamp that cannot be written again only costs the next run some hashing.
   if (touched && refresh) (void)write_file_atomically(stamp_path(job.name, roots), stamp.dump(1) + "\n");
