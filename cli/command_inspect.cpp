@@ -11,7 +11,8 @@ CLI::App* setup_inspect(CLI::App& app, InspectSettings& s) {
       "inspect",
       "What a file holds, without building (docs/inspect.md): a .gltf/.glb's scenes, meshes, materials, textures\n"
       "(size, codec, levels, bytes, GPU memory) and images; a .ktx2's header, DFD and levels; a manifest's jobs\n"
-      "with their state. --json for the schema in docs/inspect.schema.json");
+      "with their state, and for each scene the texture sizes, codecs and estimated bytes it would deliver.\n"
+      "--json for the schema in docs/inspect.schema.json");
   cmd->add_option("path", s.path, "A .gltf, .glb, .ktx2 or manifest (.toml)")->required();
   return cmd;
 }
