@@ -437,8 +437,13 @@ Result<Report> export_scene(const fs::path& input, const fs::path& output, const
     if (!doc) return doc.error();
     std::optional<ao::Request> ao_request = options.ao;
     if (ao_request && options.plan_only) {
-      ao_request->options.samples = 1;  // a plan needs the textures' sizes and places, not their values
-      if (ao_request->texture) ao_request->texture->dump.clear();
+      // A plan needs AO textures' sizes and places, not their values; per-vertex AO makes no texture.
+      if (ao_request->texture) {
+        ao_request->options.samples = 1;
+        ao_request->texture->dump.clear();
+      } else {
+        ao_request.reset();
+      }
     }
     if (ao_request && ao_request->texture) {
       if (Status s = ao::check(*ao_request->texture, ao_request->options); !s) return s.error();
@@ -519,7 +524,7 @@ Result<Report> export_scene(const fs::path& input, const fs::path& output, const
       report.ao_textures = std::move(*textures);
       report.ao_notes = occlusion->notes;
       report.ao_rays = timing.rays;
-    } else if (ao_request && !options.plan_only) {  // per vertex: no texture to plan
+    } else if (ao_request) {
       report_stage(options.stage, Phase::ao, "AO per vertex, " + std::to_string(ao_request->options.samples) + " rays a vertex");
       auto baked = bake_ao::bake_into(*doc, *scene, *ao_request);
       if (!baked) return baked.error();
