@@ -113,14 +113,14 @@ double code_of(double value, TextureClass cls, int channel) {
   return 255 * (cls == TextureClass::colour && channel < 3 ? color::encoded_from_linear(color::Transfer::srgb, v) : v);
 }
 
-struct LevelError {
+struct ReferenceError {
   double psnr[4] = {0, 0, 0, 0};
   double angle_mean = 0, angle_p95 = 0, angle_max = 0;  // degrees, normal maps
   double coverage = 0;
 };
 
-LevelError compare(const Plane& ref, const image::Image& decoded, TextureClass cls, int channels, float cutoff) {
-  LevelError e;
+ReferenceError compare(const Plane& ref, const image::Image& decoded, TextureClass cls, int channels, float cutoff) {
+  ReferenceError e;
   const std::size_t pixels = std::size_t(ref.width) * std::size_t(ref.height);
   for (int c = 0; c < channels; ++c) {
     double sum = 0;
@@ -240,9 +240,9 @@ int main(int argc, char** argv) {
   std::printf("|---|---|---|---|%s%s\n", cls == TextureClass::normal ? "---|---|" : "", cutoff > 0 ? "---|---|" : "");
   for (std::size_t l = 0; l < sizes.size(); ++l) {
     const Plane ref = reference_level(src, sizes[l], cls);
-    const LevelError a = compare(ref, ours_levels[l], cls, channels, cutoff);
-    const LevelError b = compare(ref, theirs_levels[l], cls, channels, cutoff);
-    const auto psnrs = [&](const LevelError& e) {
+    const ReferenceError a = compare(ref, ours_levels[l], cls, channels, cutoff);
+    const ReferenceError b = compare(ref, theirs_levels[l], cls, channels, cutoff);
+    const auto psnrs = [&](const ReferenceError& e) {
       std::string s;
       for (int c = 0; c < channels; ++c) {
         char text[16];

@@ -251,6 +251,36 @@ json scene_job(const json& jobs) {
   return json::object();
 }
 
+// A delivered texture's level errors (docs/delivery.md#level-error): every KTX2 level measured, a
+// PSNR within what UASTC and ETC1S give on the example (26–99 dB; 99 an exact level), angles in
+// [0°, 180°] for normal maps (the mean at most the max); nothing measured of a PNG.
+void expect_levels_measured(const json& texture, bool ktx2) {
+  if (!ktx2) {
+    EXPECT_FALSE(texture.contains("level_error")) << texture.dump();
+    return;
+  }
+  const json& levels = texture["level_error"];
+  ASSERT_EQ(levels.size(), texture["levels"].get<std::size_t>()) << texture.dump();
+  for (const json& l : levels) {
+    EXPECT_GT(l["psnr"].get<double>(), 20) << texture.dump();
+    EXPECT_LE(l["psnr"].get<double>(), 99) << texture.dump();
+    if (texture["class"] == "normal") {
+      EXPECT_GE(l["mean_angle"].get<double>(), 0);
+      EXPECT_LE(l["mean_angle"].get<double>(), l["max_angle"].get<double>());
+      EXPECT_LE(l["max_angle"].get<double>(), 180);
+    } else {
+      EXPECT_FALSE(l.contains("mean_angle"));
+    }
+  }
+  EXPECT_GT(texture["seconds"].get<double>(), 0);
+}
+
+std::size_t occurrences(const std::string& text, const std::string& what) {
+  std::size_t n = 0;
+  for (std::size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+  return n;
+}
+
 // What inspect plans for the example's scene, delivered with `settings`, is what the build then
 // delivers: every texture's number, class, codec, materials, needed side, size and levels. Bytes:
 // a colour PNG kept at its size is its source's, exactly (the ORM textures hold AO, which a plan
@@ -269,7 +299,7 @@ void expect_planned_as_built(const std::string& settings, bool ktx2) {
   if (const auto problems = schema_problems({dir / "plan.json"})) {
     EXPECT_EQ(*problems, "");
   }
-  const RunResult built = matbake({"--json", "build", manifest.string(), "--quiet"});
+  const RunResult built = matbake({"--json", "build", manifest.string(), "--quiet", "--report"});
   ASSERT_EQ(built.exit_code, 0) << built.err;
   const json delivered = scene_job(json::parse(built.out)["jobs"])["details"]["textures"];
   ASSERT_EQ(planned["textures"].size(), delivered.size()) << planned.dump();
@@ -289,8 +319,15 @@ void expect_planned_as_built(const std::string& settings, bool ktx2) {
     }
     total += estimated;
     EXPECT_EQ(d["codec"] != "png", ktx2) << i;
+    expect_levels_measured(d, ktx2);
   }
   EXPECT_EQ(planned["estimated_bytes"]["total"], total);
+  // The report page shows every measured chain: a PSNR row per KTX2 texture, angles for normal maps.
+  const std::string page = read_bytes(dir / "out/report.html");
+  EXPECT_EQ(occurrences(page, "<div>PSNR (dB):"), ktx2 ? delivered.size() : 0u);
+  std::size_t normals = 0;
+  for (const json& d : delivered) normals += d["class"] == "normal";
+  EXPECT_EQ(occurrences(page, "<div>angle mean (°):"), ktx2 ? normals : 0u);
 }
 
 TEST(Inspect, AScenesPlannedDeliveryIsWhatTheBuildDeliversPng) {

@@ -4,11 +4,16 @@
 
 #include <sys/stat.h>
 
+#include <array>
 #include <cmath>
+#include <functional>
+#include <numbers>
 #include <random>
 
 #include "lib/src/delivery/encode.hpp"
 #include "lib/src/delivery/encode_cache.hpp"
+#include "lib/src/delivery/level_error.hpp"
+#include "matbake/color.hpp"
 #include "matbake/delivery.hpp"
 #include "matbake/ktx2.hpp"
 #include "support/basisu.hpp"
@@ -315,6 +320,61 @@ TEST(Ktx2, DamagedFilesAreRefusedWithTheirName) {
   EXPECT_EQ(level.error().to_string(), "bad.ktx2: KTX2 level 0 declares a length its size or its zstd frame does not have");
 }
 
+// ---- Level error (level_error.hpp): closed forms of one level --------------------------------------
+
+// A decoded level as basisu's PNG reads: 8-bit codes / 255, `channels` of them per texel.
+image::Image decoded_codes(int width, int height, int channels, const std::function<int(int x, int y, int c)>& code) {
+  return make_image(width, height, channels, [&](int x, int y, int c) { return float(code(x, y, c)) / 255.0f; });
+}
+
+// Colour is compared in the sRGB codes the encoder read: a level whose every code is one off decodes
+// at PSNR 20·log10(255) = 48.13 dB; an exact one at 99 (identical); a file without alpha (an RGB PNG)
+// compares RGB only.
+TEST(DeliveryLevelError, ColourCodesOneOffAreTwentyLogTwoFiftyFive) {
+  const EncodeRequest colour{.texture_class = TextureClass::colour};
+  const float linear = float(color::linear_from_encoded(color::Transfer::srgb, 100.0 / 255.0));
+  const image::Image made = make_image(8, 4, 3, [&](int, int, int) { return linear; });
+  ASSERT_EQ(color::quantize(color::Transfer::srgb, 8, linear), 100);
+  const LevelError off = compare_level(made, decoded_codes(8, 4, 3, [](int x, int, int) { return x % 2 ? 101 : 99; }), {}, colour);
+  EXPECT_NEAR(off.psnr, 20 * std::log10(255.0), 1e-9);
+  EXPECT_EQ(compare_level(made, decoded_codes(8, 4, 3, [](int, int, int) { return 100; }), {}, colour).psnr, kIdenticalPsnr);
+  // Data: linear codes, the alpha compared when the file has it (a texel's alpha 255 where the level has none).
+  const EncodeRequest data_rgba{.texture_class = TextureClass::data, .alpha = true};
+  const image::Image half = make_image(8, 4, 3, [](int, int, int) { return 0.5f; });  // code 128 (127.5 rounds up)
+  const LevelError alpha_off = compare_level(half, decoded_codes(8, 4, 4, [](int, int, int c) { return c < 3 ? 128 : 245; }), {}, data_rgba);
+  EXPECT_NEAR(alpha_off.psnr, 10 * std::log10(255.0 * 255.0 * 4 / 100.0), 1e-9);  // 10 codes in one channel of four
+}
+
+// Normal maps: the angle between the normals the codes hold, per texel, mean and max; a MASK
+// texture's decoded coverage is that of the decoded alpha against the cutoff.
+TEST(DeliveryLevelError, NormalAnglesAndDecodedCoverageAreThoseOfTheCodes) {
+  const EncodeRequest normal{.texture_class = TextureClass::normal};
+  const MipRequest normal_mips{TextureClass::normal};
+  // Made: +Z exactly (codes 128, 128, 255 hold (1/255, 1/255, 1) before renormalising).
+  const image::Image made = make_image(4, 4, 3, [](int, int, int c) { return c == 2 ? 1.0f : 128.0f / 255.0f; });
+  // Decoded: half the texels tilted in x to code 200, half as made.
+  const image::Image decoded = decoded_codes(4, 4, 3, [](int x, int, int c) { return c == 2 ? 255 : c == 0 && x < 2 ? 200 : 128; });
+  const auto unit = [](double x, double y, double z) {
+    const double l = std::hypot(x, y, z);
+    return std::array<double, 3>{x / l, y / l, z / l};
+  };
+  const auto a = unit(2 * 128 / 255.0 - 1, 2 * 128 / 255.0 - 1, 1), b = unit(2 * 200 / 255.0 - 1, 2 * 128 / 255.0 - 1, 1);
+  const double cross = std::hypot(a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]);
+  const double tilt = std::atan2(cross, a[0] * b[0] + a[1] * b[1] + a[2] * b[2]) * 180 / std::numbers::pi;
+  const LevelError e = compare_level(made, decoded, normal_mips, normal);
+  EXPECT_NEAR(e.max_angle, tilt, 1e-9);
+  EXPECT_NEAR(e.mean_angle, tilt / 2, 1e-9);
+  EXPECT_NEAR(e.psnr, 10 * std::log10(255.0 * 255.0 * 6 / (72.0 * 72.0)), 1e-9);  // 72 codes in one of 3 channels, half the texels
+  EXPECT_EQ(compare_level(made, made, {TextureClass::data}, {.texture_class = TextureClass::data}).mean_angle, 0);
+
+  const MipRequest mask{TextureClass::colour, {}, 0.5f};
+  const EncodeRequest rgba{.texture_class = TextureClass::colour, .alpha = true};
+  const image::Image leaves = make_image(4, 4, 4, [](int x, int, int c) { return c < 3 ? 0.2f : x < 1 ? 1.0f : 0.0f; });
+  // Decoded: alpha 128 (≥ 0.5 in 8 bits: 127.5 rounds up) in three columns of four, 127 in the last.
+  const LevelError m = compare_level(leaves, decoded_codes(4, 4, 4, [](int x, int, int c) { return c < 3 ? 124 : x < 3 ? 128 : 127; }), mask, rgba);
+  EXPECT_DOUBLE_EQ(m.coverage, 0.75);
+}
+
 // ---- With the encoder ------------------------------------------------------------------------------
 
 // The encoder, or a reason to skip (support/basisu.hpp).
@@ -327,7 +387,8 @@ std::optional<Encoder> encoder_or_skip(std::string& why) {
   return e ? std::optional(*e) : std::nullopt;
 }
 
-double psnr(const image::Image& a, const test::RawImage& b, int channel) {
+// The mean squared difference in 8-bit codes of a linear level's channel and its decoded codes.
+double squared_error(const image::Image& a, const test::RawImage& b, int channel) {
   double sum = 0;
   const std::size_t pixels = std::size_t(a.width) * std::size_t(a.height);
   for (std::size_t p = 0; p < pixels; ++p) {
@@ -335,7 +396,12 @@ double psnr(const image::Image& a, const test::RawImage& b, int channel) {
                      b.samples[p * std::size_t(b.channels) + std::size_t(channel)];
     sum += d * d;
   }
-  return sum == 0 ? 99 : 10 * std::log10(255.0 * 255.0 / (sum / double(pixels)));
+  return sum / double(pixels);
+}
+
+double psnr(const image::Image& a, const test::RawImage& b, int channel) {
+  const double mean_squared = squared_error(a, b, channel);
+  return mean_squared == 0 ? 99 : 10 * std::log10(255.0 * 255.0 / mean_squared);
 }
 
 // A data texture's UASTC chain through basisu and our container: basisu itself validates the file
@@ -376,7 +442,20 @@ TEST(DeliveryEncoder, AUastcChainAssembledHereIsValidAndDecodesNearItsLevels) {
     // UASTC level 2 on this content: 44–49 dB at level 0, 31–39 dB on the 8×4 and 4×2 levels (a
     // block spans a larger part of the wave there).
     for (int c = 0; c < 3; ++c) EXPECT_GT(psnr(levels[l], decoded, c), l == 0 ? 42 : 30) << "level " << l << " channel " << c;
+    // What delivery measured of the same file is the PSNR of the three channels together: the mean
+    // of their squared errors.
+    double mean_squared = 0;
+    for (int c = 0; c < 3; ++c) mean_squared += squared_error(levels[l], decoded, c) / 3;
+    ASSERT_EQ(encoded->level_error.size(), levels.size());
+    const double expected = mean_squared == 0 ? kIdenticalPsnr : 10 * std::log10(255.0 * 255.0 / mean_squared);
+    EXPECT_NEAR(encoded->level_error[l].psnr, expected, 1e-9) << "level " << l;
   }
+  request.measure_levels = false;  // off: the same file, nothing measured
+  auto unmeasured = encode_texture(*encoder, smooth, {32, 16}, {TextureClass::data, {}, {}}, request, "matbake test");
+  ASSERT_TRUE(unmeasured) << unmeasured.error().to_string();
+  EXPECT_TRUE(unmeasured->file == encoded->file);
+  EXPECT_TRUE(unmeasured->level_error.empty());
+  EXPECT_EQ(test::list_folder(dir.path()).size(), 1 + 3 * levels.size()) << "the file and the test's own PNGs, nothing else";
 }
 
 
@@ -411,13 +490,13 @@ TEST(EncodeCache, TheKeyFollowsWhatTheBytesDependOn) {
            },
            [](EncodeRequest& r) { r.options.zstd = 3; }, [](EncodeRequest& r) { r.mipmaps = false; },
            [](EncodeRequest& r) { r.alpha = true; }, [](EncodeRequest& r) { r.texture_class = TextureClass::normal; },
-           [](EncodeRequest& r) { r.options.codec = Codec::etc1s; }}) {
+           [](EncodeRequest& r) { r.options.codec = Codec::etc1s; }, [](EncodeRequest& r) { r.measure_levels = false; }}) {
     EncodeRequest changed = request;
     change(changed);
     keys.insert(encode_key(source, {8, 8}, mips, changed, writer));
   }
   keys.insert(encode_key(source, {8, 8}, mips, request, "matbake 0.2.0 / basisu 1.16.5"));
-  EXPECT_EQ(keys.size(), 16u);  // each of the 15 changes a key of its own
+  EXPECT_EQ(keys.size(), 17u);  // each of the 16 changes a key of its own
 }
 
 // Eviction removes the least recently used entries until the rest fit, and nothing that is not an
@@ -427,7 +506,7 @@ TEST(EncodeCache, EvictionRemovesTheLeastRecentlyUsedEntriesAndOnlyEntries) {
   test::TempDir dir;
   const fs::path cache = dir / "encode-cache";
   fs::create_directories(cache);
-  const std::string entry_head = "matbake encoded texture 1\n";
+  const std::string entry_head = "matbake encoded texture 1\n", current_head = "matbake encoded texture 2\n";
   const auto entry = [&](char digit, int age_seconds, const std::string& head) {
     const fs::path file = cache / (std::string(32, digit) + ".ktx2e");
     test::write_bytes(file, head + std::string(1000 - head.size(), 'x'));
@@ -436,12 +515,12 @@ TEST(EncodeCache, EvictionRemovesTheLeastRecentlyUsedEntriesAndOnlyEntries) {
     return file;
   };
   const fs::path oldest = entry('0', 50, entry_head), older = entry('1', 40, entry_head), not_one = entry('2', 45, "something else");
-  const fs::path newer = entry('3', 20, entry_head), newest = entry('4', 10, entry_head);
+  const fs::path newer = entry('3', 20, current_head), newest = entry('4', 10, entry_head);
   test::write_bytes(dir / "outside.txt", "not matbake's");
   fs::create_symlink(dir / "outside.txt", cache / (std::string(32, '5') + ".ktx2e"));
   test::write_bytes(cache / "notes.txt", std::string(5000, 'n'));
-  // Five regular files named as entries, 5000 bytes: the oldest entries go (the one without a header
-  // is counted and kept) until 2000 remain.
+  // Five regular files named as entries, 5000 bytes: the oldest entries go, of this version's format
+  // or an earlier one's (the one without a header is counted and kept), until 2000 remain.
   evict_encoded(cache, 2500);
   EXPECT_FALSE(fs::exists(oldest));
   EXPECT_FALSE(fs::exists(older));
@@ -468,7 +547,7 @@ TEST(EncodeCache, PngAndWebpEntriesAreKeptAndCheckedOnTheWayBack) {
       ++made;
       auto bytes = image::encode_image(texture, "t." + format, {.type = image::SampleType::u8, .compression = "lossless"});
       if (!bytes) return bytes.error();
-      return Encoded{{bytes->begin(), bytes->end()}, 1, {0.25, 0.5}};
+      return Encoded{{bytes->begin(), bytes->end()}, 1, {0.25, 0.5}, {{41.5, 0.25, 3.5, 0.5}}};
     };
     const std::string key = made_file_key(texture, {12, 8}, {TextureClass::colour}, format, 6, "matbake test");
     bool reused = true;
@@ -481,6 +560,7 @@ TEST(EncodeCache, PngAndWebpEntriesAreKeptAndCheckedOnTheWayBack) {
     EXPECT_EQ(made, 1);
     EXPECT_TRUE(second->file == first->file);
     EXPECT_EQ(second->coverage, first->coverage);
+    EXPECT_EQ(second->level_error, first->level_error);
     EXPECT_TRUE(through_cache(cache, key, {12, 12}, encode, reused));  // not of the asked size: made again
     EXPECT_FALSE(reused);
     const fs::path entry = cache.folder / (key + ".ktx2e");

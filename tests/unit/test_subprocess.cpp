@@ -3,8 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <signal.h>
+#include <unistd.h>
 
 #include <chrono>
+#include <filesystem>
 #include <thread>
 
 #include "matbake/subprocess.hpp"
@@ -32,6 +34,22 @@ TEST(Subprocess, ExitCodeAndOutput) {
   const SubprocessResult missing = run_supervised({"/nonexistent/program", {}});
   EXPECT_EQ(missing.status, 127);
   EXPECT_EQ(missing.start_error, "cannot be run");
+}
+
+// A program that writes where it runs (basisu -unpack) is given its folder; a relative program is
+// still found from matbake's own folder; a folder that is not there is a start failure (127).
+TEST(Subprocess, RunsInTheFolderItIsGiven) {
+  const std::filesystem::path folder = std::filesystem::temp_directory_path() / ("matbake-wd-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(folder);
+  const std::filesystem::path here = std::filesystem::current_path();
+  std::filesystem::current_path("/bin");
+  const SubprocessResult r = run_supervised({"sh", {"-c", "pwd"}, 10s, 4096, folder});
+  const SubprocessResult missing = run_supervised({"sh", {"-c", "pwd"}, 10s, 4096, folder / "gone"});
+  std::filesystem::current_path(here);
+  std::filesystem::remove_all(folder);
+  EXPECT_EQ(r.status, 0);
+  EXPECT_EQ(r.output_tail, folder.string() + "\n");
+  EXPECT_EQ(missing.status, 127);
 }
 
 // A hung program is killed at its limit, with every process of its group.

@@ -96,6 +96,7 @@ struct Options {
   bool mipmaps = true;          // a full chain down to 1×1
   bool keep_alpha_coverage = false;  // MASK materials' levels keep the source's alpha coverage (MipRequest)
   bool png_fallback = false;    // keep the PNG as the texture's core source (the extension then optional)
+  bool measure_levels = true;   // each KTX2 level's error as a GPU is given it (LevelError)
   double texel_density = 0;     // texels per scene unit the textures are sized for; 0: their own sizes
   GeometryOptions geometry;
   std::string profile;          // the delivery profile these values started from (presets/delivery/); "": none
@@ -192,6 +193,17 @@ double alpha_coverage(const image::Image& im, float cutoff);
 
 // ---- What a delivery did --------------------------------------------------------------------------
 
+// One level of a delivered KTX2 file as a GPU is given it (basisu transcodes the file to BC7, what
+// desktop runtimes pick) against the level matbake made from the source, in the 8-bit codes the
+// encoder read (sRGB for colour): docs/delivery.md#level-error.
+inline constexpr double kIdenticalPsnr = 99;  // the PSNR reported for a level decoded exactly
+struct LevelError {
+  double psnr = kIdenticalPsnr;          // dB over the stored channels (RGB, and A when stored)
+  double mean_angle = 0, max_angle = 0;  // normal maps: degrees between made and decoded normals
+  double coverage = 1;                   // with an alpha cutoff: the decoded level's (what a MASK renders)
+  bool operator==(const LevelError&) const = default;
+};
+
 struct TextureReport {
   int texture = -1;          // as written
   TextureClass texture_class = TextureClass::colour;
@@ -206,6 +218,8 @@ struct TextureReport {
   std::vector<double> coverage;              // with alpha_cutoff: the source's, then each level's (8-bit, before encoding)
   std::string note;                          // why it was kept, when it was
   bool reused = false;                       // KTX2: read from the encode cache, not encoded
+  std::vector<LevelError> level_error;       // KTX2: each level's, level 0 first
+  double seconds = 0;                        // decoding and making it (0 when kept or made by another)
 };
 
 // ---- Estimates (a plan: docs/inspect.md#estimated-bytes) -----------------------------------------

@@ -21,6 +21,8 @@ struct SubprocessRequest {
   std::vector<std::string> args;
   std::chrono::milliseconds time_limit{std::chrono::seconds(60)};
   std::size_t output_limit = 64 * 1024;  // the last bytes of stdout and stderr kept
+  std::filesystem::path working_directory;  // where it runs (for a program that writes its files
+                                            // there); empty: matbake's own
 };
 
 struct SubprocessResult {

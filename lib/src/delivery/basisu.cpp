@@ -90,8 +90,9 @@ std::chrono::milliseconds encode_time_limit(std::uint64_t texels) {
   return time_limit(kEncodeBase + std::chrono::milliseconds(texels / kTexelsPerMillisecond));
 }
 
-Status run_encoder(const Encoder& encoder, const std::vector<std::string>& args, const std::string& what, std::uint64_t texels) {
-  const SubprocessResult r = run_supervised({encoder.program, args, encode_time_limit(texels)});
+Status run_encoder(const Encoder& encoder, const std::vector<std::string>& args, const std::string& what, std::uint64_t texels,
+                   const fs::path& folder) {
+  const SubprocessResult r = run_supervised({encoder.program, args, encode_time_limit(texels), SubprocessRequest{}.output_limit, folder});
   if (r.status == 0 && !r.timed_out) return success();
   if (r.status < 0 || !r.start_error.empty()) return Error{what, "cannot run " + encoder.program.string() + ": " + r.start_error};
   if (r.timed_out) {

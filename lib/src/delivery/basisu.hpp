@@ -22,8 +22,10 @@ Result<Encoder> find_encoder();
 
 // Runs the encoder with `args` on `texels` texels (all the levels it is given), supervised
 // (subprocess.hpp) with a time limit derived from them (encode_time_limit). A failure (a non-zero
-// exit, a signal, the time limit) is an error naming `what`, with the encoder's own error line.
-Status run_encoder(const Encoder& encoder, const std::vector<std::string>& args, const std::string& what, std::uint64_t texels);
+// exit, a signal, the time limit) is an error naming `what`, with the encoder's own error line. It
+// runs in `folder` when one is given (-unpack writes its files where it runs).
+Status run_encoder(const Encoder& encoder, const std::vector<std::string>& args, const std::string& what, std::uint64_t texels,
+                   const std::filesystem::path& folder = {});
 
 // A minute plus 10 µs a texel; MATBAKE_ENCODER_TIME_LIMIT (seconds) replaces it.
 std::chrono::milliseconds encode_time_limit(std::uint64_t texels);

@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <map>
 #include <set>
@@ -184,6 +185,8 @@ struct Work {
   std::vector<unsigned char> file;  // the KTX2 file, or (codec png) the resized texture's PNG or WebP
   int levels = 1;
   std::vector<double> coverage;
+  std::vector<LevelError> level_error;
+  double seconds = 0;   // decoding and making it
   bool reused = false;  // from the encode cache
   Status status = success();
 };
@@ -220,7 +223,8 @@ Status make(Work& w, image::Image source, const Options& options, const gltf::Im
   } else {
     EncodeRequest encode{.texture_class = w.use.texture_class, .options = options.of(w.use.texture_class), .sampling = w.sampling,
                          .mipmaps = options.mipmaps, .alpha = has_alpha(source),
-                         .scratch = output.parent_path() / (w.name + ".ktx2"), .threads = threads};
+                         .scratch = output.parent_path() / (w.name + ".ktx2"), .threads = threads,
+                         .measure_levels = options.measure_levels};
     made = encode_with_cache(kept, *encoder, std::move(source), w.size, request, encode,
                              "matbake " + std::string(matbake::version) + " / basisu " + encoder->version, w.reused);
   }
@@ -228,6 +232,7 @@ Status make(Work& w, image::Image source, const Options& options, const gltf::Im
   w.file = std::move(made->file);
   w.levels = made->levels;
   w.coverage = std::move(made->coverage);
+  w.level_error = std::move(made->level_error);
   return success();
 }
 
@@ -437,11 +442,13 @@ Result<std::vector<TextureReport>> deliver_textures(gltf::Document& doc, gltf::I
     // Decoded in its turn and dropped when made. Not isolated: a thread waiting inside one texture's
     // encode may start another (isolating cost 15% of the wall time on SpecGlossVsMetalRough for the
     // same peak), so a few more than --jobs textures can be held at once.
+    const auto start = std::chrono::steady_clock::now();
     w.status = guarded(doc.file, [&]() -> Status {
       auto source = cache.decode(w.texture, w.transfer);
       if (!source) return source.error();
       return make(w, std::move(*source), options, cache, encoder, output, threads);
     });
+    w.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     tell(++textures_made);
   }, tbb::simple_partitioner());
   for (Work& w : work) {
@@ -457,7 +464,7 @@ Result<std::vector<TextureReport>> deliver_textures(gltf::Document& doc, gltf::I
                          .source = w.source_size, .delivered = w.size, .needed = w.needed,
                          .materials = materials_of(w.use), .levels = made.levels,
                          .alpha_cutoff = w.use.alpha_cutoff, .coverage = made.coverage, .note = w.shared_note,
-                         .reused = made.reused};
+                         .reused = made.reused, .level_error = made.level_error, .seconds = w.seconds};
     if (options.keep_alpha_coverage && options.mipmaps && w.use.alpha_cutoff && w.codec == Codec::etc1s) {
       report.note += std::string(report.note.empty() ? "" : "; ") +
                      "ETC1S levels are basisu's own: keep_alpha_coverage does not act on them (UASTC does)";

@@ -10,6 +10,7 @@
 #include <mutex>
 #include <fstream>
 
+#include "level_error.hpp"
 #include "matbake/atomic_file.hpp"
 #include "matbake/read_file.hpp"
 #include "matbake/ktx2.hpp"
@@ -18,31 +19,23 @@ namespace matbake::delivery {
 namespace fs = std::filesystem;
 namespace {
 
-// Rows [first, first + rows) of `level` as 8-bit RGB or RGBA PNG: grey spread to RGB, colour channels
-// encoded as the class stores them (sRGB for colour), alpha linear, a normal map's texels made unit
-// length when `renormalise` (what mip_levels does at the source's own size); deflate level 0
-// (stored): read once, then removed. Written band by band, never copied whole.
+// Rows [first, first + rows) of `level` as 8-bit RGB or RGBA PNG, each texel as texel_as_stored makes
+// it (renormalise: what mip_levels does at the source's own size); deflate level 0 (stored): read
+// once, then removed. Written band by band, never copied whole.
 Result<std::string> png_bytes(const image::Image& level, int first, int rows, const EncodeRequest& request, bool renormalise) {
   image::ImageLayout rgb = level;
   rgb.height = rows;
   rgb.channels = request.alpha ? 4 : 3;
   rgb.channel_names = request.alpha ? std::vector<std::string>{"R", "G", "B", "A"} : std::vector<std::string>{"R", "G", "B"};
   rgb.alpha_channel = request.alpha ? 3 : -1;
-  const std::size_t ch = std::size_t(level.channels), out_ch = std::size_t(rgb.channels);
+  const std::size_t out_ch = std::size_t(rgb.channels), first_texel = std::size_t(first) * std::size_t(level.width);
   const auto fill = [&](int y, int band_rows, std::span<float> samples) {
-    const std::size_t texels = std::size_t(level.width) * std::size_t(band_rows);
-    const float* in_band = &level.pixels[std::size_t(first + y) * std::size_t(level.width) * ch];
-    for (std::size_t p = 0; p < texels; ++p) {
-      const float* in = in_band + p * ch;
-      float* out = &samples[p * out_ch];
-      for (std::size_t c = 0; c < 3; ++c) out[c] = ch >= 3 ? in[c] : in[0];
-      if (renormalise) renormalise_normal(out);
-      if (request.alpha) out[3] = level.alpha_channel >= 0 ? in[level.alpha_channel] : 1.0f;
-    }
+    const std::size_t texels = std::size_t(level.width) * std::size_t(band_rows), band = std::size_t(y) * std::size_t(level.width);
+    for (std::size_t p = 0; p < texels; ++p) texel_as_stored(level, first_texel + band + p, request, renormalise, &samples[p * out_ch]);
   };
   image::WriteOptions options;
   options.type = image::SampleType::u8;
-  options.colour = request.texture_class == TextureClass::colour ? color::Transfer::srgb : color::Transfer::linear;
+  options.colour = stored_transfer(request);
   options.png_level = 0;
   return image::encode_bands(rgb, fill, "level.png", options);
 }
@@ -290,6 +283,18 @@ Result<std::vector<ktx2::Level>> uastc_chain(const Encoder& encoder, image::Imag
 
 }  // namespace
 
+void texel_as_stored(const image::Image& level, std::size_t p, const EncodeRequest& request, bool renormalise, float* out) {
+  const std::size_t ch = std::size_t(level.channels);
+  const float* in = &level.pixels[p * ch];
+  for (std::size_t c = 0; c < 3; ++c) out[c] = ch >= 3 ? in[c] : in[0];
+  if (renormalise) renormalise_normal(out);
+  if (request.alpha) out[3] = level.alpha_channel >= 0 ? in[level.alpha_channel] : 1.0f;
+}
+
+color::Transfer stored_transfer(const EncodeRequest& request) {
+  return request.texture_class == TextureClass::colour ? color::Transfer::srgb : color::Transfer::linear;
+}
+
 bool has_alpha(const image::Image& im) {
   if (im.alpha_channel < 0) return false;
   const std::size_t pixels = std::size_t(im.width) * std::size_t(im.height), ch = std::size_t(im.channels);
@@ -325,8 +330,11 @@ std::vector<std::string> encoder_arguments(const EncodeRequest& request) {
   return args;
 }
 
-Result<Encoded> encode_texture(const Encoder& encoder, image::Image source, Size base, const MipRequest& mips,
-                               const EncodeRequest& request, const std::string& writer) {
+namespace {
+
+// encode_texture's file, its levels and their coverage.
+Result<Encoded> encoded_chain(const Encoder& encoder, image::Image source, Size base, const MipRequest& mips,
+                              const EncodeRequest& request, const std::string& writer) {
   Encoded out;
   if (mips.alpha_cutoff) out.coverage.push_back(alpha_coverage(source, *mips.alpha_cutoff));
   if (request.options.codec == Codec::uastc) {
@@ -373,6 +381,21 @@ Result<Encoded> encode_texture(const Encoder& encoder, image::Image source, Size
   }
   out.levels = int(read->levels.size());
   if (auto conformed = ktx2::conform_primaries(out.file, request.scratch.string()); !conformed) return conformed.error();
+  return out;
+}
+
+}  // namespace
+
+Result<Encoded> encode_texture(const Encoder& encoder, image::Image source, Size base, const MipRequest& mips,
+                               const EncodeRequest& request, const std::string& writer) {
+  if (!request.measure_levels) return encoded_chain(encoder, std::move(source), base, mips, request, writer);
+  const image::Image reference = source;  // what the delivered levels are measured against
+  auto out = encoded_chain(encoder, std::move(source), base, mips, request, writer);
+  if (!out) return out;
+  const std::vector<Size> sizes = out->levels > 1 ? mip_sizes(base) : std::vector<Size>{base};
+  auto errors = measure_levels(encoder, out->file, reference, sizes, mips, request);
+  if (!errors) return errors.error();
+  out->level_error = std::move(*errors);
   return out;
 }
 

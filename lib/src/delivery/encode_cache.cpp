@@ -7,6 +7,7 @@
 #include <xxhash.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <map>
@@ -23,10 +24,14 @@ namespace matbake::delivery {
 namespace fs = std::filesystem;
 namespace {
 
-constexpr std::string_view kMagic = "matbake encoded texture 1\n";
+// Every version's entries begin with the prefix (so that eviction removes an older version's too);
+// only this version's are read.
+constexpr std::string_view kEntryPrefix = "matbake encoded texture ";
+constexpr std::string_view kMagic = "matbake encoded texture 2\n";
 constexpr std::string_view kSuffix = ".ktx2e";
 constexpr std::size_t kKeyDigits = 32;
 constexpr std::uint32_t kMostLevels = 32;
+constexpr std::size_t kLevelErrorValues = 4;  // a LevelError's
 
 using Descriptor = UniqueFd;
 
@@ -39,7 +44,8 @@ bool is_entry_name(const std::string& name) {
 // encoder, or a PNG or WebP file of 8-bit RGBA stored uncompressed (4 bytes a texel, a filter byte a
 // row, chunks), plus the header.
 std::uint64_t entry_limit(Size base) {
-  return 5 * std::uint64_t(base.width) * std::uint64_t(base.height) + (1u << 20) + kMagic.size() + 8 + 8 * (kMostLevels + 1);
+  return 5 * std::uint64_t(base.width) * std::uint64_t(base.height) + (1u << 20) + kMagic.size() + 12 + 8 * (kMostLevels + 1) +
+         8 * kLevelErrorValues * kMostLevels;
 }
 
 template <typename T>
@@ -52,27 +58,36 @@ void hash_text(XXH3_state_t* state, const std::string& text) {
   XXH3_128bits_update(state, text.data(), text.size());
 }
 
-// An entry's bytes: the magic, the level count, the coverage count and values, the KTX2 file.
+// An entry's bytes: the magic, the level count, the coverage count, the level error count, the
+// coverage values, each level error's four values, the KTX2 file.
 std::string header_of(const Encoded& e) {
   std::string h(kMagic);
-  const std::uint32_t counts[2] = {std::uint32_t(e.levels), std::uint32_t(e.coverage.size())};
+  const std::uint32_t counts[3] = {std::uint32_t(e.levels), std::uint32_t(e.coverage.size()), std::uint32_t(e.level_error.size())};
   h.append(reinterpret_cast<const char*>(counts), sizeof counts);
-  if (!e.coverage.empty()) h.append(reinterpret_cast<const char*>(e.coverage.data()), e.coverage.size() * sizeof(double));
+  std::vector<double> values = e.coverage;
+  for (const LevelError& l : e.level_error) values.insert(values.end(), {l.psnr, l.mean_angle, l.max_angle, l.coverage});
+  if (!values.empty()) h.append(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(double));
   return h;
 }
 
 std::optional<Encoded> parse_entry(const std::vector<unsigned char>& bytes, Size base, const std::string& name) {
-  if (bytes.size() < kMagic.size() + 8 || std::memcmp(bytes.data(), kMagic.data(), kMagic.size()) != 0) return std::nullopt;
-  std::uint32_t counts[2];
+  std::uint32_t counts[3];
+  if (bytes.size() < kMagic.size() + sizeof counts || std::memcmp(bytes.data(), kMagic.data(), kMagic.size()) != 0) return std::nullopt;
   std::memcpy(counts, bytes.data() + kMagic.size(), sizeof counts);
-  if (counts[0] == 0 || counts[0] > kMostLevels || counts[1] > kMostLevels + 1) return std::nullopt;
-  const std::size_t file_at = kMagic.size() + sizeof counts + counts[1] * sizeof(double);
+  if (counts[0] == 0 || counts[0] > kMostLevels || counts[1] > kMostLevels + 1 || counts[2] > counts[0]) return std::nullopt;
+  const std::size_t value_count = counts[1] + kLevelErrorValues * counts[2];
+  const std::size_t file_at = kMagic.size() + sizeof counts + value_count * sizeof(double);
   if (bytes.size() <= file_at) return std::nullopt;
+  std::vector<double> values(value_count);
+  if (value_count > 0) {  // memcpy to an empty vector's null data() is undefined, even of 0 bytes
+    std::memcpy(values.data(), bytes.data() + kMagic.size() + sizeof counts, value_count * sizeof(double));
+  }
+  if (!std::all_of(values.begin(), values.end(), [](double v) { return std::isfinite(v) && v >= 0; })) return std::nullopt;
   Encoded e;
   e.levels = int(counts[0]);
-  e.coverage.resize(counts[1]);
-  if (counts[1] > 0) {  // memcpy to an empty vector's null data() is undefined, even of 0 bytes
-    std::memcpy(e.coverage.data(), bytes.data() + kMagic.size() + sizeof counts, counts[1] * sizeof(double));
+  e.coverage.assign(values.begin(), values.begin() + counts[1]);
+  for (std::size_t at = counts[1]; at < value_count; at += kLevelErrorValues) {
+    e.level_error.push_back({values[at], values[at + 1], values[at + 2], values[at + 3]});
   }
   e.file.assign(bytes.begin() + std::ptrdiff_t(file_at), bytes.end());
   if (e.file.size() >= 8 && std::memcmp(e.file.data(), "\xabKTX 20\xbb", 8) == 0) {
@@ -114,8 +129,8 @@ std::optional<Encoded> read_entry(const fs::path& folder, const std::string& key
 // Whether the regular file `name` in `dir` begins as an entry does: what eviction may remove.
 bool holds_an_entry(int dir, const std::string& name) {
   const Descriptor file(::openat(dir, name.c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC | O_NONBLOCK));
-  char head[kMagic.size()];
-  return file.fd >= 0 && ::read(file.fd, head, sizeof head) == ssize_t(sizeof head) && std::string_view(head, sizeof head) == kMagic;
+  char head[kEntryPrefix.size()];
+  return file.fd >= 0 && ::read(file.fd, head, sizeof head) == ssize_t(sizeof head) && std::string_view(head, sizeof head) == kEntryPrefix;
 }
 
 void keep_entry(const EncodeCache& cache, const std::string& key, const Encoded& e) {
@@ -221,7 +236,7 @@ std::string encode_key(const image::Image& source, Size base, const MipRequest& 
   XXH3_state_t* s = state.get();
   const ClassOptions& o = request.options;
   for (const double v : {double(o.codec), double(o.quality), double(o.uastc_level), o.uastc_rdo, double(o.zstd)}) hash_value(s, v);
-  for (const int v : {int(request.texture_class), int(request.mipmaps), int(request.alpha)}) hash_value(s, v);
+  for (const int v : {int(request.texture_class), int(request.mipmaps), int(request.alpha), int(request.measure_levels)}) hash_value(s, v);
   return finish_key(s, source, base, mips);
 }
 

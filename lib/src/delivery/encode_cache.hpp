@@ -26,12 +26,13 @@ struct EncodeCache {
 
 // Least recently used entries (by modification time: a read marks it) removed from `folder` until its
 // entries fit in `limit` bytes. Only regular files named as entries (32 hex digits + ".ktx2e") that
-// begin as one are removed, by name relative to the folder's descriptor (no link is followed).
+// begin as one (of any version) are removed, by name relative to the folder's descriptor (no link is followed).
 void evict_encoded(const std::filesystem::path& folder, std::uint64_t limit);
 
 // The key of an encode: XXH3-128 of everything its bytes depend on — the source's layout and pixels
 // (level 0 and every level are made from them), the size of level 0, the mip request, the class's
-// codec settings, the encoder's arguments and `writer` (matbake's and basisu's versions).
+// codec settings, the encoder's arguments, whether its levels are measured, and `writer` (matbake's
+// and basisu's versions).
 std::string encode_key(const image::Image& source, Size base, const MipRequest& mips, const EncodeRequest& request,
                        const std::string& writer);
 

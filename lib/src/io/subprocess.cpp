@@ -32,7 +32,7 @@ Running& running() {
 }
 
 // In the child, between fork and exec: async-signal-safe calls only.
-[[noreturn]] void exec_child(const char* program, char* const* argv, int output_fd, pid_t parent) {
+[[noreturn]] void exec_child(const char* program, char* const* argv, int output_fd, pid_t parent, const char* directory) {
   ::setpgid(0, 0);
   ::prctl(PR_SET_PDEATHSIG, SIGKILL);
   if (::getppid() != parent) ::_exit(127);  // the parent died before prctl took effect
@@ -45,6 +45,7 @@ Running& running() {
   // Nothing else of matbake's (a copy of its stderr kept for messages, a lock): a program that
   // outlived matbake would keep a pipe reading matbake's stderr waiting.
   ::close_range(3, ~0u, 0);
+  if (directory != nullptr && ::chdir(directory) != 0) ::_exit(127);
   ::execve(program, argv, environ);
   ::_exit(127);
 }
@@ -123,7 +124,11 @@ std::string SubprocessResult::error_line() const {
 
 SubprocessResult run_supervised(const SubprocessRequest& request) {
   SubprocessResult result;
-  std::vector<std::string> argv_text{request.program.string()};
+  // A relative program is found from matbake's folder, wherever the child runs.
+  std::error_code ec;
+  const std::filesystem::path program =
+      request.working_directory.empty() ? request.program : std::filesystem::absolute(request.program, ec);
+  std::vector<std::string> argv_text{program.string()};
   argv_text.insert(argv_text.end(), request.args.begin(), request.args.end());
   std::vector<char*> argv;
   for (std::string& a : argv_text) argv.push_back(a.data());
@@ -140,7 +145,10 @@ SubprocessResult run_supervised(const SubprocessRequest& request) {
     // setpgid below as well as in the child, so a kill never misses it).
     std::lock_guard lock(running().mutex);
     if (!running().closed) pid = ::fork();
-    if (pid == 0) exec_child(argv_text[0].c_str(), argv.data(), pipe_fds[1], parent);
+    if (pid == 0) {
+      exec_child(argv_text[0].c_str(), argv.data(), pipe_fds[1], parent,
+                 request.working_directory.empty() ? nullptr : request.working_directory.c_str());
+    }
     if (pid > 0) {
       ::setpgid(pid, pid);
       running().groups.insert(pid);

@@ -5,6 +5,7 @@
 // text from a file (a stamp, a glTF) is escaped; image paths come from the plan, or are names made
 // file-safe.
 #include <cstdio>
+#include <functional>
 #include <map>
 
 #include "../gltf/document.hpp"
@@ -58,6 +59,29 @@ std::string number(const json& v, const char* format = "%.4g") {
   char text[32];
   std::snprintf(text, sizeof text, format, v.get<double>());
   return text;
+}
+
+// A texture's numbers per level (docs/build.md#the-report-page): each KTX2 level's PSNR as a GPU is
+// given it, a normal map's mean / max angle, a MASK texture's coverage made and decoded.
+std::string per_level(const json& texture) {
+  const auto row = [&](const std::string& label, const json& values, const std::function<std::string(const json&)>& text) {
+    if (!values.is_array() || values.empty()) return std::string();
+    std::string line = "<div>" + html(label) + ":";
+    for (const json& v : values) line += " " + text(v);
+    return line + "</div>";
+  };
+  const json& errors = texture.value("level_error", json::array());
+  const auto field = [](const char* key, const char* format) {
+    return [=](const json& level) { return level.is_object() ? number(level.value(key, json()), format) : std::string("-"); };
+  };
+  std::string out = row("PSNR (dB)", errors, field("psnr", "%.1f"));
+  if (texture.value("class", "") == "normal") {
+    out += row("angle mean (°)", errors, field("mean_angle", "%.2f")) + row("angle max (°)", errors, field("max_angle", "%.1f"));
+  }
+  const json& coverage = texture.value("coverage", json::array());
+  out += row("coverage made (source first)", coverage, [](const json& c) { return number(c, "%.3f"); });
+  if (texture.contains("alpha_cutoff")) out += row("coverage decoded", errors, field("coverage", "%.3f"));
+  return out;
 }
 
 std::string figure(const std::string& src, const std::string& caption) {
@@ -201,19 +225,18 @@ std::string scene_section(const JobView& v, const fs::path& page_folder, std::ve
   const json& textures = v.details.value("textures", json::array());
   if (textures.is_array() && !textures.empty()) {
     out += "<h4>Textures</h4><table><tr><th>texture</th><th>class</th><th>source</th><th>delivered</th><th>needed side</th>"
-           "<th>codec</th><th>levels</th><th>bytes</th><th>coverage per level</th><th>note</th></tr>";
+           "<th>codec</th><th>levels</th><th>bytes</th><th>time (s)</th><th>per level, level 0 first</th><th>note</th></tr>";
     for (const json& t : textures) {
       if (!t.is_object()) continue;
       const auto size = [&](const char* key) {
         const json& s = t.value(key, json());
         return s.is_array() && s.size() == 2 ? number(s[0], "%.0f") + "×" + number(s[1], "%.0f") : std::string("-");
       };
-      std::string coverage;
-      for (const json& c : t.value("coverage", json::array())) coverage += (coverage.empty() ? "" : " ") + number(c, "%.3f");
       out += "<tr><td>" + number(t.value("texture", json()), "%.0f") + "</td><td>" + html(t.value("class", "")) + "</td><td>" +
              size("source_size") + "</td><td>" + size("size") + "</td><td>" + number(t.value("needed_side", json()), "%.0f") +
              "</td><td>" + html(t.value("codec", "")) + "</td><td>" + number(t.value("levels", json()), "%.0f") + "</td><td>" +
-             number(t.value("bytes", json()), "%.0f") + "</td><td>" + coverage + "</td><td>" + html(t.value("note", "")) + "</td></tr>";
+             number(t.value("bytes", json()), "%.0f") + "</td><td>" + number(t.value("seconds", json()), "%.2f") + "</td><td>" +
+             per_level(t) + "</td><td>" + html(t.value("note", "")) + "</td></tr>";
     }
     out += "</table>";
   }

@@ -95,7 +95,15 @@ nlohmann::json to_json(const delivery::TextureReport& t) {
                       {"levels", t.levels},
                       {"source_bytes", t.source_bytes},
                       {"bytes", t.bytes}};
-  if (!t.uri.empty()) j["reused"] = t.reused;  // a file made (KTX2, or a resized PNG or WebP)
+  if (!t.uri.empty()) j["reused"] = t.reused, j["seconds"] = t.seconds;  // a file made (KTX2, or a resized PNG or WebP)
+  if (!t.level_error.empty()) {
+    nlohmann::json& levels = j["level_error"] = nlohmann::json::array();
+    for (const delivery::LevelError& l : t.level_error) {
+      nlohmann::json& level = levels.emplace_back(nlohmann::json{{"psnr", l.psnr}});
+      if (t.texture_class == delivery::TextureClass::normal) level["mean_angle"] = l.mean_angle, level["max_angle"] = l.max_angle;
+      if (t.alpha_cutoff) level["coverage"] = l.coverage;
+    }
+  }
   if (t.needed) j["needed_side"] = *t.needed;
   if (t.alpha_cutoff) j["alpha_cutoff"] = *t.alpha_cutoff, j["coverage"] = t.coverage;
   if (!t.note.empty()) j["note"] = t.note;
