@@ -203,7 +203,7 @@ TEST(RequestTree, EveryParameterOfExportsTreeReachesTheSceneFromBothDoors) {
       ++walked;
     }
   }
-  EXPECT_EQ(walked, 61u);  // a new parameter is walked here too
+  EXPECT_EQ(walked, 62u);  // a new parameter is walked here too
 }
 
 // Each rule of a tree broken on purpose: refused at both doors, with one message in each door's spelling.
@@ -261,7 +261,7 @@ TEST(RequestTree, EveryRuleIsEnforcedAtBothDoorsInTheirOwnSpelling) {
     ASSERT_FALSE(manifest);
     EXPECT_EQ(manifest.error().message, expected);
     EXPECT_EQ(manifest.error().path.rfind("/p/assets.toml:", 0), 0u) << manifest.error().path;
-  }, 47);
+  }, 48);
 }
 
 // A manifest entry's settings as TOML: the plain branches' as keys, each table's as name = { ... }.
@@ -313,7 +313,7 @@ void walk_top_level(const Tree<Root>& tree, const std::string& entry, Read read,
 
 TEST(RequestTree, TheTopLevelGivesEveryMaterialAndSceneParameterItsDefault) {
   walk_top_level(pipeline::scene_tree(), "[scenes.s]\ninput = \"s.gltf\"\n",
-                 [](const pipeline::Manifest& m) { return m.scenes.at(0); }, 62);
+                 [](const pipeline::Manifest& m) { return m.scenes.at(0); }, 63);
   walk_top_level(pipeline::material_tree(), "[materials.m]\nsources = { kd = 0.5 }\n",
                  [](const pipeline::Manifest& m) { return m.materials.at(0); }, 15);
 }
@@ -392,7 +392,7 @@ TEST(RequestTree, BakeAosTreeIsExportsGroupsWithItsOwnFlags) {
       EXPECT_NE(tree[b].values(*cli).at(spec->name), tree[b].values(bake_ao::Options{}).at(spec->name));
     }
   }
-  walk_rules(tree, [](const auto&, const std::string&) {}, 47);
+  walk_rules(tree, [](const auto&, const std::string&) {}, 48);
 }
 
 // A request made by the command line from one parameter at its example (a flag on by default
