@@ -16,6 +16,7 @@ export MATBAKE_BASISU="${MATBAKE_BASISU:-$root/scripts/basisu/bin/basisu}"
 matbake="$root/build/cli/matbake"
 work=${BENCH_LEVEL_ERROR_WORK:-$(mktemp -d)}
 [ -n "${BENCH_LEVEL_ERROR_WORK:-}" ] || trap 'rm -rf "$work"' EXIT
+mkdir -p "$work"
 models=("$@")
 [ ${#models[@]} -gt 0 ] || models=(BoxTextured TextureCoordinateTest NormalTangentMirrorTest SpecGlossVsMetalRough)
 : > "$work/times"

@@ -532,8 +532,11 @@ ao = { samples = 8, texture = 64, per_instance = true }
   EXPECT_EQ(scene.images, texels * (4 * (4 + 5 + 13) + 16));
   EXPECT_EQ(scene.geometry, 8 * 1000);
   EXPECT_EQ(scene.ao, (1 + 2) * 64 * 64 * 24);          // a material and two placements
-  // Its 4 glTF textures decoded (RGBA float), then two encoded at once (the job's cores).
-  EXPECT_EQ(scene.encoder, 4 * texels * 16 + 2 * texels * (80 + 72));
+  // Its 4 glTF textures decoded (RGBA float), then two encoded at once (the job's cores), each
+  // with the source kept to measure its levels against (16 B a texel).
+  EXPECT_EQ(scene.encoder, 4 * texels * 16 + 2 * texels * (80 + 16 + 72));
+  EXPECT_EQ(footprint("scene:s", 1).encoder, 4 * texels * 16 + texels * (80 + 16 + 72));
+  m->scenes.at(0).options.delivery.measure_levels = false;  // no copy kept
   EXPECT_EQ(footprint("scene:s", 1).encoder, 4 * texels * 16 + texels * (80 + 72));
 
   EXPECT_EQ(pipeline::memory_request_mb({.program = 32 * mib, .images = 200 * mib}), 320);  // 290 → 320

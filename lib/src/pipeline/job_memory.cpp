@@ -37,9 +37,11 @@ constexpr double kCompressedGeometryPerBufferByte = 32;  // Draco or meshopt: de
 // the glTF at most 4 (base colour, ORM, normal, emissive).
 constexpr double kDecodedTextureBytesPerTexel = 4 * kSampleBytes;
 constexpr int kGltfMaterialTextures = 4;
-// KTX2 per texture encoded at once: matbake's level 0, mip chain and the PNG it hands over, then
-// basisu's own (ETC1S at 2048² peaked at 64.5 bytes a texel, UASTC with RDO at 21).
+// KTX2 per texture encoded at once: matbake's level 0, mip chain and the PNG it hands over, with
+// measure_levels the copy of the source its levels are measured against (RGBA float), then basisu's
+// own (ETC1S at 2048² peaked at 64.5 bytes a texel, UASTC with RDO at 21).
 constexpr double kKtx2ParentBytesPerTexel = 80;
+constexpr double kMeasuredSourceBytesPerTexel = 4 * kSampleBytes;
 constexpr double kBasisuBytesPerTexel = 72;
 
 // Work rates (seconds on the 2-core reference machine, measured on the example's jobs): only their
@@ -222,8 +224,9 @@ JobFootprint scene_footprint(const Job& job, const Manifest& manifest, int cpus)
   }
   if (s.options.delivery.texture_format == delivery::TextureFormat::ktx2) {
     // Every texture decoded, then encoded in parallel, one per core: the largest, that many at once.
+    const double parent = kKtx2ParentBytesPerTexel + (s.options.delivery.measure_levels ? kMeasuredSourceBytesPerTexel : 0);
     f.encoder = in.delivered_texels * kDecodedTextureBytesPerTexel +
-                double(std::max(1, cpus)) * in.largest_texture * (kKtx2ParentBytesPerTexel + kBasisuBytesPerTexel);
+                double(std::max(1, cpus)) * in.largest_texture * (parent + kBasisuBytesPerTexel);
   }
   return f;
 }
