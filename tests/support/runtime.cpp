@@ -75,6 +75,23 @@ std::optional<nlohmann::json> check_page_in_chromium(const fs::path& page, const
   return json::parse(in);
 }
 
+std::optional<std::vector<float>> mikktspace_in_three(const fs::path& folder, const std::vector<float>& positions,
+                                                      const std::vector<float>& normals, const std::vector<float>& texcoords,
+                                                      std::string& why_not) {
+  const auto write = [&](const char* name, const std::vector<float>& values) {
+    std::ofstream(folder / name, std::ios::binary).write(reinterpret_cast<const char*>(values.data()), std::streamsize(values.size() * sizeof(float)));
+    return (folder / name).string();
+  };
+  const std::vector<std::string> args{write("positions.f32", positions), write("normals.f32", normals),
+                                      write("texcoords.f32", texcoords), (folder / "tangents.f32").string()};
+  if (!run_harness("mikktspace.mjs", args, std::chrono::seconds(60), why_not)) return std::nullopt;
+  std::ifstream in(folder / "tangents.f32", std::ios::binary);
+  std::vector<float> tangents(positions.size() / 3 * 4);
+  in.read(reinterpret_cast<char*>(tangents.data()), std::streamsize(tangents.size() * sizeof(float)));
+  if (in.gcount() != std::streamsize(tangents.size() * sizeof(float))) throw std::runtime_error("mikktspace.mjs wrote a short file");
+  return tangents;
+}
+
 std::optional<std::map<std::string, RuntimeModel>> render_in_three(
     const fs::path& folder, const std::vector<std::pair<std::string, fs::path>>& models, std::string& why_not) {
   std::vector<std::string> args{"--out", folder.string(), "--timeout", "150"};

@@ -51,6 +51,13 @@ double render_psnr(const std::filesystem::path& reference, const std::filesystem
 std::optional<nlohmann::json> check_page_in_chromium(const std::filesystem::path& page, const std::filesystem::path& screenshot,
                                                       std::string& why_not);
 
+// MikkTSpace tangents of triangles given corner by corner (3 positions, 3 normals, 2 UVs a corner, as
+// floats), by three.js's port of the reference (tests/runtime/mikktspace.mjs): 4 floats a corner.
+// Empty with `why_not` when the harness is not installed here; a failure throws.
+std::optional<std::vector<float>> mikktspace_in_three(const std::filesystem::path& folder, const std::vector<float>& positions,
+                                                      const std::vector<float>& normals, const std::vector<float>& texcoords,
+                                                      std::string& why_not);
+
 // The colour space three.js must give a texture read for `slot`: "srgb" for colour, "" for data.
 std::string color_space_of_slot(const std::string& slot);
 

@@ -13,7 +13,9 @@ namespace matbake::delivery {
 namespace fs = std::filesystem;
 namespace {
 
-// The files `basisu -unpack` named after the file it read (NAME_unpacked_*), removed by name.
+// The files `basisu -unpack` named after the file it read (STEM_unpacked_*), removed by name. The
+// stem is this measure's own: a temporary name (unique in the process) of ".unpack" after a file
+// name delivery made URI-safe, which holds no '.', so no other file in the folder begins so.
 struct UnpackedFiles {
   fs::path folder;
   std::string prefix;
@@ -83,6 +85,7 @@ Result<std::vector<LevelError>> measure_levels(const Encoder& encoder, const std
   }
   std::error_code ec;
   const fs::path path = fs::absolute(input->temp_path(), ec), folder = path.parent_path();
+  if (ec) return Error{what, "cannot name the output folder: " + ec.message()};
   // Declared after the input: removed first, so that the temporary folder can go with the input.
   const UnpackedFiles unpacked{folder, path.stem().string() + "_unpacked_"};
   std::uint64_t texels = 0;
