@@ -121,6 +121,8 @@ constexpr int kDefaultPadding = 16;
 constexpr int kMaxTextureSide = 16384;
 int padding_for(const TextureOptions& options);  // the padding used
 Status check(const TextureOptions& options, const Options& estimator);
+// The same, for a bake of `what` ("AO", "bake") with at most max_texel_samples positions a texel.
+Status check(const TextureOptions& options, int max_texel_samples, const std::string& what);
 
 struct TextureBake {
   int width = 0, height = 0;

@@ -36,11 +36,19 @@ struct Instance {
   // TEXCOORD_n as floats (n the index; an empty entry: the file has no set n). Read only when
   // SceneContent::texcoords asks: a per-vertex bake does not need them.
   std::vector<std::vector<glm::vec2>> texcoords;
+  // The primitive's own POSITION, NORMAL and TANGENT as the file has them (object space; a runtime
+  // computes tangents from these, then transforms them). Read only when SceneContent::object_space
+  // asks; `tangents` is empty when the file has none.
+  struct ObjectSpace {
+    std::vector<Vec3> positions, normals;
+    std::vector<glm::vec4> tangents;
+  } object;
 };
 
 // What a load reads beyond positions, normals, colours and triangles.
 struct SceneContent {
   bool texcoords = false;
+  bool object_space = false;  // Instance::object: what a bake's tangent basis is computed from
 };
 
 struct Scene {

@@ -66,16 +66,23 @@ int padding_for(const TextureOptions& options) {
   return std::max(1, int(std::lround(double(kDefaultPadding) * side / 1024.0)));
 }
 
-Status check(const TextureOptions& texture, const Options& estimator) {
+Status check(const TextureOptions& texture, int max_texel_samples, const std::string& what) {
   if (texture.width < 1 || texture.height < 1 || texture.width > kMaxTextureSide || texture.height > kMaxTextureSide) {
-    return Error{"", "AO texture sides must be 1 to " + std::to_string(kMaxTextureSide) + " texels", true};
+    return Error{"", what + " texture sides must be 1 to " + std::to_string(kMaxTextureSide) + " texels", true};
   }
-  if (Status s = image::check_image_size("AO texture", texture.width, texture.height); !s) return s.error();
-  if (texture.padding < -1) return Error{"", "AO padding must be 0 or more texels", true};
-  if (texture.texel_samples < 1 || texture.texel_samples > estimator.samples) {
-    return Error{"", "AO texel samples must be 1 to the sample count (" + std::to_string(estimator.samples) + ")", true};
+  if (Status s = image::check_image_size(what + " texture", texture.width, texture.height); !s) return s.error();
+  if (texture.padding < -1) return Error{"", what + " padding must be 0 or more texels", true};
+  if (texture.texel_samples < 1 || texture.texel_samples > max_texel_samples) {
+    return Error{"", what + " texel samples must be 1 to " + std::to_string(max_texel_samples), true};
   }
   return success();
+}
+
+Status check(const TextureOptions& texture, const Options& estimator) {
+  if (texture.texel_samples > estimator.samples) {
+    return Error{"", "AO texel samples must be 1 to the sample count (" + std::to_string(estimator.samples) + ")", true};
+  }
+  return check(texture, estimator.samples, "AO");
 }
 
 Status check(const TextureRequest& request, const Options& estimator) {

@@ -21,8 +21,9 @@ void basis(const Vec3& n, Vec3& t, Vec3& b) {
   b = Vec3(c, sign + n.y * n.y * a, -n.y);
 }
 
-// The file's unit normals where it has them; else (or when asked) from the faces.
-std::vector<Vec3> ray_normals(const scene::Instance& inst, std::optional<scene::NormalWeighting> recompute) {
+}  // namespace
+
+std::vector<Vec3> shading_normals(const scene::Instance& inst, std::optional<scene::NormalWeighting> recompute) {
   const bool usable = !recompute && !inst.normals.empty() &&
                       std::all_of(inst.normals.begin(), inst.normals.end(), [](const Vec3& n) { return glm::length(n) > 0; });
   if (usable) return inst.normals;  // the common case: no face pass at all
@@ -36,9 +37,11 @@ std::vector<Vec3> ray_normals(const scene::Instance& inst, std::optional<scene::
   return normals;
 }
 
+namespace {
+
 Mesh prepare(const scene::Instance& inst, std::optional<scene::NormalWeighting> recompute) {
   Mesh m;
-  m.normals = ray_normals(inst, recompute);
+  m.normals = shading_normals(inst, recompute);
   std::vector<double> sum(inst.positions.size(), 0.0);
   std::vector<int> count(inst.positions.size(), 0);
   for (const auto& t : inst.triangles) {
@@ -57,7 +60,7 @@ Mesh prepare(const scene::Instance& inst, std::optional<scene::NormalWeighting> 
 }
 
 // One-sided occlusion: a hit on the back of a face (its normal along the ray) is not a hit.
-void reject_back_faces(const RTCFilterFunctionNArguments* args) {
+void back_face_filter(const RTCFilterFunctionNArguments* args) {
   const auto* faces = static_cast<const std::vector<Vec3>*>(args->geometryUserPtr);
   for (unsigned i = 0; i < args->N; ++i) {
     if (args->valid[i] != -1) continue;
@@ -69,6 +72,28 @@ void reject_back_faces(const RTCFilterFunctionNArguments* args) {
 }
 
 }  // namespace
+
+RTCGeometry triangle_geometry(RTCDevice device, const scene::Instance& inst) {
+  RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+  // Embree reads vertex buffers in 16-byte loads: rtcSetNewGeometryBuffer pads for us.
+  auto* vertices = static_cast<float*>(
+      rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), inst.positions.size()));
+  for (std::size_t v = 0; v < inst.positions.size(); ++v) {
+    vertices[3 * v] = inst.positions[v].x, vertices[3 * v + 1] = inst.positions[v].y, vertices[3 * v + 2] = inst.positions[v].z;
+  }
+  auto* indices = static_cast<std::uint32_t*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                                       3 * sizeof(std::uint32_t), inst.triangles.size()));
+  for (std::size_t t = 0; t < inst.triangles.size(); ++t) {
+    for (std::size_t corner = 0; corner < 3; ++corner) indices[3 * t + corner] = inst.triangles[t][corner];
+  }
+  return g;
+}
+
+void reject_back_faces(RTCGeometry geometry, const std::vector<Vec3>& face_normals) {
+  rtcSetGeometryUserData(geometry, const_cast<std::vector<Vec3>*>(&face_normals));
+  rtcSetGeometryIntersectFilterFunction(geometry, back_face_filter);
+  rtcSetGeometryOccludedFilterFunction(geometry, back_face_filter);
+}
 
 Result<std::unique_ptr<Tracer>> Tracer::build(const scene::Scene& scene, const Options& options) {
   std::unique_ptr<Tracer> tracer(new Tracer);
@@ -88,23 +113,8 @@ Result<std::unique_ptr<Tracer>> Tracer::build(const scene::Scene& scene, const O
   });
   for (std::size_t k = 0; k < scene.instances.size(); ++k) {
     const scene::Instance& inst = scene.instances[k];
-    RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
-    // Embree reads vertex buffers in 16-byte loads: rtcSetNewGeometryBuffer pads for us.
-    auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                                                  3 * sizeof(float), inst.positions.size()));
-    for (std::size_t v = 0; v < inst.positions.size(); ++v) {
-      vertices[3 * v] = inst.positions[v].x, vertices[3 * v + 1] = inst.positions[v].y, vertices[3 * v + 2] = inst.positions[v].z;
-    }
-    auto* indices = static_cast<std::uint32_t*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                                         3 * sizeof(std::uint32_t), inst.triangles.size()));
-    for (std::size_t t = 0; t < inst.triangles.size(); ++t) {
-      for (std::size_t corner = 0; corner < 3; ++corner) indices[3 * t + corner] = inst.triangles[t][corner];
-    }
-    if (!options.two_sided) {
-      rtcSetGeometryUserData(g, &tracer->meshes_[k].face_normals);
-      rtcSetGeometryIntersectFilterFunction(g, reject_back_faces);
-      rtcSetGeometryOccludedFilterFunction(g, reject_back_faces);
-    }
+    RTCGeometry g = triangle_geometry(device, inst);
+    if (!options.two_sided) reject_back_faces(g, tracer->meshes_[k].face_normals);
     rtcCommitGeometry(g);
     rtcAttachGeometry(rtc, g);
     rtcReleaseGeometry(g);

@@ -24,6 +24,16 @@ struct SceneDeleter {
   void operator()(RTCScene s) const { rtcReleaseScene(s); }
 };
 
+// The instance's unit normals: the file's, area-weighted from the faces where it has none (or when
+// asked: from the faces with that weighting).
+std::vector<scene::Vec3> shading_normals(const scene::Instance& inst, std::optional<scene::NormalWeighting> recompute = {});
+
+// A triangle geometry of the instance's world positions and triangles, not yet committed.
+RTCGeometry triangle_geometry(RTCDevice device, const scene::Instance& inst);
+// Hits on the back of a face (its normal, not normalized, along the ray) are not hits; the
+// normals must outlive the geometry.
+void reject_back_faces(RTCGeometry geometry, const std::vector<scene::Vec3>& face_normals);
+
 class Tracer {
  public:
   // Every instance occludes, whatever options.targets says. Errors: Embree failing to start or build.

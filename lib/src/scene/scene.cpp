@@ -138,6 +138,7 @@ Result<Instance> place_primitive(const Reader& read, const Json& primitive, int 
   Status s = read.floats(position, 3, [&](std::size_t v, const float* x) {
     if (!std::isfinite(x[0]) || !std::isfinite(x[1]) || !std::isfinite(x[2])) not_finite = std::min(not_finite, v);
     inst.positions.push_back(Vec3(world * glm::dvec4(x[0], x[1], x[2], 1.0)));
+    if (content.object_space) inst.object.positions.emplace_back(x[0], x[1], x[2]);
   });
   if (!s) return s.error();
   if (not_finite < vertices) return read.error(where + ": POSITION of vertex " + std::to_string(not_finite) + " is not finite");
@@ -164,10 +165,20 @@ Result<Instance> place_primitive(const Reader& read, const Json& primitive, int 
     const glm::dmat3 normal_matrix = glm::inverseTranspose(glm::dmat3(world));
     inst.normals.reserve(vertices);
     s = read.floats(normal, 3, [&](std::size_t, const float* x) {
+      if (content.object_space) inst.object.normals.emplace_back(x[0], x[1], x[2]);
       const glm::dvec3 nv = normal_matrix * glm::dvec3(x[0], x[1], x[2]);
       const double length = glm::length(nv);
       inst.normals.push_back(length > 0 ? Vec3(nv / length) : Vec3(0));
     });
+    if (!s) return s.error();
+  }
+  if (content.object_space && attributes.contains("TANGENT")) {
+    const int tangent = integer_in(attributes, "TANGENT", -1);
+    auto bytes = read.dense(tangent);
+    if (!bytes) return bytes.error();
+    if (bytes->count != vertices) return read.error(where + ": TANGENT and POSITION counts differ");
+    inst.object.tangents.reserve(vertices);
+    s = read.floats(tangent, 4, [&](std::size_t, const float* t) { inst.object.tangents.emplace_back(t[0], t[1], t[2], t[3]); });
     if (!s) return s.error();
   }
   if (attributes.contains("COLOR_0")) {

@@ -1,0 +1,83 @@
+#pragma once
+// Baking a high-poly surface onto a low-poly one's UVs, as Substance's, Marmoset's and Blender's
+// "selected to active" bakers do. For each texel of the low-poly (the texels of ao::TextureTarget:
+// covered and touched, several positions over the footprint for anti-aliasing), one ray from the
+// cage toward the low-poly: it starts `front` outside the surface along the low-poly's interpolated
+// normal and ends `back` inside it; its first hit on the front of a high-poly face is the texel's
+// sample, and every map is computed from it. A ray that finds nothing is a miss: counted, and the
+// texel takes its nearest hit neighbour's value.
+//
+// The tangent-space normal map is made for the basis a runtime shades with, so that it gives back
+// the high-poly's normal: per vertex the low-poly's TANGENT (MikkTSpace where the file has none, in
+// glTF's sign convention) and NORMAL, carried to world space; B = normalize(w · cross(N, T)) per
+// vertex; T, B and N interpolated and normalized per texel; the runtime's normal is
+// normalize(T·x + B·y + N·z) of the decoded texel (three.js's rule with vertex tangents). The
+// texel holds the (x, y, z) that gives the high-poly's normal back exactly: the basis is inverted,
+// not transposed, so a basis that is not orthogonal costs nothing.
+#include <cstdint>
+#include <vector>
+
+#include "matbake/ao.hpp"
+#include "matbake/enum_names.hpp"
+#include "matbake/result.hpp"
+#include "matbake/scene.hpp"
+
+namespace matbake::bake {
+
+enum class Map {
+  normal,    // tangent-space normal, RGB in [0, 1] as stored (x/2 + ½ ...)
+  height,    // signed distance from the low-poly to the high-poly along the low-poly's normal
+             // (positive outside), scene units
+  position,  // the hit's world position, scene units
+};
+inline constexpr NameTable<Map, 3> kMapNames{{{Map::normal, "normal"}, {Map::height, "height"}, {Map::position, "position"}}};
+int channels(Map map);
+
+// Which way the normal map's green channel points: OpenGL's (and glTF's) up the texture, against
+// the direction of increasing v; DirectX's down it.
+enum class Green { opengl, directx };
+inline constexpr NameTable<Green, 2> kGreenNames{{{Green::opengl, "opengl"}, {Green::directx, "directx"}}};
+
+struct Options {
+  std::vector<Map> maps = {Map::normal};
+  // The cage: how far outside (front) and inside (back) the low-poly the rays reach, as fractions
+  // of the low-poly's bounding-box diagonal, or in scene units when absolute.
+  double front = 0.01, back = 0.01;
+  bool absolute_distances = false;
+  Green green = Green::opengl;
+  std::uint64_t seed = 0;  // of the anti-aliasing positions
+};
+
+Status check(const Options& options);
+
+struct MapImage {
+  Map map = Map::normal;
+  int channels = 0;
+  std::vector<float> values;  // width × height × channels, row-major
+};
+
+struct TextureBake {
+  int width = 0, height = 0;
+  std::vector<MapImage> maps;     // in the order of Options::maps
+  std::vector<std::uint8_t> hit;  // per texel: 1 where a ray found the high-poly
+  std::size_t texels = 0;         // traced (covered or touched)
+  std::size_t samples = 0, misses = 0;  // rays cast, and how many found nothing
+  std::size_t missed_texels = 0;        // texels all of whose rays missed: filled from neighbours
+  std::size_t padded = 0;
+  double height_min = 0, height_max = 0;  // over the hits
+};
+
+struct Bake {
+  std::vector<TextureBake> textures;  // one per target
+  double front = 0, back = 0;         // the cage distances used, scene units
+  double setup_seconds = 0, trace_seconds = 0;
+};
+
+// `low` must have been loaded with SceneContent::object_space and texcoords (the tangents are
+// computed from the file's own attributes); `high` is used in world space. The result is the same
+// for any number of threads. Errors: options out of range, a target without its UV set's data,
+// Embree failing.
+Result<Bake> bake(const scene::Scene& low, const scene::Scene& high, const std::vector<ao::TextureTarget>& targets,
+                  const ao::TextureOptions& texture, const Options& options);
+
+}  // namespace matbake::bake

@@ -1,0 +1,246 @@
+// The high-to-low bake: per texel of the low-poly (ao/texels' coverage), rays from the cage, the
+// first hit on the high-poly, every map from it; then misses filled and padding.
+#include "matbake/bake.hpp"
+
+#include <glm/geometric.hpp>
+#include <glm/mat3x3.hpp>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "../ao/texels.hpp"
+#include "frames.hpp"
+#include "high_poly.hpp"
+
+namespace matbake::bake {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+
+constexpr int kMaxTexelSamples = 1024;
+
+// The low-poly at one point: world position and, as the runtime interpolates them, the normal and
+// the tangent basis (columns T, B, N, each normalized; not orthogonal in general).
+struct LowPoint {
+  glm::vec3 position;
+  glm::dmat3 basis;
+};
+
+LowPoint low_point(const scene::Instance& inst, const std::vector<CornerFrame>& frames, std::size_t triangle,
+                   const glm::dvec3& w) {
+  const auto& corners = inst.triangles[triangle];
+  glm::dvec3 p(0), t(0), b(0), n(0);
+  for (std::size_t k = 0; k < 3; ++k) {
+    const CornerFrame& f = frames[3 * triangle + k];
+    p += w[int(k)] * glm::dvec3(inst.positions[corners[k]]);
+    t += w[int(k)] * glm::dvec3(f.tangent);
+    b += w[int(k)] * glm::dvec3(f.bitangent);
+    n += w[int(k)] * glm::dvec3(f.normal);
+  }
+  const auto unit = [](const glm::dvec3& v) { return glm::length(v) > 0 ? glm::normalize(v) : v; };
+  return {glm::vec3(p), glm::dmat3(unit(t), unit(b), unit(n))};
+}
+
+// The texel's (x, y, z) whose shading, normalize(T·x + B·y + N·z), is the world normal h: the basis
+// inverted, then scaled to unit length (the texture holds unit vectors). A basis with no inverse
+// (the interpolated vectors coplanar) is projected onto instead.
+glm::dvec3 tangent_space(const glm::dmat3& basis, const glm::dvec3& h) {
+  const double det = glm::determinant(basis);
+  const glm::dvec3 m = std::abs(det) > 1e-9 ? glm::inverse(basis) * h : glm::transpose(basis) * h;
+  const double length = glm::length(m);
+  return length > 0 ? m / length : glm::dvec3(0, 0, 1);
+}
+
+// What a texel's hits add up to, for every map.
+struct TexelSum {
+  glm::dvec3 normal{0}, position{0};
+  double height = 0;
+  int hits = 0, rays = 0;
+};
+
+struct TraceContext {
+  const scene::Scene& low;
+  const std::vector<std::vector<CornerFrame>>& frames;  // per low instance (empty: not baked)
+  const HighPoly& high;
+  const ao::TextureTarget& target;
+  const ao::TextureOptions& texture;
+  float front, back;
+};
+
+// The texel positions of one surface point (K = texel_samples, stratified over the footprint by the
+// (0, 2)-sequence as the AO bake's, each clamped to the triangle), one ray each.
+void trace_point(const TraceContext& c, const ao::texels::SurfacePoint& point, std::uint64_t key, TexelSum& sum) {
+  const scene::Instance& inst = c.low.instances[point.instance];
+  const ao::texels::UvTriangle uv =
+      ao::texels::uv_triangle(inst, c.target.texcoord, point.triangle, c.texture.width, c.texture.height);
+  const int positions = c.texture.texel_samples;
+  for (int j = 0; j < positions; ++j) {
+    glm::dvec2 at(point.x, point.y);
+    if (positions > 1) {
+      const ao::Sample2 offset = ao::sample(ao::Sampler::sobol, std::uint32_t(j), ~key);
+      at += glm::dvec2(offset.u - 0.5, offset.v - 0.5);
+    }
+    const LowPoint low = low_point(inst, c.frames[point.instance], point.triangle, ao::texels::nearest_weights(uv, at));
+    const glm::vec3 n(low.basis[2]);
+    ++sum.rays;
+    if (!(glm::length(n) > 0)) continue;
+    const auto hit = c.high.first_hit(low.position + c.front * n, -n, c.front + c.back);
+    if (!hit) continue;
+    ++sum.hits;
+    sum.normal += tangent_space(low.basis, glm::dvec3(hit->normal));
+    sum.position += glm::dvec3(hit->position);
+    sum.height += double(c.front) - double(hit->distance);
+  }
+}
+
+// The texel's value of each map from its sum (it has hits).
+void store(const TexelSum& sum, const Options& options, std::size_t texel, TextureBake& out) {
+  for (MapImage& image : out.maps) {
+    float* v = &image.values[texel * std::size_t(image.channels)];
+    switch (image.map) {
+      case Map::normal: {
+        glm::dvec3 m = glm::length(sum.normal) > 0 ? glm::normalize(sum.normal) : glm::dvec3(0, 0, 1);
+        if (options.green == Green::directx) m.y = -m.y;
+        for (int k = 0; k < 3; ++k) v[k] = float(std::clamp(m[k] * 0.5 + 0.5, 0.0, 1.0));
+        break;
+      }
+      case Map::height: v[0] = float(sum.height / sum.hits); break;
+      case Map::position:
+        for (int k = 0; k < 3; ++k) v[k] = float(sum.position[k] / sum.hits);
+        break;
+    }
+  }
+}
+
+// What a texel nothing maps holds: a flat normal, zero height and position.
+void background(MapImage& image) {
+  const std::size_t texels = image.values.size() / std::size_t(image.channels);
+  for (std::size_t t = 0; t < texels; ++t) {
+    for (int k = 0; k < image.channels; ++k) {
+      image.values[t * std::size_t(image.channels) + std::size_t(k)] = image.map == Map::normal ? (k == 2 ? 1.0f : 0.5f) : 0.0f;
+    }
+  }
+}
+
+// Missed texels take their nearest hit texel's value (however far); then the traced ones are padded.
+std::size_t fill_and_pad(MapImage& image, const std::vector<bool>& hit, const std::vector<bool>& traced, int width,
+                         int height, int padding) {
+  const std::size_t texels = std::size_t(width) * std::size_t(height);
+  std::size_t padded = 0;
+  std::vector<float> channel(texels), filled;
+  for (int k = 0; k < image.channels; ++k) {
+    for (std::size_t t = 0; t < texels; ++t) channel[t] = image.values[t * std::size_t(image.channels) + std::size_t(k)];
+    filled = channel;
+    ao::texels::pad(filled, hit, width, height, width + height);
+    for (std::size_t t = 0; t < texels; ++t) {
+      if (traced[t] && !hit[t]) channel[t] = filled[t];
+    }
+    padded = ao::texels::pad(channel, traced, width, height, padding);
+    for (std::size_t t = 0; t < texels; ++t) image.values[t * std::size_t(image.channels) + std::size_t(k)] = channel[t];
+  }
+  return padded;
+}
+
+}  // namespace
+
+int channels(Map map) { return map == Map::normal || map == Map::position ? 3 : 1; }
+
+Status check(const Options& options) {
+  if (options.maps.empty()) return Error{"", "a bake needs at least one map", true};
+  if (!(options.front >= 0) || !(options.back >= 0) || !std::isfinite(options.front) || !std::isfinite(options.back) ||
+      options.front + options.back <= 0) {
+    return Error{"", "the cage distances must be finite, 0 or more, and not both 0", true};
+  }
+  return success();
+}
+
+Result<Bake> bake(const scene::Scene& low, const scene::Scene& high, const std::vector<ao::TextureTarget>& targets,
+                  const ao::TextureOptions& texture, const Options& options) {
+  if (Status s = check(options); !s) return s.error();
+  if (Status s = ao::check(texture, kMaxTexelSamples, "bake"); !s) return s.error();
+  const auto start = Clock::now();
+  std::vector<std::vector<CornerFrame>> frames(low.instances.size());
+  for (const ao::TextureTarget& target : targets) {
+    for (std::size_t k : target.instances) {
+      if (k >= low.instances.size()) return Error{"", "internal: a texture target names an instance that does not exist"};
+      const scene::Instance& inst = low.instances[k];
+      if (!frames[k].empty() || std::size_t(target.texcoord) >= inst.texcoords.size()) continue;  // without UVs: skipped
+      auto made = corner_frames(inst, target.texcoord);
+      if (!made) return made.error();
+      frames[k] = std::move(*made);
+    }
+  }
+  auto built = HighPoly::build(high);
+  if (!built) return built.error();
+  Bake result;
+  const double diagonal = 2.0 * double(low.radius());
+  result.front = options.absolute_distances ? options.front : options.front * diagonal;
+  result.back = options.absolute_distances ? options.back : options.back * diagonal;
+  result.setup_seconds = seconds_since(start);
+
+  const auto trace_start = Clock::now();
+  const std::size_t texel_count = std::size_t(texture.width) * std::size_t(texture.height);
+  for (std::size_t index = 0; index < targets.size(); ++index) {
+    const ao::TextureTarget& target = targets[index];
+    auto coverage = ao::texels::cover(low, target, texture.width, texture.height);
+    if (!coverage) return Error{"", (target.name.empty() ? "texture " + std::to_string(index) : target.name) + ": " +
+                                        coverage.error().message};
+    const auto& points = coverage->points;
+    std::vector<std::size_t> runs;  // where each mapped texel's points begin, and the end
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      if (i == 0 || points[i].texel != points[i - 1].texel) runs.push_back(i);
+    }
+    runs.push_back(points.size());
+
+    TextureBake& out = result.textures.emplace_back();
+    out.width = texture.width, out.height = texture.height;
+    for (Map map : options.maps) {
+      MapImage& image = out.maps.emplace_back();
+      image.map = map, image.channels = channels(map);
+      image.values.resize(texel_count * std::size_t(image.channels));
+      background(image);
+    }
+    out.hit.assign(texel_count, 0);
+    out.texels = runs.size() - 1;
+    const TraceContext context{low, frames, **built, target, texture, float(result.front), float(result.back)};
+    std::vector<TexelSum> sums(runs.size() - 1);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, sums.size(), 64), [&](const tbb::blocked_range<std::size_t>& range) {
+      for (std::size_t r = range.begin(); r != range.end(); ++r) {
+        for (std::size_t i = runs[r]; i < runs[r + 1]; ++i) {
+          const std::uint64_t key =
+              ao::sample_key(options.seed, index, points[i].texel) ^ (std::uint64_t(i - runs[r]) << 32);
+          trace_point(context, points[i], key, sums[r]);
+        }
+        if (sums[r].hits > 0) store(sums[r], options, points[runs[r]].texel, out);
+      }
+    });
+    std::vector<bool> hit(texel_count, false), traced(texel_count, false);
+    bool first = true;
+    for (std::size_t r = 0; r < sums.size(); ++r) {
+      const std::size_t texel = points[runs[r]].texel;
+      traced[texel] = true;
+      out.samples += std::size_t(sums[r].rays);
+      out.misses += std::size_t(sums[r].rays - sums[r].hits);
+      if (sums[r].hits == 0) {
+        ++out.missed_texels;
+        continue;
+      }
+      hit[texel] = true;
+      out.hit[texel] = 1;
+      const double h = sums[r].height / sums[r].hits;
+      out.height_min = first ? h : std::min(out.height_min, h);
+      out.height_max = first ? h : std::max(out.height_max, h);
+      first = false;
+    }
+    for (MapImage& image : out.maps) {
+      out.padded = fill_and_pad(image, hit, traced, texture.width, texture.height, ao::padding_for(texture));
+    }
+  }
+  result.trace_seconds = seconds_since(trace_start);
+  return result;
+}
+
+}  // namespace matbake::bake

@@ -1,0 +1,98 @@
+#include "frames.hpp"
+
+#include <glm/geometric.hpp>
+#include <glm/gtc/matrix_inverse.hpp>
+#include <glm/mat3x3.hpp>
+
+#include "mikktspace.hpp"
+
+namespace matbake::bake {
+namespace {
+
+// The scene reverses a mirrored node's triangles (to keep their facing in world space); the file's
+// own order is what its normals, and so MikkTSpace's orientation test, agree with.
+bool mirrored(const scene::Instance& inst) { return glm::determinant(glm::dmat3(inst.world)) < 0; }
+std::array<std::uint32_t, 3> file_order(const scene::Instance& inst, std::size_t t) {
+  const auto& c = inst.triangles[t];
+  return mirrored(inst) ? std::array{c[0], c[2], c[1]} : c;
+}
+// The file's corner k of triangle t is the instance's corner file_corner(k).
+std::size_t file_corner(const scene::Instance& inst, std::size_t k) { return mirrored(inst) && k != 0 ? 3 - k : k; }
+
+}  // namespace
+
+std::vector<glm::vec3> corner_normals(const scene::Instance& inst) {
+  const auto& positions = inst.object.positions;
+  std::vector<glm::vec3> normals(3 * inst.triangles.size());
+  for (std::size_t t = 0; t < inst.triangles.size(); ++t) {
+    const auto c = file_order(inst, t);
+    const glm::vec3 face = glm::cross(positions[c[1]] - positions[c[0]], positions[c[2]] - positions[c[0]]);
+    const float length = glm::length(face);
+    for (std::size_t k = 0; k < 3; ++k) {
+      const glm::vec3 n = inst.object.normals.empty() ? (length > 0 ? face / length : glm::vec3(0, 0, 1))
+                                                      : inst.object.normals[c[k]];
+      normals[3 * t + file_corner(inst, k)] = n;
+    }
+  }
+  return normals;
+}
+
+Result<std::vector<glm::vec4>> corner_tangents(const scene::Instance& inst, int texcoord) {
+  if (inst.object.positions.size() != inst.positions.size()) {
+    return Error{"", "internal: a bake's low-poly was loaded without its object-space attributes"};
+  }
+  const std::size_t corners = 3 * inst.triangles.size();
+  std::vector<glm::vec4> tangents(corners);
+  if (!inst.object.tangents.empty()) {
+    for (std::size_t t = 0; t < inst.triangles.size(); ++t) {
+      for (std::size_t k = 0; k < 3; ++k) tangents[3 * t + k] = inst.object.tangents[inst.triangles[t][k]];
+    }
+    return tangents;
+  }
+  if (texcoord < 0 || std::size_t(texcoord) >= inst.texcoords.size() || inst.texcoords[std::size_t(texcoord)].empty()) {
+    return Error{"", "internal: a bake's low-poly has no TEXCOORD_" + std::to_string(texcoord)};
+  }
+  const auto& uv = inst.texcoords[std::size_t(texcoord)];
+  const std::vector<glm::vec3> normals = corner_normals(inst);
+  std::vector<glm::vec3> file_positions(corners), file_normals(corners);
+  std::vector<glm::vec2> file_uvs(corners);
+  for (std::size_t t = 0; t < inst.triangles.size(); ++t) {
+    const auto c = file_order(inst, t);
+    for (std::size_t k = 0; k < 3; ++k) {
+      file_positions[3 * t + k] = inst.object.positions[c[k]];
+      file_normals[3 * t + k] = normals[3 * t + file_corner(inst, k)];
+      file_uvs[3 * t + k] = uv[c[k]];
+    }
+  }
+  const std::vector<glm::vec4> mikk = mikktspace_tangents({file_positions, file_normals, file_uvs});
+  for (std::size_t t = 0; t < inst.triangles.size(); ++t) {
+    for (std::size_t k = 0; k < 3; ++k) {
+      const glm::vec4& m = mikk[3 * t + k];
+      tangents[3 * t + file_corner(inst, k)] = glm::vec4(m.x, m.y, m.z, -m.w);
+    }
+  }
+  return tangents;
+}
+
+Result<std::vector<CornerFrame>> corner_frames(const scene::Instance& inst, int texcoord) {
+  auto tangents = corner_tangents(inst, texcoord);
+  if (!tangents) return tangents.error();
+  const std::vector<glm::vec3> normals = corner_normals(inst);
+  const glm::dmat3 model(inst.world);
+  const glm::dmat3 normal_matrix = glm::inverseTranspose(model);
+  const auto unit = [](glm::dvec3 v) {
+    const double length = glm::length(v);
+    return length > 0 ? glm::vec3(v / length) : glm::vec3(0);
+  };
+  std::vector<CornerFrame> frames(tangents->size());
+  for (std::size_t c = 0; c < frames.size(); ++c) {
+    const glm::vec4& t = (*tangents)[c];
+    CornerFrame& f = frames[c];
+    f.tangent = unit(model * glm::dvec3(t));
+    f.normal = unit(normal_matrix * glm::dvec3(normals[c]));
+    f.bitangent = unit(glm::dvec3(glm::cross(f.normal, f.tangent)) * double(t.w));
+  }
+  return frames;
+}
+
+}  // namespace matbake::bake

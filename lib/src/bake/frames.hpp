@@ -1,0 +1,32 @@
+#pragma once
+// The low-poly's tangent basis per triangle corner, as a runtime's vertex shader hands it to the
+// pixel shader (three.js with vertex tangents): world-space unit tangent, bitangent and normal.
+#include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
+
+#include <vector>
+
+#include "matbake/result.hpp"
+#include "matbake/scene.hpp"
+
+namespace matbake::bake {
+
+// glTF's TANGENT per corner (3 a triangle, in the instance's triangle order), object space: the
+// file's where it has them, else MikkTSpace's over the file's positions, normals (flat where it has
+// none, as glTF asks a runtime to make them) and UV set `texcoord`, with w negated — glTF's
+// bitangent w · cross(N, T) points up the texture, against increasing v, where MikkTSpace's follows v.
+// Errors: the instance was loaded without its object-space attributes or that UV set.
+Result<std::vector<glm::vec4>> corner_tangents(const scene::Instance& inst, int texcoord);
+
+// The object-space normal per corner: the file's, else the face's (glTF's flat normals).
+std::vector<glm::vec3> corner_normals(const scene::Instance& inst);
+
+struct CornerFrame {
+  glm::vec3 tangent, bitangent, normal;
+};
+
+// T = normalize(M · t), N = normalize(M⁻ᵀ · n), B = normalize(w · cross(N, T)), M the node's world
+// matrix. Errors as corner_tangents'.
+Result<std::vector<CornerFrame>> corner_frames(const scene::Instance& inst, int texcoord);
+
+}  // namespace matbake::bake

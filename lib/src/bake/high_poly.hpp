@@ -1,0 +1,43 @@
+#pragma once
+// The high-poly surface a bake's rays look for: its triangles in Embree (world space), and what a
+// hit on them gives — position, interpolated shading normal, which triangle.
+#include <embree3/rtcore.h>
+
+#include <glm/vec3.hpp>
+
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "../ao/tracer.hpp"
+#include "matbake/result.hpp"
+#include "matbake/scene.hpp"
+
+namespace matbake::bake {
+
+struct Hit {
+  float distance = 0;          // along the ray, from its origin
+  glm::vec3 position{0};       // world space
+  glm::vec3 normal{0};         // the high-poly's shading normal there: its vertex normals interpolated, unit
+  std::uint32_t instance = 0, triangle = 0;
+  glm::vec3 weights{0};        // barycentric, of the triangle's corners
+};
+
+class HighPoly {
+ public:
+  // Errors: Embree failing to start or build.
+  static Result<std::unique_ptr<HighPoly>> build(const scene::Scene& high);
+
+  // The first hit on the front of a face (its winding's normal against the ray) within `length`
+  // of `origin` along the unit `direction`.
+  std::optional<Hit> first_hit(const glm::vec3& origin, const glm::vec3& direction, float length) const;
+
+ private:
+  HighPoly() = default;
+  const scene::Scene* scene_ = nullptr;
+  std::unique_ptr<RTCDeviceTy, ao::DeviceDeleter> device_;
+  std::unique_ptr<RTCSceneTy, ao::SceneDeleter> rtc_;
+  std::vector<std::vector<glm::vec3>> normals_, face_normals_;  // per instance
+};
+
+}  // namespace matbake::bake

@@ -1,0 +1,325 @@
+// The high-to-low bake (matbake/bake.hpp) against closed forms: a hemispherical bump on a plane
+// (height and normal of the high-poly's own surface at each texel, in the plane's tangent basis,
+// both green conventions) and a tessellated sphere onto an icosphere, smooth and flat, rotated and
+// moved (each texel's normal, decoded with the runtime's rule, is the sphere's normal at the hit;
+// the hit lies on the texel's cage ray and on the tessellated sphere). Float64 references; the
+// tolerances are float32's precision or the 8-bit step, derived below.
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include <cmath>
+#include <map>
+#include <numbers>
+
+#include <glm/geometric.hpp>
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "lib/src/bake/frames.hpp"
+#include "matbake/bake.hpp"
+
+namespace matbake::bake {
+namespace {
+
+using glm::dvec3;
+
+// A unit icosphere: the icosahedron with each triangle split in four `subdivisions` times, new
+// vertices pushed out to the sphere; counter-clockwise seen from outside.
+struct Icosphere {
+  std::vector<glm::dvec3> vertices;
+  std::vector<std::array<std::uint32_t, 3>> triangles;
+};
+Icosphere icosphere(int subdivisions) {
+  const double g = (1 + std::sqrt(5.0)) / 2;
+  Icosphere s;
+  for (const dvec3& v : {dvec3(-1, g, 0), dvec3(1, g, 0), dvec3(-1, -g, 0), dvec3(1, -g, 0), dvec3(0, -1, g), dvec3(0, 1, g),
+                         dvec3(0, -1, -g), dvec3(0, 1, -g), dvec3(g, 0, -1), dvec3(g, 0, 1), dvec3(-g, 0, -1), dvec3(-g, 0, 1)}) {
+    s.vertices.push_back(glm::normalize(v));
+  }
+  s.triangles = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
+                 {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
+                 {3, 8, 9},  {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
+  for (int level = 0; level < subdivisions; ++level) {
+    std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint32_t> middle;
+    const auto mid = [&](std::uint32_t a, std::uint32_t b) {
+      const auto key = std::minmax(a, b);
+      auto [it, added] = middle.try_emplace(key, std::uint32_t(s.vertices.size()));
+      if (added) s.vertices.push_back(glm::normalize(s.vertices[a] + s.vertices[b]));
+      return it->second;
+    };
+    std::vector<std::array<std::uint32_t, 3>> finer;
+    for (const auto& t : s.triangles) {
+      const std::uint32_t ab = mid(t[0], t[1]), bc = mid(t[1], t[2]), ca = mid(t[2], t[0]);
+      finer.push_back({t[0], ab, ca}), finer.push_back({t[1], bc, ab}), finer.push_back({t[2], ca, bc});
+      finer.push_back({ab, bc, ca});
+    }
+    s.triangles = std::move(finer);
+  }
+  return s;
+}
+
+// An instance whose object space is `world`'s preimage: positions and normals given in object
+// space, carried to world space as the scene loader does.
+scene::Instance placed(const std::vector<dvec3>& positions, const std::vector<dvec3>& normals,
+                       std::vector<std::array<std::uint32_t, 3>> triangles, const glm::dmat4& world) {
+  scene::Instance inst;
+  inst.world = world;
+  inst.triangles = std::move(triangles);
+  if (glm::determinant(glm::dmat3(world)) < 0) {  // as the loader keeps a mirrored node's facing
+    for (auto& t : inst.triangles) std::swap(t[1], t[2]);
+  }
+  const glm::dmat3 normal_matrix = glm::transpose(glm::inverse(glm::dmat3(world)));
+  for (std::size_t v = 0; v < positions.size(); ++v) {
+    inst.object.positions.emplace_back(positions[v]);
+    inst.positions.emplace_back(world * glm::dvec4(positions[v], 1));
+    if (normals.empty()) continue;
+    inst.object.normals.emplace_back(normals[v]);
+    inst.normals.emplace_back(glm::normalize(normal_matrix * normals[v]));
+  }
+  return inst;
+}
+
+scene::Scene scene_of(std::vector<scene::Instance> instances) {
+  scene::Scene s;
+  s.instances = std::move(instances);
+  s.bounds_min = s.bounds_max = s.instances[0].positions[0];
+  for (const auto& inst : s.instances) {
+    for (const auto& p : inst.positions) s.bounds_min = glm::min(s.bounds_min, p), s.bounds_max = glm::max(s.bounds_max, p);
+  }
+  return s;
+}
+
+const MapImage& map_of(const TextureBake& t, Map map) {
+  for (const MapImage& m : t.maps) {
+    if (m.map == map) return m;
+  }
+  throw std::runtime_error("map not baked");
+}
+dvec3 texel3(const MapImage& m, std::size_t texel) {
+  const float* v = &m.values[3 * texel];
+  return dvec3(v[0], v[1], v[2]);
+}
+
+// The plane z = 0 over [-1, 1]², two triangles, u = (x + 1)/2, v = (1 - y)/2: up the texture is +y,
+// so glTF's tangent basis is T = +x, B = +y, N = +z and a normal (x, y, z) is stored as itself.
+// The high-poly: an n × n grid over the same square, lifted onto a hemisphere of radius r at the
+// origin (z = √(r² − x² − y²) inside it) with the sphere's normals there, +z outside.
+struct BumpPair {
+  scene::Scene low, high;
+  int n;
+  double r;
+};
+BumpPair bump_pair(int n, double r) {
+  BumpPair pair{scene_of({placed({{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}}, {{0, 0, 1}, {0, 0, 1}, {0, 0, 1}, {0, 0, 1}},
+                                 {{0, 1, 2}, {0, 2, 3}}, glm::dmat4(1))}),
+                {}, n, r};
+  scene::Instance& low = pair.low.instances[0];
+  low.texcoords.push_back({{0, 1}, {1, 1}, {1, 0}, {0, 0}});
+  std::vector<dvec3> positions, normals;
+  for (int j = 0; j <= n; ++j) {
+    for (int i = 0; i <= n; ++i) {
+      const double x = -1 + 2.0 * i / n, y = -1 + 2.0 * j / n, d2 = x * x + y * y;
+      const double z = d2 < r * r ? std::sqrt(r * r - d2) : 0;
+      positions.emplace_back(x, y, z);
+      normals.push_back(d2 < r * r ? dvec3(x, y, z) / r : dvec3(0, 0, 1));
+    }
+  }
+  std::vector<std::array<std::uint32_t, 3>> triangles;
+  const auto at = [&](int i, int j) { return std::uint32_t(j * (n + 1) + i); };
+  for (int j = 0; j < n; ++j) {
+    for (int i = 0; i < n; ++i) {
+      triangles.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
+      triangles.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
+    }
+  }
+  pair.high = scene_of({placed(positions, normals, triangles, glm::dmat4(1))});
+  return pair;
+}
+
+// The high-poly bump's surface over (x, y), in float64: the grid triangle holding the point, its
+// barycentric weights, height and interpolated normal (normalized).
+struct Surface {
+  double z;
+  dvec3 normal;
+};
+Surface bump_surface(const BumpPair& pair, double x, double y) {
+  const scene::Instance& high = pair.high.instances[0];
+  const double s = (x + 1) / 2 * pair.n, t = (y + 1) / 2 * pair.n;
+  const int i = std::min(int(s), pair.n - 1), j = std::min(int(t), pair.n - 1);
+  const double fx = s - i, fy = t - j;
+  const std::size_t cell = 2 * std::size_t(j * pair.n + i);
+  // Lower triangle (i,j) (i+1,j) (i+1,j+1) where fx ≥ fy; upper (i,j) (i+1,j+1) (i,j+1).
+  const auto& tri = high.triangles[fx >= fy ? cell : cell + 1];
+  const dvec3 w = fx >= fy ? dvec3(1 - fx, fx - fy, fy) : dvec3(1 - fy, fx, fy - fx);
+  Surface out{0, dvec3(0)};
+  for (int k = 0; k < 3; ++k) {
+    out.z += w[k] * double(high.positions[tri[std::size_t(k)]].z);
+    out.normal += w[k] * dvec3(high.normals[tri[std::size_t(k)]]);
+  }
+  out.normal = glm::normalize(out.normal);
+  return out;
+}
+
+TEST(Bake, ABumpOnAPlaneGivesTheHighPolysHeightAndNormalInThePlanesBasis) {
+  const BumpPair pair = bump_pair(40, 0.5);
+  for (const Green green : {Green::opengl, Green::directx}) {
+    Options options;
+    options.maps = {Map::normal, Map::height, Map::position};
+    options.front = 0.75, options.back = 0.25, options.absolute_distances = true;
+    options.green = green;
+    ao::TextureOptions texture{.width = 64, .height = 64, .padding = 2, .texel_samples = 1};
+    auto baked = bake(pair.low, pair.high, {ao::TextureTarget{{0}, 0}}, texture, options);
+    ASSERT_TRUE(baked) << baked.error().message;
+    const TextureBake& t = baked->textures.at(0);
+    EXPECT_EQ(t.texels, 64u * 64u);
+    EXPECT_EQ(t.misses, 0u);
+    double lowest = 1, highest = 0;
+    for (int j = 0; j < 64; ++j) {
+      for (int i = 0; i < 64; ++i) {
+        const double x = 2 * (i + 0.5) / 64 - 1, y = 1 - 2 * (j + 0.5) / 64;
+        const Surface s = bump_surface(pair, x, y);
+        lowest = std::min(lowest, s.z), highest = std::max(highest, s.z);
+        const std::size_t texel = std::size_t(j * 64 + i);
+        // float32: positions of magnitude 1 and distances of 0.75, a few ulps each.
+        ASSERT_NEAR(map_of(t, Map::height).values[texel], s.z, 1e-6) << i << "," << j;
+        const dvec3 p = texel3(map_of(t, Map::position), texel);
+        ASSERT_NEAR(glm::length(p - dvec3(x, y, s.z)), 0, 1e-6) << i << "," << j;
+        dvec3 want = s.normal;
+        if (green == Green::directx) want.y = -want.y;
+        const dvec3 got = texel3(map_of(t, Map::normal), texel) * 2.0 - 1.0;
+        ASSERT_NEAR(glm::length(got - want), 0, 1e-6) << i << "," << j << " green " << int(green);
+      }
+    }
+    EXPECT_NEAR(t.height_min, lowest, 1e-6);
+    EXPECT_NEAR(t.height_max, highest, 1e-6);
+  }
+}
+
+// A unit icosphere of 80 triangles placed by `world`, each triangle its own UV island: triangle k in
+// cell (k mod 9, k div 9) of a 9 × 9 grid, its corners at (0.1, 0.1), (0.9, 0.1), (0.1, 0.9) of the
+// cell. Normals radial (smooth) or the face's (flat).
+constexpr int kCells = 9;
+scene::Instance icosphere_low(bool flat, const glm::dmat4& world) {
+  const Icosphere ico = icosphere(1);
+  std::vector<dvec3> positions, normals;
+  std::vector<glm::vec2> uv;
+  std::vector<std::array<std::uint32_t, 3>> triangles;
+  const glm::dvec2 corner_at[3] = {{0.1, 0.1}, {0.9, 0.1}, {0.1, 0.9}};
+  for (std::size_t k = 0; k < ico.triangles.size(); ++k) {
+    const auto& t = ico.triangles[k];
+    const dvec3 face = glm::normalize(glm::cross(ico.vertices[t[1]] - ico.vertices[t[0]], ico.vertices[t[2]] - ico.vertices[t[0]]));
+    const glm::dvec2 cell(double(k % kCells), double(k / kCells));
+    for (int c = 0; c < 3; ++c) {
+      positions.push_back(ico.vertices[t[std::size_t(c)]]);
+      normals.push_back(flat ? face : ico.vertices[t[std::size_t(c)]]);
+      uv.emplace_back((cell + corner_at[c]) / double(kCells));
+    }
+    triangles.push_back({std::uint32_t(3 * k), std::uint32_t(3 * k + 1), std::uint32_t(3 * k + 2)});
+  }
+  scene::Instance inst = placed(positions, normals, triangles, world);
+  inst.texcoords.push_back(uv);
+  return inst;
+}
+
+// The runtime's shading normal at barycentric weights w of a low triangle for the decoded texel m,
+// in float64 (three.js with vertex tangents): per corner T = normalize(M t), N = normalize(M⁻ᵀ n),
+// B = normalize(w_t · cross(N, T)); interpolated, each normalized; normalize(T·m.x + B·m.y + N·m.z).
+struct CornerAttributes {
+  std::vector<glm::vec4> tangents;  // glTF's TANGENT, object space
+  std::vector<glm::vec3> normals;   // object space
+};
+glm::dmat3 runtime_basis(const scene::Instance& low, const CornerAttributes& corners, std::size_t triangle, const dvec3& w) {
+  const auto& [tangents, normals] = corners;
+  const glm::dmat3 model(low.world), normal_matrix = glm::transpose(glm::inverse(model));
+  dvec3 t(0), b(0), n(0);
+  for (int k = 0; k < 3; ++k) {
+    const std::size_t c = 3 * triangle + std::size_t(k);
+    const dvec3 tc = glm::normalize(model * dvec3(tangents[c])), nc = glm::normalize(normal_matrix * dvec3(normals[c]));
+    t += w[k] * tc, n += w[k] * nc;
+    b += w[k] * glm::normalize(glm::cross(nc, tc) * double(tangents[c].w));
+  }
+  return glm::dmat3(glm::normalize(t), glm::normalize(b), glm::normalize(n));
+}
+
+double angle(const dvec3& a, const dvec3& b) { return std::atan2(glm::length(glm::cross(a, b)), glm::dot(a, b)); }
+double frobenius(const glm::dmat3& m) {
+  double s = 0;
+  for (int c = 0; c < 3; ++c) s += glm::dot(m[c], m[c]);
+  return std::sqrt(s);
+}
+
+// The high-poly: the unit sphere at `centre` tessellated into 5120 triangles, radial normals. At any
+// point q of one of its triangles the interpolated normal is parallel to q − centre (the weights
+// that give q from the vertices give Σ w (v − centre) = q − centre): the sphere's own normal there.
+// Each low texel's decoded normal must give it back; the hit must lie on the texel's cage ray
+// (along the low-poly's interpolated normal) and on the tessellation (between its innermost plane
+// and the sphere).
+TEST(Bake, ATessellatedSphereOntoAnIcosphereDecodesToTheSpheresNormalAtEachHit) {
+  const dvec3 centre(0.3, -0.2, 0.5);
+  const Icosphere fine = icosphere(4);
+  std::vector<dvec3> high_positions, high_normals;
+  for (const dvec3& v : fine.vertices) high_positions.push_back(centre + v), high_normals.push_back(v);
+  const scene::Scene high = scene_of({placed(high_positions, high_normals, fine.triangles, glm::dmat4(1))});
+  double innermost = 1;  // the least distance from the centre to a high triangle's plane
+  for (const auto& t : fine.triangles) {
+    const dvec3 n = glm::normalize(glm::cross(fine.vertices[t[1]] - fine.vertices[t[0]], fine.vertices[t[2]] - fine.vertices[t[0]]));
+    innermost = std::min(innermost, glm::dot(n, fine.vertices[t[0]]));
+  }
+  const glm::dmat4 rotated = glm::rotate(glm::translate(glm::dmat4(1), centre), 0.7, glm::normalize(dvec3(1, 2, 3)));
+  const glm::dmat4 mirrored = glm::scale(rotated, dvec3(-1, 1, 1));
+  constexpr int kSide = 9 * 32;
+  for (const bool flat : {false, true}) {
+    for (const glm::dmat4& world : {rotated, mirrored}) {
+      const std::string what = std::string(flat ? "flat" : "smooth") + (world == mirrored ? ", mirrored" : ", rotated");
+      const scene::Scene low = scene_of({icosphere_low(flat, world)});
+      Options options;
+      options.maps = {Map::normal, Map::position};
+      options.front = 0.3, options.back = 0.3, options.absolute_distances = true;
+      auto baked = bake(low, high, {ao::TextureTarget{{0}, 0}}, {.width = kSide, .height = kSide, .padding = 2}, options);
+      ASSERT_TRUE(baked) << baked.error().message;
+      const TextureBake& t = baked->textures.at(0);
+      EXPECT_EQ(t.misses, 0u) << what;
+      const scene::Instance& inst = low.instances[0];
+      const CornerAttributes corners{*corner_tangents(inst, 0), corner_normals(inst)};
+      std::size_t checked = 0;
+      for (int j = 0; j < kSide; ++j) {
+        for (int i = 0; i < kSide; ++i) {
+          // The texel centre in its cell, and its weights in the cell's triangle when strictly inside.
+          const double cu = (i + 0.5) / kSide * kCells, cv = (j + 0.5) / kSide * kCells;
+          const std::size_t k = std::size_t(cv) * kCells + std::size_t(cu);
+          const double a = (cu - std::floor(cu) - 0.1) / 0.8, b = (cv - std::floor(cv) - 0.1) / 0.8;
+          if (k >= inst.triangles.size() || a <= 1e-9 || b <= 1e-9 || a + b >= 1 - 1e-9) continue;
+          const dvec3 w(1 - a - b, a, b);
+          const std::size_t texel = std::size_t(j * kSide + i);
+          ASSERT_EQ(t.hit[texel], 1) << what;
+          dvec3 p(0), n(0);  // the triangle's vertices are 3k, 3k + 1, 3k + 2 in the file's order
+          for (int c = 0; c < 3; ++c) {
+            p += w[c] * dvec3(inst.positions[3 * k + std::size_t(c)]);
+            n += w[c] * dvec3(inst.normals[3 * k + std::size_t(c)]);
+          }
+          const dvec3 q = texel3(map_of(t, Map::position), texel);
+          ASSERT_LT(glm::length(glm::cross(q - p, glm::normalize(n))), 1e-5) << what << ": the hit is off the ray";
+          ASSERT_GE(glm::length(q - centre), innermost - 1e-6) << what;
+          ASSERT_LE(glm::length(q - centre), 1 + 1e-6) << what;
+          const dvec3 sphere_normal = glm::normalize(q - centre);
+          // The loader reversed a mirrored node's triangles: corner 1 of the instance is the file's 2.
+          const glm::dmat3 basis = runtime_basis(inst, corners, k, world == mirrored ? dvec3(w[0], w[2], w[1]) : w);
+          const dvec3 m = texel3(map_of(t, Map::normal), texel) * 2.0 - 1.0;
+          // float32 storage and arithmetic: a few ulps of unit vectors.
+          ASSERT_LT(angle(glm::normalize(basis * m), sphere_normal), 1e-5) << what << " texel " << i << "," << j;
+          // As 8 bits: each component off by Δ (at most half a code, 1/255), the shading moves by at
+          // most atan(‖M‖ |Δ| / (1/‖M⁻¹‖ − ‖M‖ |Δ|)), spectral norms bounded by Frobenius ones.
+          dvec3 m8;
+          for (int c = 0; c < 3; ++c) m8[c] = std::round((m[c] + 1) / 2 * 255) / 255 * 2 - 1;
+          const double step = frobenius(basis) * glm::length(m8 - m);
+          const double bound = std::atan(step / (glm::length(m) / frobenius(glm::inverse(basis)) - step));
+          ASSERT_LE(angle(glm::normalize(basis * m8), sphere_normal), bound + 1e-5) << what;
+          ++checked;
+        }
+      }
+      EXPECT_GT(checked, std::size_t(kSide * kSide) / 4) << what;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace matbake::bake
