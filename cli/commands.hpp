@@ -12,6 +12,7 @@
 #include "ao_options.hpp"
 #include "material_sources.hpp"
 #include "matbake/ao.hpp"
+#include "matbake/bake_file.hpp"
 #include "matbake/convert.hpp"
 #include "matbake/export.hpp"
 #include "matbake/pipeline.hpp"
@@ -122,6 +123,16 @@ struct BakeAoSettings {
 };
 CLI::App* setup_bake_ao(CLI::App& app, BakeAoSettings& settings);
 int run_bake_ao(const BakeAoSettings& settings, const GlobalOptions& global);
+
+struct BakeSettings {
+  std::string low;
+  std::string high;
+  std::string output;
+  bake::FileOptions options;  // its tree (bake::request_tree); high and output set at run
+  std::vector<std::set<std::string>> given;
+};
+CLI::App* setup_bake(CLI::App& app, BakeSettings& settings);
+int run_bake(const BakeSettings& settings, const GlobalOptions& global);
 
 struct ExportSettings {
   std::string scene;

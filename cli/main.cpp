@@ -106,7 +106,8 @@ int main(int argc, char** argv) {
       command(app, setup_pack, run_pack),         command(app, setup_unpack, run_unpack),
       command(app, setup_workflow, run_workflow), command(app, setup_materials, run_materials),
       command(app, setup_validate, run_validate), command(app, setup_bake_ao, run_bake_ao),
-      command(app, setup_export, run_export),     command(app, setup_build, run_build),
+      command(app, setup_bake, run_bake),         command(app, setup_export, run_export),
+      command(app, setup_build, run_build),
       command(app, setup_plan, run_plan),         command(app, setup_inspect, run_inspect),
   };
 

@@ -44,6 +44,16 @@ LowPoint low_point(const scene::Instance& inst, const std::vector<CornerFrame>& 
   return {glm::vec3(p), glm::dmat3(unit(t), unit(b), unit(n))};
 }
 
+// A point on an edge (a texel centre past a triangle, clamped to it) moved a hair inside: a ray at
+// an open edge of the high-poly where it meets the low-poly's (a bake of a mesh onto itself or its
+// simplification keeps the borders) misses it as often as it hits it, and is cast again from there.
+bool on_edge(const glm::dvec3& w) { return !(w.x > 0 && w.y > 0 && w.z > 0); }
+glm::dvec3 inside(glm::dvec3 w) {
+  constexpr double kLeast = 1e-5;  // of the triangle's size: float32 resolves 1e-7 of the positions
+  w = glm::max(w, glm::dvec3(kLeast));
+  return w / (w.x + w.y + w.z);
+}
+
 // The texel's (x, y, z) whose shading, normalize(T·x + B·y + N·z), is the world normal h: the basis
 // inverted, then scaled to unit length (the texture holds unit vectors). A basis with no inverse
 // (the interpolated vectors coplanar) is projected onto instead.
@@ -70,6 +80,13 @@ struct TraceContext {
   float front, back;
 };
 
+// The cage ray at a low-poly point: from `front` outside along its normal to `back` inside.
+std::optional<Hit> cast(const TraceContext& c, const LowPoint& low) {
+  const glm::vec3 n(low.basis[2]);
+  if (!(glm::length(n) > 0)) return std::nullopt;
+  return c.high.first_hit(low.position + c.front * n, -n, c.front + c.back);
+}
+
 // The texel positions of one surface point (K = texel_samples, stratified over the footprint by the
 // (0, 2)-sequence as the AO bake's, each clamped to the triangle), one ray each.
 void trace_point(const TraceContext& c, const ao::texels::SurfacePoint& point, std::uint64_t key, TexelSum& sum) {
@@ -83,11 +100,14 @@ void trace_point(const TraceContext& c, const ao::texels::SurfacePoint& point, s
       const ao::Sample2 offset = ao::sample(ao::Sampler::sobol, std::uint32_t(j), ~key);
       at += glm::dvec2(offset.u - 0.5, offset.v - 0.5);
     }
-    const LowPoint low = low_point(inst, c.frames[point.instance], point.triangle, ao::texels::nearest_weights(uv, at));
-    const glm::vec3 n(low.basis[2]);
+    const glm::dvec3 w = ao::texels::nearest_weights(uv, at);
+    LowPoint low = low_point(inst, c.frames[point.instance], point.triangle, w);
     ++sum.rays;
-    if (!(glm::length(n) > 0)) continue;
-    const auto hit = c.high.first_hit(low.position + c.front * n, -n, c.front + c.back);
+    auto hit = cast(c, low);
+    if (!hit && on_edge(w)) {
+      low = low_point(inst, c.frames[point.instance], point.triangle, inside(w));
+      hit = cast(c, low);
+    }
     if (!hit) continue;
     ++sum.hits;
     sum.normal += tangent_space(low.basis, glm::dvec3(hit->normal));

@@ -9,23 +9,22 @@
 namespace matbake::bake {
 namespace {
 
-// The scene reverses a mirrored node's triangles (to keep their facing in world space); the file's
-// own order is what its normals, and so MikkTSpace's orientation test, agree with.
 bool mirrored(const scene::Instance& inst) { return glm::determinant(glm::dmat3(inst.world)) < 0; }
-std::array<std::uint32_t, 3> file_order(const scene::Instance& inst, std::size_t t) {
+
+}  // namespace
+
+std::array<std::uint32_t, 3> file_triangle(const scene::Instance& inst, std::size_t t) {
   const auto& c = inst.triangles[t];
   return mirrored(inst) ? std::array{c[0], c[2], c[1]} : c;
 }
-// The file's corner k of triangle t is the instance's corner file_corner(k).
-std::size_t file_corner(const scene::Instance& inst, std::size_t k) { return mirrored(inst) && k != 0 ? 3 - k : k; }
 
-}  // namespace
+std::size_t file_corner(const scene::Instance& inst, std::size_t k) { return mirrored(inst) && k != 0 ? 3 - k : k; }
 
 std::vector<glm::vec3> corner_normals(const scene::Instance& inst) {
   const auto& positions = inst.object.positions;
   std::vector<glm::vec3> normals(3 * inst.triangles.size());
   for (std::size_t t = 0; t < inst.triangles.size(); ++t) {
-    const auto c = file_order(inst, t);
+    const auto c = file_triangle(inst, t);
     const glm::vec3 face = glm::cross(positions[c[1]] - positions[c[0]], positions[c[2]] - positions[c[0]]);
     const float length = glm::length(face);
     for (std::size_t k = 0; k < 3; ++k) {
@@ -57,7 +56,7 @@ Result<std::vector<glm::vec4>> corner_tangents(const scene::Instance& inst, int 
   std::vector<glm::vec3> file_positions(corners), file_normals(corners);
   std::vector<glm::vec2> file_uvs(corners);
   for (std::size_t t = 0; t < inst.triangles.size(); ++t) {
-    const auto c = file_order(inst, t);
+    const auto c = file_triangle(inst, t);
     for (std::size_t k = 0; k < 3; ++k) {
       file_positions[3 * t + k] = inst.object.positions[c[k]];
       file_normals[3 * t + k] = normals[3 * t + file_corner(inst, k)];

@@ -11,6 +11,12 @@
 
 namespace matbake::bake {
 
+// Triangle t's vertices in the file's winding: the scene reverses a mirrored node's triangles (to
+// keep their facing in world space), and the file's order is what its normals, and so MikkTSpace's
+// orientation test, agree with. The file's corner k of triangle t is the instance's file_corner(k).
+std::array<std::uint32_t, 3> file_triangle(const scene::Instance& inst, std::size_t t);
+std::size_t file_corner(const scene::Instance& inst, std::size_t k);
+
 // glTF's TANGENT per corner (3 a triangle, in the instance's triangle order), object space: the
 // file's where it has them, else MikkTSpace's over the file's positions, normals (flat where it has
 // none, as glTF asks a runtime to make them) and UV set `texcoord`, with w negated — glTF's

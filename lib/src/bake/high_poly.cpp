@@ -20,7 +20,7 @@ Result<std::unique_ptr<HighPoly>> HighPoly::build(const scene::Scene& high) {
   h->face_normals_.resize(count);  // sized once: the filter functions keep pointers into it
   tbb::parallel_for(std::size_t{0}, count, [&](std::size_t k) {
     const scene::Instance& inst = high.instances[k];
-    h->normals_[k] = ao::shading_normals(inst);
+    if (!inst.normals.empty()) h->normals_[k] = ao::shading_normals(inst);  // none: glTF's flat normals
     auto& faces = h->face_normals_[k];
     faces.reserve(inst.triangles.size());
     for (const auto& t : inst.triangles) {
@@ -61,7 +61,7 @@ std::optional<Hit> HighPoly::first_hit(const glm::vec3& origin, const glm::vec3&
   glm::vec3 n(0);
   for (std::size_t k = 0; k < 3; ++k) {
     hit.position += hit.weights[int(k)] * inst.positions[corners[k]];
-    n += hit.weights[int(k)] * normals[corners[k]];
+    if (!normals.empty()) n += hit.weights[int(k)] * normals[corners[k]];
   }
   // Opposite vertex normals that cancel: the face's own.
   if (!(glm::length(n) > 0)) n = face_normals_[hit.instance][hit.triangle];

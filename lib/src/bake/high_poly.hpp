@@ -18,7 +18,8 @@ namespace matbake::bake {
 struct Hit {
   float distance = 0;          // along the ray, from its origin
   glm::vec3 position{0};       // world space
-  glm::vec3 normal{0};         // the high-poly's shading normal there: its vertex normals interpolated, unit
+  glm::vec3 normal{0};         // the high-poly's shading normal there, unit: its vertex normals
+                               // interpolated, or its face's where it has none (glTF's flat normals)
   std::uint32_t instance = 0, triangle = 0;
   glm::vec3 weights{0};        // barycentric, of the triangle's corners
 };
@@ -37,7 +38,7 @@ class HighPoly {
   const scene::Scene* scene_ = nullptr;
   std::unique_ptr<RTCDeviceTy, ao::DeviceDeleter> device_;
   std::unique_ptr<RTCSceneTy, ao::SceneDeleter> rtc_;
-  std::vector<std::vector<glm::vec3>> normals_, face_normals_;  // per instance
+  std::vector<std::vector<glm::vec3>> normals_, face_normals_;  // per instance; no normals: flat
 };
 
 }  // namespace matbake::bake

@@ -1,0 +1,63 @@
+#include <nlohmann/json.hpp>
+
+#include <cstdio>
+
+#include "commands.hpp"
+#include "matbake/bake_params.hpp"
+#include "params_cli.hpp"
+
+namespace matbake::cli {
+
+CLI::App* setup_bake(CLI::App& app, BakeSettings& s) {
+  CLI::App* cmd = app.add_subcommand(
+      "bake",
+      "Bake a high-poly mesh onto a low-poly one's UVs (docs/bake.md): per texel, rays from a cage around the\n"
+      "low-poly along its normal find the high-poly; its normal in the low-poly's tangent basis (the TANGENT\n"
+      "written, MikkTSpace where the file has none) becomes the material's normalTexture; height and position\n"
+      "are written as float EXR files beside the output.");
+  cmd->add_option("low", s.low, "The low-poly .gltf or .glb (its UVs take the maps)")->required();
+  cmd->add_option("--from", s.high, "The high-poly .gltf or .glb")->required();
+  cmd->add_option("-o,--output", s.output, "Output .gltf (+ .bin beside it) or .glb")->required();
+  add_tree(*cmd, bake::request_tree(), s.options, s.given, {"Options", "Options"});
+  return cmd;
+}
+
+int run_bake(const BakeSettings& s, const GlobalOptions& global) {
+  bake::FileOptions options = s.options;
+  options.high = s.high;
+  options.output = s.output;
+  if (Status st = finish_tree(bake::request_tree(), options, s.given); !st) return report_error(st.error());
+  auto report = bake::bake_file(s.low, options);
+  if (!report) return report_error(report.error());
+  if (global.json) {
+    nlohmann::json textures = nlohmann::json::array();
+    for (const bake::TextureReport& t : report->textures) {
+      textures.push_back({{"material", t.material}, {"name", t.name}, {"width", t.width}, {"height", t.height},
+                          {"texcoord", t.texcoord}, {"texels", t.texels}, {"rays", t.samples}, {"misses", t.misses},
+                          {"missed_texels", t.missed_texels}, {"padded", t.padded}, {"height_min", t.height_min},
+                          {"height_max", t.height_max}, {"files", t.files}, {"existing", t.existing}});
+    }
+    std::cout << nlohmann::json{{"command", "bake"}, {"low", s.low}, {"high", s.high}, {"output", s.output},
+                                {"front", report->front}, {"back", report->back}, {"textures", textures},
+                                {"tangent_primitives", report->tangent_primitives}, {"split_vertices", report->split_vertices},
+                                {"seconds", report->seconds}, {"setup_seconds", report->setup_seconds},
+                                {"trace_seconds", report->trace_seconds}, {"notes", report->notes}, {"written", report->written}}
+                     .dump(2)
+              << "\n";
+  } else if (!global.quiet) {
+    for (const std::string& note : report->notes) std::cout << "note: " << escape_control(note) << "\n";
+    for (const bake::TextureReport& t : report->textures) {
+      std::printf("  material %d %s: %dx%d, %zu texels, %zu rays, %zu missed (%zu texels filled)", t.material,
+                  escape_control(t.name).c_str(), t.width, t.height, t.texels, t.samples, t.misses, t.missed_texels);
+      if (t.height_max > t.height_min) std::printf(", height %.4g to %.4g", t.height_min, t.height_max);
+      std::printf("\n");
+    }
+    std::printf("%s: %zu textures, cage %.4g out / %.4g in, tangents on %zu primitives (%zu vertices split), %.2f s "
+                "(trace %.2f s)\n",
+                s.output.c_str(), report->textures.size(), report->front, report->back, report->tangent_primitives,
+                report->split_vertices, report->seconds, report->trace_seconds);
+  }
+  return kOk;
+}
+
+}  // namespace matbake::cli

@@ -1,0 +1,51 @@
+#pragma once
+// `matbake bake LOW --from HIGH -o OUT`: the high-poly's maps baked onto the low-poly's UVs, one
+// texture set per low-poly material (bake.hpp), and the low-poly written again with them: the
+// normal map as the material's normalTexture (with TANGENT written, so that every runtime shades
+// in the basis it was baked in), height and position as float EXR files beside the output.
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "matbake/bake.hpp"
+#include "matbake/image.hpp"
+
+namespace matbake::bake {
+
+struct Request {
+  Options bake;
+  ao::TextureOptions texture{.width = 1024, .height = 1024, .padding = -1, .texel_samples = 4};
+};
+
+struct FileOptions {
+  std::filesystem::path high;    // .gltf or .glb: the surface the maps come from
+  std::filesystem::path output;  // .gltf or .glb
+  Request request;
+  image::Encoding encoding;      // of the normal map's PNG
+};
+
+struct TextureReport {
+  int material = -1;
+  std::string name;                // the material's
+  int width = 0, height = 0, texcoord = 0;
+  std::size_t texels = 0, samples = 0, misses = 0, missed_texels = 0, padded = 0;
+  double height_min = 0, height_max = 0;
+  std::vector<std::string> files;  // per map, in the order asked: the image's URI or the file written
+  std::string existing;            // what happened to the material's own normalTexture ("", "replaced")
+};
+
+struct FileReport {
+  std::vector<TextureReport> textures;
+  std::size_t tangent_primitives = 0;  // primitives given TANGENT
+  std::size_t split_vertices = 0;      // vertices added where corners needed different tangents
+  double front = 0, back = 0;          // the cage, scene units
+  double seconds = 0, setup_seconds = 0, trace_seconds = 0;
+  std::vector<std::string> notes;
+  std::vector<std::string> written;    // files
+};
+
+// Errors: either file unreadable (named), an output onto an input, no low-poly material with the
+// UV set, options out of range.
+Result<FileReport> bake_file(const std::filesystem::path& low, const FileOptions& options);
+
+}  // namespace matbake::bake

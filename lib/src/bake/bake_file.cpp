@@ -1,0 +1,216 @@
+// `matbake bake`: the low-poly document read once, its scene and the high-poly's, the maps baked per
+// material, written into the document (normalTexture, TANGENT) and beside it (float maps).
+#include <chrono>
+#include <map>
+#include <set>
+
+#include "../gltf/tangents.hpp"
+#include "../gltf/texture_files.hpp"
+#include "../scene/from_document.hpp"
+#include "frames.hpp"
+#include "matbake/bake_file.hpp"
+#include "matbake/output_check.hpp"
+
+namespace matbake::bake {
+namespace fs = std::filesystem;
+namespace {
+
+using gltf::Json;
+
+struct Targets {
+  std::vector<ao::TextureTarget> targets;
+  std::vector<int> materials;  // each target's
+  std::vector<std::string> notes;
+};
+
+// The UV set a material's normal map is read through: its normalTexture's, else 0.
+int normal_texcoord(const Json& material) {
+  if (!material.contains("normalTexture") || !material["normalTexture"].is_object()) return 0;
+  return gltf::integer_in<int>(material["normalTexture"], "texCoord", 0, 0);
+}
+
+// One target per material the low-poly's instances use, when every one of them has its UV set.
+Result<Targets> material_targets(const gltf::Document& doc, const scene::Scene& low) {
+  const Json& materials = gltf::array_in(doc.json, "materials");
+  std::map<int, std::vector<std::size_t>> by_material;
+  Targets out;
+  for (std::size_t k = 0; k < low.instances.size(); ++k) {
+    const int m = low.instances[k].material;
+    if (m >= 0 && std::size_t(m) < materials.size()) by_material[m].push_back(k);
+  }
+  if (std::size_t without = low.instances.size() - [&] {
+        std::size_t n = 0;
+        for (const auto& [m, k] : by_material) n += k.size();
+        return n;
+      }()) {
+    out.notes.push_back(std::to_string(without) + " placed primitives have no material: nothing baked onto them");
+  }
+  for (const auto& [m, instances] : by_material) {
+    const Json& material = materials[std::size_t(m)];
+    ao::TextureTarget target{instances, normal_texcoord(material)};
+    target.name = "material " + std::to_string(m) + " '" + gltf::name_in(material, "") + "'";
+    const auto lacking = std::find_if(instances.begin(), instances.end(), [&](std::size_t k) {
+      const auto& uv = low.instances[k].texcoords;
+      return std::size_t(target.texcoord) >= uv.size() || uv[std::size_t(target.texcoord)].empty();
+    });
+    if (lacking != instances.end()) {
+      out.notes.push_back(target.name + " is used by mesh " + std::to_string(low.instances[*lacking].mesh) + " primitive " +
+                          std::to_string(low.instances[*lacking].primitive) + ", which has no TEXCOORD_" +
+                          std::to_string(target.texcoord) + ": not baked");
+      continue;
+    }
+    std::set<std::pair<int, int>> placed;
+    for (std::size_t k : instances) {
+      if (!placed.insert({low.instances[k].mesh, low.instances[k].primitive}).second) {
+        out.notes.push_back(target.name + ": mesh " + std::to_string(low.instances[k].mesh) +
+                            " is placed by several nodes; its texels hold the mean of the placements");
+        break;
+      }
+    }
+    out.materials.push_back(m);
+    out.targets.push_back(std::move(target));
+  }
+  if (out.targets.empty()) return Error{doc.file, "no material of the low-poly can take baked maps (each needs its UV set on all its primitives)"};
+  return out;
+}
+
+fs::path float_map_file(const fs::path& output, const std::string& material_name, Map map) {
+  return output.parent_path() / (output.stem().string() + "_" + material_name + "_" + std::string(matbake::name_in(kMapNames, map)) + ".exr");
+}
+
+// TANGENT (and NORMAL where missing) on each baked primitive, once per mesh primitive.
+Status write_tangents(gltf::Document& doc, const scene::Scene& low, const Targets& targets, FileReport& report) {
+  std::set<std::pair<int, int>> done;
+  for (const ao::TextureTarget& target : targets.targets) {
+    for (std::size_t k : target.instances) {
+      const scene::Instance& inst = low.instances[k];
+      if (!inst.object.tangents.empty() || !done.insert({inst.mesh, inst.primitive}).second) continue;
+      auto tangents = corner_tangents(inst, target.texcoord);
+      if (!tangents) return tangents.error();
+      gltf::PrimitiveTangents p{inst.mesh, inst.primitive, {}, {}, {}};
+      const std::vector<glm::vec3> normals = corner_normals(inst);
+      for (std::size_t t = 0; t < inst.triangles.size(); ++t) {
+        p.triangles.push_back(file_triangle(inst, t));
+        for (std::size_t c = 0; c < 3; ++c) {
+          p.tangents.push_back((*tangents)[3 * t + file_corner(inst, c)]);
+          p.normals.push_back(normals[3 * t + file_corner(inst, c)]);
+        }
+      }
+      auto added = gltf::add_tangents(doc, p);
+      if (!added) return added.error();
+      ++report.tangent_primitives;
+      report.split_vertices += *added;
+    }
+  }
+  return success();
+}
+
+// The texture target `t`'s maps into the document and beside the output.
+Result<TextureReport> write_maps(gltf::Document& doc, const gltf::ImageCache& cache, const FileOptions& options,
+                                 const Targets& targets, std::size_t t, TextureBake& baked) {
+  const int m = targets.materials[t];
+  Json& material = doc.json["materials"][std::size_t(m)];
+  TextureReport report;
+  report.material = m;
+  report.name = gltf::name_in(material, "");
+  report.width = baked.width, report.height = baked.height, report.texcoord = targets.targets[t].texcoord;
+  report.texels = baked.texels, report.samples = baked.samples, report.misses = baked.misses;
+  report.missed_texels = baked.missed_texels, report.padded = baked.padded;
+  report.height_min = baked.height_min, report.height_max = baked.height_max;
+  const std::string file_name = gltf::material_file_name(material, m);
+  for (MapImage& map : baked.maps) {
+    image::Image img = gltf::blank(baked.width, baked.height, map.channels);
+    img.pixels = std::move(map.values);
+    if (map.map != Map::normal) {
+      const fs::path file = float_map_file(options.output, file_name, map.map);
+      image::WriteOptions exr;
+      exr.type = image::SampleType::f32;
+      if (Status s = image::write_image(img, file, exr); !s) return s.error();
+      report.files.push_back(file.string());
+      continue;
+    }
+    int sampler_from = -1;
+    if (material.contains("normalTexture") && material["normalTexture"].is_object()) {
+      sampler_from = gltf::integer_in<int>(material["normalTexture"], "index", -1, -1);
+      report.existing = "replaced";
+    }
+    const std::string name = options.output.stem().string() + "_" + file_name + "_normal";
+    auto made = cache.add_texture(doc, img, color::Transfer::linear, name, sampler_from);
+    if (!made) return made.error();
+    Json info = {{"index", made->index}};  // scale 1 and no transform: the bake is over raw UVs
+    if (report.texcoord != 0) info["texCoord"] = report.texcoord;
+    material["normalTexture"] = std::move(info);
+    report.files.push_back(made->uri);
+  }
+  return report;
+}
+
+}  // namespace
+
+Result<FileReport> bake_file(const fs::path& low_path, const FileOptions& options) {
+  return guarded(low_path.string(), [&]() -> Result<FileReport> {
+    if (const fs::path ext = options.output.extension(); ext != ".gltf" && ext != ".glb") {
+      return Error{options.output.string(), "the output is .gltf or .glb", true};
+    }
+    if (Status s = check(options.request.bake); !s) return s.error();
+    const auto start = std::chrono::steady_clock::now();
+    auto doc = gltf::read_document(low_path);
+    if (!doc) return doc.error();
+    auto low = scene::scene_from_document(*doc, {.texcoords = true, .object_space = true});
+    if (!low) return low.error();
+    auto high = scene::load_scene(options.high);
+    if (!high) return high.error();
+    auto targets = material_targets(*doc, *low);
+    if (!targets) return targets.error();
+
+    std::vector<NamedOutput> outputs = {{options.output, "glTF output"}};
+    std::vector<fs::path> inputs = gltf::source_files(doc->file, doc->json);
+    const auto high_inputs = gltf::read_json(options.high);
+    if (high_inputs) {
+      const auto more = gltf::source_files(options.high, *high_inputs);
+      inputs.insert(inputs.end(), more.begin(), more.end());
+    }
+    const Json& materials = doc->json["materials"];
+    for (int m : targets->materials) {
+      for (Map map : options.request.bake.maps) {
+        if (map == Map::normal) continue;
+        outputs.push_back({float_map_file(options.output, gltf::material_file_name(materials[std::size_t(m)], m), map),
+                           std::string(matbake::name_in(kMapNames, map)) + " map"});
+      }
+    }
+    if (Status s = check_outputs(outputs, inputs); !s) return s.error();
+
+    auto baked = bake(*low, *high, targets->targets, options.request.texture, options.request.bake);
+    if (!baked) {
+      Error error = baked.error();
+      if (error.path.empty() && !error.usage) error.path = doc->file;
+      return error;
+    }
+    FileReport report;
+    report.notes = low->notes;
+    report.notes.insert(report.notes.end(), targets->notes.begin(), targets->notes.end());
+    report.front = baked->front, report.back = baked->back;
+    report.setup_seconds = baked->setup_seconds, report.trace_seconds = baked->trace_seconds;
+    const bool normal = std::find(options.request.bake.maps.begin(), options.request.bake.maps.end(), Map::normal) !=
+                        options.request.bake.maps.end();
+    gltf::ImageCache cache(*doc, options.encoding, gltf::MadeFormat::png);
+    for (std::size_t t = 0; t < targets->targets.size(); ++t) {
+      auto written = write_maps(*doc, cache, options, *targets, t, baked->textures[t]);
+      if (!written) return written.error();
+      for (std::size_t i = 0; i < options.request.bake.maps.size(); ++i) {
+        if (options.request.bake.maps[i] != Map::normal) report.written.push_back(written->files[i]);
+      }
+      report.textures.push_back(std::move(*written));
+    }
+    if (normal) {
+      if (Status s = write_tangents(*doc, *low, *targets, report); !s) return s.error();
+    }
+    auto written = gltf::write_document(*doc, options.output);
+    if (!written) return written.error();
+    for (const fs::path& p : *written) report.written.push_back(p.string());
+    report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return report;
+  });
+}
+
+}  // namespace matbake::bake

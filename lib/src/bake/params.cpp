@@ -1,0 +1,112 @@
+// bake::Request's parameters: names, kinds, ranges, help and examples; defaults are the struct's.
+#include <cmath>
+
+#include "matbake/bake_params.hpp"
+#include "matbake/encoding_params.hpp"
+
+namespace matbake::bake {
+namespace {
+
+using params::Param;
+using params::Spec;
+using params::Value;
+constexpr double kUnbounded = HUGE_VAL;
+
+// "normal,height": the maps, each once, in the order given.
+Param<Request> maps() {
+  Spec spec{.name = "maps",
+            .kind = params::Kind::text,
+            .help = "The maps to bake, comma-separated: " + names_in(kMapNames),
+            .example = "normal,height"};
+  return {std::move(spec),
+          [](Request& r, const Value& v) -> std::optional<std::string> {
+            const std::string& text = std::get<std::string>(v);
+            std::vector<Map> chosen;
+            for (std::size_t start = 0; start <= text.size();) {
+              const std::size_t comma = std::min(text.find(',', start), text.size());
+              const auto map = value_in(kMapNames, std::string_view(text).substr(start, comma - start));
+              if (!map) return "maps among " + names_in(kMapNames) + ", comma-separated";
+              if (std::find(chosen.begin(), chosen.end(), *map) != chosen.end()) return "each map once";
+              chosen.push_back(*map);
+              start = comma + 1;
+            }
+            r.bake.maps = std::move(chosen);
+            return std::nullopt;
+          },
+          [](const Request& r) {
+            std::string text;
+            for (Map m : r.bake.maps) text += (text.empty() ? "" : ",") + std::string(name_in(kMapNames, m));
+            return nlohmann::json(text);
+          }};
+}
+
+Param<Request> size() {
+  Spec spec{.name = "size", .kind = params::Kind::integer_or_text, .help = "The maps' size (1024, or WxH)", .example = "512x256"};
+  return {std::move(spec),
+          [](Request& r, const Value& v) -> std::optional<std::string> {
+            std::optional<std::pair<int, int>> size;
+            if (const auto* side = std::get_if<std::int64_t>(&v)) {
+              if (*side >= 1 && *side <= ao::kMaxTextureSide) size = std::pair{int(*side), int(*side)};
+            } else {
+              size = image::size_from_text(std::get<std::string>(v));
+            }
+            if (!size) return "a size such as 1024 or 2048x1024";
+            r.texture.width = size->first, r.texture.height = size->second;
+            return std::nullopt;
+          },
+          [](const Request& r) { return nlohmann::json(std::to_string(r.texture.width) + "x" + std::to_string(r.texture.height)); }};
+}
+
+params::Group<Request> make_group() {
+  params::Group<Request> g;
+  g.params = {
+      maps(),
+      params::number<Request>(Spec{.name = "front",
+                                   .help = "How far outside the low-poly the rays start: a fraction of its bounding-box "
+                                           "diagonal (scene units with absolute_cage)",
+                                   .min = 0, .max = kUnbounded, .example = "0.02"},
+                              [](auto& r) -> auto& { return r.bake.front; }),
+      params::number<Request>(Spec{.name = "back",
+                                   .help = "How far inside the low-poly the rays reach, as front",
+                                   .min = 0, .max = kUnbounded, .example = "0.02"},
+                              [](auto& r) -> auto& { return r.bake.back; }),
+      params::flag<Request>(Spec{.name = "absolute_cage", .help = "front and back in scene units", .example = "true"},
+                            [](auto& r) -> auto& { return r.bake.absolute_distances; }),
+      params::choice<Request>(Spec{.name = "green",
+                                   .help = "The normal map's green: opengl (glTF's: up the texture) or directx",
+                                   .example = "directx"},
+                              [](auto& r) -> auto& { return r.bake.green; }, kGreenNames),
+      size(),
+      params::integer<Request>(Spec{.name = "padding",
+                                    .help = "Texels around the UV islands that take the nearest island texel's value "
+                                            "(-1: 16 at 1024, scaled)",
+                                    .min = -1, .max = ao::kMaxTextureSide, .example = "2"},
+                               [](auto& r) -> auto& { return r.texture.padding; }),
+      params::integer<Request>(Spec{.name = "texel_samples",
+                                    .help = "Rays per texel, stratified over its footprint (anti-aliasing)",
+                                    .min = 1, .max = 1024, .example = "16"},
+                               [](auto& r) -> auto& { return r.texture.texel_samples; }),
+      params::integer<Request>(Spec{.name = "seed", .help = "Scrambling seed of the texel positions",
+                                    .min = 0, .max = 9007199254740992.0, .example = "3"},
+                               [](auto& r) -> auto& { return r.bake.seed; }),
+  };
+  g.check = [](const Request& r) -> Status { return check(r.bake); };
+  return g;
+}
+
+}  // namespace
+
+const params::Group<Request>& request_params() {
+  static const params::Group<Request> group = make_group();
+  return group;
+}
+
+const params::Tree<FileOptions>& request_tree() {
+  static const params::Tree<FileOptions> tree{
+      params::branch<FileOptions>(image::encoding_params(), "", "", [](auto& o) -> auto& { return o.encoding; }),
+      params::branch<FileOptions>(request_params(), "", "", [](auto& o) -> auto& { return o.request; }),
+  };
+  return tree;
+}
+
+}  // namespace matbake::bake
