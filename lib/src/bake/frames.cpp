@@ -11,6 +11,13 @@ namespace {
 
 bool mirrored(const scene::Instance& inst) { return glm::determinant(glm::dmat3(inst.world)) < 0; }
 
+// MikkTSpace leaves a tangent zero where a vertex's directions cancel or lie along its normal;
+// glTF's TANGENT is a unit vector: any one across the normal serves (nothing in the UVs prefers one).
+glm::vec3 perpendicular(const glm::vec3& n) {
+  const glm::vec3 across = glm::cross(n, std::abs(n.x) < 0.9f ? glm::vec3(1, 0, 0) : glm::vec3(0, 1, 0));
+  return glm::length(across) > 0 ? glm::normalize(across) : glm::vec3(1, 0, 0);
+}
+
 }  // namespace
 
 std::array<std::uint32_t, 3> file_triangle(const scene::Instance& inst, std::size_t t) {
@@ -67,7 +74,8 @@ Result<std::vector<glm::vec4>> corner_tangents(const scene::Instance& inst, int 
   for (std::size_t t = 0; t < inst.triangles.size(); ++t) {
     for (std::size_t k = 0; k < 3; ++k) {
       const glm::vec4& m = mikk[3 * t + k];
-      tangents[3 * t + file_corner(inst, k)] = glm::vec4(m.x, m.y, m.z, -m.w);
+      const glm::vec3 xyz = glm::length(glm::vec3(m)) > 0 ? glm::vec3(m) : perpendicular(file_normals[3 * t + k]);
+      tangents[3 * t + file_corner(inst, k)] = glm::vec4(xyz, -m.w);
     }
   }
   return tangents;

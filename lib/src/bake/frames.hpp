@@ -21,6 +21,7 @@ std::size_t file_corner(const scene::Instance& inst, std::size_t k);
 // file's where it has them, else MikkTSpace's over the file's positions, normals (flat where it has
 // none, as glTF asks a runtime to make them) and UV set `texcoord`, with w negated — glTF's
 // bitangent w · cross(N, T) points up the texture, against increasing v, where MikkTSpace's follows v.
+// Where MikkTSpace gives no direction (zero), a unit vector across the normal: TANGENT is unit.
 // Errors: the instance was loaded without its object-space attributes or that UV set.
 Result<std::vector<glm::vec4>> corner_tangents(const scene::Instance& inst, int texcoord);
 

