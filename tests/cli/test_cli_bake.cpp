@@ -5,9 +5,13 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <fstream>
+
 #include "lib/src/bake/frames.hpp"
 #include "matbake/image.hpp"
 #include "matbake/scene.hpp"
+#include "support/expect_error.hpp"
+#include "support/files.hpp"
 #include "support/gltf_validator.hpp"
 #include "support/run.hpp"
 #include "support/runtime.hpp"
@@ -107,6 +111,81 @@ TEST(CliBake, EveryKhronosModelOntoItsSimplificationIsValidatorCleanWithMikkTSpa
   }
   EXPECT_GE(baked, 5u);
   if (oracle_checks == 0) GTEST_SKIP() << "tangents not compared with three.js's MikkTSpace: " << oracle_why_not;
+}
+
+std::string file_bytes(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), {}};
+}
+
+// A mesh baked onto itself through a cage of 0.1% of the scene: every ray's first hit is the point
+// it started from, whose normal is the basis's own N, so each texel holds (0, 0, 1): codes 127 or
+// 128 (½ on either side of float rounding), 255. Where another surface lies within the cage (its
+// height not 0), it is skipped. The same bytes with one thread and with two.
+TEST(CliBake, TheExampleOntoItselfGivesTheFlatNormalMapAndTheSameBytesForAnyJobs) {
+  TempDir dir;
+  const fs::path scene = kExamples / "showroom.gltf";
+  const auto bake_with = [&](const std::string& jobs, const std::string& name) {
+    return matbake({"--json", "--jobs", jobs, "bake", scene.string(), "--from", scene.string(), "-o", (dir / name).string(),
+                    "--maps", "normal,height", "--size", "64", "--texel-samples", "1", "--front", "0.001", "--back", "0.001"});
+  };
+  const auto r = bake_with("2", "self.gltf");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto report = nlohmann::json::parse(r.out);
+  ASSERT_FALSE(report["textures"].empty());
+  std::size_t flat = 0, other = 0;
+  for (const auto& t : report["textures"]) {
+    EXPECT_EQ(t["misses"], 0) << t;
+    const RawImage normal = read_raw(dir / t["files"][0].get<std::string>());
+    const RawImage height = read_raw(t["files"][1].get<std::string>());
+    ASSERT_EQ(normal.format, "uint8");
+    ASSERT_EQ(normal.channels, 3);
+    for (std::size_t texel = 0; texel < height.samples.size(); ++texel) {
+      if (std::abs(height.samples[texel]) > 1e-6) {
+        ++other;
+        continue;
+      }
+      const double* code = &normal.samples[3 * texel];
+      ASSERT_TRUE((code[0] == 127 || code[0] == 128) && (code[1] == 127 || code[1] == 128) && code[2] == 255)
+          << t["name"] << " texel " << texel << ": " << code[0] << " " << code[1] << " " << code[2];
+      ++flat;
+    }
+  }
+  EXPECT_GT(flat, 20 * other);
+  fs::create_directories(dir / "one");
+  fs::create_directories(dir / "two");
+  const auto one = bake_with("1", "one/baked.glb"), two = bake_with("2", "two/baked.glb");
+  ASSERT_EQ(one.exit_code, 0) << one.err;
+  ASSERT_EQ(two.exit_code, 0) << two.err;
+  EXPECT_TRUE(file_bytes(dir / "one/baked.glb") == file_bytes(dir / "two/baked.glb"));
+  EXPECT_TRUE(file_bytes(dir / "one/baked_wood_height.exr") == file_bytes(dir / "two/baked_wood_height.exr"));
+}
+
+TEST(CliBake, BadRequestsAreOneErrorLineAndWriteNothing) {
+  TempDir dir;
+  const fs::path scene = kExamples / "showroom.gltf";
+  const std::string out = (dir / "out.glb").string();
+  const auto bake_args = [&](std::vector<std::string> extra) {
+    std::vector<std::string> args{"bake", scene.string(), "--from", scene.string(), "-o", out};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return matbake(args);
+  };
+  auto r = bake_args({"--maps", "normal,shiny"});
+  EXPECT_EQ(r.exit_code, 2);
+  expect_one_error_line(r, "", "--maps: 'normal,shiny': maps among normal, height or position, comma-separated");
+  r = bake_args({"--maps", "normal,normal"});
+  expect_one_error_line(r, "", "--maps: 'normal,normal': each map once");
+  r = bake_args({"--front", "0", "--back", "0"});
+  EXPECT_EQ(r.exit_code, 2);
+  expect_one_error_line(r, "", "the cage distances must be finite, 0 or more, and not both 0");
+  r = matbake({"bake", scene.string(), "--from", (dir / "missing.glb").string(), "-o", out});
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.err.find((dir / "missing.glb").string()), std::string::npos) << r.err;
+  r = matbake({"bake", scene.string(), "--from", scene.string(), "-o", scene.string()});
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.err.find("showroom.gltf"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+  EXPECT_TRUE(fs::is_empty(dir.path()));
 }
 
 }  // namespace

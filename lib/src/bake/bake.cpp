@@ -47,9 +47,9 @@ LowPoint low_point(const scene::Instance& inst, const std::vector<CornerFrame>& 
 // A point on an edge (a texel centre past a triangle, clamped to it) moved a hair inside: a ray at
 // an open edge of the high-poly where it meets the low-poly's (a bake of a mesh onto itself or its
 // simplification keeps the borders) misses it as often as it hits it, and is cast again from there.
-bool on_edge(const glm::dvec3& w) { return !(w.x > 0 && w.y > 0 && w.z > 0); }
+constexpr double kLeast = 1e-5;  // of the triangle's size: float32 resolves 1e-7 of the positions
+bool on_edge(const glm::dvec3& w) { return std::min({w.x, w.y, w.z}) < kLeast; }
 glm::dvec3 inside(glm::dvec3 w) {
-  constexpr double kLeast = 1e-5;  // of the triangle's size: float32 resolves 1e-7 of the positions
   w = glm::max(w, glm::dvec3(kLeast));
   return w / (w.x + w.y + w.z);
 }
