@@ -13,6 +13,7 @@
 #include "cli/params_cli.hpp"
 #include "matbake/ao_params.hpp"
 #include "matbake/bake_ao_params.hpp"
+#include "matbake/bake_params.hpp"
 #include "matbake/convert_params.hpp"
 #include "matbake/delivery_params.hpp"
 #include "matbake/encoding_params.hpp"
@@ -395,6 +396,19 @@ TEST(RequestTree, BakeAosTreeIsExportsGroupsWithItsOwnFlags) {
   walk_rules(tree, [](const auto&, const std::string&) {}, 48);
 }
 
+// bake's tree: each parameter at its example reaches the request through its flag.
+TEST(RequestTree, BakesTreeTakesEveryParameterAtItsExample) {
+  const Tree<bake::FileOptions>& tree = bake::request_tree();
+  for (std::size_t b = 0; b < tree.size(); ++b) {
+    for (const Spec* spec : tree[b].specs) {
+      SCOPED_TRACE(spec->name);
+      auto cli = from_flags(tree, with_needs(tree, b, spec));
+      ASSERT_TRUE(cli) << cli.error().to_string();
+      EXPECT_NE(tree[b].values(*cli).at(spec->name), tree[b].values(bake::FileOptions{}).at(spec->name));
+    }
+  }
+}
+
 // A request made by the command line from one parameter at its example (a flag on by default
 // given as --no-NAME).
 template <class T>
@@ -538,6 +552,7 @@ TEST(DocsTables, MatchTheParameterDescriptions) {
       {"docs/build.md", "params:validation", markdown_table(pipeline::validation_params(), "")},
       {"docs/build.md", "params:scene", markdown_table(pipeline::scene_params(), "")},
       {"docs/cluster.md", "params:cluster", markdown_table(pipeline::cluster_params(), "")},
+      {"docs/bake.md", "params:bake", markdown_table(bake::request_params(), "")},
   };
   for (const Table& t : tables) {
     const fs::path path = fs::path(MATBAKE_SOURCE_DIR) / t.file;
