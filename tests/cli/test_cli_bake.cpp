@@ -8,13 +8,16 @@
 #include <fstream>
 
 #include "lib/src/bake/frames.hpp"
+#include "matbake/bake.hpp"
 #include "matbake/image.hpp"
 #include "matbake/scene.hpp"
 #include "support/expect_error.hpp"
 #include "support/files.hpp"
+#include "support/gltf_files.hpp"
 #include "support/gltf_validator.hpp"
 #include "support/run.hpp"
 #include "support/runtime.hpp"
+#include "support/shapes.hpp"
 #include "support/simplify.hpp"
 #include "support/temp_dir.hpp"
 
@@ -172,7 +175,7 @@ TEST(CliBake, BadRequestsAreOneErrorLineAndWriteNothing) {
   };
   auto r = bake_args({"--maps", "normal,shiny"});
   EXPECT_EQ(r.exit_code, 2);
-  expect_one_error_line(r, "", "--maps: 'normal,shiny': maps among normal, height or position, comma-separated");
+  expect_one_error_line(r, "", "--maps: 'normal,shiny': maps among " + names_in(bake::kMapNames) + ", comma-separated");
   r = bake_args({"--maps", "normal,normal"});
   expect_one_error_line(r, "", "--maps: 'normal,normal': each map once");
   r = bake_args({"--front", "0", "--back", "0"});
@@ -186,6 +189,58 @@ TEST(CliBake, BadRequestsAreOneErrorLineAndWriteNothing) {
   EXPECT_NE(r.err.find("showroom.gltf"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(out));
   EXPECT_TRUE(fs::is_empty(dir.path()));
+}
+
+// One dark grey rough dielectric primitive (its render is not clipped to white); UVs when given.
+void write_mesh(const fs::path& path, const std::vector<glm::dvec3>& positions, const std::vector<glm::dvec3>& normals,
+                const std::vector<glm::vec2>& texcoords, const std::vector<std::array<std::uint32_t, 3>>& triangles) {
+  GltfBuilder b;
+  std::vector<float> p, n, uv;
+  std::vector<std::uint32_t> indices;
+  for (const auto& v : positions) p.insert(p.end(), {float(v.x), float(v.y), float(v.z)});
+  for (const auto& v : normals) n.insert(n.end(), {float(v.x), float(v.y), float(v.z)});
+  for (const auto& v : texcoords) uv.insert(uv.end(), {v.x, v.y});
+  for (const auto& t : triangles) indices.insert(indices.end(), t.begin(), t.end());
+  const int mesh = b.add_mesh(b.add_vec3(p), b.add_indices(indices), 4, b.add_vec3(n));
+  auto& primitive = b.doc["meshes"][std::size_t(mesh)]["primitives"][0];
+  if (!uv.empty()) primitive["attributes"]["TEXCOORD_0"] = b.add_floats(uv, "VEC2", 2);
+  primitive["material"] = 0;
+  b.doc["materials"] = {{{"name", "grey"},
+                         {"pbrMetallicRoughness", {{"baseColorFactor", {0.2, 0.2, 0.2, 1}}, {"metallicFactor", 0}, {"roughnessFactor", 0.6}}}}};
+  b.write(path, {b.add_node({{"mesh", mesh}})});
+}
+
+// What a runtime shows: a smooth sphere of 5120 triangles baked onto a flat-shaded icosphere of 320,
+// rendered by three.js in Chromium beside the sphere itself. The baked normal map must bring the
+// icosphere's render closer to the sphere's than the bare icosphere is, in every view, and closer
+// than the same bake stored in the other green convention (what a runtime shows when the basis or
+// its sign is wrong).
+TEST(CliBake, ABakedIcosphereRendersInThreeJsCloserToTheSphereThanItself) {
+  TempDir dir;
+  const Icosphere fine = icosphere(4);
+  write_mesh(dir / "high.gltf", fine.vertices, fine.vertices, {}, fine.triangles);
+  const AtlasMesh low = icosphere_atlas(2, true);
+  write_mesh(dir / "low.gltf", low.positions, low.normals, low.texcoords, low.triangles);
+  for (const std::string green : {"opengl", "directx"}) {
+    const auto r = matbake({"bake", (dir / "low.gltf").string(), "--from", (dir / "high.gltf").string(), "-o",
+                            (dir / (green + ".glb")).string(), "--size", "512", "--front", "0.3", "--back", "0.3",
+                            "--absolute-cage", "--green", green});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+  }
+  std::string why_not;
+  const auto rendered = render_in_three(dir.path(), {{"high", dir / "high.gltf"}, {"low", dir / "low.gltf"},
+                                                     {"baked", dir / "opengl.glb"}, {"flipped", dir / "directx.glb"}},
+                                        why_not);
+  if (!rendered) GTEST_SKIP() << why_not;
+  for (const auto& [name, model] : *rendered) EXPECT_TRUE(model.console.empty()) << name << ": " << model.console.front();
+  for (const std::string& view : kRuntimeViews) {
+    const auto psnr = [&](const char* name) { return render_psnr(rendered->at("high").renders.at(view), rendered->at(name).renders.at(view)); };
+    const double bare = psnr("low"), baked = psnr("baked"), flipped = psnr("flipped");
+    RecordProperty("psnr_" + view, std::to_string(bare) + " bare, " + std::to_string(baked) + " baked, " + std::to_string(flipped) + " flipped");
+    std::printf("%s: bare %.2f dB, baked %.2f dB, flipped green %.2f dB\n", view.c_str(), bare, baked, flipped);
+    EXPECT_GT(baked, bare) << view;
+    EXPECT_GT(baked, flipped) << view;
+  }
 }
 
 }  // namespace

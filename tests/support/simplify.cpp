@@ -5,6 +5,7 @@
 #include <numeric>
 #include <stdexcept>
 
+#include "lib/src/gltf/decode.hpp"
 #include "lib/src/gltf/document.hpp"
 
 namespace matbake::test {
@@ -12,9 +13,10 @@ namespace matbake::test {
 void write_simplified(const std::filesystem::path& input, const std::filesystem::path& output, double ratio) {
   auto doc = gltf::read_document(input);
   if (!doc) throw std::runtime_error(doc.error().message);
-  doc->json["accessors"];  // present before any reference into the document is taken
-  for (gltf::Json& mesh : doc->json["meshes"]) {
-    for (gltf::Json& primitive : mesh["primitives"]) {
+  for (std::size_t m = 0; m < doc->json["meshes"].size(); ++m) {
+    for (std::size_t p = 0; p < doc->json["meshes"][m]["primitives"].size(); ++p) {
+      gltf::uncompress_draco_primitive(*doc, m, p);  // its indices change: written uncompressed
+      gltf::Json& primitive = doc->json["meshes"][m]["primitives"][p];
       if (gltf::integer_in<int>(primitive, "mode", gltf::kTriangles, -1) != gltf::kTriangles) continue;
       auto positions = gltf::accessor_bytes(*doc, gltf::size_in(primitive["attributes"], "POSITION", SIZE_MAX));
       if (!positions) throw std::runtime_error(positions.error().message);
@@ -41,8 +43,7 @@ void write_simplified(const std::filesystem::path& input, const std::filesystem:
       const int view = gltf::add_view(*doc, bytes, gltf::kElementArrayBuffer);
       doc->json["accessors"].push_back(
           {{"bufferView", view}, {"componentType", gltf::kUnsignedInt}, {"count", simplified.size()}, {"type", "SCALAR"}});
-      primitive["indices"] = doc->json["accessors"].size() - 1;
-      if (primitive.contains("extensions")) primitive["extensions"].erase("KHR_draco_mesh_compression");
+      doc->json["meshes"][m]["primitives"][p]["indices"] = doc->json["accessors"].size() - 1;
     }
   }
   auto written = gltf::write_document(*doc, output);

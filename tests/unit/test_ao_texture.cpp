@@ -459,6 +459,28 @@ TEST(TextureAo, PaddingTakesTheNearestMappedTexelTiesAveraged) {
   EXPECT_EQ(count, expected_count);
 }
 
+// The nearest mapped texel of every texel, however far: at the brute force's least distance, on
+// random masks from one mapped texel to many; none mapped, none found.
+TEST(TextureAo, NearestMappedTexelIsAtTheLeastDistance) {
+  std::mt19937 random(5);
+  const int w = 41, h = 29;
+  for (const int sites : {1, 3, 40, 600}) {
+    std::vector<bool> mapped(w * h, false);
+    for (int i = 0; i < sites; ++i) mapped[random() % std::size_t(w * h)] = true;
+    const std::vector<std::int64_t> nearest = texels::nearest_mapped(mapped, w, h);
+    for (int t = 0; t < w * h; ++t) {
+      long best = std::numeric_limits<long>::max();
+      for (int s = 0; s < w * h; ++s) {
+        if (mapped[std::size_t(s)]) best = std::min(best, long(s % w - t % w) * (s % w - t % w) + long(s / w - t / w) * (s / w - t / w));
+      }
+      const std::int64_t n = nearest[std::size_t(t)];
+      ASSERT_TRUE(n >= 0 && mapped[std::size_t(n)]) << sites << " sites, texel " << t;
+      EXPECT_EQ(long(n % w - t % w) * (n % w - t % w) + long(n / w - t / w) * (n / w - t / w), best) << sites << " sites, texel " << t;
+    }
+  }
+  EXPECT_EQ(texels::nearest_mapped(std::vector<bool>(12, false), 4, 3), std::vector<std::int64_t>(12, -1));
+}
+
 TEST(TextureAo, PaddingDefaultsAndBadOptions) {
   EXPECT_EQ(padding_for(size(1024, 1024, -1)), 16);
   EXPECT_EQ(padding_for(size(4096, 512, -1)), 64);

@@ -7,8 +7,8 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include <cfloat>
 #include <cmath>
-#include <map>
 #include <numbers>
 
 #include <glm/geometric.hpp>
@@ -16,46 +16,12 @@
 
 #include "lib/src/bake/frames.hpp"
 #include "matbake/bake.hpp"
+#include "support/shapes.hpp"
 
 namespace matbake::bake {
 namespace {
 
 using glm::dvec3;
-
-// A unit icosphere: the icosahedron with each triangle split in four `subdivisions` times, new
-// vertices pushed out to the sphere; counter-clockwise seen from outside.
-struct Icosphere {
-  std::vector<glm::dvec3> vertices;
-  std::vector<std::array<std::uint32_t, 3>> triangles;
-};
-Icosphere icosphere(int subdivisions) {
-  const double g = (1 + std::sqrt(5.0)) / 2;
-  Icosphere s;
-  for (const dvec3& v : {dvec3(-1, g, 0), dvec3(1, g, 0), dvec3(-1, -g, 0), dvec3(1, -g, 0), dvec3(0, -1, g), dvec3(0, 1, g),
-                         dvec3(0, -1, -g), dvec3(0, 1, -g), dvec3(g, 0, -1), dvec3(g, 0, 1), dvec3(-g, 0, -1), dvec3(-g, 0, 1)}) {
-    s.vertices.push_back(glm::normalize(v));
-  }
-  s.triangles = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
-                 {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
-                 {3, 8, 9},  {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
-  for (int level = 0; level < subdivisions; ++level) {
-    std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint32_t> middle;
-    const auto mid = [&](std::uint32_t a, std::uint32_t b) {
-      const auto key = std::minmax(a, b);
-      auto [it, added] = middle.try_emplace(key, std::uint32_t(s.vertices.size()));
-      if (added) s.vertices.push_back(glm::normalize(s.vertices[a] + s.vertices[b]));
-      return it->second;
-    };
-    std::vector<std::array<std::uint32_t, 3>> finer;
-    for (const auto& t : s.triangles) {
-      const std::uint32_t ab = mid(t[0], t[1]), bc = mid(t[1], t[2]), ca = mid(t[2], t[0]);
-      finer.push_back({t[0], ab, ca}), finer.push_back({t[1], bc, ab}), finer.push_back({t[2], ca, bc});
-      finer.push_back({ab, bc, ca});
-    }
-    s.triangles = std::move(finer);
-  }
-  return s;
-}
 
 // An instance whose object space is `world`'s preimage: positions and normals given in object
 // space, carried to world space as the scene loader does.
@@ -194,29 +160,12 @@ TEST(Bake, ABumpOnAPlaneGivesTheHighPolysHeightAndNormalInThePlanesBasis) {
   }
 }
 
-// A unit icosphere of 80 triangles placed by `world`, each triangle its own UV island: triangle k in
-// cell (k mod 9, k div 9) of a 9 × 9 grid, its corners at (0.1, 0.1), (0.9, 0.1), (0.1, 0.9) of the
-// cell. Normals radial (smooth) or the face's (flat).
+// A unit icosphere of 80 triangles placed by `world`, each triangle its own UV island (9 × 9 cells).
 constexpr int kCells = 9;
 scene::Instance icosphere_low(bool flat, const glm::dmat4& world) {
-  const Icosphere ico = icosphere(1);
-  std::vector<dvec3> positions, normals;
-  std::vector<glm::vec2> uv;
-  std::vector<std::array<std::uint32_t, 3>> triangles;
-  const glm::dvec2 corner_at[3] = {{0.1, 0.1}, {0.9, 0.1}, {0.1, 0.9}};
-  for (std::size_t k = 0; k < ico.triangles.size(); ++k) {
-    const auto& t = ico.triangles[k];
-    const dvec3 face = glm::normalize(glm::cross(ico.vertices[t[1]] - ico.vertices[t[0]], ico.vertices[t[2]] - ico.vertices[t[0]]));
-    const glm::dvec2 cell(double(k % kCells), double(k / kCells));
-    for (int c = 0; c < 3; ++c) {
-      positions.push_back(ico.vertices[t[std::size_t(c)]]);
-      normals.push_back(flat ? face : ico.vertices[t[std::size_t(c)]]);
-      uv.emplace_back((cell + corner_at[c]) / double(kCells));
-    }
-    triangles.push_back({std::uint32_t(3 * k), std::uint32_t(3 * k + 1), std::uint32_t(3 * k + 2)});
-  }
-  scene::Instance inst = placed(positions, normals, triangles, world);
-  inst.texcoords.push_back(uv);
+  const test::AtlasMesh mesh = test::icosphere_atlas(1, flat);
+  scene::Instance inst = placed(mesh.positions, mesh.normals, mesh.triangles, world);
+  inst.texcoords.push_back(mesh.texcoords);
   return inst;
 }
 
@@ -255,7 +204,7 @@ double frobenius(const glm::dmat3& m) {
 // and the sphere).
 TEST(Bake, ATessellatedSphereOntoAnIcosphereDecodesToTheSpheresNormalAtEachHit) {
   const dvec3 centre(0.3, -0.2, 0.5);
-  const Icosphere fine = icosphere(4);
+  const test::Icosphere fine = test::icosphere(4);
   std::vector<dvec3> high_positions, high_normals;
   for (const dvec3& v : fine.vertices) high_positions.push_back(centre + v), high_normals.push_back(v);
   const scene::Scene high = scene_of({placed(high_positions, high_normals, fine.triangles, glm::dmat4(1))});
@@ -318,6 +267,43 @@ TEST(Bake, ATessellatedSphereOntoAnIcosphereDecodesToTheSpheresNormalAtEachHit) 
       }
       EXPECT_GT(checked, std::size_t(kSide * kSide) / 4) << what;
     }
+  }
+}
+
+// Curvature: a sphere of radius 2 tessellated into 5120 triangles with radial normals has mean
+// curvature 1/2 at every hit (the interpolated normals of a face are (q − centre)/r, whose
+// derivative along it is I/r); with its normals turned inward, −1/2 (concave); without normals,
+// flat faces, 0. The tolerance: float32 positions and normals, a few ulps of each over the shortest
+// edge (the differences the shape operator is solved from), through a 2 × 2 solve.
+TEST(Bake, ASpheresCurvatureIsOneOverItsRadiusAtEveryHit) {
+  const double radius = 2;
+  const dvec3 centre(0.3, -0.2, 0.5);
+  const test::Icosphere fine = test::icosphere(4);
+  double shortest = radius;
+  for (const auto& t : fine.triangles) {
+    for (int k = 0; k < 3; ++k) shortest = std::min(shortest, radius * glm::length(fine.vertices[t[k]] - fine.vertices[t[(k + 1) % 3]]));
+  }
+  const double tolerance = 64 * double(FLT_EPSILON) / shortest;  // relative 64 ε r / shortest, of 1/r
+  const glm::dmat4 world = glm::scale(glm::translate(glm::dmat4(1), centre), dvec3(radius));
+  const scene::Scene low = scene_of({icosphere_low(false, world)});
+  for (const double sign : {1.0, -1.0, 0.0}) {
+    std::vector<dvec3> positions, normals;
+    for (const dvec3& v : fine.vertices) positions.push_back(centre + radius * v), normals.push_back(sign * v);
+    const scene::Scene high = scene_of({placed(positions, sign == 0 ? std::vector<dvec3>{} : normals, fine.triangles, glm::dmat4(1))});
+    Options options;
+    options.maps = {Map::curvature};
+    options.front = 0.3, options.back = 0.3, options.absolute_distances = true;
+    auto baked = bake(low, high, {ao::TextureTarget{{0}, 0}}, {.width = 9 * 8, .height = 9 * 8, .texel_samples = 4}, options);
+    ASSERT_TRUE(baked) << baked.error().message;
+    const TextureBake& t = baked->textures.at(0);
+    EXPECT_EQ(t.misses, 0u);
+    std::size_t hits = 0;
+    for (std::size_t texel = 0; texel < t.hit.size(); ++texel) {
+      if (!t.hit[texel]) continue;
+      ASSERT_NEAR(map_of(t, Map::curvature).values[texel], sign / radius, tolerance) << "sign " << sign << ", texel " << texel;
+      ++hits;
+    }
+    EXPECT_GT(hits, t.hit.size() / 4);
   }
 }
 

@@ -29,8 +29,10 @@ enum class Map {
   height,    // signed distance from the low-poly to the high-poly along the low-poly's normal
              // (positive outside), scene units
   position,  // the hit's world position, scene units
+  curvature, // the high-poly's mean curvature at the hit, 1/scene units, positive where convex
 };
-inline constexpr NameTable<Map, 3> kMapNames{{{Map::normal, "normal"}, {Map::height, "height"}, {Map::position, "position"}}};
+inline constexpr NameTable<Map, 4> kMapNames{
+    {{Map::normal, "normal"}, {Map::height, "height"}, {Map::position, "position"}, {Map::curvature, "curvature"}}};
 int channels(Map map);
 
 // Which way the normal map's green channel points: OpenGL's (and glTF's) up the texture, against

@@ -48,8 +48,9 @@ bool inside(const UvTriangle& t, const dvec2& p) {
 // envelope of the parabolas (q − r)² + f(r), in place. Unmapped samples hold kFar, a finite stand-in
 // for infinity that keeps the envelope's intersections finite.
 constexpr double kFar = 1e20;
+// With `site`, site[q] is the r whose parabola is lowest at q.
 void distance_1d(double* f, std::size_t n, std::size_t stride, std::vector<double>& d, std::vector<int>& v,
-                 std::vector<double>& z) {
+                 std::vector<double>& z, int* site = nullptr) {
   const auto at = [&](long q) { return f[std::size_t(q) * stride]; };
   std::size_t k = 0;
   v[0] = 0;
@@ -69,6 +70,7 @@ void distance_1d(double* f, std::size_t n, std::size_t stride, std::vector<doubl
     while (z[k + 1] < double(q)) ++k;
     const long r = v[k];
     d[std::size_t(q)] = double(q - r) * double(q - r) + at(r);
+    if (site) site[std::size_t(q) * stride] = int(r);
   }
   for (std::size_t q = 0; q < n; ++q) f[q * stride] = d[q];
 }
@@ -371,24 +373,57 @@ Result<Coverage> cover(const scene::Scene& scene, const TextureTarget& target, i
   return out;
 }
 
-std::size_t pad(std::vector<float>& values, const std::vector<bool>& mapped, int width, int height, int padding) {
-  if (padding <= 0) return 0;
-  const std::size_t w = std::size_t(width), h = std::size_t(height);
+namespace {
+
+// The squared distance transform of the mapped texels, columns then rows, each line on its own (in
+// parallel, each range with its own scratch). With `sites`, per pass the line position of the
+// nearest site: a texel's nearest mapped texel is column c = sites.rows[t] of its row, and there
+// the row sites.columns[row × w + c].
+struct Sites {
+  std::vector<int> columns, rows;
+};
+std::vector<double> squared_distances(const std::vector<bool>& mapped, std::size_t w, std::size_t h, Sites* sites) {
   std::vector<double> d2(w * h);
   for (std::size_t i = 0; i < w * h; ++i) d2[i] = mapped[i] ? 0.0 : kFar;
-  // Columns, then rows, each line on its own (in parallel, each range with its own scratch).
-  const auto lines = [&](std::size_t count, std::size_t length, std::size_t start_step, std::size_t stride) {
+  const auto lines = [&](std::size_t count, std::size_t length, std::size_t start_step, std::size_t stride,
+                         std::vector<int>* site) {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 16), [&](const tbb::blocked_range<std::size_t>& range) {
       std::vector<double> scratch(length);
       std::vector<int> v(length);
       std::vector<double> z(length + 1);
       for (std::size_t line = range.begin(); line != range.end(); ++line) {
-        distance_1d(&d2[line * start_step], length, stride, scratch, v, z);
+        distance_1d(&d2[line * start_step], length, stride, scratch, v, z, site ? &(*site)[line * start_step] : nullptr);
       }
     });
   };
-  lines(w, h, 1, w);
-  lines(h, w, w, 1);
+  if (sites) sites->columns.resize(w * h), sites->rows.resize(w * h);
+  lines(w, h, 1, w, sites ? &sites->columns : nullptr);
+  lines(h, w, w, 1, sites ? &sites->rows : nullptr);
+  return d2;
+}
+
+}  // namespace
+
+std::vector<std::int64_t> nearest_mapped(const std::vector<bool>& mapped, int width, int height) {
+  const std::size_t w = std::size_t(width), h = std::size_t(height);
+  Sites sites;
+  const std::vector<double> d2 = squared_distances(mapped, w, h, &sites);
+  std::vector<std::int64_t> nearest(w * h, -1);
+  for (std::size_t y = 0; y < h; ++y) {
+    for (std::size_t x = 0; x < w; ++x) {
+      const std::size_t t = y * w + x;
+      if (d2[t] >= kFar) continue;  // nothing is mapped
+      const auto column = std::size_t(sites.rows[t]);
+      nearest[t] = std::int64_t(std::size_t(sites.columns[y * w + column]) * w + column);
+    }
+  }
+  return nearest;
+}
+
+std::size_t pad(std::vector<float>& values, const std::vector<bool>& mapped, int width, int height, int padding) {
+  if (padding <= 0) return 0;
+  const std::size_t w = std::size_t(width), h = std::size_t(height);
+  const std::vector<double> d2 = squared_distances(mapped, w, h, nullptr);
   const double limit = double(padding) * padding;
   const std::vector<float> source = values;
   std::atomic<std::size_t> padded{0};

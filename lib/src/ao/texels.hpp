@@ -52,4 +52,8 @@ glm::dvec3 nearest_weights(const UvTriangle& t, const glm::dvec2& p);
 // ties averaged); returns how many were padded. Texels farther away are left as they are.
 std::size_t pad(std::vector<float>& values, const std::vector<bool>& mapped, int width, int height, int padding);
 
+// Per texel (j × width + i) the index of one mapped texel nearest to it (Euclidean; of ties, the one
+// the transform meets first), −1 when none is mapped. Linear in the texels, however far.
+std::vector<std::int64_t> nearest_mapped(const std::vector<bool>& mapped, int width, int height);
+
 }  // namespace matbake::ao::texels

@@ -67,7 +67,7 @@ glm::dvec3 tangent_space(const glm::dmat3& basis, const glm::dvec3& h) {
 // What a texel's hits add up to, for every map.
 struct TexelSum {
   glm::dvec3 normal{0}, position{0};
-  double height = 0;
+  double height = 0, curvature = 0;
   int hits = 0, rays = 0;
 };
 
@@ -78,6 +78,7 @@ struct TraceContext {
   const ao::TextureTarget& target;
   const ao::TextureOptions& texture;
   float front, back;
+  bool curvature;  // asked for
 };
 
 // The cage ray at a low-poly point: from `front` outside along its normal to `back` inside.
@@ -113,6 +114,7 @@ void trace_point(const TraceContext& c, const ao::texels::SurfacePoint& point, s
     sum.normal += tangent_space(low.basis, glm::dvec3(hit->normal));
     sum.position += glm::dvec3(hit->position);
     sum.height += double(c.front) - double(hit->distance);
+    if (c.curvature) sum.curvature += c.high.mean_curvature(*hit);
   }
 }
 
@@ -128,6 +130,7 @@ void store(const TexelSum& sum, const Options& options, std::size_t texel, Textu
         break;
       }
       case Map::height: v[0] = float(sum.height / sum.hits); break;
+      case Map::curvature: v[0] = float(sum.curvature / sum.hits); break;
       case Map::position:
         for (int k = 0; k < 3; ++k) v[k] = float(sum.position[k] / sum.hits);
         break;
@@ -135,7 +138,7 @@ void store(const TexelSum& sum, const Options& options, std::size_t texel, Textu
   }
 }
 
-// What a texel nothing maps holds: a flat normal, zero height and position.
+// What a texel nothing maps holds: a flat normal, zero height, position and curvature.
 void background(MapImage& image) {
   const std::size_t texels = image.values.size() / std::size_t(image.channels);
   for (std::size_t t = 0; t < texels; ++t) {
@@ -148,18 +151,18 @@ void background(MapImage& image) {
 // Missed texels take their nearest hit texel's value (however far); then the traced ones are padded.
 std::size_t fill_and_pad(MapImage& image, const std::vector<bool>& hit, const std::vector<bool>& traced, int width,
                          int height, int padding) {
-  const std::size_t texels = std::size_t(width) * std::size_t(height);
+  const std::size_t texels = std::size_t(width) * std::size_t(height), channels = std::size_t(image.channels);
+  const std::vector<std::int64_t> nearest_hit = ao::texels::nearest_mapped(hit, width, height);
+  for (std::size_t t = 0; t < texels; ++t) {
+    if (!traced[t] || hit[t] || nearest_hit[t] < 0) continue;
+    for (std::size_t k = 0; k < channels; ++k) image.values[t * channels + k] = image.values[std::size_t(nearest_hit[t]) * channels + k];
+  }
   std::size_t padded = 0;
-  std::vector<float> channel(texels), filled;
-  for (int k = 0; k < image.channels; ++k) {
-    for (std::size_t t = 0; t < texels; ++t) channel[t] = image.values[t * std::size_t(image.channels) + std::size_t(k)];
-    filled = channel;
-    ao::texels::pad(filled, hit, width, height, width + height);
-    for (std::size_t t = 0; t < texels; ++t) {
-      if (traced[t] && !hit[t]) channel[t] = filled[t];
-    }
+  std::vector<float> channel(texels);
+  for (std::size_t k = 0; k < channels; ++k) {
+    for (std::size_t t = 0; t < texels; ++t) channel[t] = image.values[t * channels + k];
     padded = ao::texels::pad(channel, traced, width, height, padding);
-    for (std::size_t t = 0; t < texels; ++t) image.values[t * std::size_t(image.channels) + std::size_t(k)] = channel[t];
+    for (std::size_t t = 0; t < texels; ++t) image.values[t * channels + k] = channel[t];
   }
   return padded;
 }
@@ -225,7 +228,8 @@ Result<Bake> bake(const scene::Scene& low, const scene::Scene& high, const std::
     }
     out.hit.assign(texel_count, 0);
     out.texels = runs.size() - 1;
-    const TraceContext context{low, frames, **built, target, texture, float(result.front), float(result.back)};
+    const TraceContext context{low, frames, **built, target, texture, float(result.front), float(result.back),
+                               std::ranges::find(options.maps, Map::curvature) != options.maps.end()};
     std::vector<TexelSum> sums(runs.size() - 1);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, sums.size(), 64), [&](const tbb::blocked_range<std::size_t>& range) {
       for (std::size_t r = range.begin(); r != range.end(); ++r) {

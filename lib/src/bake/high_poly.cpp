@@ -1,6 +1,7 @@
 #include "high_poly.hpp"
 
 #include <glm/geometric.hpp>
+#include <glm/mat2x2.hpp>
 #include <tbb/parallel_for.h>
 
 namespace matbake::bake {
@@ -67,6 +68,24 @@ std::optional<Hit> HighPoly::first_hit(const glm::vec3& origin, const glm::vec3&
   if (!(glm::length(n) > 0)) n = face_normals_[hit.instance][hit.triangle];
   hit.normal = glm::normalize(n);
   return hit;
+}
+
+double HighPoly::mean_curvature(const Hit& hit) const {
+  const auto& normals = normals_[hit.instance];
+  if (normals.empty()) return 0;
+  const scene::Instance& inst = scene_->instances[hit.instance];
+  const auto& t = inst.triangles[hit.triangle];
+  const glm::dvec3 p0(inst.positions[t[0]]), n0(normals[t[0]]);
+  const glm::dvec3 e1 = glm::dvec3(inst.positions[t[1]]) - p0, e2 = glm::dvec3(inst.positions[t[2]]) - p0;
+  const glm::dvec3 dn1 = glm::dvec3(normals[t[1]]) - n0, dn2 = glm::dvec3(normals[t[2]]) - n0;
+  // The shape operator S in the edge basis: S e_i = dn_i, so with the metric G = [e_i · e_j] and
+  // M = [e_i · dn_j] (column j), S = G⁻¹ M.
+  const glm::dmat2 g(glm::dot(e1, e1), glm::dot(e1, e2), glm::dot(e1, e2), glm::dot(e2, e2));
+  const glm::dmat2 m(glm::dot(e1, dn1), glm::dot(e2, dn1), glm::dot(e1, dn2), glm::dot(e2, dn2));
+  const double det = glm::determinant(g);
+  if (!(det > 1e-12 * g[0][0] * g[1][1])) return 0;  // a degenerate face
+  const glm::dmat2 s = glm::inverse(g) * m;
+  return 0.5 * (s[0][0] + s[1][1]);
 }
 
 }  // namespace matbake::bake

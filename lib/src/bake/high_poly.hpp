@@ -33,6 +33,13 @@ class HighPoly {
   // of `origin` along the unit `direction`.
   std::optional<Hit> first_hit(const glm::vec3& origin, const glm::vec3& direction, float length) const;
 
+  // The mean curvature (κ₁ + κ₂)/2 at a hit, from the high-poly's normals: half the trace of the
+  // shape operator of its triangle, the derivative of the linearly interpolated vertex normals
+  // along the face (constant over it). Positive where the surface is convex (the normals spread), in
+  // 1/scene units; exactly 1/r on a sphere of radius r with radial normals, however coarse; 0 on a
+  // flat-shaded surface (glTF's flat normals: no curvature within a face).
+  double mean_curvature(const Hit& hit) const;
+
  private:
   HighPoly() = default;
   const scene::Scene* scene_ = nullptr;

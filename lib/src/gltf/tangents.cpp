@@ -1,5 +1,7 @@
 #include "tangents.hpp"
 
+#include "decode.hpp"
+
 #include <cstring>
 #include <map>
 #include <tuple>
@@ -63,6 +65,11 @@ int index_accessor(Document& doc, const std::vector<std::uint32_t>& indices, std
 }  // namespace
 
 Result<std::size_t> add_tangents(Document& doc, const PrimitiveTangents& p) {
+  // A Draco primitive changed is written uncompressed, as every primitive matbake changes.
+  uncompress_draco_primitive(doc, std::size_t(p.mesh), std::size_t(p.primitive));
+  for (const char* key : {"accessors", "bufferViews", "buffers"}) {  // present before references into the JSON are held
+    if (!doc.json.contains(key)) doc.json[key] = Json::array();
+  }
   Json& primitive = doc.json["meshes"][std::size_t(p.mesh)]["primitives"][std::size_t(p.primitive)];
   Json& attributes = primitive["attributes"];
   const bool has_normals = attributes.contains("NORMAL");
@@ -103,10 +110,6 @@ Result<std::size_t> add_tangents(Document& doc, const PrimitiveTangents& p) {
     }
     primitive["indices"] = index_accessor(doc, corners, source.size());
     primitive.erase("mode");  // now a triangle list
-    if (primitive.contains("extensions")) {  // its compressed attributes are the old vertices
-      primitive["extensions"].erase("KHR_draco_mesh_compression");
-      if (primitive["extensions"].empty()) primitive.erase("extensions");
-    }
   }
   std::vector<float> tangent_values, normal_values;
   for (const glm::vec4& t : tangents) tangent_values.insert(tangent_values.end(), {t.x, t.y, t.z, t.w});

@@ -4,6 +4,7 @@
 // normals (a mirror seam, a UV seam MikkTSpace splits, a flat face) is split: the copies go after
 // the primitive's vertices, every attribute and morph target gathered for them, and its indices
 // rewritten as a triangle list. Vertices keep their numbers, so accessors' min and max stay true.
+// A Draco-compressed primitive is written uncompressed.
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
 
