@@ -13,12 +13,12 @@ CLI::App* setup_bake(CLI::App& app, BakeSettings& s) {
       "bake",
       "Bake a high-poly mesh onto a low-poly one's UVs (docs/bake.md): per texel, rays from a cage around the\n"
       "low-poly along its normal find the high-poly; its normal in the low-poly's tangent basis (the TANGENT\n"
-      "written, MikkTSpace where the file has none) becomes the material's normalTexture; height and position\n"
-      "are written as float EXR files beside the output.");
+      "written, MikkTSpace where the file has none) becomes the material's normalTexture, AO its\n"
+      "occlusionTexture; the other maps are written as float EXR files beside the output.");
   cmd->add_option("low", s.low, "The low-poly .gltf or .glb (its UVs take the maps)")->required();
   cmd->add_option("--from", s.high, "The high-poly .gltf or .glb")->required();
   cmd->add_option("-o,--output", s.output, "Output .gltf (+ .bin beside it) or .glb")->required();
-  add_tree(*cmd, bake::request_tree(), s.options, s.given, {"Options", "Options"});
+  add_tree(*cmd, bake::request_tree(), s.options, s.given, {"Options", "Options", "AO and bent normal (rays from the high-poly's hit)"});
   return cmd;
 }
 
@@ -35,7 +35,7 @@ int run_bake(const BakeSettings& s, const GlobalOptions& global) {
       textures.push_back({{"material", t.material}, {"name", t.name}, {"width", t.width}, {"height", t.height},
                           {"texcoord", t.texcoord}, {"texels", t.texels}, {"rays", t.samples}, {"misses", t.misses},
                           {"missed_texels", t.missed_texels}, {"padded", t.padded}, {"height_min", t.height_min},
-                          {"height_max", t.height_max}, {"files", t.files}, {"existing", t.existing}});
+                          {"height_max", t.height_max}, {"files", t.files}, {"existing", t.existing}, {"occlusion_rays", t.occlusion_rays}});
     }
     std::cout << nlohmann::json{{"command", "bake"}, {"low", s.low}, {"high", s.high}, {"output", s.output},
                                 {"front", report->front}, {"back", report->back}, {"textures", textures},

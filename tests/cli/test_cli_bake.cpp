@@ -74,7 +74,7 @@ TEST(CliBake, EveryKhronosModelOntoItsSimplificationIsValidatorCleanWithMikkTSpa
     const fs::path low = dir / (name + "_low.glb"), out = dir / (name + "_baked.glb");
     write_simplified(high, low, 0.1);
     const auto r = matbake({"--json", "bake", low.string(), "--from", high.string(), "-o", out.string(), "--size", "64",
-                            "--texel-samples", "1"});
+                            "--texel-samples", "1", "--maps", "normal,ao", "--ao-samples", "4"});
     if (r.exit_code != 0) {  // a model without a material over UVs has nothing to bake onto: said so
       EXPECT_NE(r.err.find("no material of the low-poly can take baked maps"), std::string::npos) << name << ": " << r.err;
       continue;
@@ -125,12 +125,13 @@ std::string file_bytes(const fs::path& path) {
 // it started from, whose normal is the basis's own N, so each texel holds (0, 0, 1): codes 127 or
 // 128 (½ on either side of float rounding), 255. Where another surface lies within the cage (its
 // height not 0), it is skipped. The same bytes with one thread and with two.
-TEST(CliBake, TheExampleOntoItselfGivesTheFlatNormalMapAndTheSameBytesForAnyJobs) {
+TEST(CliBake, TheExampleOntoItselfGivesTheFlatNormalMapAndAoAndTheSameBytesForAnyJobs) {
   TempDir dir;
   const fs::path scene = kExamples / "showroom.gltf";
   const auto bake_with = [&](const std::string& jobs, const std::string& name) {
     return matbake({"--json", "--jobs", jobs, "bake", scene.string(), "--from", scene.string(), "-o", (dir / name).string(),
-                    "--maps", "normal,height", "--size", "64", "--texel-samples", "1", "--front", "0.001", "--back", "0.001"});
+                    "--maps", "normal,height,ao,bent_normal", "--size", "64", "--texel-samples", "1", "--front", "0.001",
+                    "--back", "0.001", "--ao-samples", "8"});
   };
   const auto r = bake_with("2", "self.gltf");
   ASSERT_EQ(r.exit_code, 0) << r.err;
@@ -155,6 +156,15 @@ TEST(CliBake, TheExampleOntoItselfGivesTheFlatNormalMapAndTheSameBytesForAnyJobs
     }
   }
   EXPECT_GT(flat, 20 * other);
+  // AO is each material's occlusionTexture: its own 8-bit grey PNG.
+  const auto written = nlohmann::json::parse(std::ifstream(dir / "self.gltf"));
+  for (const auto& t : report["textures"]) {
+    const auto& occlusion = written["materials"][t["material"].get<std::size_t>()]["occlusionTexture"];
+    const auto& texture = written["textures"][occlusion["index"].get<std::size_t>()];
+    EXPECT_EQ(written["images"][texture["source"].get<std::size_t>()]["uri"], t["files"][2]) << t["name"];
+    const RawImage ao = read_raw(dir / t["files"][2].get<std::string>());
+    EXPECT_TRUE(ao.format == "uint8" && ao.channels == 1) << t["name"];
+  }
   fs::create_directories(dir / "one");
   fs::create_directories(dir / "two");
   const auto one = bake_with("1", "one/baked.glb"), two = bake_with("2", "two/baked.glb");
@@ -162,6 +172,7 @@ TEST(CliBake, TheExampleOntoItselfGivesTheFlatNormalMapAndTheSameBytesForAnyJobs
   ASSERT_EQ(two.exit_code, 0) << two.err;
   EXPECT_TRUE(file_bytes(dir / "one/baked.glb") == file_bytes(dir / "two/baked.glb"));
   EXPECT_TRUE(file_bytes(dir / "one/baked_wood_height.exr") == file_bytes(dir / "two/baked_wood_height.exr"));
+  EXPECT_TRUE(file_bytes(dir / "one/baked_wood_bent_normal.exr") == file_bytes(dir / "two/baked_wood_bent_normal.exr"));
 }
 
 TEST(CliBake, BadRequestsAreOneErrorLineAndWriteNothing) {

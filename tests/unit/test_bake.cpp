@@ -307,5 +307,48 @@ TEST(Bake, ASpheresCurvatureIsOneOverItsRadiusAtEveryHit) {
   }
 }
 
+// AO and bent normal at the foot of a wall: the bump test's plane (z = 0 over [-1, 1]²) baked onto
+// itself beside a wall at x = 1 facing −x, 10⁴ high and wide. With binary AO and d_max past the
+// wall, a ray from the floor is blocked exactly when it heads toward +x, so
+//   AO = (1/π) ∫ over x < 0 of cos θ dω = 1/2,   bent ∝ ∫ over x < 0 of ω cos θ dω = (−2/3, 0, π/3).
+// AO: a texel's 256 rays (its 4 positions share them) are the first 256 points of a scrambled
+// (0, 2)-sequence, one in each strip v ∈ [k/256, (k+1)/256), and a ray heads toward +x exactly
+// when v ∈ (3/4, 1) ∪ [0, 1/4): 128 of them, whatever the scramble. Only a ray with 0 < d.x < 2·10⁻⁴
+// (over the wall's top at 2 from it) escapes: tolerance one ray, 1/256. Bent normal: each texel's
+// estimate is unbiased (a digitally shifted net: each point uniform), the texels' scrambles differ;
+// their mean is within 5 standard errors of the closed form (normalizing adds a bias of the
+// order of the variance, far below).
+TEST(Bake, AoAndBentNormalAtTheFootOfAWallAreTheirClosedForms) {
+  BumpPair pair = bump_pair(1, 0.5);  // a 1 × 1 grid: the plane itself
+  constexpr double kWall = 1e4;
+  const scene::Instance wall = placed({{1, -kWall, 0}, {1, -kWall, kWall}, {1, kWall, kWall}, {1, kWall, 0}},
+                                      {}, {{0, 1, 2}, {0, 2, 3}}, glm::dmat4(1));
+  const scene::Scene high = scene_of({pair.low.instances[0], wall});
+  Options options;
+  options.maps = {Map::ao, Map::bent_normal};
+  options.front = 0.1, options.back = 0.1, options.absolute_distances = true;
+  ao::Options occlusion;
+  occlusion.samples = 256, occlusion.falloff = ao::Falloff::none, occlusion.absolute_distance = 1e6;
+  auto baked = bake(pair.low, high, {ao::TextureTarget{{0}, 0}}, {.width = 32, .height = 32, .texel_samples = 4}, options, occlusion);
+  ASSERT_TRUE(baked) << baked.error().message;
+  const TextureBake& t = baked->textures.at(0);
+  EXPECT_EQ(t.misses, 0u);
+  EXPECT_EQ(t.occlusion_rays, t.texels * 256);
+  const dvec3 expected = glm::normalize(dvec3(-2.0 / 3, 0, std::numbers::pi / 3));
+  std::vector<dvec3> bent;
+  for (std::size_t texel = 0; texel < t.hit.size(); ++texel) {
+    ASSERT_EQ(t.hit[texel], 1);
+    ASSERT_NEAR(map_of(t, Map::ao).values[texel], 0.5, 1.0 / 256) << texel;
+    bent.push_back(texel3(map_of(t, Map::bent_normal), texel) * 2.0 - 1.0);
+  }
+  dvec3 mean(0);
+  for (const dvec3& b : bent) mean += b / double(bent.size());
+  double variance = 0;
+  for (const dvec3& b : bent) variance += glm::dot(b - mean, b - mean) / double(bent.size() - 1);
+  const double standard_error = std::sqrt(variance / double(bent.size()));
+  EXPECT_LT(glm::length(mean - expected), 5 * standard_error) << "mean " << mean.x << "," << mean.y << "," << mean.z;
+  EXPECT_LT(standard_error, 0.01);  // the test has power: a wrong direction by 0.05 would show
+}
+
 }  // namespace
 }  // namespace matbake::bake

@@ -553,6 +553,7 @@ TEST(DocsTables, MatchTheParameterDescriptions) {
       {"docs/build.md", "params:scene", markdown_table(pipeline::scene_params(), "")},
       {"docs/cluster.md", "params:cluster", markdown_table(pipeline::cluster_params(), "")},
       {"docs/bake.md", "params:bake", markdown_table(bake::request_params(), "")},
+      {"docs/bake.md", "params:bake-ao", markdown_table(ao::estimator_params(), "ao-")},
   };
   for (const Table& t : tables) {
     const fs::path path = fs::path(MATBAKE_SOURCE_DIR) / t.file;

@@ -7,5 +7,8 @@
 namespace matbake::ao {
 
 const params::Group<Request>& request_params();
+// Of those, the estimator's own (Request::options: samples, distances, falloff, bias, sides, seed,
+// sampler, traversal), for a bake that traces AO from points it finds itself (bake's `ao-*`).
+const params::Group<Request>& estimator_params();
 
 }  // namespace matbake::ao

@@ -30,9 +30,17 @@ enum class Map {
              // (positive outside), scene units
   position,  // the hit's world position, scene units
   curvature, // the high-poly's mean curvature at the hit, 1/scene units, positive where convex
+  ao,        // ambient occlusion (ao.hpp's estimator) at the hit, over the hemisphere of the
+             // high-poly's normal there, the whole high-poly occluding: in [0, 1], 1 open
+  bent_normal,  // the mean open direction of those rays (cosine-weighted, μ-weighted), in the
+                // low-poly's tangent basis as the normal map stores it
 };
-inline constexpr NameTable<Map, 4> kMapNames{
-    {{Map::normal, "normal"}, {Map::height, "height"}, {Map::position, "position"}, {Map::curvature, "curvature"}}};
+inline constexpr NameTable<Map, 6> kMapNames{{{Map::normal, "normal"},
+                                              {Map::height, "height"},
+                                              {Map::position, "position"},
+                                              {Map::curvature, "curvature"},
+                                              {Map::ao, "ao"},
+                                              {Map::bent_normal, "bent_normal"}}};
 int channels(Map map);
 
 // Which way the normal map's green channel points: OpenGL's (and glTF's) up the texture, against
@@ -64,6 +72,7 @@ struct TextureBake {
   std::vector<std::uint8_t> hit;  // per texel: 1 where a ray found the high-poly
   std::size_t texels = 0;         // traced (covered or touched)
   std::size_t samples = 0, misses = 0;  // rays cast, and how many found nothing
+  std::size_t occlusion_rays = 0;       // cast from the hits, for ao and bent_normal
   std::size_t missed_texels = 0;        // texels all of whose rays missed: filled from neighbours
   std::size_t padded = 0;
   double height_min = 0, height_max = 0;  // over the hits
@@ -76,10 +85,12 @@ struct Bake {
 };
 
 // `low` must have been loaded with SceneContent::object_space and texcoords (the tangents are
-// computed from the file's own attributes); `high` is used in world space. The result is the same
-// for any number of threads. Errors: options out of range, a target without its UV set's data,
-// Embree failing.
+// computed from the file's own attributes); `high` is used in world space. `occlusion` is the
+// estimator of the ao and bent_normal maps: its samples are a texel's rays, shared among its
+// texel_samples positions as the AO texture bake shares them (position j casts rays j, j + K, ...);
+// its distances are of the high-poly's radius. The result is the same for any number of threads.
+// Errors: options out of range, a target without its UV set's data, Embree failing.
 Result<Bake> bake(const scene::Scene& low, const scene::Scene& high, const std::vector<ao::TextureTarget>& targets,
-                  const ao::TextureOptions& texture, const Options& options);
+                  const ao::TextureOptions& texture, const Options& options, const ao::Options& occlusion = {});
 
 }  // namespace matbake::bake

@@ -2,7 +2,8 @@
 // `matbake bake LOW --from HIGH -o OUT`: the high-poly's maps baked onto the low-poly's UVs, one
 // texture set per low-poly material (bake.hpp), and the low-poly written again with them: the
 // normal map as the material's normalTexture (with TANGENT written, so that every runtime shades
-// in the basis it was baked in), height and position as float EXR files beside the output.
+// in the basis it was baked in), AO as its occlusionTexture, the other maps as float EXR files
+// beside the output.
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -15,6 +16,7 @@ namespace matbake::bake {
 struct Request {
   Options bake;
   ao::TextureOptions texture{.width = 1024, .height = 1024, .padding = -1, .texel_samples = 4};
+  ao::Request occlusion;  // the ao and bent_normal maps' estimator: its `options` (ao_params.hpp's estimator_params)
 };
 
 struct FileOptions {
@@ -28,10 +30,11 @@ struct TextureReport {
   int material = -1;
   std::string name;                // the material's
   int width = 0, height = 0, texcoord = 0;
-  std::size_t texels = 0, samples = 0, misses = 0, missed_texels = 0, padded = 0;
+  std::size_t texels = 0, samples = 0, misses = 0, missed_texels = 0, padded = 0, occlusion_rays = 0;
   double height_min = 0, height_max = 0;
   std::vector<std::string> files;  // per map, in the order asked: the image's URI or the file written
-  std::string existing;            // what happened to the material's own normalTexture ("", "replaced")
+  std::string existing;            // what happened to the material's own normalTexture and occlusionTexture
+                                   // ("", "normal replaced", "occlusion replaced", both)
 };
 
 struct FileReport {

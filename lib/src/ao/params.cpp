@@ -194,4 +194,17 @@ const params::Group<Request>& request_params() {
   return group;
 }
 
+const params::Group<Request>& estimator_params() {
+  static const params::Group<Request> group = [] {
+    params::Group<Request> g;
+    for (const char* name : {"samples", "relative_distance", "max_distance", "tau", "falloff", "bias", "two_sided", "seed",
+                             "sampler", "fast_traversal"}) {
+      g.params.push_back(*request_params().find(name));
+    }
+    g.check = [](const Request& r) { return check(r.options); };
+    return g;
+  }();
+  return group;
+}
+
 }  // namespace matbake::ao

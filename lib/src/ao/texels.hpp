@@ -3,6 +3,7 @@
 // tie rule, nearest points for touched texels), and the padding around them afterwards.
 #include <glm/vec2.hpp>
 
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -43,6 +44,13 @@ inline UvTriangle uv_triangle(const scene::Instance& inst, int texcoord, std::si
     return glm::dvec2(double(uv[v].x) * width - 0.5, double(uv[v].y) * height - 0.5);
   };
   return {texel(t[0]), texel(t[1]), texel(t[2])};
+}
+
+// A texel's size on a triangle's surface: √(world area / texel area), from twice the triangle's
+// world area and its UVs in texel space (the scale of a ray origin's offset).
+inline float texel_size(double world_area2, const UvTriangle& uv) {
+  const double uv_area2 = std::abs((uv.b.x - uv.a.x) * (uv.c.y - uv.a.y) - (uv.b.y - uv.a.y) * (uv.c.x - uv.a.x));
+  return float(std::sqrt(world_area2 / uv_area2));
 }
 
 // Barycentric weights (of a, b, c) of the point of the triangle nearest to p (p's own when inside).

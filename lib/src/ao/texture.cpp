@@ -34,9 +34,7 @@ double point_occlusion(const Tracer& tracer, const scene::Scene& scene, const te
   const texels::UvTriangle uv = texels::uv_triangle(inst, target.texcoord, point.triangle, texture.width, texture.height);
   const Mesh& mesh = tracer.mesh(point.instance);
   const Vec3& face = mesh.face_normals[point.triangle];
-  // The texel's size on the surface: √(world area / texel area), the scale of the origin's offset.
-  const double uv_area2 = std::abs((uv.b.x - uv.a.x) * (uv.c.y - uv.a.y) - (uv.b.y - uv.a.y) * (uv.c.x - uv.a.x));
-  const float texel_size = float(std::sqrt(double(glm::length(face)) / uv_area2));
+  const float texel_size = texels::texel_size(double(glm::length(face)), uv);
   const int positions = texture.texel_samples;
   double sum = 0;
   for (int j = 0; j < positions; ++j) {

@@ -134,7 +134,7 @@ float Tracer::origin_offset(const Vec3& p, float scale) const {
 }
 
 double Tracer::sum_over_rays(const Vec3& origin, const Vec3& n, std::uint64_t key, int first, int step,
-                             std::span<RTCRayHit> rays, std::uint64_t& cast) const {
+                             std::span<RTCRayHit> rays, std::uint64_t& cast, Vec3* bent) const {
   Vec3 t, b;
   basis(n, t, b);
   const float far = float(d_max_);
@@ -154,17 +154,24 @@ double Tracer::sum_over_rays(const Vec3& origin, const Vec3& n, std::uint64_t ke
   if (count == 0) return 0;
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
-  double sum = 0;
   // The rays of one point as a stream: they share an origin, and Embree packs them itself.
-  if (options_.falloff == Falloff::none) {
+  const bool binary = options_.falloff == Falloff::none;
+  if (binary) {
     rtcOccluded1M(scene_.get(), &context, &rays[0].ray, count, sizeof(RTCRayHit));
-    for (unsigned i = 0; i < count; ++i) sum += rays[i].ray.tfar >= 0 ? 1.0 : 0.0;  // occluded: tfar = −inf
   } else {
     rtcIntersect1M(scene_.get(), &context, rays.data(), count, sizeof(RTCRayHit));
-    for (unsigned i = 0; i < count; ++i) {
-      const RTCRayHit& rh = rays[i];
-      sum += rh.hit.geomID == RTC_INVALID_GEOMETRY_ID ? 1.0 : std::min(1.0, (1.0 - std::exp(-tau_ * rh.ray.tfar)) * normalization_);
+  }
+  double sum = 0;
+  for (unsigned i = 0; i < count; ++i) {
+    const RTCRayHit& rh = rays[i];
+    double mu = 0;
+    if (binary) {
+      mu = rh.ray.tfar >= 0 ? 1.0 : 0.0;  // occluded: tfar = −inf
+    } else {
+      mu = rh.hit.geomID == RTC_INVALID_GEOMETRY_ID ? 1.0 : std::min(1.0, (1.0 - std::exp(-tau_ * rh.ray.tfar)) * normalization_);
     }
+    sum += mu;
+    if (bent) *bent += float(mu) * Vec3(rh.ray.dir_x, rh.ray.dir_y, rh.ray.dir_z);
   }
   cast += count;
   return sum;

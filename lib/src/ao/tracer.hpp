@@ -51,9 +51,10 @@ class Tracer {
 
   // Σ μ over rays first, first + step, ... (below options.samples) of the sequence keyed by `key`,
   // cast from `origin` around the unit normal `n`; `rays` is scratch of at least options.samples.
-  // Returns the sum and adds the ray count to `cast`.
+  // Returns the sum and adds the ray count to `cast`; with `bent`, adds Σ μ · direction to it (the
+  // bent normal's estimator: the mean open direction, cosine-weighted).
   double sum_over_rays(const scene::Vec3& origin, const scene::Vec3& n, std::uint64_t key, int first, int step,
-                       std::span<RTCRayHit> rays, std::uint64_t& cast) const;
+                       std::span<RTCRayHit> rays, std::uint64_t& cast, scene::Vec3* bent = nullptr) const;
 
  private:
   Tracer() = default;

@@ -9,8 +9,10 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <memory>
 
 #include "../ao/texels.hpp"
+#include "../ao/tracer.hpp"
 #include "frames.hpp"
 #include "high_poly.hpp"
 
@@ -66,8 +68,9 @@ glm::dvec3 tangent_space(const glm::dmat3& basis, const glm::dvec3& h) {
 
 // What a texel's hits add up to, for every map.
 struct TexelSum {
-  glm::dvec3 normal{0}, position{0};
-  double height = 0, curvature = 0;
+  glm::dvec3 normal{0}, position{0}, bent{0};
+  double height = 0, curvature = 0, occlusion = 0;
+  std::uint64_t occlusion_rays = 0;
   int hits = 0, rays = 0;
 };
 
@@ -78,8 +81,26 @@ struct TraceContext {
   const ao::TextureTarget& target;
   const ao::TextureOptions& texture;
   float front, back;
-  bool curvature;  // asked for
+  bool curvature;                // asked for
+  const ao::Tracer* occlusion;   // the high-poly, for ao and bent_normal (null: neither asked)
+  bool bent;                     // bent_normal asked for
+  int occlusion_samples;
+  std::uint64_t occlusion_seed;
+  std::size_t target_index;
 };
+
+// AO and bent normal from a hit, around the high-poly's normal there: texel position j of K casts
+// rays j, j + K, ... of the texel's sequence (so a texel's K positions cast it once through).
+void occlude(const TraceContext& c, const Hit& hit, const LowPoint& low, float texel_size, int j, std::uint32_t texel,
+             TexelSum& sum) {
+  const int positions = c.texture.texel_samples;
+  const std::uint64_t key = ao::sample_key(c.occlusion_seed, c.target_index, texel);
+  std::vector<RTCRayHit> rays(std::size_t(c.occlusion_samples / positions + 1));
+  const glm::vec3 origin = hit.position + hit.normal * c.occlusion->origin_offset(hit.position, texel_size);
+  glm::vec3 bent(0);
+  sum.occlusion += c.occlusion->sum_over_rays(origin, hit.normal, key, j, positions, rays, sum.occlusion_rays, c.bent ? &bent : nullptr);
+  if (c.bent) sum.bent += tangent_space(low.basis, glm::dvec3(bent)) * double(glm::length(bent));
+}
 
 // The cage ray at a low-poly point: from `front` outside along its normal to `back` inside.
 std::optional<Hit> cast(const TraceContext& c, const LowPoint& low) {
@@ -95,6 +116,12 @@ void trace_point(const TraceContext& c, const ao::texels::SurfacePoint& point, s
   const ao::texels::UvTriangle uv =
       ao::texels::uv_triangle(inst, c.target.texcoord, point.triangle, c.texture.width, c.texture.height);
   const int positions = c.texture.texel_samples;
+  float texel_size = 0;
+  if (c.occlusion) {
+    const auto& t = inst.triangles[point.triangle];
+    texel_size = ao::texels::texel_size(
+        double(glm::length(glm::cross(inst.positions[t[1]] - inst.positions[t[0]], inst.positions[t[2]] - inst.positions[t[0]]))), uv);
+  }
   for (int j = 0; j < positions; ++j) {
     glm::dvec2 at(point.x, point.y);
     if (positions > 1) {
@@ -115,7 +142,16 @@ void trace_point(const TraceContext& c, const ao::texels::SurfacePoint& point, s
     sum.position += glm::dvec3(hit->position);
     sum.height += double(c.front) - double(hit->distance);
     if (c.curvature) sum.curvature += c.high.mean_curvature(*hit);
+    if (c.occlusion) occlude(c, *hit, low, texel_size, j, point.texel, sum);
   }
+}
+
+// A tangent-space direction as a normal map holds it: the sum's direction (+z when it has none),
+// green as asked, xyz/2 + ½.
+void encode_direction(const glm::dvec3& sum, Green green, float* v) {
+  glm::dvec3 m = glm::length(sum) > 0 ? glm::normalize(sum) : glm::dvec3(0, 0, 1);
+  if (green == Green::directx) m.y = -m.y;
+  for (int k = 0; k < 3; ++k) v[k] = float(std::clamp(m[k] * 0.5 + 0.5, 0.0, 1.0));
 }
 
 // The texel's value of each map from its sum (it has hits).
@@ -123,12 +159,9 @@ void store(const TexelSum& sum, const Options& options, std::size_t texel, Textu
   for (MapImage& image : out.maps) {
     float* v = &image.values[texel * std::size_t(image.channels)];
     switch (image.map) {
-      case Map::normal: {
-        glm::dvec3 m = glm::length(sum.normal) > 0 ? glm::normalize(sum.normal) : glm::dvec3(0, 0, 1);
-        if (options.green == Green::directx) m.y = -m.y;
-        for (int k = 0; k < 3; ++k) v[k] = float(std::clamp(m[k] * 0.5 + 0.5, 0.0, 1.0));
-        break;
-      }
+      case Map::normal: encode_direction(sum.normal, options.green, v); break;
+      case Map::bent_normal: encode_direction(sum.bent, options.green, v); break;
+      case Map::ao: v[0] = sum.occlusion_rays ? float(sum.occlusion / double(sum.occlusion_rays)) : 1.0f; break;
       case Map::height: v[0] = float(sum.height / sum.hits); break;
       case Map::curvature: v[0] = float(sum.curvature / sum.hits); break;
       case Map::position:
@@ -138,12 +171,14 @@ void store(const TexelSum& sum, const Options& options, std::size_t texel, Textu
   }
 }
 
-// What a texel nothing maps holds: a flat normal, zero height, position and curvature.
+// What a texel nothing maps holds: flat normals, no occlusion, zero height, position and curvature.
 void background(MapImage& image) {
+  const bool direction = image.map == Map::normal || image.map == Map::bent_normal;
   const std::size_t texels = image.values.size() / std::size_t(image.channels);
   for (std::size_t t = 0; t < texels; ++t) {
     for (int k = 0; k < image.channels; ++k) {
-      image.values[t * std::size_t(image.channels) + std::size_t(k)] = image.map == Map::normal ? (k == 2 ? 1.0f : 0.5f) : 0.0f;
+      float& v = image.values[t * std::size_t(image.channels) + std::size_t(k)];
+      v = direction ? (k == 2 ? 1.0f : 0.5f) : image.map == Map::ao ? 1.0f : 0.0f;
     }
   }
 }
@@ -169,7 +204,7 @@ std::size_t fill_and_pad(MapImage& image, const std::vector<bool>& hit, const st
 
 }  // namespace
 
-int channels(Map map) { return map == Map::normal || map == Map::position ? 3 : 1; }
+int channels(Map map) { return map == Map::normal || map == Map::bent_normal || map == Map::position ? 3 : 1; }
 
 Status check(const Options& options) {
   if (options.maps.empty()) return Error{"", "a bake needs at least one map", true};
@@ -181,9 +216,14 @@ Status check(const Options& options) {
 }
 
 Result<Bake> bake(const scene::Scene& low, const scene::Scene& high, const std::vector<ao::TextureTarget>& targets,
-                  const ao::TextureOptions& texture, const Options& options) {
+                  const ao::TextureOptions& texture, const Options& options, const ao::Options& occlusion) {
   if (Status s = check(options); !s) return s.error();
   if (Status s = ao::check(texture, kMaxTexelSamples, "bake"); !s) return s.error();
+  const auto asked = [&](Map map) { return std::ranges::find(options.maps, map) != options.maps.end(); };
+  const bool occluding = asked(Map::ao) || asked(Map::bent_normal);
+  if (occluding) {
+    if (Status s = ao::check(occlusion); !s) return s.error();
+  }
   const auto start = Clock::now();
   std::vector<std::vector<CornerFrame>> frames(low.instances.size());
   for (const ao::TextureTarget& target : targets) {
@@ -198,6 +238,12 @@ Result<Bake> bake(const scene::Scene& low, const scene::Scene& high, const std::
   }
   auto built = HighPoly::build(high);
   if (!built) return built.error();
+  std::unique_ptr<ao::Tracer> occluder;  // only where a map needs it: a second BVH of the high-poly
+  if (occluding) {
+    auto made = ao::Tracer::build(high, occlusion);
+    if (!made) return made.error();
+    occluder = std::move(*made);
+  }
   Bake result;
   const double diagonal = 2.0 * double(low.radius());
   result.front = options.absolute_distances ? options.front : options.front * diagonal;
@@ -228,8 +274,19 @@ Result<Bake> bake(const scene::Scene& low, const scene::Scene& high, const std::
     }
     out.hit.assign(texel_count, 0);
     out.texels = runs.size() - 1;
-    const TraceContext context{low, frames, **built, target, texture, float(result.front), float(result.back),
-                               std::ranges::find(options.maps, Map::curvature) != options.maps.end()};
+    const TraceContext context{low,
+                               frames,
+                               **built,
+                               target,
+                               texture,
+                               float(result.front),
+                               float(result.back),
+                               asked(Map::curvature),
+                               occluder.get(),
+                               asked(Map::bent_normal),
+                               occlusion.samples,
+                               occlusion.seed,
+                               index};
     std::vector<TexelSum> sums(runs.size() - 1);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, sums.size(), 64), [&](const tbb::blocked_range<std::size_t>& range) {
       for (std::size_t r = range.begin(); r != range.end(); ++r) {
@@ -247,6 +304,7 @@ Result<Bake> bake(const scene::Scene& low, const scene::Scene& high, const std::
       const std::size_t texel = points[runs[r]].texel;
       traced[texel] = true;
       out.samples += std::size_t(sums[r].rays);
+      out.occlusion_rays += sums[r].occlusion_rays;
       out.misses += std::size_t(sums[r].rays - sums[r].hits);
       if (sums[r].hits == 0) {
         ++out.missed_texels;

@@ -74,6 +74,11 @@ Result<Targets> material_targets(const gltf::Document& doc, const scene::Scene& 
   return out;
 }
 
+// The material's texture a map becomes, or null: a file beside the output.
+const char* material_slot(Map map) {
+  return map == Map::normal ? "normalTexture" : map == Map::ao ? "occlusionTexture" : nullptr;
+}
+
 fs::path float_map_file(const fs::path& output, const std::string& material_name, Map map) {
   return output.parent_path() / (output.stem().string() + "_" + material_name + "_" + std::string(matbake::name_in(kMapNames, map)) + ".exr");
 }
@@ -117,11 +122,13 @@ Result<TextureReport> write_maps(gltf::Document& doc, const gltf::ImageCache& ca
   report.texels = baked.texels, report.samples = baked.samples, report.misses = baked.misses;
   report.missed_texels = baked.missed_texels, report.padded = baked.padded;
   report.height_min = baked.height_min, report.height_max = baked.height_max;
+  report.occlusion_rays = baked.occlusion_rays;
   const std::string file_name = gltf::material_file_name(material, m);
   for (MapImage& map : baked.maps) {
     image::Image img = gltf::blank(baked.width, baked.height, map.channels);
     img.pixels = std::move(map.values);
-    if (map.map != Map::normal) {
+    const char* slot = material_slot(map.map);
+    if (!slot) {
       const fs::path file = float_map_file(options.output, file_name, map.map);
       image::WriteOptions exr;
       exr.type = image::SampleType::f32;
@@ -130,16 +137,19 @@ Result<TextureReport> write_maps(gltf::Document& doc, const gltf::ImageCache& ca
       continue;
     }
     int sampler_from = -1;
-    if (material.contains("normalTexture") && material["normalTexture"].is_object()) {
-      sampler_from = gltf::integer_in<int>(material["normalTexture"], "index", -1, -1);
-      report.existing = "replaced";
+    Json info = Json::object();
+    if (material.contains(slot) && material[slot].is_object()) {
+      sampler_from = gltf::integer_in<int>(material[slot], "index", -1, -1);
+      // An occlusion's strength is the artist's; a normal map's scale was for the old map.
+      if (map.map == Map::ao && material[slot].contains("strength")) info["strength"] = material[slot]["strength"];
+      report.existing += std::string(report.existing.empty() ? "" : ", ") + std::string(matbake::name_in(kMapNames, map.map)) + " replaced";
     }
-    const std::string name = options.output.stem().string() + "_" + file_name + "_normal";
+    const std::string name = options.output.stem().string() + "_" + file_name + "_" + std::string(matbake::name_in(kMapNames, map.map));
     auto made = cache.add_texture(doc, img, color::Transfer::linear, name, sampler_from);
     if (!made) return made.error();
-    Json info = {{"index", made->index}};  // scale 1 and no transform: the bake is over raw UVs
+    info["index"] = made->index;  // no transform: the bake is over raw UVs
     if (report.texcoord != 0) info["texCoord"] = report.texcoord;
-    material["normalTexture"] = std::move(info);
+    material[slot] = std::move(info);
     report.files.push_back(made->uri);
   }
   return report;
@@ -173,14 +183,14 @@ Result<FileReport> bake_file(const fs::path& low_path, const FileOptions& option
     const Json& materials = doc->json["materials"];
     for (int m : targets->materials) {
       for (Map map : options.request.bake.maps) {
-        if (map == Map::normal) continue;
+        if (material_slot(map)) continue;
         outputs.push_back({float_map_file(options.output, gltf::material_file_name(materials[std::size_t(m)], m), map),
                            std::string(matbake::name_in(kMapNames, map)) + " map"});
       }
     }
     if (Status s = check_outputs(outputs, inputs); !s) return s.error();
 
-    auto baked = bake(*low, *high, targets->targets, options.request.texture, options.request.bake);
+    auto baked = bake(*low, *high, targets->targets, options.request.texture, options.request.bake, options.request.occlusion.options);
     if (!baked) {
       Error error = baked.error();
       if (error.path.empty() && !error.usage) error.path = doc->file;
@@ -198,7 +208,7 @@ Result<FileReport> bake_file(const fs::path& low_path, const FileOptions& option
       auto written = write_maps(*doc, cache, options, *targets, t, baked->textures[t]);
       if (!written) return written.error();
       for (std::size_t i = 0; i < options.request.bake.maps.size(); ++i) {
-        if (options.request.bake.maps[i] != Map::normal) report.written.push_back(written->files[i]);
+        if (!material_slot(options.request.bake.maps[i])) report.written.push_back(written->files[i]);
       }
       report.textures.push_back(std::move(*written));
     }

@@ -1,6 +1,7 @@
 // bake::Request's parameters: names, kinds, ranges, help and examples; defaults are the struct's.
 #include <cmath>
 
+#include "matbake/ao_params.hpp"
 #include "matbake/bake_params.hpp"
 #include "matbake/encoding_params.hpp"
 
@@ -105,6 +106,7 @@ const params::Tree<FileOptions>& request_tree() {
   static const params::Tree<FileOptions> tree{
       params::branch<FileOptions>(image::encoding_params(), "", "", [](auto& o) -> auto& { return o.encoding; }),
       params::branch<FileOptions>(request_params(), "", "", [](auto& o) -> auto& { return o.request; }),
+      params::branch<FileOptions>(ao::estimator_params(), "ao", "ao-", [](auto& o) -> auto& { return o.request.occlusion; }),
   };
   return tree;
 }
