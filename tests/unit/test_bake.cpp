@@ -350,5 +350,34 @@ TEST(Bake, AoAndBentNormalAtTheFootOfAWallAreTheirClosedForms) {
   EXPECT_LT(standard_error, 0.01);  // the test has power: a wrong direction by 0.05 would show
 }
 
+// Thickness of a slab: the bump test's plane (z = 0 over [-1, 1]²) onto the top of a slab
+// 0.1 thick and 10³ wide (its top facing +z, its bottom −z). A ray into it at angle θ meets the
+// bottom (from behind: both faces count) at 0.1 / cos θ, so each ray's depth is 0.1 exactly; only a
+// ray with cos θ below 10⁻⁴ leaves by the open sides or passes d_max (a chance of ~10⁻⁸ a ray).
+// Tolerance: float32 distances, a few ulps at the coordinates' magnitude (1).
+TEST(Bake, ASlabsThicknessIsItsDepthForEveryRay) {
+  const BumpPair pair = bump_pair(1, 0.5);
+  constexpr double kWide = 1e3, kThick = 0.1;
+  const scene::Instance top = placed({{-kWide, -kWide, 0}, {kWide, -kWide, 0}, {kWide, kWide, 0}, {-kWide, kWide, 0}}, {},
+                                     {{0, 1, 2}, {0, 2, 3}}, glm::dmat4(1));
+  const scene::Instance bottom = placed({{-kWide, -kWide, -kThick}, {kWide, -kWide, -kThick}, {kWide, kWide, -kThick}, {-kWide, kWide, -kThick}},
+                                        {}, {{0, 2, 1}, {0, 3, 2}}, glm::dmat4(1));
+  Options options;
+  options.maps = {Map::thickness};
+  options.front = 0.05, options.back = 0.05, options.absolute_distances = true;
+  ao::Options rays;
+  rays.samples = 64;
+  auto baked = bake(pair.low, scene_of({top, bottom}), {ao::TextureTarget{{0}, 0}}, {.width = 16, .height = 16, .texel_samples = 4},
+                    options, rays);
+  ASSERT_TRUE(baked) << baked.error().message;
+  const TextureBake& t = baked->textures.at(0);
+  EXPECT_EQ(t.misses, 0u);
+  EXPECT_EQ(t.occlusion_rays, t.texels * 64);
+  for (std::size_t texel = 0; texel < t.hit.size(); ++texel) {
+    ASSERT_EQ(t.hit[texel], 1);
+    ASSERT_NEAR(map_of(t, Map::thickness).values[texel], kThick, 1e-5) << texel;
+  }
+}
+
 }  // namespace
 }  // namespace matbake::bake

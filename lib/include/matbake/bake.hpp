@@ -34,13 +34,17 @@ enum class Map {
              // high-poly's normal there, the whole high-poly occluding: in [0, 1], 1 open
   bent_normal,  // the mean open direction of those rays (cosine-weighted, μ-weighted), in the
                 // low-poly's tangent basis as the normal map stores it
+  thickness,    // the high-poly's depth below the hit: the mean over cosine-weighted rays into it
+                // (around −normal, either face counting) of distance × cosine (d_max where nothing
+                // is met), scene units; a slab of thickness t gives t for every ray
 };
-inline constexpr NameTable<Map, 6> kMapNames{{{Map::normal, "normal"},
+inline constexpr NameTable<Map, 7> kMapNames{{{Map::normal, "normal"},
                                               {Map::height, "height"},
                                               {Map::position, "position"},
                                               {Map::curvature, "curvature"},
                                               {Map::ao, "ao"},
-                                              {Map::bent_normal, "bent_normal"}}};
+                                              {Map::bent_normal, "bent_normal"},
+                                              {Map::thickness, "thickness"}}};
 int channels(Map map);
 
 // Which way the normal map's green channel points: OpenGL's (and glTF's) up the texture, against
@@ -72,7 +76,7 @@ struct TextureBake {
   std::vector<std::uint8_t> hit;  // per texel: 1 where a ray found the high-poly
   std::size_t texels = 0;         // traced (covered or touched)
   std::size_t samples = 0, misses = 0;  // rays cast, and how many found nothing
-  std::size_t occlusion_rays = 0;       // cast from the hits, for ao and bent_normal
+  std::size_t occlusion_rays = 0;       // cast from the hits, for ao, bent_normal and thickness
   std::size_t missed_texels = 0;        // texels all of whose rays missed: filled from neighbours
   std::size_t padded = 0;
   double height_min = 0, height_max = 0;  // over the hits
@@ -86,7 +90,7 @@ struct Bake {
 
 // `low` must have been loaded with SceneContent::object_space and texcoords (the tangents are
 // computed from the file's own attributes); `high` is used in world space. `occlusion` is the
-// estimator of the ao and bent_normal maps: its samples are a texel's rays, shared among its
+// estimator of the ao, bent_normal and thickness maps (thickness: two-sided, its falloff unused): its samples are a texel's rays, shared among its
 // texel_samples positions as the AO texture bake shares them (position j casts rays j, j + K, ...);
 // its distances are of the high-poly's radius. The result is the same for any number of threads.
 // Errors: options out of range, a target without its UV set's data, Embree failing.

@@ -133,8 +133,7 @@ float Tracer::origin_offset(const Vec3& p, float scale) const {
   return std::max(std::min(float(options_.bias) * scale, 1e-4f * radius_), 1e-6f * magnitude);
 }
 
-double Tracer::sum_over_rays(const Vec3& origin, const Vec3& n, std::uint64_t key, int first, int step,
-                             std::span<RTCRayHit> rays, std::uint64_t& cast, Vec3* bent) const {
+unsigned Tracer::aim(const Vec3& origin, const Vec3& n, std::uint64_t key, int first, int step, std::span<RTCRayHit> rays) const {
   Vec3 t, b;
   basis(n, t, b);
   const float far = float(d_max_);
@@ -151,6 +150,28 @@ double Tracer::sum_over_rays(const Vec3& origin, const Vec3& n, std::uint64_t ke
     rh.ray.mask = ~0u, rh.ray.id = unsigned(s), rh.ray.flags = 0;
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
   }
+  return count;
+}
+
+double Tracer::sum_of_depths(const Vec3& origin, const Vec3& n, std::uint64_t key, int first, int step,
+                             std::span<RTCRayHit> rays, std::uint64_t& cast) const {
+  const unsigned count = aim(origin, n, key, first, step, rays);
+  if (count == 0) return 0;
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  rtcIntersect1M(scene_.get(), &context, rays.data(), count, sizeof(RTCRayHit));
+  double sum = 0;
+  for (unsigned i = 0; i < count; ++i) {
+    const RTCRayHit& rh = rays[i];  // a miss keeps tfar = d_max
+    sum += double(rh.ray.tfar) * double(glm::dot(Vec3(rh.ray.dir_x, rh.ray.dir_y, rh.ray.dir_z), n));
+  }
+  cast += count;
+  return sum;
+}
+
+double Tracer::sum_over_rays(const Vec3& origin, const Vec3& n, std::uint64_t key, int first, int step,
+                             std::span<RTCRayHit> rays, std::uint64_t& cast, Vec3* bent) const {
+  const unsigned count = aim(origin, n, key, first, step, rays);
   if (count == 0) return 0;
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);

@@ -56,8 +56,17 @@ class Tracer {
   double sum_over_rays(const scene::Vec3& origin, const scene::Vec3& n, std::uint64_t key, int first, int step,
                        std::span<RTCRayHit> rays, std::uint64_t& cast, scene::Vec3* bent = nullptr) const;
 
+  // Over the same rays: Σ of the depth each reaches along n, its distance to the first surface
+  // (d_max where it finds none) times the cosine to n (for thickness, cast into a surface).
+  double sum_of_depths(const scene::Vec3& origin, const scene::Vec3& n, std::uint64_t key, int first, int step,
+                       std::span<RTCRayHit> rays, std::uint64_t& cast) const;
+
  private:
   Tracer() = default;
+  // Fills rays with those of the sequence (first, first + step, ...): cosine-weighted around the
+  // unit n from `origin`, out to d_max; returns how many.
+  unsigned aim(const scene::Vec3& origin, const scene::Vec3& n, std::uint64_t key, int first, int step,
+               std::span<RTCRayHit> rays) const;
   std::unique_ptr<RTCDeviceTy, DeviceDeleter> device_;
   std::unique_ptr<RTCSceneTy, SceneDeleter> scene_;
   std::vector<Mesh> meshes_;

@@ -69,8 +69,8 @@ glm::dvec3 tangent_space(const glm::dmat3& basis, const glm::dvec3& h) {
 // What a texel's hits add up to, for every map.
 struct TexelSum {
   glm::dvec3 normal{0}, position{0}, bent{0};
-  double height = 0, curvature = 0, occlusion = 0;
-  std::uint64_t occlusion_rays = 0;
+  double height = 0, curvature = 0, occlusion = 0, thickness = 0;
+  std::uint64_t occlusion_rays = 0, thickness_rays = 0;
   int hits = 0, rays = 0;
 };
 
@@ -84,22 +84,34 @@ struct TraceContext {
   bool curvature;                // asked for
   const ao::Tracer* occlusion;   // the high-poly, for ao and bent_normal (null: neither asked)
   bool bent;                     // bent_normal asked for
+  const ao::Tracer* thickness;   // the high-poly two-sided, for thickness (null: not asked)
   int occlusion_samples;
   std::uint64_t occlusion_seed;
   std::size_t target_index;
 };
 
-// AO and bent normal from a hit, around the high-poly's normal there: texel position j of K casts
-// rays j, j + K, ... of the texel's sequence (so a texel's K positions cast it once through).
-void occlude(const TraceContext& c, const Hit& hit, const LowPoint& low, float texel_size, int j, std::uint32_t texel,
-             TexelSum& sum) {
+// AO and bent normal from a hit, around the high-poly's normal there, and thickness, into it: texel
+// position j of K casts rays j, j + K, ... of the texel's sequence (so a texel's K positions cast it
+// once through).
+void trace_from_hit(const TraceContext& c, const Hit& hit, const LowPoint& low, float texel_size, int j, std::uint32_t texel,
+                    TexelSum& sum) {
   const int positions = c.texture.texel_samples;
   const std::uint64_t key = ao::sample_key(c.occlusion_seed, c.target_index, texel);
   std::vector<RTCRayHit> rays(std::size_t(c.occlusion_samples / positions + 1));
-  const glm::vec3 origin = hit.position + hit.normal * c.occlusion->origin_offset(hit.position, texel_size);
-  glm::vec3 bent(0);
-  sum.occlusion += c.occlusion->sum_over_rays(origin, hit.normal, key, j, positions, rays, sum.occlusion_rays, c.bent ? &bent : nullptr);
-  if (c.bent) sum.bent += tangent_space(low.basis, glm::dvec3(bent)) * double(glm::length(bent));
+  if (c.occlusion) {
+    const glm::vec3 origin = hit.position + hit.normal * c.occlusion->origin_offset(hit.position, texel_size);
+    glm::vec3 bent(0);
+    sum.occlusion += c.occlusion->sum_over_rays(origin, hit.normal, key, j, positions, rays, sum.occlusion_rays, c.bent ? &bent : nullptr);
+    if (c.bent) sum.bent += tangent_space(low.basis, glm::dvec3(bent)) * double(glm::length(bent));
+  }
+  if (c.thickness) {
+    // The origin's offset below the surface is depth too: added back for every ray.
+    const float offset = c.thickness->origin_offset(hit.position, texel_size);
+    std::uint64_t inward = 0;
+    sum.thickness += c.thickness->sum_of_depths(hit.position - hit.normal * offset, -hit.normal, key, j, positions, rays, inward) +
+                     double(inward) * double(offset);
+    sum.thickness_rays += inward;
+  }
 }
 
 // The cage ray at a low-poly point: from `front` outside along its normal to `back` inside.
@@ -117,7 +129,7 @@ void trace_point(const TraceContext& c, const ao::texels::SurfacePoint& point, s
       ao::texels::uv_triangle(inst, c.target.texcoord, point.triangle, c.texture.width, c.texture.height);
   const int positions = c.texture.texel_samples;
   float texel_size = 0;
-  if (c.occlusion) {
+  if (c.occlusion || c.thickness) {
     const auto& t = inst.triangles[point.triangle];
     texel_size = ao::texels::texel_size(
         double(glm::length(glm::cross(inst.positions[t[1]] - inst.positions[t[0]], inst.positions[t[2]] - inst.positions[t[0]]))), uv);
@@ -142,7 +154,7 @@ void trace_point(const TraceContext& c, const ao::texels::SurfacePoint& point, s
     sum.position += glm::dvec3(hit->position);
     sum.height += double(c.front) - double(hit->distance);
     if (c.curvature) sum.curvature += c.high.mean_curvature(*hit);
-    if (c.occlusion) occlude(c, *hit, low, texel_size, j, point.texel, sum);
+    if (c.occlusion || c.thickness) trace_from_hit(c, *hit, low, texel_size, j, point.texel, sum);
   }
 }
 
@@ -164,6 +176,7 @@ void store(const TexelSum& sum, const Options& options, std::size_t texel, Textu
       case Map::ao: v[0] = sum.occlusion_rays ? float(sum.occlusion / double(sum.occlusion_rays)) : 1.0f; break;
       case Map::height: v[0] = float(sum.height / sum.hits); break;
       case Map::curvature: v[0] = float(sum.curvature / sum.hits); break;
+      case Map::thickness: v[0] = sum.thickness_rays ? float(sum.thickness / double(sum.thickness_rays)) : 0.0f; break;
       case Map::position:
         for (int k = 0; k < 3; ++k) v[k] = float(sum.position[k] / sum.hits);
         break;
@@ -221,7 +234,7 @@ Result<Bake> bake(const scene::Scene& low, const scene::Scene& high, const std::
   if (Status s = ao::check(texture, kMaxTexelSamples, "bake"); !s) return s.error();
   const auto asked = [&](Map map) { return std::ranges::find(options.maps, map) != options.maps.end(); };
   const bool occluding = asked(Map::ao) || asked(Map::bent_normal);
-  if (occluding) {
+  if (occluding || asked(Map::thickness)) {
     if (Status s = ao::check(occlusion); !s) return s.error();
   }
   const auto start = Clock::now();
@@ -243,6 +256,14 @@ Result<Bake> bake(const scene::Scene& low, const scene::Scene& high, const std::
     auto made = ao::Tracer::build(high, occlusion);
     if (!made) return made.error();
     occluder = std::move(*made);
+  }
+  std::unique_ptr<ao::Tracer> depths;  // thickness: every face counts, seen from either side
+  if (asked(Map::thickness)) {
+    ao::Options two_sided = occlusion;
+    two_sided.two_sided = true;
+    auto made = ao::Tracer::build(high, two_sided);
+    if (!made) return made.error();
+    depths = std::move(*made);
   }
   Bake result;
   const double diagonal = 2.0 * double(low.radius());
@@ -284,6 +305,7 @@ Result<Bake> bake(const scene::Scene& low, const scene::Scene& high, const std::
                                asked(Map::curvature),
                                occluder.get(),
                                asked(Map::bent_normal),
+                               depths.get(),
                                occlusion.samples,
                                occlusion.seed,
                                index};
@@ -304,7 +326,7 @@ Result<Bake> bake(const scene::Scene& low, const scene::Scene& high, const std::
       const std::size_t texel = points[runs[r]].texel;
       traced[texel] = true;
       out.samples += std::size_t(sums[r].rays);
-      out.occlusion_rays += sums[r].occlusion_rays;
+      out.occlusion_rays += sums[r].occlusion_rays + sums[r].thickness_rays;
       out.misses += std::size_t(sums[r].rays - sums[r].hits);
       if (sums[r].hits == 0) {
         ++out.missed_texels;
