@@ -74,7 +74,7 @@ TEST(CliBake, EveryKhronosModelOntoItsSimplificationIsValidatorCleanWithMikkTSpa
     const fs::path low = dir / (name + "_low.glb"), out = dir / (name + "_baked.glb");
     write_simplified(high, low, 0.1);
     const auto r = matbake({"--json", "bake", low.string(), "--from", high.string(), "-o", out.string(), "--size", "64",
-                            "--texel-samples", "1", "--maps", "normal,ao", "--ao-samples", "4"});
+                            "--texel-samples", "1", "--maps", "normal,ao,transfer", "--ao-samples", "4"});
     if (r.exit_code != 0) {  // a model without a material over UVs has nothing to bake onto: said so
       EXPECT_NE(r.err.find("no material of the low-poly can take baked maps"), std::string::npos) << name << ": " << r.err;
       continue;

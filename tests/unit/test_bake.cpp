@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include <algorithm>
 #include <cfloat>
 #include <cmath>
 #include <numbers>
@@ -376,6 +377,51 @@ TEST(Bake, ASlabsThicknessIsItsDepthForEveryRay) {
   for (std::size_t texel = 0; texel < t.hit.size(); ++texel) {
     ASSERT_EQ(t.hit[texel], 1);
     ASSERT_NEAR(map_of(t, Map::thickness).values[texel], kThick, 1e-5) << texel;
+  }
+}
+
+// Colour transfer: the plane onto itself, the high-poly's copy with UVs turned (u = (y + 1)/2,
+// v = (x + 1)/2), COLOR_0 affine over it (blue = (x + 1)/2, exact under interpolation), factor
+// (0.5, 1, 1, 0.8) and a 4 × 4 texture ramping red along u and green along v with clamp: sampled
+// bilinearly a ramp is clamp((4s − ½)/3, 0, 1) exactly. Each texel (one position, its centre) holds
+// factor × texture × COLOR_0 at its own point. Tolerance: float32 weights and texture values.
+TEST(Bake, TransferGivesTheHighPolysBaseColourAtEachTexel) {
+  const BumpPair pair = bump_pair(1, 0.5);
+  scene::Instance high = pair.low.instances[0];
+  high.texcoords = {{}};
+  for (const auto& p : high.positions) {
+    high.texcoords[0].emplace_back((p.y + 1) / 2, (p.x + 1) / 2);
+    high.colors.emplace_back(1, 1, (p.x + 1) / 2, 1);
+  }
+  high.material = 0;
+  BaseColor color;
+  color.factor = glm::vec4(0.5f, 1, 1, 0.8f);
+  color.wrap_s = color.wrap_t = Wrap::clamp_to_edge;
+  image::Image& ramp = color.texture.emplace();
+  ramp.width = ramp.height = 4, ramp.channels = 4;
+  for (int y = 0; y < 4; ++y) {
+    for (int x = 0; x < 4; ++x) ramp.pixels.insert(ramp.pixels.end(), {float(x) / 3, float(y) / 3, 1, 1});
+  }
+  Options options;
+  options.maps = {Map::transfer};
+  options.front = 0.05, options.back = 0.05, options.absolute_distances = true;
+  constexpr int kSide = 16;
+  auto baked = bake(pair.low, scene_of({high}), {ao::TextureTarget{{0}, 0}}, {.width = kSide, .height = kSide, .texel_samples = 1},
+                    options, {}, {color});
+  ASSERT_TRUE(baked) << baked.error().message;
+  const TextureBake& t = baked->textures.at(0);
+  const auto ramped = [](double s) { return std::clamp((4 * s - 0.5) / 3, 0.0, 1.0); };
+  for (int j = 0; j < kSide; ++j) {
+    for (int i = 0; i < kSide; ++i) {
+      const double x = 2 * (i + 0.5) / kSide - 1, y = 1 - 2 * (j + 0.5) / kSide;
+      const std::size_t texel = std::size_t(j * kSide + i);
+      ASSERT_EQ(t.hit[texel], 1);
+      const float* v = &map_of(t, Map::transfer).values[4 * texel];
+      EXPECT_NEAR(v[0], 0.5 * ramped((y + 1) / 2), 1e-6) << i << "," << j;
+      EXPECT_NEAR(v[1], ramped((x + 1) / 2), 1e-6) << i << "," << j;
+      EXPECT_NEAR(v[2], (x + 1) / 2, 1e-6) << i << "," << j;
+      EXPECT_NEAR(v[3], 0.8, 1e-6) << i << "," << j;
+    }
   }
 }
 

@@ -14,11 +14,17 @@
 // normalize(T·x + B·y + N·z) of the decoded texel (three.js's rule with vertex tangents). The
 // texel holds the (x, y, z) that gives the high-poly's normal back exactly: the basis is inverted,
 // not transposed, so a basis that is not orthogonal costs nothing.
+#include <glm/vec2.hpp>
+#include <glm/vec4.hpp>
+
 #include <cstdint>
+#include <functional>
+#include <optional>
 #include <vector>
 
 #include "matbake/ao.hpp"
 #include "matbake/enum_names.hpp"
+#include "matbake/image.hpp"
 #include "matbake/result.hpp"
 #include "matbake/scene.hpp"
 
@@ -37,14 +43,16 @@ enum class Map {
   thickness,    // the high-poly's depth below the hit: the mean over cosine-weighted rays into it
                 // (around −normal, either face counting) of distance × cosine (d_max where nothing
                 // is met), scene units; a slab of thickness t gives t for every ray
+  transfer,     // the high-poly's base colour at the hit (BaseColor below), linear RGBA
 };
-inline constexpr NameTable<Map, 7> kMapNames{{{Map::normal, "normal"},
+inline constexpr NameTable<Map, 8> kMapNames{{{Map::normal, "normal"},
                                               {Map::height, "height"},
                                               {Map::position, "position"},
                                               {Map::curvature, "curvature"},
                                               {Map::ao, "ao"},
                                               {Map::bent_normal, "bent_normal"},
-                                              {Map::thickness, "thickness"}}};
+                                              {Map::thickness, "thickness"},
+                                              {Map::transfer, "transfer"}}};
 int channels(Map map);
 
 // Which way the normal map's green channel points: OpenGL's (and glTF's) up the texture, against
@@ -63,6 +71,15 @@ struct Options {
 };
 
 Status check(const Options& options);
+
+// A high-poly material's base colour as a runtime shades it: factor × texture × COLOR_0 (linear).
+struct BaseColor {
+  glm::vec4 factor{1.0f};
+  std::optional<image::Image> texture;  // linear RGBA floats (colour channels decoded from sRGB)
+  int texcoord = 0;
+  std::function<glm::dvec2(glm::dvec2)> transform;  // the texture's UV transform; empty: none
+  Wrap wrap_s = Wrap::repeat, wrap_t = Wrap::repeat;
+};
 
 struct MapImage {
   Map map = Map::normal;
@@ -94,7 +111,10 @@ struct Bake {
 // texel_samples positions as the AO texture bake shares them (position j casts rays j, j + K, ...);
 // its distances are of the high-poly's radius. The result is the same for any number of threads.
 // Errors: options out of range, a target without its UV set's data, Embree failing.
+// `base_colors` (the transfer map's) holds one per high-poly material index; an instance without a
+// material, or beyond them, is white. The high-poly then needs its texcoords loaded.
 Result<Bake> bake(const scene::Scene& low, const scene::Scene& high, const std::vector<ao::TextureTarget>& targets,
-                  const ao::TextureOptions& texture, const Options& options, const ao::Options& occlusion = {});
+                  const ao::TextureOptions& texture, const Options& options, const ao::Options& occlusion = {},
+                  const std::vector<BaseColor>& base_colors = {});
 
 }  // namespace matbake::bake

@@ -13,6 +13,7 @@
 
 #include "../ao/texels.hpp"
 #include "../ao/tracer.hpp"
+#include "../gltf/texture_transform.hpp"
 #include "frames.hpp"
 #include "high_poly.hpp"
 
@@ -69,6 +70,7 @@ glm::dvec3 tangent_space(const glm::dmat3& basis, const glm::dvec3& h) {
 // What a texel's hits add up to, for every map.
 struct TexelSum {
   glm::dvec3 normal{0}, position{0}, bent{0};
+  glm::dvec4 color{0};
   double height = 0, curvature = 0, occlusion = 0, thickness = 0;
   std::uint64_t occlusion_rays = 0, thickness_rays = 0;
   int hits = 0, rays = 0;
@@ -88,7 +90,30 @@ struct TraceContext {
   int occlusion_samples;
   std::uint64_t occlusion_seed;
   std::size_t target_index;
+  const std::vector<BaseColor>* base_colors;  // for transfer (null: not asked)
 };
+
+// The high-poly's base colour at a hit: COLOR_0 × the material's factor × its texture.
+glm::dvec4 base_color(const std::vector<BaseColor>& colors, const scene::Instance& inst, const Hit& hit) {
+  const auto& corners = inst.triangles[hit.triangle];
+  glm::dvec4 c(1.0);
+  if (!inst.colors.empty()) {
+    c = glm::dvec4(0.0);
+    for (int k = 0; k < 3; ++k) c += double(hit.weights[k]) * glm::dvec4(inst.colors[corners[std::size_t(k)]]);
+  }
+  if (inst.material < 0 || std::size_t(inst.material) >= colors.size()) return c;
+  const BaseColor& m = colors[std::size_t(inst.material)];
+  c *= glm::dvec4(m.factor);
+  if (!m.texture || std::size_t(m.texcoord) >= inst.texcoords.size()) return c;
+  glm::dvec2 uv(0.0);
+  for (int k = 0; k < 3; ++k) uv += double(hit.weights[k]) * glm::dvec2(inst.texcoords[std::size_t(m.texcoord)][corners[std::size_t(k)]]);
+  if (m.transform) uv = m.transform(uv);
+  float texel[4] = {1, 1, 1, 1};
+  gltf::sample_bilinear(*m.texture, uv, m.wrap_s, m.wrap_t, texel);
+  const int channels = m.texture->channels;
+  if (channels < 3) texel[3] = channels == 2 ? texel[1] : 1.0f, texel[1] = texel[2] = texel[0];  // grey (and alpha)
+  return c * glm::dvec4(texel[0], texel[1], texel[2], texel[3]);
+}
 
 // AO and bent normal from a hit, around the high-poly's normal there, and thickness, into it: texel
 // position j of K casts rays j, j + K, ... of the texel's sequence (so a texel's K positions cast it
@@ -154,6 +179,7 @@ void trace_point(const TraceContext& c, const ao::texels::SurfacePoint& point, s
     sum.position += glm::dvec3(hit->position);
     sum.height += double(c.front) - double(hit->distance);
     if (c.curvature) sum.curvature += c.high.mean_curvature(*hit);
+    if (c.base_colors) sum.color += base_color(*c.base_colors, c.high.instance(*hit), *hit);
     if (c.occlusion || c.thickness) trace_from_hit(c, *hit, low, texel_size, j, point.texel, sum);
   }
 }
@@ -180,18 +206,22 @@ void store(const TexelSum& sum, const Options& options, std::size_t texel, Textu
       case Map::position:
         for (int k = 0; k < 3; ++k) v[k] = float(sum.position[k] / sum.hits);
         break;
+      case Map::transfer:
+        for (int k = 0; k < 4; ++k) v[k] = float(sum.color[k] / sum.hits);
+        break;
     }
   }
 }
 
-// What a texel nothing maps holds: flat normals, no occlusion, zero height, position and curvature.
+// What a texel nothing maps holds: flat normals, no occlusion, white, zero height, position and
+// curvature.
 void background(MapImage& image) {
   const bool direction = image.map == Map::normal || image.map == Map::bent_normal;
   const std::size_t texels = image.values.size() / std::size_t(image.channels);
   for (std::size_t t = 0; t < texels; ++t) {
     for (int k = 0; k < image.channels; ++k) {
       float& v = image.values[t * std::size_t(image.channels) + std::size_t(k)];
-      v = direction ? (k == 2 ? 1.0f : 0.5f) : image.map == Map::ao ? 1.0f : 0.0f;
+      v = direction ? (k == 2 ? 1.0f : 0.5f) : image.map == Map::ao || image.map == Map::transfer ? 1.0f : 0.0f;
     }
   }
 }
@@ -217,7 +247,10 @@ std::size_t fill_and_pad(MapImage& image, const std::vector<bool>& hit, const st
 
 }  // namespace
 
-int channels(Map map) { return map == Map::normal || map == Map::bent_normal || map == Map::position ? 3 : 1; }
+int channels(Map map) {
+  if (map == Map::transfer) return 4;
+  return map == Map::normal || map == Map::bent_normal || map == Map::position ? 3 : 1;
+}
 
 Status check(const Options& options) {
   if (options.maps.empty()) return Error{"", "a bake needs at least one map", true};
@@ -229,7 +262,8 @@ Status check(const Options& options) {
 }
 
 Result<Bake> bake(const scene::Scene& low, const scene::Scene& high, const std::vector<ao::TextureTarget>& targets,
-                  const ao::TextureOptions& texture, const Options& options, const ao::Options& occlusion) {
+                  const ao::TextureOptions& texture, const Options& options, const ao::Options& occlusion,
+                  const std::vector<BaseColor>& base_colors) {
   if (Status s = check(options); !s) return s.error();
   if (Status s = ao::check(texture, kMaxTexelSamples, "bake"); !s) return s.error();
   const auto asked = [&](Map map) { return std::ranges::find(options.maps, map) != options.maps.end(); };
@@ -308,7 +342,8 @@ Result<Bake> bake(const scene::Scene& low, const scene::Scene& high, const std::
                                depths.get(),
                                occlusion.samples,
                                occlusion.seed,
-                               index};
+                               index,
+                               asked(Map::transfer) ? &base_colors : nullptr};
     std::vector<TexelSum> sums(runs.size() - 1);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, sums.size(), 64), [&](const tbb::blocked_range<std::size_t>& range) {
       for (std::size_t r = range.begin(); r != range.end(); ++r) {

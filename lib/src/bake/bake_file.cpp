@@ -6,6 +6,7 @@
 
 #include "../gltf/tangents.hpp"
 #include "../gltf/texture_files.hpp"
+#include "../gltf/texture_transform.hpp"
 #include "../scene/from_document.hpp"
 #include "frames.hpp"
 #include "matbake/bake_file.hpp"
@@ -74,9 +75,55 @@ Result<Targets> material_targets(const gltf::Document& doc, const scene::Scene& 
   return out;
 }
 
-// The material's texture a map becomes, or null: a file beside the output.
-const char* material_slot(Map map) {
-  return map == Map::normal ? "normalTexture" : map == Map::ao ? "occlusionTexture" : nullptr;
+// The material's texture a map becomes (`key` of the material, or of its `parent` object), and how
+// its colour channels are encoded; none: a float file beside the output.
+struct Slot {
+  const char* parent;
+  const char* key;
+  color::Transfer colour;
+};
+std::optional<Slot> material_slot(Map map) {
+  switch (map) {
+    case Map::normal: return Slot{nullptr, "normalTexture", color::Transfer::linear};
+    case Map::ao: return Slot{nullptr, "occlusionTexture", color::Transfer::linear};
+    case Map::transfer: return Slot{"pbrMetallicRoughness", "baseColorTexture", color::Transfer::srgb};
+    default: return std::nullopt;
+  }
+}
+
+// The high-poly's materials' base colours (transfer): factors, and textures decoded to linear
+// with their UV sets, transforms and wrap modes.
+Result<std::vector<BaseColor>> base_colors(const fs::path& high, const image::Encoding& encoding) {
+  auto doc = gltf::read_document(high);
+  if (!doc) return doc.error();
+  gltf::ImageCache cache(*doc, encoding, gltf::MadeFormat::png);
+  std::vector<BaseColor> out;
+  const Json& materials = doc->json.value("materials", Json::array());
+  for (std::size_t m = 0; m < materials.size(); ++m) {
+    BaseColor& color = out.emplace_back();
+    const Json pbr = materials[m].value("pbrMetallicRoughness", Json::object());
+    const Json factor = pbr.value("baseColorFactor", Json::array({1, 1, 1, 1}));
+    if (factor.is_array() && factor.size() == 4) {
+      for (int k = 0; k < 4; ++k) color.factor[k] = factor[std::size_t(k)].is_number() ? factor[std::size_t(k)].get<float>() : 1.0f;
+    }
+    if (!pbr.contains("baseColorTexture") || !pbr["baseColorTexture"].is_object()) continue;
+    const Json& info = pbr["baseColorTexture"];
+    const int index = gltf::integer_in<int>(info, "index", -1, -1);
+    auto decoded = cache.decode(index, color::Transfer::srgb);
+    if (!decoded) return decoded.error();
+    color.texture = std::move(*decoded);
+    auto transform = gltf::uv_transform_of(info, doc->file, "/materials/" + std::to_string(m) + "/pbrMetallicRoughness/baseColorTexture");
+    if (!transform) return transform.error();
+    color.texcoord = transform->texcoord >= 0 ? transform->texcoord : gltf::integer_in<int>(info, "texCoord", 0, 0);
+    if (!transform->identity()) color.transform = [t = *transform](glm::dvec2 uv) { return t.apply(uv); };
+    const std::size_t texture = std::size_t(index);
+    const int sampler = gltf::integer_in<int>(doc->json["textures"][texture], "sampler", -1, -1);
+    if (sampler >= 0) {
+      const Json& s = doc->json["samplers"][std::size_t(sampler)];
+      color.wrap_s = gltf::wrap_of(s, "wrapS"), color.wrap_t = gltf::wrap_of(s, "wrapT");
+    }
+  }
+  return out;
 }
 
 fs::path float_map_file(const fs::path& output, const std::string& material_name, Map map) {
@@ -127,7 +174,7 @@ Result<TextureReport> write_maps(gltf::Document& doc, const gltf::ImageCache& ca
   for (MapImage& map : baked.maps) {
     image::Image img = gltf::blank(baked.width, baked.height, map.channels);
     img.pixels = std::move(map.values);
-    const char* slot = material_slot(map.map);
+    const std::optional<Slot> slot = material_slot(map.map);
     if (!slot) {
       const fs::path file = float_map_file(options.output, file_name, map.map);
       image::WriteOptions exr;
@@ -136,20 +183,22 @@ Result<TextureReport> write_maps(gltf::Document& doc, const gltf::ImageCache& ca
       report.files.push_back(file.string());
       continue;
     }
+    Json& holder = slot->parent ? material[slot->parent] : material;
     int sampler_from = -1;
     Json info = Json::object();
-    if (material.contains(slot) && material[slot].is_object()) {
-      sampler_from = gltf::integer_in<int>(material[slot], "index", -1, -1);
+    if (holder.contains(slot->key) && holder[slot->key].is_object()) {
+      sampler_from = gltf::integer_in<int>(holder[slot->key], "index", -1, -1);
       // An occlusion's strength is the artist's; a normal map's scale was for the old map.
-      if (map.map == Map::ao && material[slot].contains("strength")) info["strength"] = material[slot]["strength"];
+      if (map.map == Map::ao && holder[slot->key].contains("strength")) info["strength"] = holder[slot->key]["strength"];
       report.existing += std::string(report.existing.empty() ? "" : ", ") + std::string(matbake::name_in(kMapNames, map.map)) + " replaced";
     }
     const std::string name = options.output.stem().string() + "_" + file_name + "_" + std::string(matbake::name_in(kMapNames, map.map));
-    auto made = cache.add_texture(doc, img, color::Transfer::linear, name, sampler_from);
+    auto made = cache.add_texture(doc, img, slot->colour, name, sampler_from);
     if (!made) return made.error();
     info["index"] = made->index;  // no transform: the bake is over raw UVs
     if (report.texcoord != 0) info["texCoord"] = report.texcoord;
-    material[slot] = std::move(info);
+    holder[slot->key] = std::move(info);
+    if (map.map == Map::transfer) holder["baseColorFactor"] = {1.0, 1.0, 1.0, 1.0};  // the texture holds it
     report.files.push_back(made->uri);
   }
   return report;
@@ -168,8 +217,16 @@ Result<FileReport> bake_file(const fs::path& low_path, const FileOptions& option
     if (!doc) return doc.error();
     auto low = scene::scene_from_document(*doc, {.texcoords = true, .object_space = true});
     if (!low) return low.error();
-    auto high = scene::load_scene(options.high);
+    const auto& maps = options.request.bake.maps;
+    const bool transfer = std::find(maps.begin(), maps.end(), Map::transfer) != maps.end();
+    auto high = scene::load_scene(options.high, {.texcoords = transfer});
     if (!high) return high.error();
+    std::vector<BaseColor> colors;
+    if (transfer) {
+      auto read = base_colors(options.high, options.encoding);
+      if (!read) return read.error();
+      colors = std::move(*read);
+    }
     auto targets = material_targets(*doc, *low);
     if (!targets) return targets.error();
 
@@ -190,7 +247,8 @@ Result<FileReport> bake_file(const fs::path& low_path, const FileOptions& option
     }
     if (Status s = check_outputs(outputs, inputs); !s) return s.error();
 
-    auto baked = bake(*low, *high, targets->targets, options.request.texture, options.request.bake, options.request.occlusion.options);
+    auto baked = bake(*low, *high, targets->targets, options.request.texture, options.request.bake, options.request.occlusion.options,
+                      colors);
     if (!baked) {
       Error error = baked.error();
       if (error.path.empty() && !error.usage) error.path = doc->file;

@@ -40,6 +40,8 @@ class HighPoly {
   // flat-shaded surface (glTF's flat normals: no curvature within a face).
   double mean_curvature(const Hit& hit) const;
 
+  const scene::Instance& instance(const Hit& hit) const { return scene_->instances[hit.instance]; }
+
  private:
   HighPoly() = default;
   const scene::Scene* scene_ = nullptr;

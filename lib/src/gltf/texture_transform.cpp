@@ -49,6 +49,24 @@ Result<UvTransform> uv_transform_of(const Json& info, const std::string& file, c
   return t;
 }
 
+void sample_bilinear(const image::Image& source, glm::dvec2 uv, Wrap wrap_s, Wrap wrap_t, float* out) {
+  const std::size_t channels = std::size_t(source.channels);
+  const double sx = uv.x * source.width - 0.5, sy = uv.y * source.height - 0.5;
+  const double fx = std::floor(sx), fy = std::floor(sy);
+  const double wx = sx - fx, wy = sy - fy;
+  const long long ix = static_cast<long long>(fx), iy = static_cast<long long>(fy);
+  const int x0 = wrapped(ix, source.width, wrap_s), x1 = wrapped(ix + 1, source.width, wrap_s);
+  const int y0 = wrapped(iy, source.height, wrap_t), y1 = wrapped(iy + 1, source.height, wrap_t);
+  const auto at = [&](int tx, int ty, std::size_t c) {
+    return double(source.pixels[(std::size_t(ty) * std::size_t(source.width) + std::size_t(tx)) * channels + c]);
+  };
+  for (std::size_t c = 0; c < channels; ++c) {
+    const double top = at(x0, y0, c) * (1 - wx) + at(x1, y0, c) * wx;
+    const double bottom = at(x0, y1, c) * (1 - wx) + at(x1, y1, c) * wx;
+    out[c] = float(top * (1 - wy) + bottom * wy);
+  }
+}
+
 image::Image sample_through(const image::Image& source, const UvTransform& transform, Wrap wrap_s, Wrap wrap_t,
                             int width, int height) {
   image::Image out;
@@ -59,20 +77,7 @@ image::Image sample_through(const image::Image& source, const UvTransform& trans
   for (int y = 0; y < height; ++y) {
     for (int x = 0; x < width; ++x) {
       const glm::dvec2 uv = transform.apply({(x + 0.5) / width, (y + 0.5) / height});
-      const double sx = uv.x * source.width - 0.5, sy = uv.y * source.height - 0.5;
-      const double fx = std::floor(sx), fy = std::floor(sy);
-      const double wx = sx - fx, wy = sy - fy;
-      const long long ix = static_cast<long long>(fx), iy = static_cast<long long>(fy);
-      const int x0 = wrapped(ix, source.width, wrap_s), x1 = wrapped(ix + 1, source.width, wrap_s);
-      const int y0 = wrapped(iy, source.height, wrap_t), y1 = wrapped(iy + 1, source.height, wrap_t);
-      const auto at = [&](int tx, int ty, std::size_t c) {
-        return double(source.pixels[(std::size_t(ty) * std::size_t(source.width) + std::size_t(tx)) * channels + c]);
-      };
-      for (std::size_t c = 0; c < channels; ++c) {
-        const double top = at(x0, y0, c) * (1 - wx) + at(x1, y0, c) * wx;
-        const double bottom = at(x0, y1, c) * (1 - wx) + at(x1, y1, c) * wx;
-        out.pixels[(std::size_t(y) * std::size_t(width) + std::size_t(x)) * channels + c] = float(top * (1 - wy) + bottom * wy);
-      }
+      sample_bilinear(source, uv, wrap_s, wrap_t, &out.pixels[(std::size_t(y) * std::size_t(width) + std::size_t(x)) * channels]);
     }
   }
   return out;

@@ -23,6 +23,10 @@ struct UvTransform {
 // an error naming `where` ("/materials/0/occlusionTexture").
 Result<UvTransform> uv_transform_of(const Json& info, const std::string& file, const std::string& where);
 
+// `source` at uv sampled bilinearly as a GPU does (texel centres at half-integers), wrapped per the
+// sampler's modes: one value per channel into `out`.
+void sample_bilinear(const image::Image& source, glm::dvec2 uv, Wrap wrap_s, Wrap wrap_t, float* out);
+
 // A width × height image over raw UVs: texel (x, y) holds `source` sampled bilinearly (as a GPU does,
 // texel centres at half-integers) at transform((x + ½) / width, (y + ½) / height), wrapped per the
 // sampler's modes.
