@@ -425,5 +425,32 @@ TEST(Bake, TransferGivesTheHighPolysBaseColourAtEachTexel) {
   }
 }
 
+// ID: the plane onto a high-poly split at x = 0 into two primitives of materials 0 and 3. A texel
+// whose footprint lies on one side holds that material's colour: hue 0 → (0.9, 0.225, 0.225);
+// 3 × 0.618034 = 1.854102, hue 0.854102 (sector 5, f = 0.124612) → (0.9, 0.225, 0.815887).
+TEST(Bake, IdGivesEachTexelItsHitsMaterialColour) {
+  const BumpPair pair = bump_pair(1, 0.5);
+  const std::vector<dvec3> up(4, dvec3(0, 0, 1));
+  scene::Instance left = placed({{-1, -1, 0}, {0, -1, 0}, {0, 1, 0}, {-1, 1, 0}}, up, {{0, 1, 2}, {0, 2, 3}}, glm::dmat4(1));
+  scene::Instance right = placed({{0, -1, 0}, {1, -1, 0}, {1, 1, 0}, {0, 1, 0}}, up, {{0, 1, 2}, {0, 2, 3}}, glm::dmat4(1));
+  left.material = 0, right.material = 3;
+  Options options;
+  options.maps = {Map::id};
+  options.front = 0.05, options.back = 0.05, options.absolute_distances = true;
+  constexpr int kSide = 16;
+  auto baked = bake(pair.low, scene_of({left, right}), {ao::TextureTarget{{0}, 0}}, {.width = kSide, .height = kSide, .texel_samples = 4},
+                    options);
+  ASSERT_TRUE(baked) << baked.error().message;
+  const TextureBake& t = baked->textures.at(0);
+  EXPECT_EQ(t.misses, 0u);
+  const dvec3 left_color(0.9, 0.225, 0.225), right_color(0.9, 0.225, 0.815887);
+  for (int j = 0; j < kSide; ++j) {
+    for (int i = 0; i < kSide; ++i) {
+      const dvec3 got = texel3(map_of(t, Map::id), std::size_t(j * kSide + i));
+      EXPECT_LT(glm::length(got - (i < kSide / 2 ? left_color : right_color)), 1e-6) << i << "," << j;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace matbake::bake

@@ -15,6 +15,7 @@
 // texel holds the (x, y, z) that gives the high-poly's normal back exactly: the basis is inverted,
 // not transposed, so a basis that is not orthogonal costs nothing.
 #include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
 
 #include <cstdint>
@@ -44,16 +45,22 @@ enum class Map {
                 // (around −normal, either face counting) of distance × cosine (d_max where nothing
                 // is met), scene units; a slab of thickness t gives t for every ray
   transfer,     // the high-poly's base colour at the hit (BaseColor below), linear RGBA
+  id,           // the material of the texel's first hit, as id_color's RGB (no blending: a mask)
 };
-inline constexpr NameTable<Map, 8> kMapNames{{{Map::normal, "normal"},
+inline constexpr NameTable<Map, 9> kMapNames{{{Map::normal, "normal"},
                                               {Map::height, "height"},
                                               {Map::position, "position"},
                                               {Map::curvature, "curvature"},
                                               {Map::ao, "ao"},
                                               {Map::bent_normal, "bent_normal"},
                                               {Map::thickness, "thickness"},
-                                              {Map::transfer, "transfer"}}};
+                                              {Map::transfer, "transfer"},
+                                              {Map::id, "id"}}};
 int channels(Map map);
+
+// The id map's colour of high-poly material `material`: hue = frac(material × 0.618034) (the golden
+// ratio keeps neighbours apart), saturation 0.75, value 0.9; grey 0.5 for none (−1).
+glm::vec3 id_color(int material);
 
 // Which way the normal map's green channel points: OpenGL's (and glTF's) up the texture, against
 // the direction of increasing v; DirectX's down it.

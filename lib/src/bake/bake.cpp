@@ -74,6 +74,7 @@ struct TexelSum {
   double height = 0, curvature = 0, occlusion = 0, thickness = 0;
   std::uint64_t occlusion_rays = 0, thickness_rays = 0;
   int hits = 0, rays = 0;
+  int material = -1;  // of the first hit
 };
 
 struct TraceContext {
@@ -174,6 +175,7 @@ void trace_point(const TraceContext& c, const ao::texels::SurfacePoint& point, s
       hit = cast(c, low);
     }
     if (!hit) continue;
+    if (sum.hits == 0) sum.material = c.high.instance(*hit).material;
     ++sum.hits;
     sum.normal += tangent_space(low.basis, glm::dvec3(hit->normal));
     sum.position += glm::dvec3(hit->position);
@@ -209,6 +211,11 @@ void store(const TexelSum& sum, const Options& options, std::size_t texel, Textu
       case Map::transfer:
         for (int k = 0; k < 4; ++k) v[k] = float(sum.color[k] / sum.hits);
         break;
+      case Map::id: {
+        const glm::vec3 rgb = id_color(sum.material);
+        for (int k = 0; k < 3; ++k) v[k] = rgb[k];
+        break;
+      }
     }
   }
 }
@@ -249,7 +256,16 @@ std::size_t fill_and_pad(MapImage& image, const std::vector<bool>& hit, const st
 
 int channels(Map map) {
   if (map == Map::transfer) return 4;
-  return map == Map::normal || map == Map::bent_normal || map == Map::position ? 3 : 1;
+  return map == Map::normal || map == Map::bent_normal || map == Map::position || map == Map::id ? 3 : 1;
+}
+
+glm::vec3 id_color(int material) {
+  if (material < 0) return glm::vec3(0.5f);
+  const double hue = std::fmod(material * 0.618034, 1.0) * 6, s = 0.75, v = 0.9;
+  const int sector = int(hue) % 6;
+  const double f = hue - std::floor(hue), p = v * (1 - s), q = v * (1 - s * f), t = v * (1 - s * (1 - f));
+  const glm::dvec3 rgb[6] = {{v, t, p}, {q, v, p}, {p, v, t}, {p, q, v}, {t, p, v}, {v, p, q}};
+  return glm::vec3(rgb[sector]);
 }
 
 Status check(const Options& options) {
