@@ -66,9 +66,17 @@ std::string number(const json& v, const char* format = "%.4g") {
 std::string per_level(const json& texture) {
   const auto row = [&](const std::string& label, const json& values, const std::function<std::string(const json&)>& text) {
     if (!values.is_array() || values.empty()) return std::string();
-    std::string line = "<div>" + html(label) + ":";
-    for (const json& v : values) line += " " + text(v);
-    return line + "</div>";
+    // Appended, not `"<div>" + html(label)`: GCC 12 at -O3 misreads that operator+ as a memcpy of
+    // more than PTRDIFF_MAX bytes (-Wstringop-overflow) and the release build fails with -Werror.
+    std::string line = "<div>";
+    line += html(label);
+    line += ':';
+    for (const json& v : values) {
+      line += ' ';
+      line += text(v);
+    }
+    line += "</div>";
+    return line;
   };
   const json& errors = texture.value("level_error", json::array());
   const auto field = [](const char* key, const char* format) {
