@@ -4,6 +4,7 @@
 
 #include "commands.hpp"
 #include "matbake/bake_params.hpp"
+#include "matbake/report_json.hpp"
 #include "params_cli.hpp"
 
 namespace matbake::cli {
@@ -30,20 +31,9 @@ int run_bake(const BakeSettings& s, const GlobalOptions& global) {
   auto report = bake::bake_file(s.low, options);
   if (!report) return report_error(report.error());
   if (global.json) {
-    nlohmann::json textures = nlohmann::json::array();
-    for (const bake::TextureReport& t : report->textures) {
-      textures.push_back({{"material", t.material}, {"name", t.name}, {"width", t.width}, {"height", t.height},
-                          {"texcoord", t.texcoord}, {"texels", t.texels}, {"rays", t.samples}, {"misses", t.misses},
-                          {"missed_texels", t.missed_texels}, {"padded", t.padded}, {"height_min", t.height_min},
-                          {"height_max", t.height_max}, {"files", t.files}, {"existing", t.existing}, {"occlusion_rays", t.occlusion_rays}});
-    }
-    std::cout << nlohmann::json{{"command", "bake"}, {"low", s.low}, {"high", s.high}, {"output", s.output},
-                                {"front", report->front}, {"back", report->back}, {"textures", textures},
-                                {"tangent_primitives", report->tangent_primitives}, {"split_vertices", report->split_vertices},
-                                {"seconds", report->seconds}, {"setup_seconds", report->setup_seconds},
-                                {"trace_seconds", report->trace_seconds}, {"notes", report->notes}, {"written", report->written}}
-                     .dump(2)
-              << "\n";
+    nlohmann::json out = {{"command", "bake"}, {"low", s.low}, {"high", s.high}, {"output", s.output}};
+    out.update(to_json(*report));
+    std::cout << out.dump(2) << "\n";
   } else if (!global.quiet) {
     for (const std::string& note : report->notes) std::cout << "note: " << escape_control(note) << "\n";
     for (const bake::TextureReport& t : report->textures) {

@@ -50,6 +50,21 @@ dielectric_f0 = "ior"
 orm = false
 mapping = "walter"
 ao = { samples = 32, absolute_distance = 2.5, falloff = "none", into = "_AO", seed = 7, two_sided = true, tau = 2, bias = 1e-4, sampler = "random", recompute_normals = "angle", fast_traversal = true }
+[bake]
+size = 256
+[scenes.hero]
+input = "low.glb"
+[scenes.hero.bake]
+from = "sculpt/high.glb"
+maps = ["normal", "thickness", "ao"]
+front = 0.5
+back = 0.25
+absolute_cage = true
+green = "directx"
+padding = 3
+texel_samples = 9
+seed = 11
+ao = { samples = 24, relative_distance = 0.5 }
 )";
 
 TEST(BuildManifest, EveryKeyReachesItsField) {
@@ -85,8 +100,26 @@ TEST(BuildManifest, EveryKeyReachesItsField) {
   EXPECT_DOUBLE_EQ(gold.validation.options.tolerance, 0.2);  // inherited, then overridden key by key
   EXPECT_DOUBLE_EQ(gold.validation.options.max_violations, 0.5);
   EXPECT_TRUE(gold.validation.heatmap);
-  ASSERT_EQ(m->scenes.size(), 1u);
-  const pipeline::SceneSpec& room = m->scenes[0];
+  ASSERT_EQ(m->scenes.size(), 2u);
+  const pipeline::SceneSpec& hero = m->scenes[0];
+  ASSERT_TRUE(hero.bake);
+  EXPECT_EQ(hero.bake->from, "sculpt/high.glb");
+  EXPECT_EQ(hero.bake->high, fs::path("/project/sculpt/high.glb"));
+  const bake::Request& r = hero.bake->request;
+  EXPECT_EQ(r.bake.maps, (std::vector<bake::Map>{bake::Map::normal, bake::Map::thickness, bake::Map::ao}));
+  EXPECT_DOUBLE_EQ(r.bake.front, 0.5);
+  EXPECT_DOUBLE_EQ(r.bake.back, 0.25);
+  EXPECT_TRUE(r.bake.absolute_distances);
+  EXPECT_EQ(r.bake.green, bake::Green::directx);
+  EXPECT_EQ(r.texture.width, 256);  // the top level's [bake], a default for each baking scene
+  EXPECT_EQ(r.texture.height, 256);
+  EXPECT_EQ(r.texture.padding, 3);
+  EXPECT_EQ(r.texture.texel_samples, 9);
+  EXPECT_EQ(r.bake.seed, 11u);
+  EXPECT_EQ(r.occlusion.options.samples, 24);
+  EXPECT_DOUBLE_EQ(r.occlusion.options.relative_distance, 0.5);
+  EXPECT_FALSE(m->scenes[1].bake);  // the top level's [bake] alone bakes nothing
+  const pipeline::SceneSpec& room = m->scenes[1];
   EXPECT_EQ(room.input, fs::path("/project/room.gltf"));
   EXPECT_EQ(room.output, fs::path("sub/room.gltf"));
   EXPECT_EQ(room.materials.at("Bricks"), "brick");
@@ -167,6 +200,22 @@ TEST(BuildManifest, ErrorsSayWhereAndWhat) {
       {"[materials.a]\nsources = { kd = 0.5 }\npng_compression = \"quick\"\n", "m.toml:3:", "materials.a.png_compression"},
       {"[materials.a]\nsources = { kd = 0.5 }\npng_compression = 6.0\n", "m.toml:3:19",
        "materials.a.png_compression: an integer or a string expected"},
+      // A scene's bake: its high-poly, its maps (a list or the command line's text), its ao table.
+      {"[scenes.s]\ninput = \"a.gltf\"\nbake = { maps = \"normal\" }\n", "m.toml:3:", "scenes.s.bake: from = \"high.glb\" is required"},
+      {"[scenes.s]\ninput = \"a.gltf\"\nbake = { from = \"h.glb\", maps = [\"normal\", \"nromal\"] }\n", "m.toml:3:",
+       "scenes.s.bake.maps: maps among"},
+      {"[scenes.s]\ninput = \"a.gltf\"\nbake = { from = \"h.glb\", maps = [\"ao\", 3] }\n", "m.toml:3:",
+       "scenes.s.bake.maps: a number, a string, a list of names or true/false expected"},
+      {"[scenes.s]\ninput = \"a.gltf\"\nbake = { from = \"h.glb\", mpas = \"ao\" }\n", "m.toml:3:",
+       "unknown key 'mpas' in scenes.s.bake"},
+      {"[scenes.s]\ninput = \"a.gltf\"\nbake = { from = \"h.glb\", ao = { sample = 3 } }\n", "m.toml:3:",
+       "unknown key 'sample' in scenes.s.bake.ao"},
+      {"[scenes.s]\ninput = \"a.gltf\"\nbake = { from = \"h.glb\", ao = { samples = 0 } }\n", "m.toml:3:",
+       "scenes.s.bake.ao.samples: 1 to"},
+      {"[scenes.s]\ninput = \"a.gltf\"\nbake = { from = \"h.glb\", ao = 3 }\n", "m.toml:3:", "scenes.s.bake.ao must be a table"},
+      {"[scenes.s]\ninput = \"a.gltf\"\nbake = \"h.glb\"\n", "m.toml:3:", "scenes.s.bake must be a table"},
+      {"[scenes.s]\ninput = \"a.gltf\"\nao = { samples = 4 }\nbake = { from = \"h.glb\", maps = \"normal,ao\" }\n",
+       "m.toml:3:", "the export's ao and the bake's ao map would both make the occlusion"},
   };
   for (const Case& c : cases) {
     auto m = pipeline::parse_manifest(c.text, "m.toml");

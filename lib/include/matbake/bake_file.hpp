@@ -45,6 +45,7 @@ struct FileReport {
   double seconds = 0, setup_seconds = 0, trace_seconds = 0;
   std::vector<std::string> notes;
   std::vector<std::string> written;    // files
+  std::vector<std::string> beside;     // those of them the glTF does not reference: the float maps
 };
 
 // Errors: either file unreadable (named), an output onto an input, no low-poly material with the

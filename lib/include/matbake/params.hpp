@@ -232,13 +232,16 @@ template <class Root>
 nlohmann::json tree_json(const Tree<Root>& tree, const Root& root) {
   nlohmann::json j = nlohmann::json::object();
   for (const Branch<Root>& b : tree) {
+    std::string pointer = "/" + b.table;  // a nested table "bake.ao" within its table: /bake/ao
+    std::replace(pointer.begin(), pointer.end(), '.', '/');
     if (b.table.empty()) {
       j.update(b.values(root));
     } else if (!b.made(root)) {
-      j[b.table] = nullptr;
+      if (b.table.find('.') == std::string::npos) j[b.table] = nullptr;  // a nested one is in that null
     } else {
-      if (!j[b.table].is_object()) j[b.table] = nlohmann::json::object();
-      j[b.table].update(b.values(root));
+      nlohmann::json& part = j[nlohmann::json::json_pointer(pointer)];
+      if (!part.is_object()) part = nlohmann::json::object();
+      part.update(b.values(root));
     }
   }
   return j;

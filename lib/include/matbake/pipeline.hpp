@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "matbake/ao.hpp"
+#include "matbake/bake_file.hpp"
 #include "matbake/enum_names.hpp"
 #include "matbake/export.hpp"
 #include "matbake/image.hpp"
@@ -70,6 +71,15 @@ struct MaterialSpec {
   ValidationRules validation;
 };
 
+// A scene's `bake = { from = "high.glb", maps = [...], ... }`: the high-poly's maps baked onto the
+// scene's glTF (matbake bake) before it is exported; its `ao` table is the ao and bent_normal maps'
+// estimator.
+struct SceneBake {
+  std::string from;             // as written, relative to the manifest's folder
+  std::filesystem::path high;   // resolved
+  bake::Request request;
+};
+
 struct SceneSpec {
   std::string name;
   Origins origins;
@@ -78,6 +88,7 @@ struct SceneSpec {
   std::map<std::string, std::string> materials;  // glTF material name → manifest material
   bool match_names = true;  // also: glTF materials named like a manifest material get it
   exporter::Options options;  // as `matbake export` fills it; its materials are added when the job runs
+  std::optional<SceneBake> bake;  // set: the input is baked onto first, and the export reads the bake
 };
 
 // A [material_rules.NAME] entry and the materials it made, one per file its pattern matched.

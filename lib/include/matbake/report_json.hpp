@@ -3,6 +3,7 @@
 // --report`, `export --report`, `build`) and validation results (`validate --json`, `build`).
 #include <nlohmann/json.hpp>
 
+#include "matbake/bake_file.hpp"
 #include "matbake/export.hpp"
 #include "matbake/validate.hpp"
 #include "matbake/workflow_maps.hpp"
@@ -33,5 +34,8 @@ nlohmann::json to_json(const bake_ao::TextureReport& t);
 nlohmann::json to_json(const exporter::Options& o);
 nlohmann::json to_json(const delivery::TextureReport& t);
 nlohmann::json delivered_json(const std::vector<delivery::TextureReport>& textures);
+// A bake: the cage, each material's texture set (rays, misses, height range, files), tangents,
+// times, notes and files written, as `bake --json` prints it (without its "command" and paths).
+nlohmann::json to_json(const bake::FileReport& r);
 
 }  // namespace matbake

@@ -266,7 +266,9 @@ Result<FileReport> bake_file(const fs::path& low_path, const FileOptions& option
       auto written = write_maps(*doc, cache, options, *targets, t, baked->textures[t]);
       if (!written) return written.error();
       for (std::size_t i = 0; i < options.request.bake.maps.size(); ++i) {
-        if (!material_slot(options.request.bake.maps[i])) report.written.push_back(written->files[i]);
+        if (material_slot(options.request.bake.maps[i])) continue;
+        report.written.push_back(written->files[i]);
+        report.beside.push_back(written->files[i]);
       }
       report.textures.push_back(std::move(*written));
     }

@@ -36,7 +36,10 @@ Param<Request> maps() {
           },
           [](const Request& r) {
             std::string text;
-            for (Map m : r.bake.maps) text += (text.empty() ? "" : ",") + std::string(name_in(kMapNames, m));
+            for (Map m : r.bake.maps) {
+              if (!text.empty()) text += ',';  // appended: GCC 12 -O3 misreads `"," + std::string` (report_page.cpp)
+              text += name_in(kMapNames, m);
+            }
             return nlohmann::json(text);
           }};
 }

@@ -9,7 +9,17 @@ Result<Value> toml_value(const toml::node& node) {
   if (node.is_integer()) return Value(*node.value<std::int64_t>());
   if (auto d = node.value_exact<double>()) return Value(*d);
   if (auto text = node.value_exact<std::string>()) return Value(*text);
-  return Error{"", "a number, a string or true/false expected"};
+  // A list of names (maps = ["normal", "ao"]) as the command line's comma-separated text.
+  if (const toml::array* list = node.as_array(); list && !list->empty()) {
+    std::string joined;
+    for (const toml::node& item : *list) {
+      auto name = item.value_exact<std::string>();
+      if (!name || name->empty() || name->find(',') != std::string::npos) break;
+      joined += (joined.empty() ? "" : ",") + *name;
+      if (&item == &list->back()) return Value(joined);
+    }
+  }
+  return Error{"", "a number, a string, a list of names or true/false expected"};
 }
 
 }  // namespace matbake::params

@@ -100,6 +100,23 @@ params::Spelling key_spelling(std::vector<std::string> wheres) {
   };
 }
 
+// A branch's table `table` within `t`: "ao", or nested, "bake.ao"; null when absent (or when a part
+// of the way is not a table: read_branches says so of that part).
+const toml::node* sub_node(const toml::table& t, std::string_view table) {
+  const toml::node* node = &t;
+  for (std::size_t start = 0; node && start <= table.size();) {
+    const std::size_t dot = std::min(table.find('.', start), table.size());
+    const toml::table* in = node->as_table();
+    node = in ? in->get(table.substr(start, dot - start)) : nullptr;
+    start = dot + 1;
+  }
+  return node;
+}
+const toml::table* sub_table(const toml::table& t, std::string_view table) {
+  const toml::node* node = sub_node(t, table);
+  return node ? node->as_table() : nullptr;
+}
+
 // The keys parameters are read from, with their older names.
 std::vector<std::string> keys_of(const std::vector<const params::Spec*>& specs) {
   std::vector<std::string> keys;
@@ -115,7 +132,8 @@ std::vector<std::string> keys_of(const std::vector<const params::Spec*>& specs) 
 template <class Root>
 std::vector<std::string> keys_of_tree(const params::Tree<Root>& tree, std::vector<std::string> keys) {
   for (const params::Branch<Root>& b : tree) {
-    for (const std::string& key : b.table.empty() ? keys_of(b.specs) : std::vector<std::string>{b.table}) {
+    const std::string table = b.table.substr(0, b.table.find('.'));  // "bake" of "bake.ao"
+    for (const std::string& key : b.table.empty() ? keys_of(b.specs) : std::vector<std::string>{table}) {
       if (std::find(keys.begin(), keys.end(), key) == keys.end()) keys.push_back(key);
     }
   }
@@ -127,6 +145,10 @@ template <class Root>
 std::vector<std::string> keys_in_table(const params::Tree<Root>& tree, const std::string& table) {
   std::vector<std::string> keys;
   for (const params::Branch<Root>& b : tree) {
+    if (b.table.rfind(table + ".", 0) == 0) {  // a table within it: "ao" of "bake.ao" in "bake"
+      const std::string inner = b.table.substr(table.size() + 1, b.table.find('.', table.size() + 1) - table.size() - 1);
+      if (std::find(keys.begin(), keys.end(), inner) == keys.end()) keys.push_back(inner);
+    }
     if (b.table != table) continue;
     const std::vector<std::string> own = keys_of(b.specs);
     keys.insert(keys.end(), own.begin(), own.end());
@@ -180,7 +202,7 @@ Status read_branches(const Reader& r, const toml::table& t, const std::string& w
   for (std::size_t i = 0; i < tree.size(); ++i) {
     const params::Branch<Root>& b = tree[i];
     const std::string at = where_of(b, where);
-    const toml::node* node = b.table.empty() ? &static_cast<const toml::node&>(t) : t.get(b.table);
+    const toml::node* node = b.table.empty() ? &static_cast<const toml::node&>(t) : sub_node(t, b.table);
     if (!node) continue;
     const toml::table* table = node->as_table();
     if (!table) return r.at(*node, at + " must be a table: " + b.table + " = { ... }");
@@ -208,10 +230,10 @@ template <class Root>
 const toml::node& key_node(const params::Branch<Root>& b, const std::string& key, const toml::table& t,
                            const toml::table& top) {
   for (const toml::table* in : {&t, &top}) {
-    const toml::table* table = b.table.empty() ? in : in->get_as<toml::table>(b.table);
+    const toml::table* table = b.table.empty() ? in : sub_table(*in, b.table);
     if (const toml::node* found = table ? table->get(key) : nullptr) return *found;
   }
-  const toml::table* own = b.table.empty() ? &t : t.get_as<toml::table>(b.table);
+  const toml::table* own = b.table.empty() ? &t : sub_table(t, b.table);
   return own ? *own : t;
 }
 
@@ -227,7 +249,7 @@ Status check_tree(const Reader& r, const toml::table& t, const toml::table& top,
   }
   for (std::size_t i = 0; i < tree.size(); ++i) {
     if (Status s = tree[i].check(entry.request); !s) {
-      const toml::table* own = tree[i].table.empty() ? &t : t.get_as<toml::table>(tree[i].table);
+      const toml::table* own = tree[i].table.empty() ? &t : sub_table(t, tree[i].table);
       return r.at(own ? *own : t, wheres[i] + ": " + s.error().message);
     }
   }
@@ -487,6 +509,25 @@ Status read_material_rule(const Reader& r, const std::string& rule, const toml::
   return success();
 }
 
+// A scene bakes when its own table has `bake` (the top level's gives defaults only), from a
+// high-poly it names; its ao map is the occlusion, so the export's own AO would bake another.
+Status read_scene_bake(const Reader& r, const toml::table& t, const std::string& where, const Manifest& m, SceneSpec& spec) {
+  const toml::node* node = t.get("bake");
+  if (!node) {
+    spec.bake.reset();
+    return success();
+  }
+  if (!spec.bake || spec.bake->from.empty()) return r.at(*node, where + ".bake: from = \"high.glb\" is required");
+  spec.bake->high = m.folder / spec.bake->from;
+  const auto& maps = spec.bake->request.bake.maps;
+  if (spec.options.ao && std::find(maps.begin(), maps.end(), bake::Map::ao) != maps.end()) {
+    const toml::node* ao = t.get("ao");
+    return r.at(ao ? *ao : *node, where + ": the export's ao and the bake's ao map would both make the occlusion; "
+                                  "keep one (drop `ao`, or ao from bake.maps)");
+  }
+  return success();
+}
+
 Result<SceneSpec> read_scene(const Reader& r, const std::string& name, const toml::node& node, const Manifest& m,
                              const TopLevel& top, std::vector<std::string>& notes) {
   const std::string where = "scenes." + name;
@@ -513,6 +554,7 @@ Result<SceneSpec> read_scene(const Reader& r, const std::string& name, const tom
                 where + ".output '" + output + "': a .gltf or .glb path inside the output folder");
   }
   spec.output = out.lexically_normal();
+  if (Status s = read_scene_bake(r, *t, where, m, spec); !s) return s.error();
   if (const toml::node* mats = t->get("materials")) {
     if (!mats->is_table()) return r.at(*mats, where + ".materials must be a table: { \"glTF name\" = \"material\" }");
     for (const auto& [key, value] : *mats->as_table()) {

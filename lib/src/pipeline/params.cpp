@@ -1,6 +1,8 @@
 #include <algorithm>
 #include <cctype>
 
+#include "matbake/ao_params.hpp"
+#include "matbake/bake_params.hpp"
 #include "matbake/cluster.hpp"
 #include "matbake/encoding_params.hpp"
 #include "matbake/export_params.hpp"
@@ -41,6 +43,19 @@ const params::Group<SceneSpec>& scene_params() {
   return group;
 }
 
+const params::Group<SceneBake>& bake_source_params() {
+  using params::Spec;
+  static const params::Group<SceneBake> group{{
+      params::text<SceneBake>(Spec{.name = "from",
+                                   .help = "The high-poly glTF (.gltf or .glb) whose maps are baked onto the scene "
+                                           "(matbake bake --from) before it is exported; required in a bake table",
+                                   .example = "sculpts/hero_high.glb",
+                                   .manifest_only = true},
+                              [](auto& b) -> auto& { return b.from; }),
+  }};
+  return group;
+}
+
 const params::Tree<MaterialSpec>& material_tree() {
   static const params::Tree<MaterialSpec> tree{
       params::branch<MaterialSpec>(pack::material_params(), "", "", [](auto& m) -> auto& { return m.options; }),
@@ -59,6 +74,14 @@ const params::Tree<SceneSpec>& scene_tree() {
          params::subtree<SceneSpec>(exporter::request_tree(), [](auto& s) -> auto& { return s.options; })) {
       t.push_back(std::move(b));
     }
+    // A scene bakes when its own table has `bake` (read_scene); the top level's gives defaults.
+    const params::OptionalPart<SceneSpec, SceneBake> bake{&SceneSpec::bake};
+    const auto baking = [](const SceneSpec& s) { return s.bake.has_value(); };
+    t.push_back(params::branch<SceneSpec>(bake_source_params(), "bake", "", bake, baking));
+    t.push_back(params::branch<SceneSpec>(bake::request_params(), "bake", "",
+                                          [bake](auto& s) -> auto& { return bake(s).request; }, baking));
+    t.push_back(params::branch<SceneSpec>(ao::estimator_params(), "bake.ao", "",
+                                          [bake](auto& s) -> auto& { return bake(s).request.occlusion; }, baking));
     return t;
   }();
   return tree;

@@ -204,6 +204,17 @@ std::size_t Report::over_validation_limit() const {
   }));
 }
 
+// A baking scene reads its high-poly's files too.
+void add_high_poly(Job& job, const SceneSpec& s) {
+  auto json = gltf::read_json(s.bake->high);
+  if (!json) {
+    if (!job.problem) job.problem = Error{s.origins.of("bake.from"), "scenes." + s.name + ".bake.from: " + json.error().to_string()};
+    add_unique(job.inputs, {normalized(s.bake->high)});
+    return;
+  }
+  add_unique(job.inputs, gltf::source_files(s.bake->high, *json));
+}
+
 Result<Plan> make_plan(const Manifest& manifest) {
   return guarded(manifest.file.string(), [&]() -> Result<Plan> {
     Plan plan;
@@ -284,6 +295,10 @@ Result<Plan> make_plan(const Manifest& manifest) {
                                 {"output", s.output.string()},
                                 {"materials", materials},
                                 {"export", to_json(s.options)}};
+      if (s.bake) {
+        options["bake"] = params::tree_json(scene_tree(), s)["bake"];
+        add_high_poly(job, s);
+      }
       // The encoder's version too: a new basisu rebuilds the KTX2 scenes.
       if (s.options.delivery.texture_format == delivery::TextureFormat::ktx2) options["encoder"] = delivery::encoder_identity();
       job.options = options.dump();

@@ -23,6 +23,7 @@
 #include "matbake/workflow_maps.hpp"
 #include "../delivery/encode_cache.hpp"
 #include "made_log.hpp"
+#include "scene_bake.hpp"
 #include "state.hpp"
 
 namespace matbake::pipeline {
@@ -258,7 +259,8 @@ Result<exporter::Options> scene_options(const Job& job, const Manifest& manifest
   return options;
 }
 
-Result<std::vector<fs::path>> run_scene(const Job& job, const JobContext& ctx, const StageReport& stage, JobReport& report) {
+Result<std::vector<fs::path>> run_scene(const Job& job, const JobContext& ctx, const fs::path& state_folder,
+                                        const StageReport& stage, JobReport& report) {
   return guarded(ctx.manifest.scenes[job.spec].input.string(), [&]() -> Result<std::vector<fs::path>> {
     const SceneSpec& s = ctx.manifest.scenes[job.spec];
     report_stage(stage, Phase::read, "decoding materials");
@@ -271,10 +273,26 @@ Result<std::vector<fs::path>> run_scene(const Job& job, const JobContext& ctx, c
     options.delivery.encode_cache_bytes = ctx.encode_cache_bytes;
     const fs::path& output = job.outputs.scene;
     if (Status st = ensure_folder(output.parent_path()); !st) return st.error();
-    auto exported = exporter::export_scene(s.input, output, options);
+    std::optional<BakedScene> baked;
+    if (s.bake) {
+      report_stage(stage, Phase::ao, "baking from " + s.bake->from);
+      auto made = bake_scene(job, s, state_folder, options.encoding);
+      if (!made) return made.error();
+      if (Status st = check_baked_materials(s, *made, options.materials); !st) return st.error();
+      baked = std::move(*made);
+    }
+    auto exported = exporter::export_scene(baked ? baked->gltf : s.input, output, options);
     if (!exported) return Error{s.origins.of("input"), "scenes." + s.name + ": " + exported.error().to_string()};
     report.details = to_json(*exported);
-    return std::vector<fs::path>(exported->written.begin(), exported->written.end());
+    std::vector<fs::path> written(exported->written.begin(), exported->written.end());
+    if (baked) {
+      auto maps = finish_bake(job, *baked);
+      if (!maps) return maps.error();
+      written.insert(written.end(), maps->begin(), maps->end());
+      report.details["bake"] = to_json(baked->report);
+      report.details["bake"].erase("written");  // the bake's own files, removed or moved (in `written`)
+    }
+    return written;
   });
 }
 
@@ -322,7 +340,7 @@ void run_job(const Job& job, const JobContext& ctx, const RunOptions& run_option
     status = *job.problem;
   } else if (job.kind == JobKind::material) {
     status = run_material(job, ctx, stage, report);
-  } else if (auto files = run_scene(job, ctx, stage, report); files) {
+  } else if (auto files = run_scene(job, ctx, roots.state_folder, stage, report); files) {
     written = *files;
   } else {
     status = files.error();

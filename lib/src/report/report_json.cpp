@@ -158,4 +158,18 @@ nlohmann::json to_json(const bake_ao::TextureReport& t) {
 
 nlohmann::json to_json(const exporter::Options& o) { return params::tree_json(exporter::request_tree(), o); }
 
+nlohmann::json to_json(const bake::FileReport& r) {
+  nlohmann::json textures = nlohmann::json::array();
+  for (const bake::TextureReport& t : r.textures) {
+    textures.push_back({{"material", t.material}, {"name", t.name}, {"width", t.width}, {"height", t.height},
+                        {"texcoord", t.texcoord}, {"texels", t.texels}, {"rays", t.samples}, {"misses", t.misses},
+                        {"missed_texels", t.missed_texels}, {"padded", t.padded}, {"height_min", t.height_min},
+                        {"height_max", t.height_max}, {"files", t.files}, {"existing", t.existing},
+                        {"occlusion_rays", t.occlusion_rays}});
+  }
+  return {{"front", r.front}, {"back", r.back}, {"textures", textures}, {"tangent_primitives", r.tangent_primitives},
+          {"split_vertices", r.split_vertices}, {"seconds", r.seconds}, {"setup_seconds", r.setup_seconds},
+          {"trace_seconds", r.trace_seconds}, {"notes", r.notes}, {"written", r.written}};
+}
+
 }  // namespace matbake

@@ -1,0 +1,66 @@
+#include "scene_bake.hpp"
+
+#include <algorithm>
+#include <system_error>
+
+#include "matbake/output_check.hpp"
+#include "state.hpp"
+
+namespace matbake::pipeline {
+namespace fs = std::filesystem;
+
+Result<BakedScene> bake_scene(const Job& job, const SceneSpec& s, const fs::path& state_folder, const image::Encoding& encoding) {
+  const fs::path work = state_folder / "bake" / job_file_stem(job.name);
+  std::error_code ec;
+  fs::create_directories(work, ec);
+  if (ec) return Error{work.string(), "cannot make the bake's folder: " + ec.message()};
+  // Named as the scene's output, so that the float maps are named as `matbake bake` names them.
+  BakedScene baked{work / (job.outputs.scene.stem().string() + ".glb"), {}};
+  bake::FileOptions options{s.bake->high, baked.gltf, s.bake->request, encoding};
+  auto report = bake::bake_file(s.input, options);
+  if (!report) return Error{s.origins.of("bake"), "scenes." + s.name + ".bake: " + report.error().to_string()};
+  baked.report = std::move(*report);
+  return baked;
+}
+
+Status check_baked_materials(const SceneSpec& s, const BakedScene& baked, const std::vector<exporter::MaterialMaps>& given) {
+  const auto& maps = s.bake->request.bake.maps;
+  const auto asks = [&](bake::Map m) { return std::find(maps.begin(), maps.end(), m) != maps.end(); };
+  for (const bake::TextureReport& t : baked.report.textures) {
+    for (const exporter::MaterialMaps& g : given) {
+      if (g.material != t.name) continue;
+      const char* lost = asks(bake::Map::ao)                                    ? "ao"
+                         : asks(bake::Map::transfer)                            ? "transfer"
+                         : asks(bake::Map::normal) && g.maps.find(material::kNormal) ? "normal"
+                                                                                 : nullptr;
+      if (!lost) continue;
+      return Error{s.origins.of("bake"), "scenes." + s.name + ": glTF material '" + t.name +
+                                             "' is baked and also given a manifest material, whose maps would replace the "
+                                             "baked " + lost + " map; bake it onto a material the manifest does not give, "
+                                             "or drop " + lost + " from bake.maps"};
+    }
+  }
+  return success();
+}
+
+Result<std::vector<fs::path>> finish_bake(const Job& job, const BakedScene& baked) {
+  std::vector<NamedOutput> targets;
+  std::vector<fs::path> moved;
+  for (const std::string& file : baked.report.beside) {
+    moved.push_back(job.outputs.scene.parent_path() / fs::path(file).filename());
+    targets.push_back({moved.back(), "baked map"});
+  }
+  if (Status s = check_outputs(targets, job.inputs); !s) return s.error();
+  for (std::size_t i = 0; i < moved.size(); ++i) {
+    std::error_code ec;
+    fs::rename(baked.report.beside[i], moved[i], ec);
+    if (ec) return Error{moved[i].string(), "cannot move the baked map here: " + ec.message()};
+  }
+  for (const std::string& file : baked.report.written) {
+    std::error_code ec;
+    if (std::find(baked.report.beside.begin(), baked.report.beside.end(), file) == baked.report.beside.end()) fs::remove(file, ec);
+  }
+  return moved;
+}
+
+}  // namespace matbake::pipeline

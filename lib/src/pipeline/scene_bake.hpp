@@ -1,0 +1,30 @@
+#pragma once
+// A manifest scene's bake (`bake = { from, maps, ... }`, docs/build.md#baking): the high-poly's maps
+// baked onto the scene's glTF in the state folder, which the export then reads; the float maps the
+// glTF does not reference are moved beside the scene's output once the export has succeeded.
+#include <filesystem>
+#include <vector>
+
+#include "matbake/bake_file.hpp"
+#include "matbake/export.hpp"
+#include "matbake/pipeline.hpp"
+
+namespace matbake::pipeline {
+
+struct BakedScene {
+  std::filesystem::path gltf;  // the bake's output, OUT/.matbake/bake/<job>/<scene stem>.glb: the export's input
+  bake::FileReport report;
+};
+
+Result<BakedScene> bake_scene(const Job& job, const SceneSpec& s, const std::filesystem::path& state_folder,
+                              const image::Encoding& encoding);
+
+// A baked material that the manifest also gives a material: its maps would replace the baked ones
+// (base colour and ORM always, the normal map when it has one), which is refused, naming both.
+Status check_baked_materials(const SceneSpec& s, const BakedScene& baked, const std::vector<exporter::MaterialMaps>& given);
+
+// After the export: the float maps moved beside the scene's output (never onto an input), the rest
+// of the bake removed. Returns the maps as moved.
+Result<std::vector<std::filesystem::path>> finish_bake(const Job& job, const BakedScene& baked);
+
+}  // namespace matbake::pipeline
