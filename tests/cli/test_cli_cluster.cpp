@@ -17,7 +17,7 @@ using nlohmann::json;
 
 // Noise a PNG compresses poorly, as painted textures do: `channels` of side², 8-bit; a normal
 // map's tilts stay within about 15° of the surface normal.
-void write_noise(const fs::path& file, int side, int channels, std::uint32_t seed, bool normal = false) {
+void write_painted_noise(const fs::path& file, int side, int channels, std::uint32_t seed, bool normal = false) {
   std::vector<double> samples(std::size_t(side) * std::size_t(side) * std::size_t(channels));
   for (std::size_t i = 0; i < samples.size(); ++i) {
     seed = seed * 1664525u + 1013904223u;
@@ -85,12 +85,12 @@ TEST(ClusterMemory, RequestsCoverAFiveMapLibrarysPeaks) {
   SKIP_UNLESS_RELEASE();
   TempDir dir;
   constexpr int kSide = 1024;
-  write_noise(dir / "base.png", kSide, 3, 1);
-  write_noise(dir / "normal.png", kSide, 3, 2, true);
-  write_noise(dir / "emissive.png", kSide, 3, 3);
-  write_noise(dir / "metal.png", kSide, 1, 4);
-  write_noise(dir / "rough.png", kSide, 1, 5);
-  write_noise(dir / "orm.png", kSide, 3, 6);
+  write_painted_noise(dir / "base.png", kSide, 3, 1);
+  write_painted_noise(dir / "normal.png", kSide, 3, 2, true);
+  write_painted_noise(dir / "emissive.png", kSide, 3, 3);
+  write_painted_noise(dir / "metal.png", kSide, 1, 4);
+  write_painted_noise(dir / "rough.png", kSide, 1, 5);
+  write_painted_noise(dir / "orm.png", kSide, 3, 6);
   for (const char* f : {"showroom.gltf", "showroom.bin"}) fs::copy_file(kExamples / f, dir / f);
   std::string why_not;
   const bool ktx2 = !basisu_for_tests(why_not).empty();

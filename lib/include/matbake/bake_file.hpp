@@ -24,6 +24,9 @@ struct FileOptions {
   std::filesystem::path output;  // .gltf or .glb
   Request request;
   image::Encoding encoding;      // of the normal map's PNG
+  // Where the maps are kept between bakes (a build's state folder; empty: nowhere): a map whose
+  // inputs and parameters are those it was kept with is read back, not traced (docs/bake.md).
+  std::filesystem::path keep;
 };
 
 struct TextureReport {
@@ -46,6 +49,7 @@ struct FileReport {
   std::vector<std::string> notes;
   std::vector<std::string> written;    // files
   std::vector<std::string> beside;     // those of them the glTF does not reference: the float maps
+  std::vector<std::string> reused;     // maps read back from FileOptions::keep, not traced
 };
 
 // Errors: either file unreadable (named), an output onto an input, no low-poly material with the

@@ -35,7 +35,7 @@ nlohmann::json to_json(const exporter::Options& o);
 nlohmann::json to_json(const delivery::TextureReport& t);
 nlohmann::json delivered_json(const std::vector<delivery::TextureReport>& textures);
 // A bake: the cage, each material's texture set (rays, misses, height range, files), tangents,
-// times, notes and files written, as `bake --json` prints it (without its "command" and paths).
+// times, notes, files written and maps reused (kept from an earlier bake), as `bake --json` prints it (without its "command" and paths).
 nlohmann::json to_json(const bake::FileReport& r);
 
 }  // namespace matbake

@@ -9,6 +9,7 @@
 #include "../gltf/texture_transform.hpp"
 #include "../scene/from_document.hpp"
 #include "frames.hpp"
+#include "map_cache.hpp"
 #include "matbake/bake_file.hpp"
 #include "matbake/output_check.hpp"
 
@@ -204,6 +205,86 @@ Result<TextureReport> write_maps(gltf::Document& doc, const gltf::ImageCache& ca
   return report;
 }
 
+// The files a glTF is read from (itself, its buffers and images); none when its JSON cannot be
+// read (its loading then says why).
+std::vector<fs::path> files_of(const fs::path& gltf) {
+  const auto json = gltf::read_json(gltf);
+  return json ? gltf::source_files(gltf, *json) : std::vector<fs::path>{gltf};
+}
+
+// The bake of `maps` alone: the high-poly loaded (with its base colours only for transfer), traced.
+Result<Bake> trace_maps(const scene::Scene& low, const Targets& targets, const FileOptions& options, const std::vector<Map>& maps) {
+  const bool transfer = std::find(maps.begin(), maps.end(), Map::transfer) != maps.end();
+  auto high = scene::load_scene(options.high, {.texcoords = transfer});
+  if (!high) return high.error();
+  std::vector<BaseColor> colors;
+  if (transfer) {
+    auto read = base_colors(options.high, options.encoding);
+    if (!read) return read.error();
+    colors = std::move(*read);
+  }
+  Options asked = options.request.bake;
+  asked.maps = maps;
+  return bake(low, *high, targets.targets, options.request.texture, asked, options.request.occlusion.options, colors);
+}
+
+// Every asked map, each read back from options.keep when kept there under its key (map_cache.hpp),
+// the others traced and kept; `reused` names those read back.
+Result<Bake> bake_or_reuse(const scene::Scene& low, const Targets& targets, const FileOptions& options, const std::string& inputs,
+                           std::vector<std::string>& reused) {
+  const std::vector<Map>& maps = options.request.bake.maps;
+  const ao::TextureOptions& texture = options.request.texture;
+  std::string targets_text;
+  for (std::size_t t = 0; t < targets.targets.size(); ++t) {
+    targets_text += std::to_string(targets.materials[t]) + ":" + std::to_string(targets.targets[t].texcoord) + " ";
+  }
+  const bool keeping = !options.keep.empty() && !inputs.empty();
+  const std::string trace_key = keeping ? map_key(inputs, std::nullopt, options.request, targets_text) : "";
+  std::vector<std::optional<KeptMap>> kept(maps.size());
+  std::vector<Map> to_trace;
+  for (std::size_t i = 0; i < maps.size(); ++i) {
+    if (keeping) kept[i] = load_map(options.keep, maps[i], map_key(inputs, maps[i], options.request, targets_text),
+                                    targets.targets.size(), texture.width, texture.height);
+    if (!kept[i]) to_trace.push_back(maps[i]);
+  }
+  std::optional<std::vector<TextureBake>> counts;
+  if (to_trace.empty()) {
+    counts = load_trace(options.keep, trace_key, targets.targets.size());
+    if (!counts) to_trace = maps, kept.assign(maps.size(), std::nullopt);  // kept maps without their trace's counts
+  }
+  Bake out;
+  if (!to_trace.empty()) {
+    auto traced = trace_maps(low, targets, options, to_trace);
+    if (!traced) return traced.error();
+    if (keeping) {
+      std::vector<std::pair<Map, std::string>> keys;
+      for (Map m : to_trace) keys.emplace_back(m, map_key(inputs, m, options.request, targets_text));
+      if (Status s = store_maps(options.keep, traced->textures, trace_key, keys); !s) return s.error();
+    }
+    out = std::move(*traced);
+  } else {
+    out.textures = std::move(*counts);
+  }
+  for (std::size_t t = 0; t < out.textures.size(); ++t) {
+    TextureBake& texture_bake = out.textures[t];
+    texture_bake.width = texture.width, texture_bake.height = texture.height;
+    std::vector<MapImage> in_order;
+    for (std::size_t i = 0; i < maps.size(); ++i) {
+      if (kept[i]) {
+        in_order.push_back(std::move(kept[i]->images[t]));
+        continue;
+      }
+      const auto traced = std::find_if(texture_bake.maps.begin(), texture_bake.maps.end(), [&](const MapImage& m) { return m.map == maps[i]; });
+      in_order.push_back(std::move(*traced));
+    }
+    texture_bake.maps = std::move(in_order);
+  }
+  for (std::size_t i = 0; i < maps.size(); ++i) {
+    if (kept[i]) reused.emplace_back(matbake::name_in(kMapNames, maps[i]));
+  }
+  return out;
+}
+
 }  // namespace
 
 Result<FileReport> bake_file(const fs::path& low_path, const FileOptions& options) {
@@ -213,30 +294,22 @@ Result<FileReport> bake_file(const fs::path& low_path, const FileOptions& option
     }
     if (Status s = check(options.request.bake); !s) return s.error();
     const auto start = std::chrono::steady_clock::now();
+    // The inputs' content before they are loaded: kept maps are keyed by what was read, at worst older.
+    std::vector<fs::path> inputs = files_of(low_path);
+    const std::vector<fs::path> high_inputs = files_of(options.high);
+    inputs.insert(inputs.end(), high_inputs.begin(), high_inputs.end());
+    std::string inputs_key;
+    if (!options.keep.empty()) {
+      if (auto hashed = inputs_hash(inputs)) inputs_key = *hashed;  // else nothing is reused; loading says why
+    }
     auto doc = gltf::read_document(low_path);
     if (!doc) return doc.error();
     auto low = scene::scene_from_document(*doc, {.texcoords = true, .object_space = true});
     if (!low) return low.error();
-    const auto& maps = options.request.bake.maps;
-    const bool transfer = std::find(maps.begin(), maps.end(), Map::transfer) != maps.end();
-    auto high = scene::load_scene(options.high, {.texcoords = transfer});
-    if (!high) return high.error();
-    std::vector<BaseColor> colors;
-    if (transfer) {
-      auto read = base_colors(options.high, options.encoding);
-      if (!read) return read.error();
-      colors = std::move(*read);
-    }
     auto targets = material_targets(*doc, *low);
     if (!targets) return targets.error();
 
     std::vector<NamedOutput> outputs = {{options.output, "glTF output"}};
-    std::vector<fs::path> inputs = gltf::source_files(doc->file, doc->json);
-    const auto high_inputs = gltf::read_json(options.high);
-    if (high_inputs) {
-      const auto more = gltf::source_files(options.high, *high_inputs);
-      inputs.insert(inputs.end(), more.begin(), more.end());
-    }
     const Json& materials = doc->json["materials"];
     for (int m : targets->materials) {
       for (Map map : options.request.bake.maps) {
@@ -245,16 +318,18 @@ Result<FileReport> bake_file(const fs::path& low_path, const FileOptions& option
                            std::string(matbake::name_in(kMapNames, map)) + " map"});
       }
     }
+    if (!options.keep.empty()) {
+      for (const fs::path& f : kept_files(options.keep, options.request.bake.maps, targets->targets.size())) outputs.push_back({f, "kept map"});
+    }
     if (Status s = check_outputs(outputs, inputs); !s) return s.error();
 
-    auto baked = bake(*low, *high, targets->targets, options.request.texture, options.request.bake, options.request.occlusion.options,
-                      colors);
+    FileReport report;
+    auto baked = bake_or_reuse(*low, *targets, options, inputs_key, report.reused);
     if (!baked) {
       Error error = baked.error();
       if (error.path.empty() && !error.usage) error.path = doc->file;
       return error;
     }
-    FileReport report;
     report.notes = low->notes;
     report.notes.insert(report.notes.end(), targets->notes.begin(), targets->notes.end());
     report.front = baked->front, report.back = baked->back;

@@ -169,7 +169,7 @@ nlohmann::json to_json(const bake::FileReport& r) {
   }
   return {{"front", r.front}, {"back", r.back}, {"textures", textures}, {"tangent_primitives", r.tangent_primitives},
           {"split_vertices", r.split_vertices}, {"seconds", r.seconds}, {"setup_seconds", r.setup_seconds},
-          {"trace_seconds", r.trace_seconds}, {"notes", r.notes}, {"written", r.written}};
+          {"trace_seconds", r.trace_seconds}, {"notes", r.notes}, {"written", r.written}, {"reused", r.reused}};
 }
 
 }  // namespace matbake

@@ -1,0 +1,163 @@
+#include "map_cache.hpp"
+
+#include <xxhash.h>
+
+#include <cstring>
+
+#include "matbake/ao_params.hpp"
+#include "matbake/atomic_file.hpp"
+#include "matbake/bake_params.hpp"
+#include "matbake/read_file.hpp"
+#include "matbake/version.hpp"
+
+namespace matbake::bake {
+namespace fs = std::filesystem;
+namespace {
+
+constexpr int kForm = 1;
+constexpr std::uintmax_t kIndexLimit = 1u << 20;  // a few hundred bytes a target and map
+
+std::string hex128(XXH128_hash_t hash) {
+  XXH128_canonical_t canonical;
+  XXH128_canonicalFromHash(&canonical, hash);
+  static const char* digits = "0123456789abcdef";
+  std::string text;
+  for (unsigned char byte : canonical.digest) {
+    text += digits[byte >> 4];
+    text += digits[byte & 15];
+  }
+  return text;
+}
+
+std::string text_hash(const std::string& text) { return hex128(XXH3_128bits(text.data(), text.size())); }
+
+fs::path index_file(const fs::path& folder) { return folder / "maps.json"; }
+fs::path map_file(const fs::path& folder, Map map, std::size_t target) {
+  return folder / (std::to_string(target) + "_" + std::string(name_in(kMapNames, map)) + ".f32");
+}
+
+// The index as stored, or an empty one: too large, not JSON, another form or shape.
+nlohmann::json read_index(const fs::path& folder) {
+  std::error_code ec;
+  const std::uintmax_t size = fs::file_size(index_file(folder), ec);
+  std::string text;
+  if (ec || size > kIndexLimit || !read_whole_file(index_file(folder), text)) return nlohmann::json::object();
+  nlohmann::json index = nlohmann::json::parse(text, nullptr, false);
+  if (!index.is_object() || index.value("form", 0) != kForm) return nlohmann::json::object();
+  return index;
+}
+
+bool text_at(const nlohmann::json& j, const char* key, const std::string& expected) {
+  return j.is_object() && j.contains(key) && j[key].is_string() && j[key].get<std::string>() == expected;
+}
+
+}  // namespace
+
+nlohmann::json map_parameters(std::optional<Map> map, const Request& request) {
+  nlohmann::json p = params::to_json(request_params(), request);
+  p.erase("maps");  // another map asked or dropped changes none of the others
+  const bool tangent = map == Map::normal || map == Map::bent_normal;
+  if (!tangent) p.erase("green");
+  if (map == Map::ao || map == Map::bent_normal || map == Map::thickness) p["ao"] = params::to_json(ao::estimator_params(), request.occlusion);
+  p["matbake"] = version;
+  return p;
+}
+
+Result<std::string> inputs_hash(std::span<const fs::path> files) {
+  std::string digests;
+  for (const fs::path& file : files) {
+    std::string bytes;
+    if (!read_whole_file(file, bytes)) return Error{file.string(), "cannot be read"};
+    digests += file.filename().string() + "\n" + hex128(XXH3_128bits(bytes.data(), bytes.size())) + "\n";
+  }
+  return text_hash(digests);
+}
+
+std::string map_key(const std::string& inputs, std::optional<Map> map, const Request& request, const std::string& targets) {
+  const std::string name = map ? std::string(name_in(kMapNames, *map)) : "trace";
+  return text_hash(inputs + "\n" + targets + "\n" + name + "\n" + map_parameters(map, request).dump());
+}
+
+std::optional<KeptMap> load_map(const fs::path& folder, Map map, const std::string& key, std::size_t targets, int width,
+                                int height) {
+  const nlohmann::json index = read_index(folder);
+  const nlohmann::json entry = index.value("maps", nlohmann::json::object()).value(std::string(name_in(kMapNames, map)), nlohmann::json());
+  if (!text_at(entry, "key", key) || !entry.contains("files") || !entry["files"].is_array() || entry["files"].size() != targets) {
+    return std::nullopt;
+  }
+  KeptMap kept;
+  const std::size_t floats = std::size_t(width) * std::size_t(height) * std::size_t(channels(map));
+  for (std::size_t t = 0; t < targets; ++t) {
+    const fs::path file = map_file(folder, map, t);
+    std::error_code ec;
+    if (fs::file_size(file, ec) != floats * sizeof(float) || ec) return std::nullopt;  // before any allocation
+    std::string bytes;
+    if (!read_whole_file(file, bytes) || bytes.size() != floats * sizeof(float)) return std::nullopt;
+    if (!text_at(entry["files"][t], "hash", hex128(XXH3_128bits(bytes.data(), bytes.size())))) return std::nullopt;
+    MapImage& image = kept.images.emplace_back();
+    image.map = map, image.channels = channels(map);
+    image.values.resize(floats);
+    std::memcpy(image.values.data(), bytes.data(), bytes.size());
+  }
+  return kept;
+}
+
+std::optional<std::vector<TextureBake>> load_trace(const fs::path& folder, const std::string& key, std::size_t targets) {
+  const nlohmann::json trace = read_index(folder).value("trace", nlohmann::json());
+  if (!text_at(trace, "key", key) || !trace.contains("targets") || !trace["targets"].is_array() || trace["targets"].size() != targets) {
+    return std::nullopt;
+  }
+  std::vector<TextureBake> out;
+  for (const nlohmann::json& t : trace["targets"]) {
+    if (!t.is_object()) return std::nullopt;
+    TextureBake& b = out.emplace_back();
+    const auto count = [&](const char* k) { return t.value(k, nlohmann::json()).is_number_unsigned() ? t[k].get<std::size_t>() : 0; };
+    const auto number = [&](const char* k) { return t.value(k, nlohmann::json()).is_number() ? t[k].get<double>() : 0.0; };
+    b.texels = count("texels"), b.missed_texels = count("missed_texels"), b.padded = count("padded");
+    b.height_min = number("height_min"), b.height_max = number("height_max");
+  }
+  return out;
+}
+
+Status store_maps(const fs::path& folder, const std::vector<TextureBake>& baked, const std::string& trace_key,
+                  const std::vector<std::pair<Map, std::string>>& keys) {
+  std::error_code ec;
+  fs::create_directories(folder, ec);
+  if (ec) return Error{folder.string(), "cannot make the folder of kept maps: " + ec.message()};
+  nlohmann::json index = read_index(folder);
+  index["form"] = kForm;
+  if (!index.contains("maps") || !index["maps"].is_object()) index["maps"] = nlohmann::json::object();
+  for (const auto& [map, key] : keys) {
+    const std::string name(name_in(kMapNames, map));
+    index["maps"].erase(name);  // until its files are written
+  }
+  nlohmann::json stats = nlohmann::json::array();
+  for (const TextureBake& t : baked) {
+    stats.push_back({{"texels", t.texels}, {"missed_texels", t.missed_texels}, {"padded", t.padded},
+                     {"height_min", t.height_min}, {"height_max", t.height_max}});
+  }
+  index["trace"] = {{"key", trace_key}, {"targets", stats}};
+  if (Status s = write_file_atomically(index_file(folder), index.dump()); !s) return s;
+  for (const auto& [map, key] : keys) {
+    nlohmann::json files = nlohmann::json::array();
+    for (std::size_t t = 0; t < baked.size(); ++t) {
+      const auto found = std::find_if(baked[t].maps.begin(), baked[t].maps.end(), [&](const MapImage& m) { return m.map == map; });
+      if (found == baked[t].maps.end()) return Error{"", "internal: a kept map is not in the bake"};
+      const std::string_view bytes(reinterpret_cast<const char*>(found->values.data()), found->values.size() * sizeof(float));
+      if (Status s = write_file_atomically(map_file(folder, map, t), bytes); !s) return s;
+      files.push_back({{"hash", hex128(XXH3_128bits(bytes.data(), bytes.size()))}});
+    }
+    index["maps"][std::string(name_in(kMapNames, map))] = {{"key", key}, {"files", files}};
+  }
+  return write_file_atomically(index_file(folder), index.dump());
+}
+
+std::vector<fs::path> kept_files(const fs::path& folder, std::span<const Map> maps, std::size_t targets) {
+  std::vector<fs::path> files{index_file(folder)};
+  for (Map map : maps) {
+    for (std::size_t t = 0; t < targets; ++t) files.push_back(map_file(folder, map, t));
+  }
+  return files;
+}
+
+}  // namespace matbake::bake

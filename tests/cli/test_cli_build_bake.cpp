@@ -1,0 +1,151 @@
+// A manifest scene's bake (`bake = { from, maps, ... }`) through `matbake build`: what it writes, and
+// that it is incremental per map: the parameters a map reads decide whether it is traced again,
+// kept maps are checked before they are trusted, and a rebuild gives the bytes of a fresh build.
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include <map>
+
+#include "lib/src/gltf/document.hpp"
+#include "support/files.hpp"
+#include "support/gltf_validator.hpp"
+#include "support/run.hpp"
+#include "support/temp_dir.hpp"
+
+namespace matbake::test {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+// The example's scene baked onto itself (no ../shared needed): the cage finds the same surface, so
+// the normal map is flat and the height zero; what matters here is what is traced and written.
+std::string manifest_text(const std::string& output, const std::string& maps, int ao_samples) {
+  return "output = \"" + output + "\"\n[scenes.s]\ninput = \"showroom.gltf\"\noutput = \"s.glb\"\n"
+         "bake = { from = \"showroom.gltf\", maps = " + maps + ", size = 32, texel_samples = 2, ao = { samples = " +
+         std::to_string(ao_samples) + " } }\n";
+}
+
+struct Built {
+  json job;  // the scene job's report
+  std::map<std::string, std::string> files;  // what the build wrote, by name, with its bytes
+};
+
+Built build(const fs::path& dir, const std::string& output, const std::string& maps, int ao_samples,
+            const std::string& manifest = "m.toml") {
+  write_bytes(dir / manifest, manifest_text(output, maps, ao_samples));
+  const RunResult r = matbake({"--json", "build", (dir / manifest).string()});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  const json report = json::parse(r.out, nullptr, false);
+  Built out;
+  if (report.is_object() && report["jobs"].size() == 1) out.job = report["jobs"][0];
+  for (const auto& e : fs::directory_iterator(dir / output)) {
+    if (e.is_regular_file()) out.files[e.path().filename().string()] = read_bytes(e.path());
+  }
+  return out;
+}
+
+// The names of the files that differ between two builds (or are in one only).
+std::vector<std::string> differing(const Built& a, const Built& b) {
+  std::vector<std::string> names;
+  for (const auto& [name, bytes] : a.files) {
+    if (!b.files.count(name) || b.files.at(name) != bytes) names.push_back(name);
+  }
+  for (const auto& [name, bytes] : b.files) {
+    if (!a.files.count(name)) names.push_back(name);
+  }
+  return names;
+}
+
+std::vector<std::string> reused(const Built& b) { return b.job["details"]["bake"]["reused"].get<std::vector<std::string>>(); }
+
+TEST(CliBuildBake, ASceneIsBakedThenExportedAndOnlyWhatAChangeDecidesIsTracedAgain) {
+  TempDir dir;
+  for (const char* f : {"showroom.gltf", "showroom.bin"}) fs::copy_file(kExamples / f, dir / f);
+  const std::string maps = "[\"normal\", \"ao\", \"height\"]";
+  const Built first = build(dir.path(), "out", maps, 4);
+  EXPECT_EQ(first.job["outcome"], "built");
+  EXPECT_EQ(first.job["details"]["bake"]["textures"].size(), 5u);  // five materials
+  EXPECT_TRUE(reused(first).empty());
+  // The normal map and AO are the materials' own textures (with TANGENT written); height beside.
+  {
+    const auto doc = gltf::read_document(dir / "out/s.glb");
+    ASSERT_TRUE(doc) << doc.error().to_string();
+    for (const auto& m : doc->json["materials"]) {
+      EXPECT_TRUE(m.contains("normalTexture") && m.contains("occlusionTexture")) << m.dump();
+    }
+    for (const auto& mesh : doc->json["meshes"]) {
+      for (const auto& p : mesh["primitives"]) EXPECT_TRUE(p["attributes"].contains("TANGENT"));
+    }
+  }
+  EXPECT_EQ(first.files.count("s_wood_height.exr"), 1u);
+  EXPECT_EQ(first.files.size(), 6u);  // the scene and five height maps: nothing of the bake's own work
+  MATBAKE_VALIDATE_OR_SKIP(report, dir / "out/s.glb");
+  EXPECT_EQ(report->errors, 0) << report->summary;
+  EXPECT_EQ(report->warnings, 0) << report->summary;
+
+  // Up to date: nothing runs.
+  const RunResult again = matbake({"build", (dir / "m.toml").string()});
+  EXPECT_EQ(again.out, "nothing to do: 1 jobs up to date\n") << again.err;
+
+  // The AO's samples alone: AO is traced again, normal and height are read back, and the bytes are
+  // those of a fresh build with the new samples.
+  const Built ao8 = build(dir.path(), "out", maps, 8);
+  EXPECT_EQ(ao8.job["reason"], "its options changed: bake.ao.samples 4 → 8");
+  EXPECT_EQ(reused(ao8), (std::vector<std::string>{"normal", "height"}));
+  const Built fresh8 = build(dir.path(), "fresh", maps, 8, "fresh.toml");
+  EXPECT_TRUE(reused(fresh8).empty());
+  EXPECT_TRUE(differing(ao8, fresh8).empty()) << differing(ao8, fresh8).front();
+  EXPECT_EQ(differing(ao8, first), std::vector<std::string>{"s.glb"});  // the AO differs, the heights do not
+
+  // A kept map that is not as it was kept (same size, other bytes) is traced again, never trusted.
+  const fs::path kept = dir / "out/.matbake/bake/scene-s/kept/0_normal.f32";
+  ASSERT_TRUE(fs::exists(kept));
+  write_bytes(kept, std::string(read_bytes(kept).size(), '\0'));  // every normal (0, 0, 0)
+  write_bytes(dir / "out/.matbake/bake/scene-s/kept/maps.json.tmp", "not mine");  // a stray file: ignored
+  const Built ao4 = build(dir.path(), "out", maps, 4);
+  EXPECT_EQ(reused(ao4), (std::vector<std::string>{"height"}));
+  EXPECT_TRUE(differing(ao4, first).empty()) << differing(ao4, first).front();
+
+  // A garbled index: everything traced again.
+  write_bytes(dir / "out/.matbake/bake/scene-s/kept/maps.json", "{\"form\": 1, \"maps\": {\"normal\": 7}");
+  const Built garbled = build(dir.path(), "out", maps, 8);
+  EXPECT_TRUE(reused(garbled).empty());
+  EXPECT_TRUE(differing(garbled, fresh8).empty()) << differing(garbled, fresh8).front();
+
+  // A change to the high-poly (here also the low-poly) traces every map again.
+  write_bytes(dir / "showroom.gltf", read_bytes(dir / "showroom.gltf") + " ");
+  const Built changed = build(dir.path(), "out", maps, 8);
+  EXPECT_EQ(changed.job["reason"].get<std::string>().rfind("input changed", 0), 0u) << changed.job.dump();
+  EXPECT_TRUE(reused(changed).empty());
+
+  // A map dropped: its files are stale and removed; the others are read back.
+  const Built dropped = build(dir.path(), "out", "[\"normal\", \"ao\"]", 8);
+  EXPECT_EQ(reused(dropped), (std::vector<std::string>{"normal", "ao"}));
+  EXPECT_EQ(dropped.files.size(), 1u) << "the height maps are stale";
+}
+
+TEST(CliBuildBake, BadBakesFailTheirJobNamingTheManifestsLine) {
+  TempDir dir;
+  for (const char* f : {"showroom.gltf", "showroom.bin"}) fs::copy_file(kExamples / f, dir / f);
+  // No such high-poly: the job fails at planning, naming the key's line.
+  write_bytes(dir / "m.toml", "output = \"out\"\n[scenes.s]\ninput = \"showroom.gltf\"\nbake = { from = \"nope.glb\" }\n");
+  RunResult r = matbake({"build", (dir / "m.toml").string()});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find((dir / "m.toml").string() + ":4:"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("scenes.s.bake.from"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("nope.glb"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "out/s.glb"));
+
+  // A manifest material given to a baked material would replace the baked AO: refused, naming both.
+  write_bytes(dir / "m.toml", "output = \"out\"\n[materials.wood]\nsources = { base_color = 0.5, metallic = 0, roughness = 0.5 }\n"
+                              "[scenes.s]\ninput = \"showroom.gltf\"\nbake = { from = \"showroom.gltf\", maps = \"ao\", size = 16 }\n");
+  r = matbake({"build", (dir / "m.toml").string()});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("glTF material 'wood' is baked and also given a manifest material"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "out/s.glb"));
+}
+
+}  // namespace
+}  // namespace matbake::test
