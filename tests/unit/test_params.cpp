@@ -551,6 +551,7 @@ TEST(DocsTables, MatchTheParameterDescriptions) {
       {"docs/preview.md", "params:preview", markdown_table(preview::options_params(), "")},
       {"docs/build.md", "params:validation", markdown_table(pipeline::validation_params(), "")},
       {"docs/build.md", "params:scene", markdown_table(pipeline::scene_params(), "")},
+      {"docs/build.md", "params:bake-source", markdown_table(pipeline::bake_source_params(), "")},
       {"docs/cluster.md", "params:cluster", markdown_table(pipeline::cluster_params(), "")},
       {"docs/bake.md", "params:bake", markdown_table(bake::request_params(), "")},
       {"docs/bake.md", "params:bake-ao", markdown_table(ao::estimator_params(), "ao-")},

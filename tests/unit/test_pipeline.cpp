@@ -549,6 +549,8 @@ TEST(ClusterMemory, FootprintIsTheModelsClosedForm) {
   write_bytes(dir / "b.bin", std::string(1000, '\0'));
   write_bytes(dir / "s.gltf", R"({"asset": {"version": "2.0"}, "buffers": [{"byteLength": 1000, "uri": "b.bin"}],
     "materials": [{"name": "mr"}], "nodes": [{}, {}]})");
+  write_bytes(dir / "h.bin", std::string(2000, '\0'));
+  write_bytes(dir / "h.gltf", R"({"asset": {"version": "2.0"}, "buffers": [{"byteLength": 2000, "uri": "h.bin"}]})");
   auto m = pipeline::parse_manifest(R"(
 [materials.mr]                     # files 3 + 1 channels, maps 3 + 1 + 1, textures 4 + 3
 sources = { base_color = "base.png", roughness = "rough.png", metallic = 0.0 }
@@ -560,6 +562,11 @@ layout = "gltf-orm"
 input = "s.gltf"
 texture_format = "ktx2"
 ao = { samples = 8, texture = 64, per_instance = true }
+[scenes.t]                         # a bake onto s.gltf's one material from a high-poly of 2000 bytes
+input = "s.gltf"
+output = "t.glb"
+match_names = false
+bake = { from = "h.gltf", maps = ["normal", "ao", "height", "thickness"], size = 16, texel_samples = 2 }
 )", dir / "m.toml");
   ASSERT_TRUE(m) << m.error().to_string();
   auto plan = pipeline::make_plan(*m);
@@ -587,6 +594,15 @@ ao = { samples = 8, texture = 64, per_instance = true }
   EXPECT_EQ(footprint("scene:s", 1).encoder, 4 * texels * 16 + texels * (80 + 16 + 72));
   m->scenes.at(0).options.delivery.measure_levels = false;  // no copy kept
   EXPECT_EQ(footprint("scene:s", 1).encoder, 4 * texels * 16 + texels * (80 + 72));
+
+  // The bake: the high-poly's geometry with a BVH each for the cage, AO and thickness; per texel the
+  // maps' 6 channels (one material), 2 positions of 20 B and 200 B of sums; the normal map and AO
+  // read again by the export as its own images (48 B a texel).
+  const pipeline::JobFootprint baking = footprint("scene:t", 1);
+  EXPECT_EQ(baking.geometry, 8 * 1000 + 3 * 8 * 2000);
+  EXPECT_EQ(baking.ao, 16 * 16 * (6 * 4 + 2 * 20 + 200));
+  EXPECT_EQ(baking.images, 2 * 16 * 16 * 48);
+  EXPECT_EQ(baking.encoder, 0);
 
   EXPECT_EQ(pipeline::memory_request_mb({.program = 32 * mib, .images = 200 * mib}), 320);  // 290 → 320
   EXPECT_EQ(pipeline::memory_request_mb({.program = 32 * mib}), 64);                        // 40 → 64

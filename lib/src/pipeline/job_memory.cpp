@@ -54,6 +54,12 @@ constexpr double kRaySeconds = 5e-8;                // an AO ray (20 M rays/s)
 constexpr double kKtx2SecondsPerTexel = 1e-6;       // basisu's chain, UASTC and ETC1S alike
 constexpr double kGeometrySecondsPerByte = 2e-9;    // a scene's buffers read, written
 
+// A scene's bake (bake/bake.cpp), per material of the low-poly: each map's floats, kept until they
+// are written; while a material is traced, its texel positions (ao/texels' SurfacePoint) and per
+// texel the sums of its hits (TexelSum), run index, hit flags and the fill's nearest-texel transform.
+constexpr double kBakeBytesPerPoint = 20;
+constexpr double kBakeBytesPerTexel = 200;
+
 constexpr double kHeadroom = 1.25;
 constexpr std::int64_t kMemoryStepMb = 64;
 
@@ -211,6 +217,31 @@ double ao_textures(const ao::TextureRequest& t, const std::optional<gltf::Json>&
   return textures;
 }
 
+// A scene's bake: one texture set per material of the low-poly, the maps' channels, and the maps
+// that become the material's own textures (normal, ao, transfer: decoded again by the export).
+struct BakeShape {
+  double targets = 0, texels = 0, channels = 0, slot_maps = 0, high_geometry = 0;
+  int tracers = 1;  // BVHs of the high-poly: the cage's, AO's, thickness's
+};
+
+BakeShape bake_shape(const SceneBake& b, const std::optional<gltf::Json>& low) {
+  BakeShape shape;
+  shape.targets = double(std::max<std::size_t>(1, low ? array_size(*low, "materials") : 1));
+  shape.texels = double(b.request.texture.width) * double(b.request.texture.height);
+  for (bake::Map m : b.request.bake.maps) {
+    shape.channels += bake::channels(m);
+    if (m == bake::Map::normal || m == bake::Map::ao || m == bake::Map::transfer) ++shape.slot_maps;
+    if (m == bake::Map::thickness) ++shape.tracers;
+  }
+  const auto& maps = b.request.bake.maps;
+  if (std::find(maps.begin(), maps.end(), bake::Map::ao) != maps.end() ||
+      std::find(maps.begin(), maps.end(), bake::Map::bent_normal) != maps.end()) {
+    ++shape.tracers;
+  }
+  if (auto high = gltf::read_json(b.high)) shape.high_geometry = geometry_bytes(*high);
+  return shape;
+}
+
 JobFootprint scene_footprint(const Job& job, const Manifest& manifest, int cpus) {
   const SceneSpec& s = manifest.scenes[job.spec];
   const SceneInputs in = scene_inputs(job, manifest);
@@ -222,11 +253,21 @@ JobFootprint scene_footprint(const Job& job, const Manifest& manifest, int cpus)
     const ao::TextureRequest& t = *s.options.ao->texture;
     f.ao = ao_textures(t, in.json) * double(t.size.width) * double(t.size.height) * kAoBytesPerTexel;
   }
+  double delivered_texels = in.delivered_texels, largest_texture = in.largest_texture;
+  if (s.bake) {
+    const BakeShape b = bake_shape(*s.bake, in.json);
+    f.geometry += b.high_geometry * b.tracers;
+    f.ao += b.texels * (b.targets * b.channels * kSampleBytes + s.bake->request.texture.texel_samples * kBakeBytesPerPoint +
+                        kBakeBytesPerTexel);
+    f.images += b.targets * b.slot_maps * b.texels * kOwnImageBytesPerTexel;  // the export reads them as its own
+    delivered_texels += b.targets * b.slot_maps * b.texels;
+    largest_texture = std::max(largest_texture, b.slot_maps > 0 ? b.texels : 0.0);
+  }
   if (s.options.delivery.texture_format == delivery::TextureFormat::ktx2) {
     // Every texture decoded, then encoded in parallel, one per core: the largest, that many at once.
     const double parent = kKtx2ParentBytesPerTexel + (s.options.delivery.measure_levels ? kMeasuredSourceBytesPerTexel : 0);
-    f.encoder = in.delivered_texels * kDecodedTextureBytesPerTexel +
-                double(std::max(1, cpus)) * in.largest_texture * (parent + kBasisuBytesPerTexel);
+    f.encoder = delivered_texels * kDecodedTextureBytesPerTexel +
+                double(std::max(1, cpus)) * largest_texture * (parent + kBasisuBytesPerTexel);
   }
   return f;
 }
@@ -258,8 +299,17 @@ JobWork scene_work(const Job& job, const Manifest& manifest) {
       w.ao = mesh_vertices(*in.json) * samples * kRaySeconds;
     }
   }
+  double delivered_texels = in.delivered_texels;
+  if (s.bake) {
+    // A ray per texel position; AO's (shared by the bent normal) and thickness's rays per texel.
+    const BakeShape b = bake_shape(*s.bake, in.json);
+    const double rays_per_texel = s.bake->request.texture.texel_samples +
+                                  (b.tracers - 1) * double(s.bake->request.occlusion.options.samples);
+    w.ao += b.targets * b.texels * rays_per_texel * kRaySeconds;
+    delivered_texels += b.targets * b.slot_maps * b.texels;
+  }
   const bool ktx2 = s.options.delivery.texture_format == delivery::TextureFormat::ktx2;
-  w.textures = in.delivered_texels * (ktx2 ? kKtx2SecondsPerTexel : 4 * kWriteSecondsPerSample);
+  w.textures = delivered_texels * (ktx2 ? kKtx2SecondsPerTexel : 4 * kWriteSecondsPerSample);
   w.write = geometry * kGeometrySecondsPerByte;
   return w;
 }
