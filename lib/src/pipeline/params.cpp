@@ -48,7 +48,7 @@ const params::Group<SceneBake>& bake_source_params() {
   static const params::Group<SceneBake> group{{
       params::text<SceneBake>(Spec{.name = "from",
                                    .help = "The high-poly glTF (.gltf or .glb) whose maps are baked onto the scene "
-                                           "(matbake bake --from) before it is exported; required in a bake table",
+                                           "before it is exported (as matbake bake's); required in a bake table",
                                    .example = "sculpts/hero_high.glb",
                                    .manifest_only = true},
                               [](auto& b) -> auto& { return b.from; }),
