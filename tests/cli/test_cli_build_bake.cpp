@@ -21,8 +21,8 @@ using nlohmann::json;
 
 // The example's scene baked onto itself (no ../shared needed): the cage finds the same surface, so
 // the normal map is flat and the height zero; what matters here is what is traced and written.
-std::string manifest_text(const std::string& output, const std::string& maps, int ao_samples) {
-  return "output = \"" + output + "\"\n[scenes.s]\ninput = \"showroom.gltf\"\noutput = \"s.glb\"\n"
+std::string manifest_text(const std::string& output, const std::string& maps, int ao_samples, const std::string& more = "") {
+  return "output = \"" + output + "\"\n[scenes.s]\ninput = \"showroom.gltf\"\noutput = \"s.glb\"\n" + more +
          "bake = { from = \"showroom.gltf\", maps = " + maps + ", size = 32, texel_samples = 2, ao = { samples = " +
          std::to_string(ao_samples) + " } }\n";
 }
@@ -33,8 +33,8 @@ struct Built {
 };
 
 Built build(const fs::path& dir, const std::string& output, const std::string& maps, int ao_samples,
-            const std::string& manifest = "m.toml") {
-  write_bytes(dir / manifest, manifest_text(output, maps, ao_samples));
+            const std::string& manifest = "m.toml", const std::string& more = "") {
+  write_bytes(dir / manifest, manifest_text(output, maps, ao_samples, more));
   const RunResult r = matbake({"--json", "build", (dir / manifest).string()});
   EXPECT_EQ(r.exit_code, 0) << r.err;
   const json report = json::parse(r.out, nullptr, false);
@@ -124,6 +124,19 @@ TEST(CliBuildBake, ASceneIsBakedThenExportedAndOnlyWhatAChangeDecidesIsTracedAga
   const Built dropped = build(dir.path(), "out", "[\"normal\", \"ao\"]", 8);
   EXPECT_EQ(reused(dropped), (std::vector<std::string>{"normal", "ao"}));
   EXPECT_EQ(dropped.files.size(), 1u) << "the height maps are stale";
+
+  // An export parameter alone: nothing is traced, every map is read back, and the report gives the
+  // cage and texel counts of the trace they were kept from (no rays cast this time).
+  const Built export_only = build(dir.path(), "out", "[\"normal\", \"ao\"]", 8, "m.toml", "png_compression = 1\n");
+  EXPECT_EQ(reused(export_only), (std::vector<std::string>{"normal", "ao"}));
+  const json& kept_report = export_only.job["details"]["bake"];
+  EXPECT_GT(first.job["details"]["bake"]["front"].get<double>(), 0);
+  EXPECT_EQ(kept_report["front"], first.job["details"]["bake"]["front"]);
+  EXPECT_EQ(kept_report["back"], first.job["details"]["bake"]["back"]);
+  for (const char* count : {"texels", "missed_texels", "padded"}) {
+    EXPECT_EQ(kept_report["textures"][2][count], first.job["details"]["bake"]["textures"][2][count]) << count;
+  }
+  EXPECT_EQ(kept_report["textures"][2]["rays"], 0);
 }
 
 TEST(CliBuildBake, BadBakesFailTheirJobNamingTheManifestsLine) {

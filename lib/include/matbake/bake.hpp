@@ -21,6 +21,7 @@
 #include <cstdint>
 #include <functional>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "matbake/ao.hpp"
@@ -78,6 +79,10 @@ struct Options {
 };
 
 Status check(const Options& options);
+
+// The cage's front and back distances in scene units (Options's fractions of the low-poly's
+// bounding-box diagonal, or as given with absolute_distances).
+std::pair<double, double> cage_distances(const scene::Scene& low, const Options& options);
 
 // A high-poly material's base colour as a runtime shades it: factor × texture × COLOR_0 (linear).
 struct BaseColor {

@@ -10,6 +10,7 @@
 #include <chrono>
 #include <cmath>
 #include <memory>
+#include <tuple>
 
 #include "../ao/texels.hpp"
 #include "../ao/tracer.hpp"
@@ -277,6 +278,12 @@ Status check(const Options& options) {
   return success();
 }
 
+std::pair<double, double> cage_distances(const scene::Scene& low, const Options& options) {
+  if (options.absolute_distances) return {options.front, options.back};
+  const double diagonal = 2.0 * double(low.radius());
+  return {options.front * diagonal, options.back * diagonal};
+}
+
 Result<Bake> bake(const scene::Scene& low, const scene::Scene& high, const std::vector<ao::TextureTarget>& targets,
                   const ao::TextureOptions& texture, const Options& options, const ao::Options& occlusion,
                   const std::vector<BaseColor>& base_colors) {
@@ -316,9 +323,7 @@ Result<Bake> bake(const scene::Scene& low, const scene::Scene& high, const std::
     depths = std::move(*made);
   }
   Bake result;
-  const double diagonal = 2.0 * double(low.radius());
-  result.front = options.absolute_distances ? options.front : options.front * diagonal;
-  result.back = options.absolute_distances ? options.back : options.back * diagonal;
+  std::tie(result.front, result.back) = cage_distances(low, options);
   result.setup_seconds = seconds_since(start);
 
   const auto trace_start = Clock::now();

@@ -3,6 +3,7 @@
 #include <chrono>
 #include <map>
 #include <set>
+#include <tuple>
 
 #include "../gltf/tangents.hpp"
 #include "../gltf/texture_files.hpp"
@@ -264,6 +265,7 @@ Result<Bake> bake_or_reuse(const scene::Scene& low, const Targets& targets, cons
     out = std::move(*traced);
   } else {
     out.textures = std::move(*counts);
+    std::tie(out.front, out.back) = cage_distances(low, options.request.bake);  // as the kept maps were traced
   }
   for (std::size_t t = 0; t < out.textures.size(); ++t) {
     TextureBake& texture_bake = out.textures[t];
