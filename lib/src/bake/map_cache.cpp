@@ -141,7 +141,8 @@ Status store_maps(const fs::path& folder, const std::vector<TextureBake>& baked,
   for (const auto& [map, key] : keys) {
     nlohmann::json files = nlohmann::json::array();
     for (std::size_t t = 0; t < baked.size(); ++t) {
-      const auto found = std::find_if(baked[t].maps.begin(), baked[t].maps.end(), [&](const MapImage& m) { return m.map == map; });
+      // The map by value: clang 14 (the fuzz build) refuses a lambda naming a structured binding.
+      const auto found = std::find_if(baked[t].maps.begin(), baked[t].maps.end(), [kept = map](const MapImage& m) { return m.map == kept; });
       if (found == baked[t].maps.end()) return Error{"", "internal: a kept map is not in the bake"};
       const std::string_view bytes(reinterpret_cast<const char*>(found->values.data()), found->values.size() * sizeof(float));
       if (Status s = write_file_atomically(map_file(folder, map, t), bytes); !s) return s;
