@@ -23,7 +23,12 @@ bash "$root/scripts/deps.sh"
 CXX=clang++-14 cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMATBAKE_FUZZ=ON \
   -DMATBAKE_BUILD_TESTS=OFF -DMATBAKE_BUILD_BENCH=OFF >/dev/null
 # The targets only (the command-line program is not fuzzed through its binary).
-cmake --build "$build" --target "${targets[@]/#/fuzz_}" >/dev/null
+# Quiet when it builds; the compiler's errors (the end of its output) when it does not.
+if ! build_log=$(cmake --build "$build" --target "${targets[@]/#/fuzz_}" 2>&1); then
+  printf '%s\n' "$build_log" | tail -n 60 >&2
+  echo "scripts/fuzz.sh: the fuzz build failed (above)" >&2
+  exit 1
+fi
 
 # Seeds: copies of the matching files, flat (libFuzzer reads every file of a folder it is given).
 seed() {  # target, then find arguments
