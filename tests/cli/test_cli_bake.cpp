@@ -202,25 +202,6 @@ TEST(CliBake, BadRequestsAreOneErrorLineAndWriteNothing) {
   EXPECT_TRUE(fs::is_empty(dir.path()));
 }
 
-// One dark grey rough dielectric primitive (its render is not clipped to white); UVs when given.
-void write_mesh(const fs::path& path, const std::vector<glm::dvec3>& positions, const std::vector<glm::dvec3>& normals,
-                const std::vector<glm::vec2>& texcoords, const std::vector<std::array<std::uint32_t, 3>>& triangles) {
-  GltfBuilder b;
-  std::vector<float> p, n, uv;
-  std::vector<std::uint32_t> indices;
-  for (const auto& v : positions) p.insert(p.end(), {float(v.x), float(v.y), float(v.z)});
-  for (const auto& v : normals) n.insert(n.end(), {float(v.x), float(v.y), float(v.z)});
-  for (const auto& v : texcoords) uv.insert(uv.end(), {v.x, v.y});
-  for (const auto& t : triangles) indices.insert(indices.end(), t.begin(), t.end());
-  const int mesh = b.add_mesh(b.add_vec3(p), b.add_indices(indices), 4, b.add_vec3(n));
-  auto& primitive = b.doc["meshes"][std::size_t(mesh)]["primitives"][0];
-  if (!uv.empty()) primitive["attributes"]["TEXCOORD_0"] = b.add_floats(uv, "VEC2", 2);
-  primitive["material"] = 0;
-  b.doc["materials"] = {{{"name", "grey"},
-                         {"pbrMetallicRoughness", {{"baseColorFactor", {0.2, 0.2, 0.2, 1}}, {"metallicFactor", 0}, {"roughnessFactor", 0.6}}}}};
-  b.write(path, {b.add_node({{"mesh", mesh}})});
-}
-
 // What a runtime shows: a smooth sphere of 5120 triangles baked onto a flat-shaded icosphere of 320,
 // rendered by three.js in Chromium beside the sphere itself. The baked normal map must bring the
 // icosphere's render closer to the sphere's than the bare icosphere is, in every view, and closer
@@ -229,9 +210,9 @@ void write_mesh(const fs::path& path, const std::vector<glm::dvec3>& positions, 
 TEST(CliBake, ABakedIcosphereRendersInThreeJsCloserToTheSphereThanItself) {
   TempDir dir;
   const Icosphere fine = icosphere(4);
-  write_mesh(dir / "high.gltf", fine.vertices, fine.vertices, {}, fine.triangles);
+  write_grey_mesh(dir / "high.gltf", fine.vertices, fine.vertices, {}, fine.triangles);
   const AtlasMesh low = icosphere_atlas(2, true);
-  write_mesh(dir / "low.gltf", low.positions, low.normals, low.texcoords, low.triangles);
+  write_grey_mesh(dir / "low.gltf", low.positions, low.normals, low.texcoords, low.triangles);
   for (const std::string green : {"opengl", "directx"}) {
     const auto r = matbake({"bake", (dir / "low.gltf").string(), "--from", (dir / "high.gltf").string(), "-o",
                             (dir / (green + ".glb")).string(), "--size", "512", "--front", "0.3", "--back", "0.3",

@@ -112,11 +112,14 @@ namespace {
 
 // A run of one instance's triangles: coverage is worked out per chunk in parallel and merged in
 // chunk order, so the result (and the order of points within a texel) is the serial one for any
-// number of threads.
+// number of threads. A chunk ends at kChunkTriangles or at kChunkCells texels of UV area, whichever
+// comes first: a low-poly of a few hundred triangles over a 2048² texture is many chunks, not one.
 constexpr std::size_t kChunkTriangles = 2048;
+constexpr double kChunkCells = 65536;
 struct Chunk {
   std::uint32_t instance;
   std::size_t first, last;
+  double cells;  // the triangles' UV area in texels (those within max_cells): what to reserve
 };
 
 struct Touch {
@@ -281,8 +284,16 @@ Result<Coverage> cover(const scene::Scene& scene, const TextureTarget& target, i
       ++out.instances_without_uv;
       continue;
     }
-    for (std::size_t first = 0; first < inst.triangles.size(); first += kChunkTriangles) {
-      chunks.push_back({std::uint32_t(k), first, std::min(first + kChunkTriangles, inst.triangles.size())});
+    std::size_t first = 0;
+    double cells = 0;
+    for (std::size_t t = 0; t < inst.triangles.size(); ++t) {
+      const UvTriangle uv = uv_triangle(inst, target.texcoord, t, width, height);
+      const double area = std::abs(cross(uv.b - uv.a, uv.c - uv.a)) / 2;
+      if (area <= raster.max_cells) cells += area;  // false for NaN
+      if (t + 1 - first == kChunkTriangles || cells >= kChunkCells || t + 1 == inst.triangles.size()) {
+        chunks.push_back({std::uint32_t(k), first, t + 1, cells});
+        first = t + 1, cells = 0;
+      }
     }
   }
   std::vector<ChunkCoverage> parts(chunks.size());
@@ -295,6 +306,7 @@ Result<Coverage> cover(const scene::Scene& scene, const TextureTarget& target, i
   // Centres inside a triangle (the tie rule takes each shared edge's once).
   each_chunk([&](const Chunk& chunk, ChunkCoverage& part) {
     std::size_t unbudgeted = 0;
+    part.points.reserve(std::size_t(std::min(chunk.cells, kChunkCells)) + 64);  // a chunk's centres ≈ its area
     raster.for_each_cell(chunk, Cells::inside, &part, [&](std::size_t t, const UvTriangle&, double i, double j) {
       part.points.push_back({raster.texel_at(i, j), chunk.instance, std::uint32_t(t), float(i), float(j)});
       if (++unbudgeted < kBudgetBatch) return true;
@@ -420,15 +432,17 @@ std::vector<std::int64_t> nearest_mapped(const std::vector<bool>& mapped, int wi
   return nearest;
 }
 
-std::size_t pad(std::vector<float>& values, const std::vector<bool>& mapped, int width, int height, int padding) {
+std::size_t pad_channels(std::vector<float>& values, int channels, const std::vector<bool>& mapped, int width,
+                         int height, int padding) {
   if (padding <= 0) return 0;
-  const std::size_t w = std::size_t(width), h = std::size_t(height);
+  const std::size_t w = std::size_t(width), h = std::size_t(height), c = std::size_t(channels);
   const std::vector<double> d2 = squared_distances(mapped, w, h, nullptr);
   const double limit = double(padding) * padding;
   const std::vector<float> source = values;
   std::atomic<std::size_t> padded{0};
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, h, 16), [&](const tbb::blocked_range<std::size_t>& rows) {
     std::size_t padded_here = 0;
+    std::vector<double> sum(c);
     for (std::size_t y = rows.begin(); y != rows.end(); ++y) {
       for (std::size_t x = 0; x < w; ++x) {
         const double d = d2[y * w + x];
@@ -436,7 +450,7 @@ std::size_t pad(std::vector<float>& values, const std::vector<bool>& mapped, int
         // Every mapped texel at exactly this squared distance: for each column offset, at most the two
         // rows with dx² + dy² = d.
         const auto r = long(std::floor(std::sqrt(d)));
-        double sum = 0;
+        std::fill(sum.begin(), sum.end(), 0.0);
         int count = 0;
         for (long dx = -r; dx <= r; ++dx) {
           const double rest = d - double(dx) * double(dx);
@@ -445,14 +459,15 @@ std::size_t pad(std::vector<float>& values, const std::vector<bool>& mapped, int
           for (long sy : {-dy, dy}) {
             const long xx = long(x) + dx, yy = long(y) + sy;
             if (xx >= 0 && yy >= 0 && xx < long(w) && yy < long(h) && mapped[std::size_t(yy) * w + std::size_t(xx)]) {
-              sum += source[std::size_t(yy) * w + std::size_t(xx)];
+              const std::size_t from = (std::size_t(yy) * w + std::size_t(xx)) * c;
+              for (std::size_t k = 0; k < c; ++k) sum[k] += source[from + k];
               ++count;
             }
             if (dy == 0) break;
           }
         }
         if (count) {
-          values[y * w + x] = float(sum / count);
+          for (std::size_t k = 0; k < c; ++k) values[(y * w + x) * c + k] = float(sum[k] / count);
           ++padded_here;
         }
       }

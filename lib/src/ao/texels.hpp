@@ -58,7 +58,12 @@ glm::dvec3 nearest_weights(const UvTriangle& t, const glm::dvec2& p);
 
 // Texels within `padding` of a mapped one take the value of the nearest mapped texel (Euclidean,
 // ties averaged); returns how many were padded. Texels farther away are left as they are.
-std::size_t pad(std::vector<float>& values, const std::vector<bool>& mapped, int width, int height, int padding);
+// `values` holds `channels` interleaved floats per texel (the distances are found once for all).
+std::size_t pad_channels(std::vector<float>& values, int channels, const std::vector<bool>& mapped, int width,
+                         int height, int padding);
+inline std::size_t pad(std::vector<float>& values, const std::vector<bool>& mapped, int width, int height, int padding) {
+  return pad_channels(values, 1, mapped, width, height, padding);
+}
 
 // Per texel (j × width + i) the index of one mapped texel nearest to it (Euclidean; of ties, the one
 // the transform meets first), −1 when none is mapped. Linear in the texels, however far.

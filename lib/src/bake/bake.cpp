@@ -78,6 +78,13 @@ struct TexelSum {
   int material = -1;  // of the first hit
 };
 
+// What the report keeps of a traced texel.
+struct TexelTally {
+  double height = 0;
+  std::uint64_t occlusion_rays = 0;  // and thickness rays
+  int hits = 0, rays = 0;
+};
+
 struct TraceContext {
   const scene::Scene& low;
   const std::vector<std::vector<CornerFrame>>& frames;  // per low instance (empty: not baked)
@@ -234,23 +241,15 @@ void background(MapImage& image) {
   }
 }
 
-// Missed texels take their nearest hit texel's value (however far); then the traced ones are padded.
-std::size_t fill_and_pad(MapImage& image, const std::vector<bool>& hit, const std::vector<bool>& traced, int width,
-                         int height, int padding) {
-  const std::size_t texels = std::size_t(width) * std::size_t(height), channels = std::size_t(image.channels);
-  const std::vector<std::int64_t> nearest_hit = ao::texels::nearest_mapped(hit, width, height);
-  for (std::size_t t = 0; t < texels; ++t) {
+// Texels all of whose rays missed take their nearest hit texel's value (however far); `nearest_hit`
+// is empty when none missed.
+void fill_missed(MapImage& image, const std::vector<std::int64_t>& nearest_hit, const std::vector<bool>& hit,
+                 const std::vector<bool>& traced) {
+  const std::size_t channels = std::size_t(image.channels);
+  for (std::size_t t = 0; t < nearest_hit.size(); ++t) {
     if (!traced[t] || hit[t] || nearest_hit[t] < 0) continue;
     for (std::size_t k = 0; k < channels; ++k) image.values[t * channels + k] = image.values[std::size_t(nearest_hit[t]) * channels + k];
   }
-  std::size_t padded = 0;
-  std::vector<float> channel(texels);
-  for (std::size_t k = 0; k < channels; ++k) {
-    for (std::size_t t = 0; t < texels; ++t) channel[t] = image.values[t * channels + k];
-    padded = ao::texels::pad(channel, traced, width, height, padding);
-    for (std::size_t t = 0; t < texels; ++t) image.values[t * channels + k] = channel[t];
-  }
-  return padded;
 }
 
 }  // namespace
@@ -365,38 +364,47 @@ Result<Bake> bake(const scene::Scene& low, const scene::Scene& high, const std::
                                occlusion.seed,
                                index,
                                asked(Map::transfer) ? &base_colors : nullptr};
-    std::vector<TexelSum> sums(runs.size() - 1);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, sums.size(), 64), [&](const tbb::blocked_range<std::size_t>& range) {
+    // A texel's sums live only while it is traced (a map's worth of doubles per texel, kept for
+    // all, cost more to clear than the one-ray trace itself); its counts are kept for the report.
+    std::vector<TexelTally> tallies(runs.size() - 1);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, tallies.size(), 64), [&](const tbb::blocked_range<std::size_t>& range) {
       for (std::size_t r = range.begin(); r != range.end(); ++r) {
+        TexelSum sum;
         for (std::size_t i = runs[r]; i < runs[r + 1]; ++i) {
           const std::uint64_t key =
               ao::sample_key(options.seed, index, points[i].texel) ^ (std::uint64_t(i - runs[r]) << 32);
-          trace_point(context, points[i], key, sums[r]);
+          trace_point(context, points[i], key, sum);
         }
-        if (sums[r].hits > 0) store(sums[r], options, points[runs[r]].texel, out);
+        if (sum.hits > 0) store(sum, options, points[runs[r]].texel, out);
+        tallies[r] = {sum.height, sum.occlusion_rays + sum.thickness_rays, sum.hits, sum.rays};
       }
     });
     std::vector<bool> hit(texel_count, false), traced(texel_count, false);
     bool first = true;
-    for (std::size_t r = 0; r < sums.size(); ++r) {
+    for (std::size_t r = 0; r < tallies.size(); ++r) {
       const std::size_t texel = points[runs[r]].texel;
       traced[texel] = true;
-      out.samples += std::size_t(sums[r].rays);
-      out.occlusion_rays += sums[r].occlusion_rays + sums[r].thickness_rays;
-      out.misses += std::size_t(sums[r].rays - sums[r].hits);
-      if (sums[r].hits == 0) {
+      out.samples += std::size_t(tallies[r].rays);
+      out.occlusion_rays += tallies[r].occlusion_rays;
+      out.misses += std::size_t(tallies[r].rays - tallies[r].hits);
+      if (tallies[r].hits == 0) {
         ++out.missed_texels;
         continue;
       }
       hit[texel] = true;
       out.hit[texel] = 1;
-      const double h = sums[r].height / sums[r].hits;
+      const double h = tallies[r].height / tallies[r].hits;
       out.height_min = first ? h : std::min(out.height_min, h);
       out.height_max = first ? h : std::max(out.height_max, h);
       first = false;
     }
+    // Only where a texel missed every ray: the nearest-hit transform is over the whole texture.
+    const std::vector<std::int64_t> nearest_hit =
+        out.missed_texels ? ao::texels::nearest_mapped(hit, texture.width, texture.height) : std::vector<std::int64_t>{};
     for (MapImage& image : out.maps) {
-      out.padded = fill_and_pad(image, hit, traced, texture.width, texture.height, ao::padding_for(texture));
+      fill_missed(image, nearest_hit, hit, traced);
+      out.padded = ao::texels::pad_channels(image.values, image.channels, traced, texture.width, texture.height,
+                                            ao::padding_for(texture));
     }
   }
   result.trace_seconds = seconds_since(trace_start);
