@@ -1,0 +1,85 @@
+# Blender's "selected to active" bake of one pair, for scripts/bench-bake-blender.sh:
+#   blender -b --factory-startup --python scripts/bench-bake-blender.py -- \
+#     LOW.gltf HIGH.gltf OUT.exr normal|ao SIZE SAMPLES EXTRUSION MAX_RAY_DISTANCE AO_DISTANCE THREADS
+# Cycles on the CPU; the cage is the low-poly extruded by EXTRUSION along its normals, rays reach
+# MAX_RAY_DISTANCE inward (scene units). The low-poly is invisible to every ray (it is the surface
+# being replaced: it must not occlude the high-poly's AO). Prints one line `seconds=T`: the time of
+# the bake call alone (not Blender's start, the imports or the image write).
+import sys
+import time
+
+import bpy
+import numpy
+
+# Debian's Blender 3.4 glTF importer calls numpy.bool, an alias NumPy 1.24 (Debian's) removed: the
+# importer fails on any mesh with normals. The alias was the builtin bool; give it back.
+if not hasattr(numpy, "bool"):
+    numpy.bool = bool
+
+args = sys.argv[sys.argv.index("--") + 1:]
+low_path, high_path, out_path, kind = args[0], args[1], args[2], args[3]
+size, samples = int(args[4]), int(args[5])
+extrusion, max_ray, ao_distance, threads = float(args[6]), float(args[7]), float(args[8]), int(args[9])
+
+bpy.ops.wm.read_factory_settings(use_empty=True)
+
+
+def import_mesh(path):
+    """The file's mesh objects joined into one; returns it."""
+    bpy.ops.object.select_all(action="DESELECT")
+    bpy.ops.import_scene.gltf(filepath=path)
+    meshes = [o for o in bpy.context.selected_objects if o.type == "MESH"]
+    bpy.ops.object.select_all(action="DESELECT")
+    for o in meshes:
+        o.select_set(True)
+    bpy.context.view_layer.objects.active = meshes[0]
+    if len(meshes) > 1:
+        bpy.ops.object.join()
+    return bpy.context.view_layer.objects.active
+
+
+high = import_mesh(high_path)
+low = import_mesh(low_path)
+for attribute in ("visible_camera", "visible_diffuse", "visible_glossy", "visible_transmission",
+                  "visible_volume_scatter", "visible_shadow"):
+    setattr(low, attribute, False)
+
+image = bpy.data.images.new("bake", size, size, float_buffer=True, alpha=False)
+image.colorspace_settings.name = "Non-Color"
+for slot in low.material_slots:
+    nodes = slot.material.node_tree.nodes
+    node = nodes.new("ShaderNodeTexImage")
+    node.image = image
+    nodes.active = node
+
+scene = bpy.context.scene
+scene.render.engine = "CYCLES"
+scene.cycles.device = "CPU"
+scene.cycles.samples = samples
+scene.cycles.use_adaptive_sampling = False  # SAMPLES rays a texel, as asked (adaptive stops early)
+scene.cycles.use_denoising = False
+scene.render.threads_mode = "FIXED"
+scene.render.threads = threads
+scene.world = bpy.data.worlds.new("world")
+scene.world.light_settings.distance = ao_distance
+bake = scene.render.bake
+bake.use_selected_to_active = True
+bake.use_cage = False
+bake.cage_extrusion = extrusion
+bake.max_ray_distance = max_ray
+bake.margin = 0
+bake.normal_space = "TANGENT"
+bake.normal_r, bake.normal_g, bake.normal_b = "POS_X", "POS_Y", "POS_Z"
+
+bpy.ops.object.select_all(action="DESELECT")
+high.select_set(True)
+low.select_set(True)
+bpy.context.view_layer.objects.active = low
+started = time.perf_counter()
+bpy.ops.object.bake(type={"normal": "NORMAL", "ao": "AO"}[kind])
+seconds = time.perf_counter() - started
+
+image.filepath_raw = out_path
+image.file_format = "OPEN_EXR"
+image.save()
+print(f"seconds={seconds:.4f}")

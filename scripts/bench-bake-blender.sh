@@ -1,0 +1,107 @@
+#!/usr/bin/env bash
+# The baker against Blender's (docs/bake.md): on three pairs with known geometry (bench/bake_pairs.cpp:
+# sphere, bump, sculpt), the tangent-space normal map and binary AO baked by `matbake bake` and by
+# Blender's Cycles "selected to active" (scripts/bench-bake-blender.py) with the same cage, the same
+# AO distance, 2 threads each, at equal samples; each compared with a high-sample reference
+# (bake_pairs error: the texels the low-poly's UVs cover, 8 bits). matbake's time is its whole run
+# (load, trace, PNG, glTF written); Blender's the bake call alone (not its start, imports or write).
+# Markdown on stdout. Usage: scripts/bench-bake-blender.sh   (about 10 minutes on 2 cores)
+# BENCH_BAKE_WORK=DIR keeps the pairs and every image there.
+set -euo pipefail
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+bash "$root/scripts/apt-install.sh" "the bake bench needs Blender" blender:blender python3-numpy
+bash "$root/scripts/build.sh" "$root/build" >/dev/null
+matbake=$root/build/cli/matbake
+pairs_tool=$root/build/bench/bake_pairs
+work=${BENCH_BAKE_WORK:-}
+if [ -z "$work" ]; then
+  work=$(mktemp -d)
+  trap 'rm -rf "$work"' EXIT
+fi
+mkdir -p "$work"
+"$pairs_tool" write "$work"
+threads=2
+ao_distance=0.5
+
+now() { date +%s.%N; }
+elapsed() { echo "$1 $(now)" | awk '{printf "%.2f", $2 - $1}'; }
+
+# matbake_bake PAIR FRONT BACK MAP SIZE NAME FLAGS...: bakes into $work/NAME/, leaves the map's PNG
+# at $work/NAME.png, the whole run's time in $run_seconds and the bake's (set-up and trace, from
+# --json: what Blender's bake call spans) in $seconds.
+matbake_bake() {
+  local pair=$1 front=$2 back=$3 map=$4 size=$5 name=$6
+  shift 6
+  rm -rf "${work:?}/$name" && mkdir -p "$work/$name"
+  local start
+  start=$(now)
+  "$matbake" --json bake "$work/${pair}_low.gltf" --from "$work/${pair}_high.gltf" -o "$work/$name/out.gltf" --maps "$map" \
+    --size "$size" --front "$front" --back "$back" --absolute-cage --padding 0 --jobs "$threads" "$@" >"$work/$name.json"
+  run_seconds=$(elapsed "$start")
+  seconds=$(python3 -c 'import json, sys; r = json.load(open(sys.argv[1])); print("%.2f" % (r["setup_seconds"] + r["trace_seconds"]))' "$work/$name.json")
+  cp "$work/$name"/*_"$map".png "$work/$name.png"
+}
+
+# blender_bake PAIR FRONT BACK MAP SIZE SAMPLES NAME: bakes $work/NAME.exr, its bake call's time in $seconds.
+blender_bake() {
+  local pair=$1 front=$2 back=$3 map=$4 size=$5 samples=$6 name=$7
+  local log
+  log=$(timeout 3600 blender -b --factory-startup --python "$root/scripts/bench-bake-blender.py" -- \
+    "$work/${pair}_low.gltf" "$work/${pair}_high.gltf" "$work/$name.exr" "$map" "$size" "$samples" "$front" \
+    "$(echo "$front $back" | awk '{print $1 + $2}')" "$ao_distance" "$threads" 2>&1)
+  seconds=$(printf '%s\n' "$log" | sed -n 's/^seconds=//p')
+  [ -n "$seconds" ] || { printf '%s\n' "$log" | tail -20 >&2; echo "bench-bake-blender: Blender's bake failed" >&2; exit 1; }
+  seconds=$(printf '%.2f' "$seconds")
+}
+
+# error KIND PAIR REFERENCE IMAGE: IMAGE's two error figures against REFERENCE, space-separated.
+error() {
+  "$pairs_tool" error "$1" "$work/${2}_low.gltf" "$work/$3" "$work/$4" | sed -E 's/^[^ ]+ texels=[0-9]+ //; s/[a-z0-9_]+=//g'
+}
+ratio() { echo "$1 $2" | awk '{printf "%.1f×", $1 / ($2 > 0 ? $2 : 0.005)}'; }
+
+blender_version=$(blender -b --factory-startup --python-expr 'import bpy; print("version=" + bpy.app.version_string)' 2>/dev/null |
+  sed -n 's/^version=//p')
+echo "matbake $("$matbake" --version | head -1 | awk '{print $NF}') against Blender $blender_version (Cycles, CPU), $threads threads each, $(nproc) cores."
+echo "Time: matbake's bake (set-up and trace; in brackets its whole run: reading, tangents, PNG and glTF"
+echo "written) and Blender's bake call (its start, imports and image write left out)."
+echo
+# pair, cage front and back (scene units).
+pairs=("sphere 0.3 0.3" "bump 0.6 0.05" "sculpt 0.15 0.15" "rivets 0.05 0.02")
+
+echo "### Tangent-space normal map, 1024², against matbake at 64 positions a texel"
+echo
+echo "| pair | rays a texel | matbake (s) | Blender (s) | faster | matbake error: mean, 99th pct (°) | Blender error (°) |"
+echo "|---|---|---|---|---|---|---|"
+for p in "${pairs[@]}"; do
+  read -r pair front back <<<"$p"
+  matbake_bake "$pair" "$front" "$back" normal 1024 "${pair}_normal_ref" --texel-samples 64
+  matbake_bake "$pair" "$front" "$back" normal 1024 "${pair}_normal_m1" --texel-samples 1
+  m_seconds=$seconds m_run=$run_seconds
+  read -r m_mean m_p99 <<<"$(error normal "$pair" "${pair}_normal_ref.png" "${pair}_normal_m1.png")"
+  blender_bake "$pair" "$front" "$back" normal 1024 1 "${pair}_normal_blender"
+  read -r b_mean b_p99 <<<"$(error normal "$pair" "${pair}_normal_ref.png" "${pair}_normal_blender.exr")"
+  echo "| $pair | 1 | $m_seconds ($m_run) | $seconds | $(ratio "$seconds" "$m_seconds") | $m_mean, $m_p99 | $b_mean, $b_p99 |"
+  matbake_bake "$pair" "$front" "$back" normal 1024 "${pair}_normal_m4" --texel-samples 4
+  read -r m_mean m_p99 <<<"$(error normal "$pair" "${pair}_normal_ref.png" "${pair}_normal_m4.png")"
+  echo "| $pair | 4 | $seconds ($run_seconds) | — | | $m_mean, $m_p99 | (no anti-aliasing) |"
+done
+echo
+
+echo "### Binary AO (distance $ao_distance), 256², against matbake at 16 positions × 4096 rays a texel"
+echo
+echo "| pair | rays a texel | matbake (s) | Blender (s) | faster | matbake error: RMSE, largest | Blender error |"
+echo "|---|---|---|---|---|---|---|"
+for p in "${pairs[@]}"; do
+  read -r pair front back <<<"$p"
+  ao_flags=(--ao-falloff none --ao-max-distance "$ao_distance")
+  matbake_bake "$pair" "$front" "$back" ao 256 "${pair}_ao_ref" --texel-samples 16 --ao-samples 4096 "${ao_flags[@]}"
+  for s in 16 64 256 1024; do
+    matbake_bake "$pair" "$front" "$back" ao 256 "${pair}_ao_m$s" --texel-samples 1 --ao-samples "$s" "${ao_flags[@]}"
+    m_seconds=$seconds m_run=$run_seconds
+    read -r m_rmse m_largest <<<"$(error scalar "$pair" "${pair}_ao_ref.png" "${pair}_ao_m$s.png")"
+    blender_bake "$pair" "$front" "$back" ao 256 "$s" "${pair}_ao_blender$s"
+    read -r b_rmse b_largest <<<"$(error scalar "$pair" "${pair}_ao_ref.png" "${pair}_ao_blender$s.exr")"
+    echo "| $pair | $s | $m_seconds ($m_run) | $seconds | $(ratio "$seconds" "$m_seconds") | $m_rmse, $m_largest | $b_rmse, $b_largest |"
+  done
+done
