@@ -18,6 +18,9 @@ CLI::App* setup_bake(CLI::App& app, BakeSettings& s) {
       "occlusionTexture; the other maps are written as float EXR files beside the output.");
   cmd->add_option("low", s.low, "The low-poly .gltf or .glb (its UVs take the maps)")->required();
   cmd->add_option("--from", s.high, "The high-poly .gltf or .glb")->required();
+  cmd->add_option("--cage", s.cage,
+                  "A cage mesh (.gltf or .glb): the low-poly with its vertices moved out; rays start on it and head "
+                  "for the low-poly (--front only where it touches the low-poly)");
   cmd->add_option("-o,--output", s.output, "Output .gltf (+ .bin beside it) or .glb")->required();
   add_tree(*cmd, bake::request_tree(), s.options, s.given, {"Options", "Options", "AO and bent normal (rays from the high-poly's hit)"});
   return cmd;
@@ -26,12 +29,14 @@ CLI::App* setup_bake(CLI::App& app, BakeSettings& s) {
 int run_bake(const BakeSettings& s, const GlobalOptions& global) {
   bake::FileOptions options = s.options;
   options.high = s.high;
+  options.cage = s.cage;
   options.output = s.output;
   if (Status st = finish_tree(bake::request_tree(), options, s.given); !st) return report_error(st.error());
   auto report = bake::bake_file(s.low, options);
   if (!report) return report_error(report.error());
   if (global.json) {
     nlohmann::json out = {{"command", "bake"}, {"low", s.low}, {"high", s.high}, {"output", s.output}};
+    if (!s.cage.empty()) out["cage"] = s.cage;
     out.update(to_json(*report));
     std::cout << out.dump(2) << "\n";
   } else if (!global.quiet) {

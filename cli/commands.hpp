@@ -127,8 +127,9 @@ int run_bake_ao(const BakeAoSettings& settings, const GlobalOptions& global);
 struct BakeSettings {
   std::string low;
   std::string high;
+  std::string cage;           // empty: extrusion
   std::string output;
-  bake::FileOptions options;  // its tree (bake::request_tree); high and output set at run
+  bake::FileOptions options;  // its tree (bake::request_tree); high, cage and output set at run
   std::vector<std::set<std::string>> given;
 };
 CLI::App* setup_bake(CLI::App& app, BakeSettings& settings);

@@ -198,6 +198,15 @@ TEST(CliBake, BadRequestsAreOneErrorLineAndWriteNothing) {
   r = matbake({"bake", scene.string(), "--from", scene.string(), "-o", scene.string()});
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.err.find("showroom.gltf"), std::string::npos) << r.err;
+  // A cage that is not the low-poly with its vertices moved; one that is the output.
+  TempDir other;
+  write_grey_mesh(other / "quad.gltf", {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {}, {}, {{0, 1, 2}});
+  r = bake_args({"--cage", (other / "quad.gltf").string()});
+  EXPECT_EQ(r.exit_code, 1);
+  expect_one_error_line(r, (other / "quad.gltf").string(), "cannot be the low-poly's cage: it places 1 primitives where the low-poly places");
+  r = bake_args({"--cage", out});
+  EXPECT_EQ(r.exit_code, 2);  // the output named as an input: a usage error, as -o naming the low-poly
+  EXPECT_NE(r.err.find(out), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(out));
   EXPECT_TRUE(fs::is_empty(dir.path()));
 }

@@ -139,6 +139,26 @@ TEST(CliBuildBake, ASceneIsBakedThenExportedAndOnlyWhatAChangeDecidesIsTracedAga
   EXPECT_EQ(kept_report["textures"][2]["rays"], 0);
 }
 
+// A cage mesh is an input of the scene's job: a change to it rebuilds the scene and traces every map.
+TEST(CliBuildBake, ACageMeshIsAnInputOfTheBake) {
+  TempDir dir;
+  for (const char* f : {"showroom.gltf", "showroom.bin"}) fs::copy_file(kExamples / f, dir / f);
+  fs::copy_file(kExamples / "showroom.gltf", dir / "cage.gltf");  // the low-poly itself: rays along its normals
+  const std::string maps = "[\"normal\"], cage = \"cage.gltf\"";
+  const Built first = build(dir.path(), "out", maps, 4);
+  EXPECT_EQ(first.job["outcome"], "built");
+  // The cage touches the low-poly everywhere: the extrusion's rays, as without it.
+  const Built plain = build(dir.path(), "plain", "[\"normal\"]", 4, "plain.toml");
+  EXPECT_EQ(first.job["details"]["bake"]["front"], plain.job["details"]["bake"]["front"]);
+  EXPECT_TRUE(differing(first, plain).empty());
+  EXPECT_EQ(first.job["details"]["bake"]["textures"][0]["misses"], 0);
+  write_bytes(dir / "cage.gltf", read_bytes(dir / "cage.gltf") + " ");
+  const Built changed = build(dir.path(), "out", maps, 4);
+  EXPECT_NE(changed.job["reason"].get<std::string>().find("cage.gltf"), std::string::npos) << changed.job.dump();
+  EXPECT_TRUE(reused(changed).empty());
+  EXPECT_TRUE(differing(changed, first).empty());
+}
+
 TEST(CliBuildBake, BadBakesFailTheirJobNamingTheManifestsLine) {
   TempDir dir;
   for (const char* f : {"showroom.gltf", "showroom.bin"}) fs::copy_file(kExamples / f, dir / f);
@@ -149,6 +169,15 @@ TEST(CliBuildBake, BadBakesFailTheirJobNamingTheManifestsLine) {
   EXPECT_NE(r.err.find((dir / "m.toml").string() + ":4:"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("scenes.s.bake.from"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("nope.glb"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "out/s.glb"));
+
+  // No such cage mesh: the same, naming its key.
+  write_bytes(dir / "m.toml", "output = \"out\"\n[scenes.s]\ninput = \"showroom.gltf\"\n"
+                              "bake = { from = \"showroom.gltf\", cage = \"cage.glb\" }\n");
+  r = matbake({"build", (dir / "m.toml").string()});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find((dir / "m.toml").string() + ":4:"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("scenes.s.bake.cage"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir / "out/s.glb"));
 
   // A manifest material given to a baked material would replace the baked AO: refused, naming both.

@@ -380,6 +380,42 @@ TEST(Bake, ASlabsThicknessIsItsDepthForEveryRay) {
   }
 }
 
+// A cage mesh: the plane's quad moved by (0.25, 0, 0.5) onto a high-poly plane 0.1 below it. Each
+// ray runs from the cage point towards the low-poly point L and on, so it meets z = −0.1 at
+// L + (−0.05, 0, −0.1) (the extrusion's ray, along −z, would meet it at L − (0, 0, 0.1)), and the
+// height is −|(−0.05, 0, −0.1)|: inside, along the ray. Tolerance: float32 at magnitude 1.
+TEST(Bake, ACageMeshCastsFromItsPointTowardsTheLowPolysPoint) {
+  const BumpPair pair = bump_pair(1, 0.5);
+  scene::Scene cage = pair.low;
+  for (auto& p : cage.instances[0].positions) p += glm::vec3(0.25f, 0.0f, 0.5f);
+  const scene::Instance below = placed({{-3, -3, -0.1}, {3, -3, -0.1}, {3, 3, -0.1}, {-3, 3, -0.1}}, {},
+                                       {{0, 1, 2}, {0, 2, 3}}, glm::dmat4(1));
+  Options options;
+  options.maps = {Map::height, Map::position};
+  options.front = 0.01, options.back = 0.5, options.absolute_distances = true;  // front: where the cage touches
+  const ao::TextureOptions texture{.width = 16, .height = 16, .padding = 0, .texel_samples = 1};
+  auto baked = bake(pair.low, scene_of({below}), {ao::TextureTarget{{0}, 0}}, texture, options, {}, {}, &cage);
+  ASSERT_TRUE(baked) << baked.error().message;
+  EXPECT_NEAR(baked->front, std::sqrt(0.25 * 0.25 + 0.5 * 0.5), 1e-6);  // the farthest cage vertex
+  const TextureBake& t = baked->textures.at(0);
+  EXPECT_EQ(t.misses, 0u);
+  for (int j = 0; j < 16; ++j) {
+    for (int i = 0; i < 16; ++i) {
+      const std::size_t texel = std::size_t(j * 16 + i);
+      const dvec3 low(2 * (i + 0.5) / 16 - 1, 1 - 2 * (j + 0.5) / 16, 0);
+      ASSERT_NEAR(glm::length(texel3(map_of(t, Map::position), texel) - (low + dvec3(-0.05, 0, -0.1))), 0, 1e-6) << i << "," << j;
+      ASSERT_NEAR(map_of(t, Map::height).values[texel], -std::sqrt(0.05 * 0.05 + 0.1 * 0.1), 1e-6) << i << "," << j;
+    }
+  }
+  // Not the low-poly's topology: refused, saying why.
+  scene::Scene other = cage;
+  other.instances[0].triangles.pop_back();
+  EXPECT_NE(cage_mismatch(pair.low, other).find("other vertices or triangles"), std::string::npos);
+  auto refused = bake(pair.low, scene_of({below}), {ao::TextureTarget{{0}, 0}}, texture, options, {}, {}, &other);
+  ASSERT_FALSE(refused);
+  EXPECT_NE(refused.error().message.find("the cage"), std::string::npos) << refused.error().message;
+}
+
 // Colour transfer: the plane onto itself, the high-poly's copy with UVs turned (u = (y + 1)/2,
 // v = (x + 1)/2), COLOR_0 affine over it (blue = (x + 1)/2, exact under interpolation), factor
 // (0.5, 1, 1, 0.8) and a 4 × 4 texture ramping red along u and green along v with clamp: sampled

@@ -81,8 +81,13 @@ struct Options {
 Status check(const Options& options);
 
 // The cage's front and back distances in scene units (Options's fractions of the low-poly's
-// bounding-box diagonal, or as given with absolute_distances).
-std::pair<double, double> cage_distances(const scene::Scene& low, const Options& options);
+// bounding-box diagonal, or as given with absolute_distances). With a cage mesh, front is the
+// farthest any low-poly vertex lies from its cage vertex (the extrusion's where it touches them all).
+std::pair<double, double> cage_distances(const scene::Scene& low, const Options& options, const scene::Scene* cage = nullptr);
+
+// Why `cage` cannot be the cage of `low` (empty when it can): it must place the low-poly's
+// primitives in the same order with the same vertex count and triangles (its positions moved).
+std::string cage_mismatch(const scene::Scene& low, const scene::Scene& cage);
 
 // A high-poly material's base colour as a runtime shades it: factor × texture × COLOR_0 (linear).
 struct BaseColor {
@@ -125,8 +130,11 @@ struct Bake {
 // Errors: options out of range, a target without its UV set's data, Embree failing.
 // `base_colors` (the transfer map's) holds one per high-poly material index; an instance without a
 // material, or beyond them, is white. The high-poly then needs its texcoords loaded.
+// With a `cage` mesh (cage_mismatch empty), each ray starts at the cage's point with the low-poly
+// point's barycentric weights and heads for the low-poly point, reaching `back` beyond it; where
+// the two coincide, the ray is the extrusion's (Options::front along the low-poly's normal).
 Result<Bake> bake(const scene::Scene& low, const scene::Scene& high, const std::vector<ao::TextureTarget>& targets,
                   const ao::TextureOptions& texture, const Options& options, const ao::Options& occlusion = {},
-                  const std::vector<BaseColor>& base_colors = {});
+                  const std::vector<BaseColor>& base_colors = {}, const scene::Scene* cage = nullptr);
 
 }  // namespace matbake::bake

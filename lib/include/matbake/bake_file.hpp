@@ -21,6 +21,7 @@ struct Request {
 
 struct FileOptions {
   std::filesystem::path high;    // .gltf or .glb: the surface the maps come from
+  std::filesystem::path cage;    // .gltf or .glb: the low-poly with its vertices moved out (empty: extrusion)
   std::filesystem::path output;  // .gltf or .glb
   Request request;
   image::Encoding encoding;      // of the normal map's PNG

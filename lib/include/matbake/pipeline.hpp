@@ -77,6 +77,8 @@ struct MaterialSpec {
 struct SceneBake {
   std::string from;             // as written, relative to the manifest's folder
   std::filesystem::path high;   // resolved
+  std::string cage_file;        // the cage mesh as written (empty: extrusion)
+  std::filesystem::path cage;   // resolved
   bake::Request request;
 };
 

@@ -92,6 +92,7 @@ struct TraceContext {
   const ao::TextureTarget& target;
   const ao::TextureOptions& texture;
   float front, back;
+  const scene::Scene* cage;      // the cage mesh (null: extrusion by front)
   bool curvature;                // asked for
   const ao::Tracer* occlusion;   // the high-poly, for ao and bent_normal (null: neither asked)
   bool bent;                     // bent_normal asked for
@@ -148,11 +149,37 @@ void trace_from_hit(const TraceContext& c, const Hit& hit, const LowPoint& low, 
   }
 }
 
-// The cage ray at a low-poly point: from `front` outside along its normal to `back` inside.
-std::optional<Hit> cast(const TraceContext& c, const LowPoint& low) {
+// A cage ray's first hit, and how far before the low-poly point it lies (the height: positive outside).
+struct CageHit {
+  Hit hit;
+  double height;
+};
+
+// The cage ray at a low-poly point (triangle `triangle` of low instance `instance`, weights `w`):
+// from the cage mesh's point with the same weights towards it, else (no cage mesh, or it touches the
+// low-poly there) from the extrusion's `front` outside along its normal; either reaching `back`
+// beyond it.
+std::optional<CageHit> cast(const TraceContext& c, const LowPoint& low, std::size_t instance, std::size_t triangle,
+                            const glm::dvec3& w) {
+  const float front = c.front;
+  if (c.cage) {
+    const auto& corners = c.low.instances[instance].triangles[triangle];
+    const auto& cage = c.cage->instances[instance].positions;
+    const glm::dvec3 from = w.x * glm::dvec3(cage[corners[0]]) + w.y * glm::dvec3(cage[corners[1]]) + w.z * glm::dvec3(cage[corners[2]]);
+    const glm::dvec3 to_low = glm::dvec3(low.position) - from;
+    const double distance = glm::length(to_low);
+    // Below float32's resolution at the point the direction is noise: the cage touches the low-poly.
+    if (distance > 1e-6 * (1 + glm::length(glm::dvec3(low.position)))) {
+      auto hit = c.high.first_hit(glm::vec3(from), glm::vec3(to_low / distance), float(distance) + c.back);
+      if (!hit) return std::nullopt;
+      return CageHit{*hit, distance - double(hit->distance)};
+    }
+  }
   const glm::vec3 n(low.basis[2]);
   if (!(glm::length(n) > 0)) return std::nullopt;
-  return c.high.first_hit(low.position + c.front * n, -n, c.front + c.back);
+  auto hit = c.high.first_hit(low.position + front * n, -n, front + c.back);
+  if (!hit) return std::nullopt;
+  return CageHit{*hit, double(front) - double(hit->distance)};
 }
 
 // The texel positions of one surface point (K = texel_samples, stratified over the footprint by the
@@ -177,17 +204,18 @@ void trace_point(const TraceContext& c, const ao::texels::SurfacePoint& point, s
     const glm::dvec3 w = ao::texels::nearest_weights(uv, at);
     LowPoint low = low_point(inst, c.frames[point.instance], point.triangle, w);
     ++sum.rays;
-    auto hit = cast(c, low);
-    if (!hit && on_edge(w)) {
+    auto cage_hit = cast(c, low, point.instance, point.triangle, w);
+    if (!cage_hit && on_edge(w)) {
       low = low_point(inst, c.frames[point.instance], point.triangle, inside(w));
-      hit = cast(c, low);
+      cage_hit = cast(c, low, point.instance, point.triangle, inside(w));
     }
-    if (!hit) continue;
+    if (!cage_hit) continue;
+    const Hit* hit = &cage_hit->hit;
     if (sum.hits == 0) sum.material = c.high.instance(*hit).material;
     ++sum.hits;
     sum.normal += tangent_space(low.basis, glm::dvec3(hit->normal));
     sum.position += glm::dvec3(hit->position);
-    sum.height += double(c.front) - double(hit->distance);
+    sum.height += cage_hit->height;
     if (c.curvature) sum.curvature += c.high.mean_curvature(*hit);
     if (c.base_colors) sum.color += base_color(*c.base_colors, c.high.instance(*hit), *hit);
     if (c.occlusion || c.thickness) trace_from_hit(c, *hit, low, texel_size, j, point.texel, sum);
@@ -277,16 +305,41 @@ Status check(const Options& options) {
   return success();
 }
 
-std::pair<double, double> cage_distances(const scene::Scene& low, const Options& options) {
-  if (options.absolute_distances) return {options.front, options.back};
-  const double diagonal = 2.0 * double(low.radius());
-  return {options.front * diagonal, options.back * diagonal};
+std::pair<double, double> cage_distances(const scene::Scene& low, const Options& options, const scene::Scene* cage) {
+  const double scale = options.absolute_distances ? 1.0 : 2.0 * double(low.radius());
+  if (!cage) return {options.front * scale, options.back * scale};
+  double farthest = 0;  // where the cage touches the low-poly everywhere, the extrusion's front
+  for (std::size_t k = 0; k < low.instances.size() && k < cage->instances.size(); ++k) {
+    const auto& from = cage->instances[k].positions;
+    const auto& to = low.instances[k].positions;
+    for (std::size_t v = 0; v < to.size() && v < from.size(); ++v) farthest = std::max(farthest, double(glm::distance(from[v], to[v])));
+  }
+  return {farthest > 0 ? farthest : options.front * scale, options.back * scale};
+}
+
+std::string cage_mismatch(const scene::Scene& low, const scene::Scene& cage) {
+  if (cage.instances.size() != low.instances.size()) {
+    return "places " + std::to_string(cage.instances.size()) + " primitives where the low-poly places " +
+           std::to_string(low.instances.size()) + ": a cage is the low-poly with its vertices moved";
+  }
+  for (std::size_t k = 0; k < low.instances.size(); ++k) {
+    const scene::Instance &a = low.instances[k], &b = cage.instances[k];
+    if (a.positions.size() != b.positions.size() || a.triangles != b.triangles) {
+      return "primitive " + std::to_string(k) + " (mesh " + std::to_string(b.mesh) + ", primitive " +
+             std::to_string(b.primitive) + ") has other vertices or triangles than the low-poly's: a cage is the "
+             "low-poly with its vertices moved";
+    }
+  }
+  return "";
 }
 
 Result<Bake> bake(const scene::Scene& low, const scene::Scene& high, const std::vector<ao::TextureTarget>& targets,
                   const ao::TextureOptions& texture, const Options& options, const ao::Options& occlusion,
-                  const std::vector<BaseColor>& base_colors) {
+                  const std::vector<BaseColor>& base_colors, const scene::Scene* cage) {
   if (Status s = check(options); !s) return s.error();
+  if (cage) {
+    if (const std::string why = cage_mismatch(low, *cage); !why.empty()) return Error{"", "the cage " + why, true};
+  }
   if (Status s = ao::check(texture, kMaxTexelSamples, "bake"); !s) return s.error();
   const auto asked = [&](Map map) { return std::ranges::find(options.maps, map) != options.maps.end(); };
   const bool occluding = asked(Map::ao) || asked(Map::bent_normal);
@@ -322,7 +375,7 @@ Result<Bake> bake(const scene::Scene& low, const scene::Scene& high, const std::
     depths = std::move(*made);
   }
   Bake result;
-  std::tie(result.front, result.back) = cage_distances(low, options);
+  std::tie(result.front, result.back) = cage_distances(low, options, cage);
   result.setup_seconds = seconds_since(start);
 
   const auto trace_start = Clock::now();
@@ -354,8 +407,9 @@ Result<Bake> bake(const scene::Scene& low, const scene::Scene& high, const std::
                                **built,
                                target,
                                texture,
-                               float(result.front),
+                               float(cage_distances(low, options).first),  // the extrusion's, where a cage touches
                                float(result.back),
+                               cage,
                                asked(Map::curvature),
                                occluder.get(),
                                asked(Map::bent_normal),

@@ -224,9 +224,17 @@ Result<Bake> trace_maps(const scene::Scene& low, const Targets& targets, const F
     if (!read) return read.error();
     colors = std::move(*read);
   }
+  std::optional<scene::Scene> cage;
+  if (!options.cage.empty()) {
+    auto loaded = scene::load_scene(options.cage);
+    if (!loaded) return loaded.error();
+    if (const std::string why = cage_mismatch(low, *loaded); !why.empty()) return Error{options.cage.string(), "cannot be the low-poly's cage: it " + why};
+    cage = std::move(*loaded);
+  }
   Options asked = options.request.bake;
   asked.maps = maps;
-  return bake(low, *high, targets.targets, options.request.texture, asked, options.request.occlusion.options, colors);
+  return bake(low, *high, targets.targets, options.request.texture, asked, options.request.occlusion.options, colors,
+              cage ? &*cage : nullptr);
 }
 
 // Every asked map, each read back from options.keep when kept there under its key (map_cache.hpp),
@@ -265,7 +273,13 @@ Result<Bake> bake_or_reuse(const scene::Scene& low, const Targets& targets, cons
     out = std::move(*traced);
   } else {
     out.textures = std::move(*counts);
-    std::tie(out.front, out.back) = cage_distances(low, options.request.bake);  // as the kept maps were traced
+    std::optional<scene::Scene> cage;  // as the kept maps were traced (the same content: in their key)
+    if (!options.cage.empty()) {
+      auto loaded = scene::load_scene(options.cage);
+      if (!loaded) return loaded.error();
+      cage = std::move(*loaded);
+    }
+    std::tie(out.front, out.back) = cage_distances(low, options.request.bake, cage ? &*cage : nullptr);
   }
   for (std::size_t t = 0; t < out.textures.size(); ++t) {
     TextureBake& texture_bake = out.textures[t];
@@ -298,8 +312,11 @@ Result<FileReport> bake_file(const fs::path& low_path, const FileOptions& option
     const auto start = std::chrono::steady_clock::now();
     // The inputs' content before they are loaded: kept maps are keyed by what was read, at worst older.
     std::vector<fs::path> inputs = files_of(low_path);
-    const std::vector<fs::path> high_inputs = files_of(options.high);
-    inputs.insert(inputs.end(), high_inputs.begin(), high_inputs.end());
+    for (const fs::path& source : {options.high, options.cage}) {
+      if (source.empty()) continue;
+      const std::vector<fs::path> files = files_of(source);
+      inputs.insert(inputs.end(), files.begin(), files.end());
+    }
     std::string inputs_key;
     if (!options.keep.empty()) {
       if (auto hashed = inputs_hash(inputs)) inputs_key = *hashed;  // else nothing is reused; loading says why

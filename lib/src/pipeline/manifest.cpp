@@ -519,6 +519,7 @@ Status read_scene_bake(const Reader& r, const toml::table& t, const std::string&
   }
   if (!spec.bake || spec.bake->from.empty()) return r.at(*node, where + ".bake: from = \"high.glb\" is required");
   spec.bake->high = m.folder / spec.bake->from;
+  spec.bake->cage = spec.bake->cage_file.empty() ? fs::path() : m.folder / spec.bake->cage_file;
   const auto& maps = spec.bake->request.bake.maps;
   if (spec.options.ao && std::find(maps.begin(), maps.end(), bake::Map::ao) != maps.end()) {
     const toml::node* ao = t.get("ao");

@@ -52,6 +52,12 @@ const params::Group<SceneBake>& bake_source_params() {
                                    .example = "sculpts/hero_high.glb",
                                    .manifest_only = true},
                               [](auto& b) -> auto& { return b.from; }),
+      params::text<SceneBake>(Spec{.name = "cage",
+                                   .help = "A cage mesh (.gltf or .glb): the scene's input with its vertices moved "
+                                           "out; the rays start on it and head for the input (as matbake bake's cage)",
+                                   .example = "sculpts/hero_cage.glb",
+                                   .manifest_only = true},
+                              [](auto& b) -> auto& { return b.cage_file; }),
   }};
   return group;
 }

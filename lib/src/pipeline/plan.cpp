@@ -204,15 +204,20 @@ std::size_t Report::over_validation_limit() const {
   }));
 }
 
-// A baking scene reads its high-poly's files too.
+// A baking scene reads its high-poly's files too, and its cage mesh's.
 void add_high_poly(Job& job, const SceneSpec& s) {
-  auto json = gltf::read_json(s.bake->high);
-  if (!json) {
-    if (!job.problem) job.problem = Error{s.origins.of("bake.from"), "scenes." + s.name + ".bake.from: " + json.error().to_string()};
-    add_unique(job.inputs, {normalized(s.bake->high)});
-    return;
+  for (const auto& [file, key] : {std::pair{s.bake->high, "from"}, std::pair{s.bake->cage, "cage"}}) {
+    if (file.empty()) continue;
+    auto json = gltf::read_json(file);
+    if (!json) {
+      if (!job.problem) {
+        job.problem = Error{s.origins.of(std::string("bake.") + key), "scenes." + s.name + ".bake." + key + ": " + json.error().to_string()};
+      }
+      add_unique(job.inputs, {normalized(file)});
+      continue;
+    }
+    add_unique(job.inputs, gltf::source_files(file, *json));
   }
-  add_unique(job.inputs, gltf::source_files(s.bake->high, *json));
 }
 
 Result<Plan> make_plan(const Manifest& manifest) {

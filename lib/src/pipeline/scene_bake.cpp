@@ -17,7 +17,7 @@ Result<BakedScene> bake_scene(const Job& job, const SceneSpec& s, const fs::path
   // Named as the scene's output, so that the float maps are named as `matbake bake` names them.
   BakedScene baked{work / (job.outputs.scene.stem().string() + ".glb"), {}};
   // The maps are kept there too: a change to some parameters re-traces only the maps they decide.
-  bake::FileOptions options{s.bake->high, baked.gltf, s.bake->request, encoding, work / "kept"};
+  bake::FileOptions options{s.bake->high, s.bake->cage, baked.gltf, s.bake->request, encoding, work / "kept"};
   auto report = bake::bake_file(s.input, options);
   if (!report) return Error{s.origins.of("bake"), "scenes." + s.name + ".bake: " + report.error().to_string()};
   baked.report = std::move(*report);
