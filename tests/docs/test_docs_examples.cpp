@@ -210,7 +210,7 @@ void write_small_scene(const fs::path& file) {
 
 // The files the examples name, small: 8×8 images (a Schüler pair A/B and brick_a/brick_b of a
 // plausible dielectric), the example as assets.toml and as examples/, its scene as scene.gltf
-// (a material renamed Brick) and scene.glb (and as low.glb and high.glb), the presets.
+// (a material renamed Brick) and scene.glb (and as low.glb, high.glb and cage.glb), the presets.
 void write_example_files(const fs::path& dir) {
   const auto image = [&](const char* name, int channels, double value) {
     write_raw(dir / name, 8, 8, channels, "uint8", std::vector<double>(std::size_t(64 * channels), value));
@@ -233,6 +233,7 @@ void write_example_files(const fs::path& dir) {
   // bake's pair: the scene onto itself (the commands run; bake.md has its closed forms).
   fs::copy_file(dir / "scene.glb", dir / "low.glb");
   fs::copy_file(dir / "scene.glb", dir / "high.glb");
+  fs::copy_file(dir / "scene.glb", dir / "cage.glb");  // the low-poly itself: a cage that touches it
   // texture.ktx2: UASTC 4×4, one level (inspect reads it; no encoder needed).
   const auto ktx2_file = ktx2::write_uastc({.width = 4, .height = 4, .levels = {*ktx2::uastc_level(std::vector<unsigned char>(16), 0)}});
   ASSERT_TRUE(ktx2_file);

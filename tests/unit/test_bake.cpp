@@ -464,7 +464,7 @@ TEST(Bake, TransferGivesTheHighPolysBaseColourAtEachTexel) {
 // ID: the plane onto a high-poly split at x = 0 into two primitives of materials 0 and 3. A texel
 // whose footprint lies on one side holds that material's colour: hue 0 → (0.9, 0.225, 0.225);
 // 3 × 0.618034 = 1.854102, hue 0.854102 (sector 5, f = 0.124612) → (0.9, 0.225, 0.815887).
-TEST(Bake, IdGivesEachTexelItsHitsMaterialColour) {
+TEST(Bake, IdGivesEachTexelItsHitsMaterialOrPrimitiveColour) {
   const BumpPair pair = bump_pair(1, 0.5);
   const std::vector<dvec3> up(4, dvec3(0, 0, 1));
   scene::Instance left = placed({{-1, -1, 0}, {0, -1, 0}, {0, 1, 0}, {-1, 1, 0}}, up, {{0, 1, 2}, {0, 2, 3}}, glm::dmat4(1));
@@ -484,6 +484,21 @@ TEST(Bake, IdGivesEachTexelItsHitsMaterialColour) {
     for (int i = 0; i < kSide; ++i) {
       const dvec3 got = texel3(map_of(t, Map::id), std::size_t(j * kSide + i));
       EXPECT_LT(glm::length(got - (i < kSide / 2 ? left_color : right_color)), 1e-6) << i << "," << j;
+    }
+  }
+  // By primitive: left is mesh 4's primitive 1, right mesh 2's primitive 0, so right is number 0
+  // (hue 0) and left number 1 (hue frac(0.618034) × 6 = 3.708204: sector 3, (p, q, v) with
+  // q = 0.9 (1 − 0.75 × 0.708204)), whatever their materials.
+  left.mesh = 4, left.primitive = 1, right.mesh = 2, right.primitive = 0;
+  options.id_by = IdSource::primitive;
+  baked = bake(pair.low, scene_of({left, right}), {ao::TextureTarget{{0}, 0}}, {.width = kSide, .height = kSide, .texel_samples = 4},
+               options);
+  ASSERT_TRUE(baked) << baked.error().message;
+  const dvec3 primitive_1(0.225, 0.4219623, 0.9), primitive_0(0.9, 0.225, 0.225);
+  for (int j = 0; j < kSide; ++j) {
+    for (int i = 0; i < kSide; ++i) {
+      const dvec3 got = texel3(map_of(baked->textures.at(0), Map::id), std::size_t(j * kSide + i));
+      EXPECT_LT(glm::length(got - (i < kSide / 2 ? primitive_1 : primitive_0)), 1e-6) << i << "," << j;
     }
   }
 }

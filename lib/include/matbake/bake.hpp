@@ -59,14 +59,23 @@ inline constexpr NameTable<Map, 9> kMapNames{{{Map::normal, "normal"},
                                               {Map::id, "id"}}};
 int channels(Map map);
 
-// The id map's colour of high-poly material `material`: hue = frac(material × 0.618034) (the golden
-// ratio keeps neighbours apart), saturation 0.75, value 0.9; grey 0.5 for none (−1).
-glm::vec3 id_color(int material);
+// The id map's colour of id `id` (a material or primitive number): hue = frac(id × 0.618034) (the
+// golden ratio keeps neighbours apart), saturation 0.75, value 0.9; grey 0.5 for none (−1).
+glm::vec3 id_color(int id);
+
+// Each instance's glTF primitive number: its (mesh, primitive) pair's place in order among the
+// pairs `scene` places (two placements of one primitive share it).
+std::vector<int> primitive_numbers(const scene::Scene& scene);
 
 // Which way the normal map's green channel points: OpenGL's (and glTF's) up the texture, against
 // the direction of increasing v; DirectX's down it.
 enum class Green { opengl, directx };
 inline constexpr NameTable<Green, 2> kGreenNames{{{Green::opengl, "opengl"}, {Green::directx, "directx"}}};
+
+// What the id map colours: the hit's material, or its glTF primitive (mesh m's primitive p,
+// numbered in (mesh, primitive) order among those the high-poly's scene places).
+enum class IdSource { material, primitive };
+inline constexpr NameTable<IdSource, 2> kIdSourceNames{{{IdSource::material, "material"}, {IdSource::primitive, "primitive"}}};
 
 struct Options {
   std::vector<Map> maps = {Map::normal};
@@ -75,6 +84,7 @@ struct Options {
   double front = 0.01, back = 0.01;
   bool absolute_distances = false;
   Green green = Green::opengl;
+  IdSource id_by = IdSource::material;
   std::uint64_t seed = 0;  // of the anti-aliasing positions
 };
 

@@ -75,7 +75,7 @@ struct TexelSum {
   double height = 0, curvature = 0, occlusion = 0, thickness = 0;
   std::uint64_t occlusion_rays = 0, thickness_rays = 0;
   int hits = 0, rays = 0;
-  int material = -1;  // of the first hit
+  int id = -1;  // the first hit's material or primitive number (Options::id_by)
 };
 
 // What the report keeps of a traced texel.
@@ -101,6 +101,7 @@ struct TraceContext {
   std::uint64_t occlusion_seed;
   std::size_t target_index;
   const std::vector<BaseColor>* base_colors;  // for transfer (null: not asked)
+  const std::vector<int>* primitive_numbers;  // per high instance, for an id map by primitive (null: by material)
 };
 
 // The high-poly's base colour at a hit: COLOR_0 × the material's factor × its texture.
@@ -211,7 +212,7 @@ void trace_point(const TraceContext& c, const ao::texels::SurfacePoint& point, s
     }
     if (!cage_hit) continue;
     const Hit* hit = &cage_hit->hit;
-    if (sum.hits == 0) sum.material = c.high.instance(*hit).material;
+    if (sum.hits == 0) sum.id = c.primitive_numbers ? (*c.primitive_numbers)[hit->instance] : c.high.instance(*hit).material;
     ++sum.hits;
     sum.normal += tangent_space(low.basis, glm::dvec3(hit->normal));
     sum.position += glm::dvec3(hit->position);
@@ -248,7 +249,7 @@ void store(const TexelSum& sum, const Options& options, std::size_t texel, Textu
         for (int k = 0; k < 4; ++k) v[k] = float(sum.color[k] / sum.hits);
         break;
       case Map::id: {
-        const glm::vec3 rgb = id_color(sum.material);
+        const glm::vec3 rgb = id_color(sum.id);
         for (int k = 0; k < 3; ++k) v[k] = rgb[k];
         break;
       }
@@ -287,13 +288,24 @@ int channels(Map map) {
   return map == Map::normal || map == Map::bent_normal || map == Map::position || map == Map::id ? 3 : 1;
 }
 
-glm::vec3 id_color(int material) {
-  if (material < 0) return glm::vec3(0.5f);
-  const double hue = std::fmod(material * 0.618034, 1.0) * 6, s = 0.75, v = 0.9;
+glm::vec3 id_color(int id) {
+  if (id < 0) return glm::vec3(0.5f);
+  const double hue = std::fmod(id * 0.618034, 1.0) * 6, s = 0.75, v = 0.9;
   const int sector = int(hue) % 6;
   const double f = hue - std::floor(hue), p = v * (1 - s), q = v * (1 - s * f), t = v * (1 - s * (1 - f));
   const glm::dvec3 rgb[6] = {{v, t, p}, {q, v, p}, {p, v, t}, {p, q, v}, {t, p, v}, {v, p, q}};
   return glm::vec3(rgb[sector]);
+}
+
+std::vector<int> primitive_numbers(const scene::Scene& scene) {
+  std::vector<std::pair<int, int>> pairs;
+  for (const scene::Instance& inst : scene.instances) pairs.emplace_back(inst.mesh, inst.primitive);
+  std::vector<std::pair<int, int>> ordered = pairs;
+  std::sort(ordered.begin(), ordered.end());
+  ordered.erase(std::unique(ordered.begin(), ordered.end()), ordered.end());
+  std::vector<int> numbers;
+  for (const auto& pair : pairs) numbers.push_back(int(std::lower_bound(ordered.begin(), ordered.end(), pair) - ordered.begin()));
+  return numbers;
 }
 
 Status check(const Options& options) {
@@ -378,6 +390,7 @@ Result<Bake> bake(const scene::Scene& low, const scene::Scene& high, const std::
   std::tie(result.front, result.back) = cage_distances(low, options, cage);
   result.setup_seconds = seconds_since(start);
 
+  const std::vector<int> primitives = primitive_numbers(high);
   const auto trace_start = Clock::now();
   const std::size_t texel_count = std::size_t(texture.width) * std::size_t(texture.height);
   for (std::size_t index = 0; index < targets.size(); ++index) {
@@ -417,7 +430,8 @@ Result<Bake> bake(const scene::Scene& low, const scene::Scene& high, const std::
                                occlusion.samples,
                                occlusion.seed,
                                index,
-                               asked(Map::transfer) ? &base_colors : nullptr};
+                               asked(Map::transfer) ? &base_colors : nullptr,
+                               options.id_by == IdSource::primitive ? &primitives : nullptr};
     // A texel's sums live only while it is traced (a map's worth of doubles per texel, kept for
     // all, cost more to clear than the one-ray trace itself); its counts are kept for the report.
     std::vector<TexelTally> tallies(runs.size() - 1);

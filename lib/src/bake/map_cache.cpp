@@ -58,6 +58,7 @@ nlohmann::json map_parameters(std::optional<Map> map, const Request& request) {
   p.erase("maps");  // another map asked or dropped changes none of the others
   const bool tangent = map == Map::normal || map == Map::bent_normal;
   if (!tangent) p.erase("green");
+  if (map != Map::id) p.erase("id_by");
   if (map == Map::ao || map == Map::bent_normal || map == Map::thickness) p["ao"] = params::to_json(ao::estimator_params(), request.occlusion);
   p["matbake"] = version;
   return p;

@@ -80,6 +80,10 @@ params::Group<Request> make_group() {
                                    .help = "The normal map's green: opengl (glTF's: up the texture) or directx",
                                    .example = "directx"},
                               [](auto& r) -> auto& { return r.bake.green; }, kGreenNames),
+      params::choice<Request>(Spec{.name = "id_by",
+                                   .help = "What the id map colours: the hit's material or its glTF primitive",
+                                   .example = "primitive"},
+                              [](auto& r) -> auto& { return r.bake.id_by; }, kIdSourceNames),
       size(),
       params::integer<Request>(Spec{.name = "padding",
                                     .help = "Texels around the UV islands that take the nearest island texel's value "
