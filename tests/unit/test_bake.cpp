@@ -503,5 +503,95 @@ TEST(Bake, IdGivesEachTexelItsHitsMaterialOrPrimitiveColour) {
   }
 }
 
+// Per-vertex maps on a sphere: an icosphere of 42 vertices at radius 1.8 (radial normals) inside
+// the radius-2 sphere of the curvature test. Every low vertex's direction d is a vertex of the fine
+// tessellation too (subdividing keeps them), so its ray, radial (the extrusion's, or from a cage
+// vertex at radius 2.4), meets the sphere at centre + 2d: height 0.2 and curvature 1/2 exactly.
+// Tolerances: float32 at the coordinates' magnitude (a few ulps of 2.5); curvature as that test's.
+TEST(Bake, PerVertexHeightAndCurvatureOfASphereAreItsClosedFormsWithOrWithoutACage) {
+  const dvec3 centre(0.3, -0.2, 0.5);
+  const test::Icosphere fine = test::icosphere(4), coarse = test::icosphere(1);
+  const auto sphere = [&](const test::Icosphere& mesh, double radius) {
+    std::vector<dvec3> positions, normals;
+    for (const dvec3& v : mesh.vertices) positions.push_back(centre + radius * v), normals.push_back(v);
+    return scene_of({placed(positions, normals, mesh.triangles, glm::dmat4(1))});
+  };
+  const scene::Scene high = sphere(fine, 2), low = sphere(coarse, 1.8), cage = sphere(coarse, 2.4);
+  for (const scene::Scene* with : {static_cast<const scene::Scene*>(nullptr), &cage}) {
+    Options options;
+    options.maps = {};
+    options.vertex_maps = {Map::height, Map::curvature};
+    options.front = 0.5, options.back = 0.5, options.absolute_distances = true;
+    auto baked = bake(low, high, {}, {}, options, {}, {}, with);
+    ASSERT_TRUE(baked) << baked.error().message;
+    const VertexBake& v = baked->vertices;
+    EXPECT_TRUE(baked->textures.empty());
+    EXPECT_EQ(v.vertices, coarse.vertices.size());
+    EXPECT_EQ(v.misses, 0u);
+    ASSERT_EQ(v.values.size(), 2u);
+    for (std::size_t i = 0; i < coarse.vertices.size(); ++i) {
+      ASSERT_NEAR(v.values[0][0][i], 0.2, 4e-6) << "vertex " << i << (with ? " (cage)" : "");
+      ASSERT_NEAR(v.values[1][0][i], 0.5, 1e-3) << "vertex " << i;
+    }
+  }
+}
+
+// Per-vertex AO and thickness: the bump test's plane's four vertices, (±1, ±1, 0), over the closed
+// forms of the texture tests. AO: a floor to x = 1.5 under a wall there, 10⁴ high and wide: a
+// vertex's 256 rays, the first 256 points of its (0, 2)-sequence, block exactly the 128 heading
+// toward +x (tolerance one ray, 1/256). Thickness: the slab 0.1 thick, every ray's depth 0.1.
+TEST(Bake, PerVertexAoAndThicknessAreTheTexelsClosedForms) {
+  const BumpPair pair = bump_pair(1, 0.5);
+  constexpr double kWide = 1e4, kThick = 0.1;
+  const scene::Instance floor = placed({{-3, -kWide, 0}, {1.5, -kWide, 0}, {1.5, kWide, 0}, {-3, kWide, 0}}, {},
+                                       {{0, 1, 2}, {0, 2, 3}}, glm::dmat4(1));
+  const scene::Instance wall = placed({{1.5, -kWide, 0}, {1.5, -kWide, kWide}, {1.5, kWide, kWide}, {1.5, kWide, 0}}, {},
+                                      {{0, 1, 2}, {0, 2, 3}}, glm::dmat4(1));
+  const scene::Instance top = placed({{-kWide, -kWide, 0}, {kWide, -kWide, 0}, {kWide, kWide, 0}, {-kWide, kWide, 0}}, {},
+                                     {{0, 1, 2}, {0, 2, 3}}, glm::dmat4(1));
+  const scene::Instance bottom = placed({{-kWide, -kWide, -kThick}, {kWide, -kWide, -kThick}, {kWide, kWide, -kThick}, {-kWide, kWide, -kThick}},
+                                        {}, {{0, 2, 1}, {0, 3, 2}}, glm::dmat4(1));
+  Options options;
+  options.maps = {};
+  options.front = 0.1, options.back = 0.1, options.absolute_distances = true;
+  ao::Options occlusion;
+  occlusion.samples = 256, occlusion.falloff = ao::Falloff::none, occlusion.absolute_distance = 1e6;
+  options.vertex_maps = {Map::ao};
+  auto walled = bake(pair.low, scene_of({floor, wall}), {}, {}, options, occlusion);
+  ASSERT_TRUE(walled) << walled.error().message;
+  EXPECT_EQ(walled->vertices.occlusion_rays, 4u * 256);
+  options.vertex_maps = {Map::thickness};
+  auto slab = bake(pair.low, scene_of({top, bottom}), {}, {}, options, occlusion);
+  ASSERT_TRUE(slab) << slab.error().message;
+  for (std::size_t v = 0; v < 4; ++v) {
+    EXPECT_NEAR(walled->vertices.values[0][0][v], 0.5, 1.0 / 256) << v;
+    EXPECT_NEAR(slab->vertices.values[0][0][v], kThick, 1e-5) << v;
+  }
+  EXPECT_EQ(walled->vertices.misses + slab->vertices.misses, 0u);
+}
+
+// A vertex whose ray misses: the plane's quad (vertices 0 (−1, −1), 1 (1, −1), 2 (1, 1), 3 (−1, 1);
+// triangles 0 1 2 and 0 2 3) over a high-poly only where x < 0.5, the plane z = −0.1 − 0.05 y.
+// Vertices 0 and 3 hit it at heights −0.05 and −0.15; 1 and 2 miss and take the mean of their hit
+// neighbours: 1 sees only 0 (−0.05), 2 sees 0 and 3 (−0.1).
+TEST(Bake, AVertexWhoseRayMissesTakesTheMeanOfItsHitNeighbours) {
+  const BumpPair pair = bump_pair(1, 0.5);
+  const scene::Instance half = placed({{-3, -3, 0.05}, {0.5, -3, 0.05}, {0.5, 3, -0.25}, {-3, 3, -0.25}}, {},
+                                      {{0, 1, 2}, {0, 2, 3}}, glm::dmat4(1));
+  Options options;
+  options.maps = {};
+  options.vertex_maps = {Map::height};
+  options.front = 0.5, options.back = 0.5, options.absolute_distances = true;
+  auto baked = bake(pair.low, scene_of({half}), {}, {}, options);
+  ASSERT_TRUE(baked) << baked.error().message;
+  EXPECT_EQ(baked->vertices.misses, 2u);
+  const std::vector<float>& height = baked->vertices.values[0][0];
+  const double expected[4] = {-0.05, -0.05, -0.1, -0.15};
+  for (std::size_t v = 0; v < 4; ++v) EXPECT_NEAR(height[v], expected[v], 1e-6) << v;
+  // Only scalar maps a vertex can hold.
+  options.vertex_maps = {Map::normal};
+  EXPECT_FALSE(bake(pair.low, scene_of({half}), {}, {}, options));
+}
+
 }  // namespace
 }  // namespace matbake::bake

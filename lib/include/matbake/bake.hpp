@@ -58,6 +58,8 @@ inline constexpr NameTable<Map, 9> kMapNames{{{Map::normal, "normal"},
                                               {Map::transfer, "transfer"},
                                               {Map::id, "id"}}};
 int channels(Map map);
+// The maps a low-poly vertex can take (one value each: ao, thickness, curvature, height).
+bool per_vertex(Map map);
 
 // The id map's colour of id `id` (a material or primitive number): hue = frac(id × 0.618034) (the
 // golden ratio keeps neighbours apart), saturation 0.75, value 0.9; grey 0.5 for none (−1).
@@ -79,6 +81,9 @@ inline constexpr NameTable<IdSource, 2> kIdSourceNames{{{IdSource::material, "ma
 
 struct Options {
   std::vector<Map> maps = {Map::normal};
+  // Per low-poly vertex (per_vertex maps): one ray from the cage along the vertex's normal, the
+  // map's value at its hit as a texel's (VertexBake).
+  std::vector<Map> vertex_maps;
   // The cage: how far outside (front) and inside (back) the low-poly the rays reach, as fractions
   // of the low-poly's bounding-box diagonal, or in scene units when absolute.
   double front = 0.01, back = 0.01;
@@ -126,8 +131,22 @@ struct TextureBake {
   double height_min = 0, height_max = 0;  // over the hits
 };
 
+// Options::vertex_maps at each vertex of each low-poly instance: the cage ray from the vertex (its
+// cage vertex, or `front` out along its normal: the file's, else area-weighted) to `back` inside,
+// the map's value at the hit as a texel with one position computes it (ao and thickness: the
+// estimator's samples from the hit, keyed by instance and vertex). A vertex whose ray misses takes
+// the mean of its hit neighbours (sharing a triangle), repeatedly outwards; where none is reached,
+// the background (ao 1, others 0).
+struct VertexBake {
+  std::vector<Map> maps;                                // Options::vertex_maps
+  std::vector<std::vector<std::vector<float>>> values;  // per map, per low instance, per vertex
+  std::size_t vertices = 0, misses = 0;                 // rays cast (one a vertex), and missed
+  std::size_t occlusion_rays = 0;
+};
+
 struct Bake {
   std::vector<TextureBake> textures;  // one per target
+  VertexBake vertices;                // with Options::vertex_maps
   double front = 0, back = 0;         // the cage distances used, scene units
   double setup_seconds = 0, trace_seconds = 0;
 };

@@ -37,11 +37,7 @@ std::vector<Vec3> shading_normals(const scene::Instance& inst, std::optional<sce
   return normals;
 }
 
-namespace {
-
-Mesh prepare(const scene::Instance& inst, std::optional<scene::NormalWeighting> recompute) {
-  Mesh m;
-  m.normals = shading_normals(inst, recompute);
+std::vector<float> mean_edge_lengths(const scene::Instance& inst) {
   std::vector<double> sum(inst.positions.size(), 0.0);
   std::vector<int> count(inst.positions.size(), 0);
   for (const auto& t : inst.triangles) {
@@ -51,11 +47,21 @@ Mesh prepare(const scene::Instance& inst, std::optional<scene::NormalWeighting> 
       sum[a] += length, sum[b] += length;
       ++count[a], ++count[b];
     }
-    const Vec3 n = glm::cross(inst.positions[t[1]] - inst.positions[t[0]], inst.positions[t[2]] - inst.positions[t[0]]);
-    m.face_normals.push_back(n);
   }
-  m.edge_length.resize(inst.positions.size());
-  for (std::size_t v = 0; v < sum.size(); ++v) m.edge_length[v] = count[v] ? float(sum[v] / count[v]) : 0.0f;
+  std::vector<float> lengths(inst.positions.size());
+  for (std::size_t v = 0; v < sum.size(); ++v) lengths[v] = count[v] ? float(sum[v] / count[v]) : 0.0f;
+  return lengths;
+}
+
+namespace {
+
+Mesh prepare(const scene::Instance& inst, std::optional<scene::NormalWeighting> recompute) {
+  Mesh m;
+  m.normals = shading_normals(inst, recompute);
+  m.edge_length = mean_edge_lengths(inst);
+  for (const auto& t : inst.triangles) {
+    m.face_normals.push_back(glm::cross(inst.positions[t[1]] - inst.positions[t[0]], inst.positions[t[2]] - inst.positions[t[0]]));
+  }
   return m;
 }
 

@@ -28,6 +28,9 @@ struct SceneDeleter {
 // asked: from the faces with that weighting).
 std::vector<scene::Vec3> shading_normals(const scene::Instance& inst, std::optional<scene::NormalWeighting> recompute = {});
 
+// Per vertex, the mean length of its edges (0 for a vertex no triangle uses).
+std::vector<float> mean_edge_lengths(const scene::Instance& inst);
+
 // A triangle geometry of the instance's world positions and triangles, not yet committed.
 RTCGeometry triangle_geometry(RTCDevice device, const scene::Instance& inst);
 // Hits on the back of a face (its normal, not normalized, along the ray) are not hits; the

@@ -85,12 +85,10 @@ struct TexelTally {
   int hits = 0, rays = 0;
 };
 
-struct TraceContext {
+// What every cage ray and the maps at its hit need, for texels and vertices alike.
+struct Rays {
   const scene::Scene& low;
-  const std::vector<std::vector<CornerFrame>>& frames;  // per low instance (empty: not baked)
   const HighPoly& high;
-  const ao::TextureTarget& target;
-  const ao::TextureOptions& texture;
   float front, back;
   const scene::Scene* cage;      // the cage mesh (null: extrusion by front)
   bool curvature;                // asked for
@@ -99,9 +97,17 @@ struct TraceContext {
   const ao::Tracer* thickness;   // the high-poly two-sided, for thickness (null: not asked)
   int occlusion_samples;
   std::uint64_t occlusion_seed;
-  std::size_t target_index;
   const std::vector<BaseColor>* base_colors;  // for transfer (null: not asked)
   const std::vector<int>* primitive_numbers;  // per high instance, for an id map by primitive (null: by material)
+};
+
+// One texture target's trace.
+struct TraceContext {
+  const Rays& rays;
+  const std::vector<std::vector<CornerFrame>>& frames;  // per low instance (empty: not baked)
+  const ao::TextureTarget& target;
+  const ao::TextureOptions& texture;
+  std::size_t target_index;
 };
 
 // The high-poly's base colour at a hit: COLOR_0 × the material's factor × its texture.
@@ -126,23 +132,21 @@ glm::dvec4 base_color(const std::vector<BaseColor>& colors, const scene::Instanc
   return c * glm::dvec4(texel[0], texel[1], texel[2], texel[3]);
 }
 
-// AO and bent normal from a hit, around the high-poly's normal there, and thickness, into it: texel
-// position j of K casts rays j, j + K, ... of the texel's sequence (so a texel's K positions cast it
-// once through).
-void trace_from_hit(const TraceContext& c, const Hit& hit, const LowPoint& low, float texel_size, int j, std::uint32_t texel,
+// AO and bent normal from a hit, around the high-poly's normal there, and thickness, into it: the
+// point's rays j, j + positions, ... of the sequence keyed by `key` (so a texel's positions cast it
+// once through); `scale` is the surface's local length (ao::Tracer::origin_offset).
+void trace_from_hit(const Rays& c, const Hit& hit, const LowPoint& low, float scale, int j, int positions, std::uint64_t key,
                     TexelSum& sum) {
-  const int positions = c.texture.texel_samples;
-  const std::uint64_t key = ao::sample_key(c.occlusion_seed, c.target_index, texel);
   std::vector<RTCRayHit> rays(std::size_t(c.occlusion_samples / positions + 1));
   if (c.occlusion) {
-    const glm::vec3 origin = hit.position + hit.normal * c.occlusion->origin_offset(hit.position, texel_size);
+    const glm::vec3 origin = hit.position + hit.normal * c.occlusion->origin_offset(hit.position, scale);
     glm::vec3 bent(0);
     sum.occlusion += c.occlusion->sum_over_rays(origin, hit.normal, key, j, positions, rays, sum.occlusion_rays, c.bent ? &bent : nullptr);
     if (c.bent) sum.bent += tangent_space(low.basis, glm::dvec3(bent)) * double(glm::length(bent));
   }
   if (c.thickness) {
     // The origin's offset below the surface is depth too: added back for every ray.
-    const float offset = c.thickness->origin_offset(hit.position, texel_size);
+    const float offset = c.thickness->origin_offset(hit.position, scale);
     std::uint64_t inward = 0;
     sum.thickness += c.thickness->sum_of_depths(hit.position - hit.normal * offset, -hit.normal, key, j, positions, rays, inward) +
                      double(inward) * double(offset);
@@ -156,22 +160,17 @@ struct CageHit {
   double height;
 };
 
-// The cage ray at a low-poly point (triangle `triangle` of low instance `instance`, weights `w`):
-// from the cage mesh's point with the same weights towards it, else (no cage mesh, or it touches the
-// low-poly there) from the extrusion's `front` outside along its normal; either reaching `back`
-// beyond it.
-std::optional<CageHit> cast(const TraceContext& c, const LowPoint& low, std::size_t instance, std::size_t triangle,
-                            const glm::dvec3& w) {
+// The cage ray at a low-poly point: from `from_cage` (the cage mesh's point with the same weights)
+// towards it, else (no cage mesh, or it touches the low-poly there) from the extrusion's `front`
+// outside along its normal; either reaching `back` beyond it.
+std::optional<CageHit> cast(const Rays& c, const LowPoint& low, const std::optional<glm::dvec3>& from_cage) {
   const float front = c.front;
-  if (c.cage) {
-    const auto& corners = c.low.instances[instance].triangles[triangle];
-    const auto& cage = c.cage->instances[instance].positions;
-    const glm::dvec3 from = w.x * glm::dvec3(cage[corners[0]]) + w.y * glm::dvec3(cage[corners[1]]) + w.z * glm::dvec3(cage[corners[2]]);
-    const glm::dvec3 to_low = glm::dvec3(low.position) - from;
+  if (from_cage) {
+    const glm::dvec3 to_low = glm::dvec3(low.position) - *from_cage;
     const double distance = glm::length(to_low);
     // Below float32's resolution at the point the direction is noise: the cage touches the low-poly.
     if (distance > 1e-6 * (1 + glm::length(glm::dvec3(low.position)))) {
-      auto hit = c.high.first_hit(glm::vec3(from), glm::vec3(to_low / distance), float(distance) + c.back);
+      auto hit = c.high.first_hit(glm::vec3(*from_cage), glm::vec3(to_low / distance), float(distance) + c.back);
       if (!hit) return std::nullopt;
       return CageHit{*hit, distance - double(hit->distance)};
     }
@@ -183,43 +182,59 @@ std::optional<CageHit> cast(const TraceContext& c, const LowPoint& low, std::siz
   return CageHit{*hit, double(front) - double(hit->distance)};
 }
 
+// The cage mesh's point of low instance `instance`'s triangle at weights `w` (none without a cage).
+std::optional<glm::dvec3> cage_point(const Rays& c, std::size_t instance, std::size_t triangle, const glm::dvec3& w) {
+  if (!c.cage) return std::nullopt;
+  const auto& corners = c.low.instances[instance].triangles[triangle];
+  const auto& cage = c.cage->instances[instance].positions;
+  return w.x * glm::dvec3(cage[corners[0]]) + w.y * glm::dvec3(cage[corners[1]]) + w.z * glm::dvec3(cage[corners[2]]);
+}
+
+// A cage hit into the sums of the maps: the first hit's id, and all that the hit itself gives.
+void add_hit(const Rays& c, const CageHit& cage_hit, const LowPoint& low, TexelSum& sum) {
+  const Hit& hit = cage_hit.hit;
+  if (sum.hits == 0) sum.id = c.primitive_numbers ? (*c.primitive_numbers)[hit.instance] : c.high.instance(hit).material;
+  ++sum.hits;
+  sum.normal += tangent_space(low.basis, glm::dvec3(hit.normal));
+  sum.position += glm::dvec3(hit.position);
+  sum.height += cage_hit.height;
+  if (c.curvature) sum.curvature += c.high.mean_curvature(hit);
+  if (c.base_colors) sum.color += base_color(*c.base_colors, c.high.instance(hit), hit);
+}
+
 // The texel positions of one surface point (K = texel_samples, stratified over the footprint by the
 // (0, 2)-sequence as the AO bake's, each clamped to the triangle), one ray each.
-void trace_point(const TraceContext& c, const ao::texels::SurfacePoint& point, std::uint64_t key, TexelSum& sum) {
+void trace_point(const TraceContext& t, const ao::texels::SurfacePoint& point, std::uint64_t key, TexelSum& sum) {
+  const Rays& c = t.rays;
   const scene::Instance& inst = c.low.instances[point.instance];
   const ao::texels::UvTriangle uv =
-      ao::texels::uv_triangle(inst, c.target.texcoord, point.triangle, c.texture.width, c.texture.height);
-  const int positions = c.texture.texel_samples;
+      ao::texels::uv_triangle(inst, t.target.texcoord, point.triangle, t.texture.width, t.texture.height);
+  const int positions = t.texture.texel_samples;
   float texel_size = 0;
   if (c.occlusion || c.thickness) {
-    const auto& t = inst.triangles[point.triangle];
+    const auto& tri = inst.triangles[point.triangle];
     texel_size = ao::texels::texel_size(
-        double(glm::length(glm::cross(inst.positions[t[1]] - inst.positions[t[0]], inst.positions[t[2]] - inst.positions[t[0]]))), uv);
+        double(glm::length(glm::cross(inst.positions[tri[1]] - inst.positions[tri[0]], inst.positions[tri[2]] - inst.positions[tri[0]]))), uv);
   }
+  const std::uint64_t occlusion_key = ao::sample_key(c.occlusion_seed, t.target_index, point.texel);
   for (int j = 0; j < positions; ++j) {
     glm::dvec2 at(point.x, point.y);
     if (positions > 1) {
       const ao::Sample2 offset = ao::sample(ao::Sampler::sobol, std::uint32_t(j), ~key);
       at += glm::dvec2(offset.u - 0.5, offset.v - 0.5);
     }
-    const glm::dvec3 w = ao::texels::nearest_weights(uv, at);
-    LowPoint low = low_point(inst, c.frames[point.instance], point.triangle, w);
+    glm::dvec3 w = ao::texels::nearest_weights(uv, at);
+    LowPoint low = low_point(inst, t.frames[point.instance], point.triangle, w);
     ++sum.rays;
-    auto cage_hit = cast(c, low, point.instance, point.triangle, w);
+    auto cage_hit = cast(c, low, cage_point(c, point.instance, point.triangle, w));
     if (!cage_hit && on_edge(w)) {
-      low = low_point(inst, c.frames[point.instance], point.triangle, inside(w));
-      cage_hit = cast(c, low, point.instance, point.triangle, inside(w));
+      w = inside(w);
+      low = low_point(inst, t.frames[point.instance], point.triangle, w);
+      cage_hit = cast(c, low, cage_point(c, point.instance, point.triangle, w));
     }
     if (!cage_hit) continue;
-    const Hit* hit = &cage_hit->hit;
-    if (sum.hits == 0) sum.id = c.primitive_numbers ? (*c.primitive_numbers)[hit->instance] : c.high.instance(*hit).material;
-    ++sum.hits;
-    sum.normal += tangent_space(low.basis, glm::dvec3(hit->normal));
-    sum.position += glm::dvec3(hit->position);
-    sum.height += cage_hit->height;
-    if (c.curvature) sum.curvature += c.high.mean_curvature(*hit);
-    if (c.base_colors) sum.color += base_color(*c.base_colors, c.high.instance(*hit), *hit);
-    if (c.occlusion || c.thickness) trace_from_hit(c, *hit, low, texel_size, j, point.texel, sum);
+    add_hit(c, *cage_hit, low, sum);
+    if (c.occlusion || c.thickness) trace_from_hit(c, cage_hit->hit, low, texel_size, j, positions, occlusion_key, sum);
   }
 }
 
@@ -231,6 +246,17 @@ void encode_direction(const glm::dvec3& sum, Green green, float* v) {
   for (int k = 0; k < 3; ++k) v[k] = float(std::clamp(m[k] * 0.5 + 0.5, 0.0, 1.0));
 }
 
+// A per_vertex map's value from a sum with hits.
+float scalar(const TexelSum& sum, Map map) {
+  switch (map) {
+    case Map::ao: return sum.occlusion_rays ? float(sum.occlusion / double(sum.occlusion_rays)) : 1.0f;
+    case Map::height: return float(sum.height / sum.hits);
+    case Map::curvature: return float(sum.curvature / sum.hits);
+    case Map::thickness: return sum.thickness_rays ? float(sum.thickness / double(sum.thickness_rays)) : 0.0f;
+    default: return 0.0f;
+  }
+}
+
 // The texel's value of each map from its sum (it has hits).
 void store(const TexelSum& sum, const Options& options, std::size_t texel, TextureBake& out) {
   for (MapImage& image : out.maps) {
@@ -238,10 +264,10 @@ void store(const TexelSum& sum, const Options& options, std::size_t texel, Textu
     switch (image.map) {
       case Map::normal: encode_direction(sum.normal, options.green, v); break;
       case Map::bent_normal: encode_direction(sum.bent, options.green, v); break;
-      case Map::ao: v[0] = sum.occlusion_rays ? float(sum.occlusion / double(sum.occlusion_rays)) : 1.0f; break;
-      case Map::height: v[0] = float(sum.height / sum.hits); break;
-      case Map::curvature: v[0] = float(sum.curvature / sum.hits); break;
-      case Map::thickness: v[0] = sum.thickness_rays ? float(sum.thickness / double(sum.thickness_rays)) : 0.0f; break;
+      case Map::ao:
+      case Map::height:
+      case Map::curvature:
+      case Map::thickness: v[0] = scalar(sum, image.map); break;
       case Map::position:
         for (int k = 0; k < 3; ++k) v[k] = float(sum.position[k] / sum.hits);
         break;
@@ -257,16 +283,16 @@ void store(const TexelSum& sum, const Options& options, std::size_t texel, Textu
   }
 }
 
-// What a texel nothing maps holds: flat normals, no occlusion, white, zero height, position and
-// curvature.
+// What a texel nothing maps holds in channel k: flat normals, no occlusion, white, zero height,
+// position and curvature.
+float background(Map map, int k) {
+  if (map == Map::normal || map == Map::bent_normal) return k == 2 ? 1.0f : 0.5f;
+  return map == Map::ao || map == Map::transfer ? 1.0f : 0.0f;
+}
 void background(MapImage& image) {
-  const bool direction = image.map == Map::normal || image.map == Map::bent_normal;
   const std::size_t texels = image.values.size() / std::size_t(image.channels);
   for (std::size_t t = 0; t < texels; ++t) {
-    for (int k = 0; k < image.channels; ++k) {
-      float& v = image.values[t * std::size_t(image.channels) + std::size_t(k)];
-      v = direction ? (k == 2 ? 1.0f : 0.5f) : image.map == Map::ao || image.map == Map::transfer ? 1.0f : 0.0f;
-    }
+    for (int k = 0; k < image.channels; ++k) image.values[t * std::size_t(image.channels) + std::size_t(k)] = background(image.map, k);
   }
 }
 
@@ -281,7 +307,91 @@ void fill_missed(MapImage& image, const std::vector<std::int64_t>& nearest_hit, 
   }
 }
 
+// The local length at a vertex's hit (the origin offset's scale): the smaller of the low-poly's
+// mean edge length at the vertex and the high-poly's at the hit (its corners', interpolated), so
+// that the offset stays below the features of either (a slab's huge faces, a coarse low-poly).
+float hit_scale(const ao::Tracer& tracer, const HighPoly& high, const Hit& hit, float low_edge) {
+  const auto& lengths = tracer.mesh(hit.instance).edge_length;
+  const auto& corners = high.instance(hit).triangles[hit.triangle];
+  float scale = 0;
+  for (int k = 0; k < 3; ++k) scale += hit.weights[k] * lengths[corners[std::size_t(k)]];
+  return std::min(scale, low_edge);
+}
+
+// Low instance `instance`'s missed vertices take the mean of their hit neighbours (sharing a
+// triangle), ring by ring outwards; those no ring reaches keep the background.
+void fill_missed(const scene::Instance& inst, std::vector<std::uint8_t> hit, std::size_t instance, VertexBake& out) {
+  std::vector<std::vector<std::uint32_t>> neighbours(hit.size());
+  for (const auto& t : inst.triangles) {
+    for (std::size_t a = 0; a < 3; ++a) neighbours[t[a]].push_back(t[(a + 1) % 3]), neighbours[t[(a + 1) % 3]].push_back(t[a]);
+  }
+  for (auto& n : neighbours) {
+    std::sort(n.begin(), n.end());
+    n.erase(std::unique(n.begin(), n.end()), n.end());
+  }
+  for (;;) {
+    std::vector<std::uint32_t> ring;
+    for (std::uint32_t v = 0; v < hit.size(); ++v) {
+      if (!hit[v] && std::ranges::any_of(neighbours[v], [&](std::uint32_t u) { return hit[u] != 0; })) ring.push_back(v);
+    }
+    if (ring.empty()) return;
+    for (auto& per_map : out.values) {
+      std::vector<float>& values = per_map[instance];
+      for (std::uint32_t v : ring) {
+        double sum = 0;
+        int count = 0;
+        for (std::uint32_t u : neighbours[v]) {
+          if (hit[u]) sum += values[u], ++count;
+        }
+        values[v] = float(sum / count);
+      }
+    }
+    for (std::uint32_t v : ring) hit[v] = 1;
+  }
+}
+
+// Options::vertex_maps at every vertex of every low instance (VertexBake); `c` holds the tracers
+// those maps need and no others.
+VertexBake bake_vertices(const Rays& c, const std::vector<Map>& maps) {
+  VertexBake out;
+  out.maps = maps;
+  out.values.assign(maps.size(), std::vector<std::vector<float>>(c.low.instances.size()));
+  const ao::Tracer* from_hit = c.occlusion ? c.occlusion : c.thickness;
+  for (std::size_t k = 0; k < c.low.instances.size(); ++k) {
+    const scene::Instance& inst = c.low.instances[k];
+    const std::vector<scene::Vec3> normals = ao::shading_normals(inst);
+    const std::vector<float> edges = from_hit ? ao::mean_edge_lengths(inst) : std::vector<float>{};
+    const std::size_t n = inst.positions.size();
+    for (std::size_t m = 0; m < maps.size(); ++m) out.values[m][k].assign(n, background(maps[m], 0));
+    std::vector<std::uint8_t> hit(n, 0);
+    std::vector<std::uint64_t> rays(n, 0);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 256), [&](const tbb::blocked_range<std::size_t>& range) {
+      for (std::size_t v = range.begin(); v != range.end(); ++v) {
+        // A vertex needs no tangent basis: only the normal's column is read.
+        const LowPoint low{inst.positions[v], glm::dmat3(glm::dvec3(0), glm::dvec3(0), glm::dvec3(normals[v]))};
+        const auto cage_hit = cast(c, low, c.cage ? std::optional(glm::dvec3(c.cage->instances[k].positions[v])) : std::nullopt);
+        if (!cage_hit) continue;
+        TexelSum sum;
+        add_hit(c, *cage_hit, low, sum);
+        if (from_hit) {
+          trace_from_hit(c, cage_hit->hit, low, hit_scale(*from_hit, c.high, cage_hit->hit, edges[v]), 0, 1,
+                         ao::sample_key(c.occlusion_seed, k, v), sum);
+        }
+        for (std::size_t m = 0; m < maps.size(); ++m) out.values[m][k][v] = scalar(sum, maps[m]);
+        hit[v] = 1;
+        rays[v] = sum.occlusion_rays + sum.thickness_rays;
+      }
+    });
+    out.vertices += n;
+    for (std::size_t v = 0; v < n; ++v) out.misses += hit[v] ? 0 : 1, out.occlusion_rays += rays[v];
+    fill_missed(inst, std::move(hit), k, out);
+  }
+  return out;
+}
+
 }  // namespace
+
+bool per_vertex(Map map) { return map == Map::ao || map == Map::thickness || map == Map::curvature || map == Map::height; }
 
 int channels(Map map) {
   if (map == Map::transfer) return 4;
@@ -309,7 +419,8 @@ std::vector<int> primitive_numbers(const scene::Scene& scene) {
 }
 
 Status check(const Options& options) {
-  if (options.maps.empty()) return Error{"", "a bake needs at least one map", true};
+  if (options.maps.empty() && options.vertex_maps.empty()) return Error{"", "a bake needs at least one map", true};
+  if (!std::ranges::all_of(options.vertex_maps, per_vertex)) return Error{"", "the vertex maps are ao, thickness, curvature and height", true};
   if (!(options.front >= 0) || !(options.back >= 0) || !std::isfinite(options.front) || !std::isfinite(options.back) ||
       options.front + options.back <= 0) {
     return Error{"", "the cage distances must be finite, 0 or more, and not both 0", true};
@@ -345,20 +456,37 @@ std::string cage_mismatch(const scene::Scene& low, const scene::Scene& cage) {
   return "";
 }
 
-Result<Bake> bake(const scene::Scene& low, const scene::Scene& high, const std::vector<ao::TextureTarget>& targets,
-                  const ao::TextureOptions& texture, const Options& options, const ao::Options& occlusion,
-                  const std::vector<BaseColor>& base_colors, const scene::Scene* cage) {
-  if (Status s = check(options); !s) return s.error();
-  if (cage) {
-    if (const std::string why = cage_mismatch(low, *cage); !why.empty()) return Error{"", "the cage " + why, true};
+namespace {
+
+// The high-poly as the asked maps trace it: the cage rays' BVH, and the estimator's only where a map
+// needs it (occluder: ao and bent_normal, a second BVH; depths: thickness, every face from either side).
+struct Tracers {
+  std::unique_ptr<HighPoly> high;
+  std::unique_ptr<ao::Tracer> occluder, depths;
+};
+
+Result<Tracers> build_tracers(const scene::Scene& high, bool occluding, bool thickness, const ao::Options& occlusion) {
+  Tracers out;
+  auto built = HighPoly::build(high);
+  if (!built) return built.error();
+  out.high = std::move(*built);
+  if (occluding) {
+    auto made = ao::Tracer::build(high, occlusion);
+    if (!made) return made.error();
+    out.occluder = std::move(*made);
   }
-  if (Status s = ao::check(texture, kMaxTexelSamples, "bake"); !s) return s.error();
-  const auto asked = [&](Map map) { return std::ranges::find(options.maps, map) != options.maps.end(); };
-  const bool occluding = asked(Map::ao) || asked(Map::bent_normal);
-  if (occluding || asked(Map::thickness)) {
-    if (Status s = ao::check(occlusion); !s) return s.error();
+  if (thickness) {
+    ao::Options two_sided = occlusion;
+    two_sided.two_sided = true;
+    auto made = ao::Tracer::build(high, two_sided);
+    if (!made) return made.error();
+    out.depths = std::move(*made);
   }
-  const auto start = Clock::now();
+  return out;
+}
+
+// The tangent frames of every instance a target bakes (none for the others).
+Result<std::vector<std::vector<CornerFrame>>> target_frames(const scene::Scene& low, const std::vector<ao::TextureTarget>& targets) {
   std::vector<std::vector<CornerFrame>> frames(low.instances.size());
   for (const ao::TextureTarget& target : targets) {
     for (std::size_t k : target.instances) {
@@ -370,110 +498,149 @@ Result<Bake> bake(const scene::Scene& low, const scene::Scene& high, const std::
       frames[k] = std::move(*made);
     }
   }
-  auto built = HighPoly::build(high);
-  if (!built) return built.error();
-  std::unique_ptr<ao::Tracer> occluder;  // only where a map needs it: a second BVH of the high-poly
-  if (occluding) {
-    auto made = ao::Tracer::build(high, occlusion);
-    if (!made) return made.error();
-    occluder = std::move(*made);
+  return frames;
+}
+
+// The counts of a texture's traced texels into its report; marks `hit` and `traced`.
+void tally(const std::vector<TexelTally>& tallies, const std::vector<std::size_t>& runs,
+           const std::vector<ao::texels::SurfacePoint>& points, TextureBake& out, std::vector<bool>& hit, std::vector<bool>& traced) {
+  bool first = true;
+  for (std::size_t r = 0; r < tallies.size(); ++r) {
+    const std::size_t texel = points[runs[r]].texel;
+    traced[texel] = true;
+    out.samples += std::size_t(tallies[r].rays);
+    out.occlusion_rays += tallies[r].occlusion_rays;
+    out.misses += std::size_t(tallies[r].rays - tallies[r].hits);
+    if (tallies[r].hits == 0) {
+      ++out.missed_texels;
+      continue;
+    }
+    hit[texel] = true;
+    out.hit[texel] = 1;
+    const double h = tallies[r].height / tallies[r].hits;
+    out.height_min = first ? h : std::min(out.height_min, h);
+    out.height_max = first ? h : std::max(out.height_max, h);
+    first = false;
   }
-  std::unique_ptr<ao::Tracer> depths;  // thickness: every face counts, seen from either side
-  if (asked(Map::thickness)) {
-    ao::Options two_sided = occlusion;
-    two_sided.two_sided = true;
-    auto made = ao::Tracer::build(high, two_sided);
-    if (!made) return made.error();
-    depths = std::move(*made);
+}
+
+// Options::maps over one texture target: its texels traced, misses filled, padded.
+Result<TextureBake> trace_target(const TraceContext& context, const Options& options) {
+  const ao::TextureOptions& texture = context.texture;
+  const std::size_t index = context.target_index;
+  auto coverage = ao::texels::cover(context.rays.low, context.target, texture.width, texture.height);
+  if (!coverage) {
+    return Error{"", (context.target.name.empty() ? "texture " + std::to_string(index) : context.target.name) + ": " +
+                         coverage.error().message};
   }
+  const auto& points = coverage->points;
+  std::vector<std::size_t> runs;  // where each mapped texel's points begin, and the end
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (i == 0 || points[i].texel != points[i - 1].texel) runs.push_back(i);
+  }
+  runs.push_back(points.size());
+
+  TextureBake out;
+  const std::size_t texel_count = std::size_t(texture.width) * std::size_t(texture.height);
+  out.width = texture.width, out.height = texture.height;
+  for (Map map : options.maps) {
+    MapImage& image = out.maps.emplace_back();
+    image.map = map, image.channels = channels(map);
+    image.values.resize(texel_count * std::size_t(image.channels));
+    background(image);
+  }
+  out.hit.assign(texel_count, 0);
+  out.texels = runs.size() - 1;
+  // A texel's sums live only while it is traced (a map's worth of doubles per texel, kept for
+  // all, cost more to clear than the one-ray trace itself); its counts are kept for the report.
+  std::vector<TexelTally> tallies(runs.size() - 1);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, tallies.size(), 64), [&](const tbb::blocked_range<std::size_t>& range) {
+    for (std::size_t r = range.begin(); r != range.end(); ++r) {
+      TexelSum sum;
+      for (std::size_t i = runs[r]; i < runs[r + 1]; ++i) {
+        const std::uint64_t key = ao::sample_key(options.seed, index, points[i].texel) ^ (std::uint64_t(i - runs[r]) << 32);
+        trace_point(context, points[i], key, sum);
+      }
+      if (sum.hits > 0) store(sum, options, points[runs[r]].texel, out);
+      tallies[r] = {sum.height, sum.occlusion_rays + sum.thickness_rays, sum.hits, sum.rays};
+    }
+  });
+  std::vector<bool> hit(texel_count, false), traced(texel_count, false);
+  tally(tallies, runs, points, out, hit, traced);
+  // Only where a texel missed every ray: the nearest-hit transform is over the whole texture.
+  const std::vector<std::int64_t> nearest_hit =
+      out.missed_texels ? ao::texels::nearest_mapped(hit, texture.width, texture.height) : std::vector<std::int64_t>{};
+  for (MapImage& image : out.maps) {
+    fill_missed(image, nearest_hit, hit, traced);
+    out.padded = ao::texels::pad_channels(image.values, image.channels, traced, texture.width, texture.height,
+                                          ao::padding_for(texture));
+  }
+  return out;
+}
+
+}  // namespace
+
+Result<Bake> bake(const scene::Scene& low, const scene::Scene& high, const std::vector<ao::TextureTarget>& targets,
+                  const ao::TextureOptions& texture, const Options& options, const ao::Options& occlusion,
+                  const std::vector<BaseColor>& base_colors, const scene::Scene* cage) {
+  if (Status s = check(options); !s) return s.error();
+  if (cage) {
+    if (const std::string why = cage_mismatch(low, *cage); !why.empty()) return Error{"", "the cage " + why, true};
+  }
+  if (Status s = ao::check(texture, kMaxTexelSamples, "bake"); !s) return s.error();
+  const auto in = [](const std::vector<Map>& maps, Map map) { return std::ranges::find(maps, map) != maps.end(); };
+  const auto asked = [&](Map map) { return in(options.maps, map); };
+  const auto asked_per_vertex = [&](Map map) { return in(options.vertex_maps, map); };
+  const bool occluding = asked(Map::ao) || asked(Map::bent_normal) || asked_per_vertex(Map::ao);
+  const bool thickness = asked(Map::thickness) || asked_per_vertex(Map::thickness);
+  if (occluding || thickness) {
+    if (Status s = ao::check(occlusion); !s) return s.error();
+  }
+  const auto start = Clock::now();
+  auto frames = target_frames(low, options.maps.empty() ? std::vector<ao::TextureTarget>{} : targets);
+  if (!frames) return frames.error();
+  auto tracers = build_tracers(high, occluding, thickness, occlusion);
+  if (!tracers) return tracers.error();
   Bake result;
   std::tie(result.front, result.back) = cage_distances(low, options, cage);
   result.setup_seconds = seconds_since(start);
 
   const std::vector<int> primitives = primitive_numbers(high);
   const auto trace_start = Clock::now();
-  const std::size_t texel_count = std::size_t(texture.width) * std::size_t(texture.height);
-  for (std::size_t index = 0; index < targets.size(); ++index) {
-    const ao::TextureTarget& target = targets[index];
-    auto coverage = ao::texels::cover(low, target, texture.width, texture.height);
-    if (!coverage) return Error{"", (target.name.empty() ? "texture " + std::to_string(index) : target.name) + ": " +
-                                        coverage.error().message};
-    const auto& points = coverage->points;
-    std::vector<std::size_t> runs;  // where each mapped texel's points begin, and the end
-    for (std::size_t i = 0; i < points.size(); ++i) {
-      if (i == 0 || points[i].texel != points[i - 1].texel) runs.push_back(i);
-    }
-    runs.push_back(points.size());
-
-    TextureBake& out = result.textures.emplace_back();
-    out.width = texture.width, out.height = texture.height;
-    for (Map map : options.maps) {
-      MapImage& image = out.maps.emplace_back();
-      image.map = map, image.channels = channels(map);
-      image.values.resize(texel_count * std::size_t(image.channels));
-      background(image);
-    }
-    out.hit.assign(texel_count, 0);
-    out.texels = runs.size() - 1;
-    const TraceContext context{low,
-                               frames,
-                               **built,
-                               target,
-                               texture,
-                               float(cage_distances(low, options).first),  // the extrusion's, where a cage touches
-                               float(result.back),
-                               cage,
-                               asked(Map::curvature),
-                               occluder.get(),
-                               asked(Map::bent_normal),
-                               depths.get(),
-                               occlusion.samples,
-                               occlusion.seed,
-                               index,
-                               asked(Map::transfer) ? &base_colors : nullptr,
-                               options.id_by == IdSource::primitive ? &primitives : nullptr};
-    // A texel's sums live only while it is traced (a map's worth of doubles per texel, kept for
-    // all, cost more to clear than the one-ray trace itself); its counts are kept for the report.
-    std::vector<TexelTally> tallies(runs.size() - 1);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, tallies.size(), 64), [&](const tbb::blocked_range<std::size_t>& range) {
-      for (std::size_t r = range.begin(); r != range.end(); ++r) {
-        TexelSum sum;
-        for (std::size_t i = runs[r]; i < runs[r + 1]; ++i) {
-          const std::uint64_t key =
-              ao::sample_key(options.seed, index, points[i].texel) ^ (std::uint64_t(i - runs[r]) << 32);
-          trace_point(context, points[i], key, sum);
-        }
-        if (sum.hits > 0) store(sum, options, points[runs[r]].texel, out);
-        tallies[r] = {sum.height, sum.occlusion_rays + sum.thickness_rays, sum.hits, sum.rays};
-      }
-    });
-    std::vector<bool> hit(texel_count, false), traced(texel_count, false);
-    bool first = true;
-    for (std::size_t r = 0; r < tallies.size(); ++r) {
-      const std::size_t texel = points[runs[r]].texel;
-      traced[texel] = true;
-      out.samples += std::size_t(tallies[r].rays);
-      out.occlusion_rays += tallies[r].occlusion_rays;
-      out.misses += std::size_t(tallies[r].rays - tallies[r].hits);
-      if (tallies[r].hits == 0) {
-        ++out.missed_texels;
-        continue;
-      }
-      hit[texel] = true;
-      out.hit[texel] = 1;
-      const double h = tallies[r].height / tallies[r].hits;
-      out.height_min = first ? h : std::min(out.height_min, h);
-      out.height_max = first ? h : std::max(out.height_max, h);
-      first = false;
-    }
-    // Only where a texel missed every ray: the nearest-hit transform is over the whole texture.
-    const std::vector<std::int64_t> nearest_hit =
-        out.missed_texels ? ao::texels::nearest_mapped(hit, texture.width, texture.height) : std::vector<std::int64_t>{};
-    for (MapImage& image : out.maps) {
-      fill_missed(image, nearest_hit, hit, traced);
-      out.padded = ao::texels::pad_channels(image.values, image.channels, traced, texture.width, texture.height,
-                                            ao::padding_for(texture));
-    }
+  // Each pass's rays read only the tracers and inputs its maps need.
+  const Rays texel_rays{low,
+                        *tracers->high,
+                        float(cage_distances(low, options).first),  // the extrusion's, where a cage touches
+                        float(result.back),
+                        cage,
+                        asked(Map::curvature),
+                        asked(Map::ao) || asked(Map::bent_normal) ? tracers->occluder.get() : nullptr,
+                        asked(Map::bent_normal),
+                        asked(Map::thickness) ? tracers->depths.get() : nullptr,
+                        occlusion.samples,
+                        occlusion.seed,
+                        asked(Map::transfer) ? &base_colors : nullptr,
+                        options.id_by == IdSource::primitive ? &primitives : nullptr};
+  for (std::size_t index = 0; index < targets.size() && !options.maps.empty(); ++index) {
+    auto traced = trace_target(TraceContext{texel_rays, *frames, targets[index], texture, index}, options);
+    if (!traced) return traced.error();
+    result.textures.push_back(std::move(*traced));
+  }
+  if (!options.vertex_maps.empty()) {
+    const Rays vertex_rays{low,
+                           *tracers->high,
+                           texel_rays.front,
+                           texel_rays.back,
+                           cage,
+                           asked_per_vertex(Map::curvature),
+                           asked_per_vertex(Map::ao) ? tracers->occluder.get() : nullptr,
+                           false,
+                           asked_per_vertex(Map::thickness) ? tracers->depths.get() : nullptr,
+                           occlusion.samples,
+                           occlusion.seed,
+                           nullptr,
+                           nullptr};
+    result.vertices = bake_vertices(vertex_rays, options.vertex_maps);
   }
   result.trace_seconds = seconds_since(trace_start);
   return result;
