@@ -15,7 +15,8 @@ CLI::App* setup_bake(CLI::App& app, BakeSettings& s) {
       "Bake a high-poly mesh onto a low-poly one's UVs (docs/bake.md): per texel, rays from a cage around the\n"
       "low-poly along its normal find the high-poly; its normal in the low-poly's tangent basis (the TANGENT\n"
       "written, MikkTSpace where the file has none) becomes the material's normalTexture, AO its\n"
-      "occlusionTexture; the other maps are written as float EXR files beside the output.");
+      "occlusionTexture; the other maps are written as float EXR files beside the output. --vertex-maps\n"
+      "bakes AO, thickness, curvature or height per low-poly vertex into attributes instead (_AO or COLOR_0, ...).");
   cmd->add_option("low", s.low, "The low-poly .gltf or .glb (its UVs take the maps)")->required();
   cmd->add_option("--from", s.high, "The high-poly .gltf or .glb")->required();
   cmd->add_option("--cage", s.cage,
@@ -46,6 +47,12 @@ int run_bake(const BakeSettings& s, const GlobalOptions& global) {
                   escape_control(t.name).c_str(), t.width, t.height, t.texels, t.samples, t.misses, t.missed_texels);
       if (t.height_max > t.height_min) std::printf(", height %.4g to %.4g", t.height_min, t.height_max);
       std::printf("\n");
+    }
+    if (!report->vertices.attributes.empty()) {
+      std::string attributes;
+      for (const std::string& a : report->vertices.attributes) attributes += (attributes.empty() ? "" : ", ") + a;
+      std::printf("  vertices: %zu, %zu missed%s, written as %s\n", report->vertices.vertices, report->vertices.misses,
+                  report->vertices.misses ? " (each filled from its neighbours)" : "", attributes.c_str());
     }
     std::printf("%s: %zu textures, cage %.4g out / %.4g in, tangents on %zu primitives (%zu vertices split), %.2f s "
                 "(trace %.2f s)\n",

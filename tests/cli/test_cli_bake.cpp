@@ -1,6 +1,6 @@
 // `matbake bake` end to end: every Khronos model of ../shared baked from itself onto its 10%
 // simplification (validator-clean, TANGENT on every baked primitive, equal to three.js's MikkTSpace
-// port where the low-poly had none), the bundled example baked onto itself (a flat normal map where
+// port where the low-poly had none, per-vertex AO and curvature on every vertex), the bundled example baked onto itself (a flat normal map where
 // the surfaces coincide: the 8-bit codes of (0, 0, 1)), and bad requests refused.
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -8,6 +8,7 @@
 #include <fstream>
 
 #include "lib/src/bake/frames.hpp"
+#include "lib/src/gltf/document.hpp"
 #include "matbake/bake.hpp"
 #include "matbake/image.hpp"
 #include "matbake/scene.hpp"
@@ -74,7 +75,8 @@ TEST(CliBake, EveryKhronosModelOntoItsSimplificationIsValidatorCleanWithMikkTSpa
     const fs::path low = dir / (name + "_low.glb"), out = dir / (name + "_baked.glb");
     write_simplified(high, low, 0.1);
     const auto r = matbake({"--json", "bake", low.string(), "--from", high.string(), "-o", out.string(), "--size", "64",
-                            "--texel-samples", "1", "--maps", "normal,ao,transfer", "--ao-samples", "4"});
+                            "--texel-samples", "1", "--maps", "normal,ao,transfer", "--ao-samples", "4",
+                            "--vertex-maps", "ao,curvature"});
     if (r.exit_code != 0) {  // a model without a material over UVs has nothing to bake onto: said so
       EXPECT_NE(r.err.find("no material of the low-poly can take baked maps"), std::string::npos) << name << ": " << r.err;
       continue;
@@ -90,6 +92,9 @@ TEST(CliBake, EveryKhronosModelOntoItsSimplificationIsValidatorCleanWithMikkTSpa
     ASSERT_TRUE(before && after) << name;
     ASSERT_EQ(before->instances.size(), after->instances.size()) << name;
     const auto echoed = nlohmann::json::parse(r.out);
+    std::size_t vertices = 0;  // each placement's, all given _AO and _CURVATURE (the validator: as many as the rest)
+    for (const scene::Instance& inst : before->instances) vertices += inst.positions.size();
+    EXPECT_EQ(echoed["vertices"]["vertices"], vertices) << name;
     for (std::size_t k = 0; k < after->instances.size(); ++k) {
       const scene::Instance& inst = after->instances[k];
       if (inst.material < 0 || inst.texcoords.empty()) continue;
@@ -173,6 +178,80 @@ TEST(CliBake, TheExampleOntoItselfGivesTheFlatNormalMapAndAoAndTheSameBytesForAn
   EXPECT_TRUE(file_bytes(dir / "one/baked.glb") == file_bytes(dir / "two/baked.glb"));
   EXPECT_TRUE(file_bytes(dir / "one/baked_wood_height.exr") == file_bytes(dir / "two/baked_wood_height.exr"));
   EXPECT_TRUE(file_bytes(dir / "one/baked_wood_bent_normal.exr") == file_bytes(dir / "two/baked_wood_bent_normal.exr"));
+}
+
+// Per-vertex maps through the file. The low-poly: a 3 × 2 grid of the plane z = 0 over
+// [−1, 1] × [0, 1] whose UVs mirror at x = 0 (u = |x|: its middle vertices need two tangents each,
+// so the normal map splits them), with COLOR_0. The high-poly: the plane z = h(x, y) =
+// 0.02 + 0.01 x + 0.005 y, to x = 1.5 where a wall stands. Every written vertex, the split copies
+// too, holds h at its position as _HEIGHT (the extrusion's ray along −z meets the plane there), and
+// the _AO of its original (same position); a bake with --vertex-ao-into COLOR_0 writes the file's
+// colour times that AO (the same seed, the same rays). Tolerance: float32 at magnitude 1.
+TEST(CliBake, VertexMapsAreAttributesThatSplitVerticesCarryAndColoursMultiply) {
+  TempDir dir;
+  const auto h = [](double x, double y) { return 0.02 + 0.01 * x + 0.005 * y; };
+  {
+    GltfBuilder b;
+    std::vector<float> p, n, uv, colors;
+    for (int row = 0; row < 2; ++row) {
+      for (int col = 0; col < 3; ++col) {
+        const float x = float(col - 1), y = float(row);
+        p.insert(p.end(), {x, y, 0}), n.insert(n.end(), {0, 0, 1}), uv.insert(uv.end(), {std::abs(x), 1 - y});
+        colors.insert(colors.end(), {(x + 1) / 2, 0.5f, 1 - y});
+      }
+    }
+    const int mesh = b.add_mesh(b.add_vec3(p), b.add_indices({0, 1, 4, 0, 4, 3, 1, 2, 5, 1, 5, 4}), 4, b.add_vec3(n));
+    auto& primitive = b.doc["meshes"][0]["primitives"][0];
+    primitive["attributes"]["TEXCOORD_0"] = b.add_floats(uv, "VEC2", 2);
+    primitive["attributes"]["COLOR_0"] = b.add_floats(colors, "VEC3", 3);
+    primitive["material"] = 0;
+    b.doc["materials"] = {{{"name", "plane"}}};
+    b.write(dir / "low.gltf", {b.add_node({{"mesh", mesh}})});
+  }
+  {
+    GltfBuilder b;
+    const std::vector<float> floor = {-3, -3, float(h(-3, -3)), 1.5f, -3, float(h(1.5, -3)), 1.5f, 3, float(h(1.5, 3)), -3, 3, float(h(-3, 3))};
+    const std::vector<float> wall = {1.5f, -1e4f, -1, 1.5f, -1e4f, 1e4f, 1.5f, 1e4f, 1e4f, 1.5f, 1e4f, -1};
+    const int a = b.add_mesh(b.add_vec3(floor), b.add_indices({0, 1, 2, 0, 2, 3}));
+    const int c = b.add_mesh(b.add_vec3(wall), b.add_indices({0, 1, 2, 0, 2, 3}));
+    b.write(dir / "high.gltf", {b.add_node({{"mesh", a}}), b.add_node({{"mesh", c}})});
+  }
+  const std::vector<std::string> common = {"bake", (dir / "low.gltf").string(), "--from", (dir / "high.gltf").string(),
+                                           "--front", "0.1", "--back", "0.1", "--absolute-cage", "--size", "16",
+                                           "--ao-samples", "64", "--ao-max-distance", "100", "--ao-falloff", "none"};
+  std::vector<std::string> with_normal = common, with_colour = common;
+  with_normal.insert(with_normal.end(), {"--json", "--maps", "normal", "--vertex-maps", "height,ao", "-o", (dir / "a.glb").string()});
+  with_colour.insert(with_colour.end(), {"--maps", "none", "--vertex-maps", "ao", "--vertex-ao-into", "COLOR_0", "-o", (dir / "b.glb").string()});
+  const auto r = matbake(with_normal);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto report = nlohmann::json::parse(r.out.substr(r.out.find('{')));
+  EXPECT_GT(report["split_vertices"].get<int>(), 0) << "the mirrored UVs split no vertex: the test tests nothing";
+  EXPECT_EQ(report["vertices"]["attributes"], nlohmann::json({"_HEIGHT", "_AO"}));
+  const auto rc = matbake(with_colour);
+  ASSERT_EQ(rc.exit_code, 0) << rc.err;
+  MATBAKE_VALIDATE_OR_SKIP(validated, dir / "a.glb");
+  EXPECT_EQ(validated->errors, 0) << validated->summary;
+
+  const gltf::Document a = read_output(dir / "a.glb"), b = read_output(dir / "b.glb");
+  const auto& attributes = a.json["meshes"][0]["primitives"][0]["attributes"];
+  const std::vector<float> positions = float_accessor(a, attributes["POSITION"]), height = float_accessor(a, attributes["_HEIGHT"]);
+  const std::vector<float> ao = float_accessor(a, attributes["_AO"]);
+  const std::vector<float> colored = float_accessor(b, b.json["meshes"][0]["primitives"][0]["attributes"]["COLOR_0"]);
+  ASSERT_EQ(height.size(), positions.size() / 3);
+  ASSERT_GT(height.size(), 6u);
+  ASSERT_EQ(colored.size(), 6u * 3);
+  double least_ao = 1;
+  for (std::size_t v = 0; v < height.size(); ++v) {
+    const float x = positions[3 * v], y = positions[3 * v + 1];
+    EXPECT_NEAR(height[v], h(x, y), 1e-6) << "vertex " << v;
+    const std::size_t original = std::size_t(y) * 3 + std::size_t(x + 1);  // the grid vertex at (x, y)
+    EXPECT_EQ(ao[v], ao[original]) << "vertex " << v;
+    least_ao = std::min(least_ao, double(ao[v]));
+    if (v >= 6) continue;
+    const float colour[3] = {(x + 1) / 2, 0.5f, 1 - y};
+    for (int k = 0; k < 3; ++k) EXPECT_EQ(colored[3 * v + std::size_t(k)], colour[k] * ao[v]) << "vertex " << v;
+  }
+  EXPECT_LT(least_ao, 0.9) << "the wall occludes nothing: the COLOR_0 check tests nothing";
 }
 
 TEST(CliBake, BadRequestsAreOneErrorLineAndWriteNothing) {

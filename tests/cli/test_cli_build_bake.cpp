@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include <map>
+#include <set>
 
 #include "lib/src/gltf/document.hpp"
 #include "support/files.hpp"
@@ -157,6 +158,49 @@ TEST(CliBuildBake, ACageMeshIsAnInputOfTheBake) {
   EXPECT_NE(changed.job["reason"].get<std::string>().find("cage.gltf"), std::string::npos) << changed.job.dump();
   EXPECT_TRUE(reused(changed).empty());
   EXPECT_TRUE(differing(changed, first).empty());
+}
+
+// Vertex maps through a build: attributes on every primitive of the exported scene (AO as COLOR_0
+// here), validator-clean; a change to them alone traces only the vertices, reading every texture
+// map back (their keys do not hold the vertex parameters).
+TEST(CliBuildBake, VertexMapsReachTheExportedSceneAndAChangeToThemReadsTheTexturesBack) {
+  TempDir dir;
+  for (const char* f : {"showroom.gltf", "showroom.bin"}) fs::copy_file(kExamples / f, dir / f);
+  const auto run = [&](const std::string& vertex_maps) {
+    write_bytes(dir / "m.toml", "output = \"out\"\n[scenes.s]\ninput = \"showroom.gltf\"\noutput = \"s.glb\"\n"
+                                "bake = { from = \"showroom.gltf\", maps = [\"normal\", \"ao\"], size = 16, vertex_maps = \"" +
+                                    vertex_maps + "\", vertex_ao_into = \"COLOR_0\", ao = { samples = 4 } }\n");
+    const RunResult r = matbake({"--json", "build", (dir / "m.toml").string()});
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    return json::parse(r.out, nullptr, false)["jobs"][0];
+  };
+  const json first = run("curvature,ao");
+  EXPECT_EQ(first["details"]["bake"]["reused"], json::array());
+  EXPECT_EQ(first["details"]["bake"]["vertices"]["attributes"], json({"_CURVATURE", "COLOR_0"}));
+  const auto attributes_of_every_primitive = [&] {
+    std::set<std::string> common;
+    const json doc = gltf::read_document(dir / "out/s.glb")->json;
+    bool first_primitive = true;
+    for (const auto& mesh : doc["meshes"]) {
+      for (const auto& primitive : mesh["primitives"]) {
+        std::set<std::string> names;
+        for (const auto& [name, accessor] : primitive["attributes"].items()) names.insert(name);
+        if (first_primitive) common = names;
+        std::erase_if(common, [&](const std::string& n) { return !names.count(n); });
+        first_primitive = false;
+      }
+    }
+    return common;
+  };
+  EXPECT_TRUE(attributes_of_every_primitive().count("_CURVATURE"));
+  EXPECT_TRUE(attributes_of_every_primitive().count("COLOR_0"));
+  MATBAKE_VALIDATE_OR_SKIP(report, dir / "out/s.glb");
+  EXPECT_EQ(report->errors, 0) << report->summary;
+
+  const json second = run("curvature");
+  EXPECT_EQ(second["outcome"], "built");
+  EXPECT_EQ(second["details"]["bake"]["reused"], json({"normal", "ao"}));
+  EXPECT_FALSE(attributes_of_every_primitive().count("COLOR_0"));
 }
 
 TEST(CliBuildBake, BadBakesFailTheirJobNamingTheManifestsLine) {

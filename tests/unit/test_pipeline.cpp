@@ -216,6 +216,10 @@ TEST(BuildManifest, ErrorsSayWhereAndWhat) {
       {"[scenes.s]\ninput = \"a.gltf\"\nbake = \"h.glb\"\n", "m.toml:3:", "scenes.s.bake must be a table"},
       {"[scenes.s]\ninput = \"a.gltf\"\nao = { samples = 4 }\nbake = { from = \"h.glb\", maps = \"normal,ao\" }\n",
        "m.toml:3:", "the export's ao and the bake's ao map would both make the occlusion"},
+      {"[scenes.s]\ninput = \"a.gltf\"\nao = { samples = 4 }\nbake = { from = \"h.glb\", vertex_maps = [\"ao\"] }\n",
+       "m.toml:3:", "keep one (drop `ao`, or ao from bake.vertex_maps)"},
+      {"[scenes.s]\ninput = \"a.gltf\"\nbake = { from = \"h.glb\", vertex_maps = [\"ao\", \"normal\"] }\n", "m.toml:3:",
+       "scenes.s.bake.vertex_maps: vertex maps among ao, thickness, curvature, height"},
   };
   for (const Case& c : cases) {
     auto m = pipeline::parse_manifest(c.text, "m.toml");

@@ -16,7 +16,8 @@ namespace matbake::bake {
 struct Request {
   Options bake;
   ao::TextureOptions texture{.width = 1024, .height = 1024, .padding = -1, .texel_samples = 4};
-  ao::Request occlusion;  // the ao and bent_normal maps' estimator: its `options` (ao_params.hpp's estimator_params)
+  ao::Request occlusion;  // the ao, bent_normal and thickness maps' estimator: its `options` (ao_params.hpp's estimator_params)
+  ao::Into vertex_ao_into = ao::Into::attribute;  // where per-vertex AO goes (the other vertex maps: _THICKNESS, ...)
 };
 
 struct FileOptions {
@@ -41,8 +42,14 @@ struct TextureReport {
                                    // ("", "normal replaced", "occlusion replaced", both)
 };
 
+struct VertexReport {
+  std::size_t vertices = 0, misses = 0, occlusion_rays = 0;  // of the low-poly instances
+  std::vector<std::string> attributes;                       // written, per vertex map asked
+};
+
 struct FileReport {
   std::vector<TextureReport> textures;
+  VertexReport vertices;               // with vertex maps
   std::size_t tangent_primitives = 0;  // primitives given TANGENT
   std::size_t split_vertices = 0;      // vertices added where corners needed different tangents
   double front = 0, back = 0;          // the cage, scene units

@@ -44,38 +44,6 @@ Param<Request> texture_size() {
           }};
 }
 
-// COLOR_0 or _AO, and what happens to a primitive's own COLOR_0: two names, one ao::Into.
-Param<Request> into_attribute() {
-  Spec spec{.name = "into",
-            .kind = params::Kind::choice,
-            .help = "Per-vertex values as COLOR_0 (multiplies the base colour in any viewer) or _AO (a float attribute)",
-            .choices = {"COLOR_0", "_AO"},
-            .example = "_AO",
-            .excludes = {"texture"}};
-  return {std::move(spec),
-          [](Request& r, const Value& v) -> std::optional<std::string> {
-            r.into = *into_from_names(std::get<std::string>(v), into_existing_colors_name(r.into));
-            return std::nullopt;
-          },
-          [](const Request& r) { return nlohmann::json(std::string(into_attribute_name(r.into))); }};
-}
-
-Param<Request> existing_colors() {
-  Spec spec{.name = "existing_colors",
-            .kind = params::Kind::choice,
-            .help = "With COLOR_0, a primitive's own COLOR_0: multiply (kept, times AO; alpha kept) or replace",
-            .choices = {"multiply", "replace"},
-            .example = "replace",
-            .needs = {{"into", "COLOR_0"}},
-            .excludes = {"texture"}};
-  return {std::move(spec),
-          [](Request& r, const Value& v) -> std::optional<std::string> {
-            if (r.into != Into::attribute) r.into = *into_from_names("COLOR_0", std::get<std::string>(v));
-            return std::nullopt;
-          },
-          [](const Request& r) { return nlohmann::json(std::string(into_existing_colors_name(r.into))); }};
-}
-
 Param<Request> existing_occlusion() {
   Spec spec{.name = "existing_occlusion",
             .kind = params::Kind::choice,
@@ -153,8 +121,18 @@ params::Group<Request> make_group() {
          return std::nullopt;
        },
        [](const Request& r) { return nlohmann::json(!r.options.watertight); }},
-      into_attribute(),
-      existing_colors(),
+      into_attribute<Request>(Spec{.name = "into",
+                                   .help = "Per-vertex values as COLOR_0 (multiplies the base colour in any viewer) or "
+                                           "_AO (a float attribute)",
+                                   .example = "_AO",
+                                   .excludes = {"texture"}},
+                              &Request::into),
+      into_existing<Request>(Spec{.name = "existing_colors",
+                                  .help = "With COLOR_0, a primitive's own COLOR_0: multiply (kept, times AO; alpha "
+                                          "kept) or replace",
+                                  .example = "replace",
+                                  .excludes = {"texture"}},
+                             "into", &Request::into),
       texture_size(),
       params::integer<Request>(Spec{.name = "texcoord",
                                     .help = "UV set of the texture (-1: the material's occlusionTexture texCoord, else 0)",

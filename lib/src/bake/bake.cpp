@@ -350,6 +350,30 @@ void fill_missed(const scene::Instance& inst, std::vector<std::uint8_t> hit, std
   }
 }
 
+// A vertex's cage ray, or where it misses, the ray of a point a hair inside each triangle using the
+// vertex (in order) until one hits: at an open border of the high-poly that the low-poly shares (a
+// bake onto itself, a simplification keeping its borders), a ray through the border's vertex misses
+// as often as it hits, as a texel's through its edge does. `low` becomes the point that hit.
+std::optional<CageHit> cast_at_vertex(const Rays& c, std::size_t instance, std::uint32_t vertex, const std::vector<scene::Vec3>& normals,
+                                      const std::vector<std::uint32_t>& triangles, LowPoint& low) {
+  const scene::Instance& inst = c.low.instances[instance];
+  low = {inst.positions[vertex], glm::dmat3(glm::dvec3(0), glm::dvec3(0), glm::dvec3(normals[vertex]))};  // no tangents read
+  const std::optional<glm::dvec3> from_cage =
+      c.cage ? std::optional(glm::dvec3(c.cage->instances[instance].positions[vertex])) : std::nullopt;
+  if (auto hit = cast(c, low, from_cage)) return hit;
+  for (std::uint32_t t : triangles) {
+    const auto& corners = inst.triangles[t];
+    glm::dvec3 w(0);
+    for (int k = 0; k < 3; ++k) w[k] = corners[std::size_t(k)] == vertex ? 1.0 : 0.0;
+    w = inside(w);
+    glm::dvec3 p(0), n(0);
+    for (int k = 0; k < 3; ++k) p += w[k] * glm::dvec3(inst.positions[corners[std::size_t(k)]]), n += w[k] * glm::dvec3(normals[corners[std::size_t(k)]]);
+    low = {glm::vec3(p), glm::dmat3(glm::dvec3(0), glm::dvec3(0), glm::length(n) > 0 ? glm::normalize(n) : n)};
+    if (auto hit = cast(c, low, cage_point(c, instance, t, w))) return hit;
+  }
+  return std::nullopt;
+}
+
 // Options::vertex_maps at every vertex of every low instance (VertexBake); `c` holds the tracers
 // those maps need and no others.
 VertexBake bake_vertices(const Rays& c, const std::vector<Map>& maps) {
@@ -362,14 +386,17 @@ VertexBake bake_vertices(const Rays& c, const std::vector<Map>& maps) {
     const std::vector<scene::Vec3> normals = ao::shading_normals(inst);
     const std::vector<float> edges = from_hit ? ao::mean_edge_lengths(inst) : std::vector<float>{};
     const std::size_t n = inst.positions.size();
+    std::vector<std::vector<std::uint32_t>> triangles_of(n);
+    for (std::uint32_t t = 0; t < inst.triangles.size(); ++t) {
+      for (std::uint32_t v : inst.triangles[t]) triangles_of[v].push_back(t);
+    }
     for (std::size_t m = 0; m < maps.size(); ++m) out.values[m][k].assign(n, background(maps[m], 0));
     std::vector<std::uint8_t> hit(n, 0);
     std::vector<std::uint64_t> rays(n, 0);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 256), [&](const tbb::blocked_range<std::size_t>& range) {
       for (std::size_t v = range.begin(); v != range.end(); ++v) {
-        // A vertex needs no tangent basis: only the normal's column is read.
-        const LowPoint low{inst.positions[v], glm::dmat3(glm::dvec3(0), glm::dvec3(0), glm::dvec3(normals[v]))};
-        const auto cage_hit = cast(c, low, c.cage ? std::optional(glm::dvec3(c.cage->instances[k].positions[v])) : std::nullopt);
+        LowPoint low;
+        const auto cage_hit = cast_at_vertex(c, k, std::uint32_t(v), normals, triangles_of[v], low);
         if (!cage_hit) continue;
         TexelSum sum;
         add_hit(c, *cage_hit, low, sum);
@@ -419,8 +446,8 @@ std::vector<int> primitive_numbers(const scene::Scene& scene) {
 }
 
 Status check(const Options& options) {
-  if (options.maps.empty() && options.vertex_maps.empty()) return Error{"", "a bake needs at least one map", true};
-  if (!std::ranges::all_of(options.vertex_maps, per_vertex)) return Error{"", "the vertex maps are ao, thickness, curvature and height", true};
+  if (options.maps.empty() && options.vertex_maps.empty()) return Error{"", "a bake needs at least one map: " + mention("maps") + " or " + mention("vertex_maps"), true};
+  if (!std::ranges::all_of(options.vertex_maps, per_vertex)) return Error{"", mention("vertex_maps") + " are among ao, thickness, curvature and height", true};
   if (!(options.front >= 0) || !(options.back >= 0) || !std::isfinite(options.front) || !std::isfinite(options.back) ||
       options.front + options.back <= 0) {
     return Error{"", "the cage distances must be finite, 0 or more, and not both 0", true};

@@ -1,5 +1,6 @@
 // `matbake bake`: the low-poly document read once, its scene and the high-poly's, the maps baked per
 // material, written into the document (normalTexture, TANGENT) and beside it (float maps).
+#include <cctype>
 #include <chrono>
 #include <map>
 #include <set>
@@ -8,6 +9,7 @@
 #include "../gltf/tangents.hpp"
 #include "../gltf/texture_files.hpp"
 #include "../gltf/texture_transform.hpp"
+#include "../gltf/vertex_occlusion.hpp"
 #include "../scene/from_document.hpp"
 #include "frames.hpp"
 #include "map_cache.hpp"
@@ -206,6 +208,44 @@ Result<TextureReport> write_maps(gltf::Document& doc, const gltf::ImageCache& ca
   return report;
 }
 
+// The vertex maps into the low-poly's primitives (ao where Request::vertex_ao_into says, the others
+// as _THICKNESS, _CURVATURE, _HEIGHT): per mesh primitive the mean over the nodes placing it (as a
+// texel holds the mean of the placements), written through the first of them.
+void write_vertex_maps(gltf::Document& doc, const scene::Scene& low, const VertexBake& baked, ao::Into ao_into, FileReport& report) {
+  std::map<std::pair<int, int>, std::vector<std::size_t>> placements;  // (mesh, primitive) → instances
+  for (std::size_t k = 0; k < low.instances.size(); ++k) placements[{low.instances[k].mesh, low.instances[k].primitive}].push_back(k);
+  for (const auto& [primitive, instances] : placements) {
+    if (instances.size() > 1) {
+      report.notes.push_back("mesh " + std::to_string(primitive.first) +
+                             " is placed by several nodes; its vertices hold the mean of the placements");
+    }
+  }
+  for (std::size_t m = 0; m < baked.maps.size(); ++m) {
+    std::vector<std::vector<float>> means;
+    std::vector<gltf::PlacedValues> placed;
+    means.reserve(placements.size());
+    for (const auto& [primitive, instances] : placements) {
+      std::vector<float>& mean = means.emplace_back(baked.values[m][instances[0]].size(), 0.0f);
+      for (std::size_t k : instances) {
+        for (std::size_t v = 0; v < mean.size(); ++v) mean[v] += baked.values[m][k][v] / float(instances.size());
+      }
+      const scene::Instance& first = low.instances[instances[0]];
+      placed.push_back({first.node, first.primitive, mean, first.colors, first.colors_have_alpha});
+    }
+    std::string name(matbake::name_in(kMapNames, baked.maps[m]));
+    if (baked.maps[m] == Map::ao) {
+      gltf::add_vertex_occlusion(doc, placed, ao_into);
+      report.vertices.attributes.emplace_back(ao::into_attribute_name(ao_into));
+      continue;
+    }
+    std::transform(name.begin(), name.end(), name.begin(), [](unsigned char c) { return char(std::toupper(c)); });
+    gltf::add_vertex_scalars(doc, placed, "_" + name);
+    report.vertices.attributes.push_back("_" + name);
+  }
+  report.vertices.vertices = baked.vertices, report.vertices.misses = baked.misses;
+  report.vertices.occlusion_rays = baked.occlusion_rays;
+}
+
 // The files a glTF is read from (itself, its buffers and images); none when its JSON cannot be
 // read (its loading then says why).
 std::vector<fs::path> files_of(const fs::path& gltf) {
@@ -257,19 +297,21 @@ Result<Bake> bake_or_reuse(const scene::Scene& low, const Targets& targets, cons
     if (!kept[i]) to_trace.push_back(maps[i]);
   }
   std::optional<std::vector<TextureBake>> counts;
-  if (to_trace.empty()) {
+  if (to_trace.empty() && !maps.empty()) {
     counts = load_trace(options.keep, trace_key, targets.targets.size());
     if (!counts) to_trace = maps, kept.assign(maps.size(), std::nullopt);  // kept maps without their trace's counts
   }
   Bake out;
-  if (!to_trace.empty()) {
+  // The vertex maps are traced every time: one ray a vertex, not worth a kept file.
+  if (!to_trace.empty() || !options.request.bake.vertex_maps.empty()) {
     auto traced = trace_maps(low, targets, options, to_trace);
     if (!traced) return traced.error();
-    if (keeping) {
+    if (keeping && !to_trace.empty()) {
       std::vector<std::pair<Map, std::string>> keys;
       for (Map m : to_trace) keys.emplace_back(m, map_key(inputs, m, options.request, targets_text));
       if (Status s = store_maps(options.keep, traced->textures, trace_key, keys); !s) return s.error();
     }
+    if (counts) traced->textures = std::move(*counts);  // every texture map kept: only the vertices traced
     out = std::move(*traced);
   } else {
     out.textures = std::move(*counts);
@@ -325,7 +367,8 @@ Result<FileReport> bake_file(const fs::path& low_path, const FileOptions& option
     if (!doc) return doc.error();
     auto low = scene::scene_from_document(*doc, {.texcoords = true, .object_space = true});
     if (!low) return low.error();
-    auto targets = material_targets(*doc, *low);
+    // Vertex maps alone need no UVs: no texture targets.
+    auto targets = options.request.bake.maps.empty() ? Result<Targets>(Targets{}) : material_targets(*doc, *low);
     if (!targets) return targets.error();
 
     std::vector<NamedOutput> outputs = {{options.output, "glTF output"}};
@@ -366,6 +409,8 @@ Result<FileReport> bake_file(const fs::path& low_path, const FileOptions& option
       }
       report.textures.push_back(std::move(*written));
     }
+    // Before the tangents: a vertex they split gathers these attributes with the others.
+    if (!options.request.bake.vertex_maps.empty()) write_vertex_maps(*doc, *low, baked->vertices, options.request.vertex_ao_into, report);
     if (normal) {
       if (Status s = write_tangents(*doc, *low, *targets, report); !s) return s.error();
     }

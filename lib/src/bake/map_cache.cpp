@@ -55,7 +55,8 @@ bool text_at(const nlohmann::json& j, const char* key, const std::string& expect
 
 nlohmann::json map_parameters(std::optional<Map> map, const Request& request) {
   nlohmann::json p = params::to_json(request_params(), request);
-  p.erase("maps");  // another map asked or dropped changes none of the others
+  // Another map asked or dropped changes none of the others; the vertex maps are never kept.
+  for (const char* unread : {"maps", "vertex_maps", "vertex_ao_into", "vertex_existing_colors"}) p.erase(unread);
   const bool tangent = map == Map::normal || map == Map::bent_normal;
   if (!tangent) p.erase("green");
   if (map != Map::id) p.erase("id_by");

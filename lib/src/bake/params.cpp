@@ -13,35 +13,51 @@ using params::Spec;
 using params::Value;
 constexpr double kUnbounded = HUGE_VAL;
 
-// "normal,height": the maps, each once, in the order given.
+// "normal,height": maps, each once, in the order given ("none": no map), of those `allowed` takes.
+std::optional<std::string> read_maps(const std::string& text, bool (*allowed)(Map), const std::string& which, std::vector<Map>& out) {
+  std::vector<Map> chosen;
+  for (std::size_t start = 0; text != "none" && start <= text.size();) {
+    const std::size_t comma = std::min(text.find(',', start), text.size());
+    const auto map = value_in(kMapNames, std::string_view(text).substr(start, comma - start));
+    if (!map || !allowed(*map)) return which + ", comma-separated, or none";
+    if (std::find(chosen.begin(), chosen.end(), *map) != chosen.end()) return "each map once";
+    chosen.push_back(*map);
+    start = comma + 1;
+  }
+  out = std::move(chosen);
+  return std::nullopt;
+}
+std::string maps_text(const std::vector<Map>& maps) {
+  std::string text;
+  for (Map m : maps) {
+    if (!text.empty()) text += ',';  // appended: GCC 12 -O3 misreads `"," + std::string` (report_page.cpp)
+    text += name_in(kMapNames, m);
+  }
+  return text.empty() ? "none" : text;
+}
+bool any_map(Map) { return true; }
+
 Param<Request> maps() {
   Spec spec{.name = "maps",
             .kind = params::Kind::text,
-            .help = "The maps to bake, comma-separated: " + names_in(kMapNames),
+            .help = "The texture maps to bake, comma-separated (or none): " + names_in(kMapNames),
             .example = "normal,height"};
   return {std::move(spec),
-          [](Request& r, const Value& v) -> std::optional<std::string> {
-            const std::string& text = std::get<std::string>(v);
-            std::vector<Map> chosen;
-            for (std::size_t start = 0; start <= text.size();) {
-              const std::size_t comma = std::min(text.find(',', start), text.size());
-              const auto map = value_in(kMapNames, std::string_view(text).substr(start, comma - start));
-              if (!map) return "maps among " + names_in(kMapNames) + ", comma-separated";
-              if (std::find(chosen.begin(), chosen.end(), *map) != chosen.end()) return "each map once";
-              chosen.push_back(*map);
-              start = comma + 1;
-            }
-            r.bake.maps = std::move(chosen);
-            return std::nullopt;
+          [](Request& r, const Value& v) { return read_maps(std::get<std::string>(v), any_map, "maps among " + names_in(kMapNames), r.bake.maps); },
+          [](const Request& r) { return nlohmann::json(maps_text(r.bake.maps)); }};
+}
+
+Param<Request> vertex_maps() {
+  Spec spec{.name = "vertex_maps",
+            .kind = params::Kind::text,
+            .help = "Maps baked per low-poly vertex into attributes (_AO, _THICKNESS, _CURVATURE, _HEIGHT), "
+                    "comma-separated: ao, thickness, curvature, height",
+            .example = "ao,curvature"};
+  return {std::move(spec),
+          [](Request& r, const Value& v) {
+            return read_maps(std::get<std::string>(v), per_vertex, "vertex maps among ao, thickness, curvature, height", r.bake.vertex_maps);
           },
-          [](const Request& r) {
-            std::string text;
-            for (Map m : r.bake.maps) {
-              if (!text.empty()) text += ',';  // appended: GCC 12 -O3 misreads `"," + std::string` (report_page.cpp)
-              text += name_in(kMapNames, m);
-            }
-            return nlohmann::json(text);
-          }};
+          [](const Request& r) { return nlohmann::json(maps_text(r.bake.vertex_maps)); }};
 }
 
 Param<Request> size() {
@@ -65,6 +81,17 @@ params::Group<Request> make_group() {
   params::Group<Request> g;
   g.params = {
       maps(),
+      vertex_maps(),
+      ao::into_attribute<Request>(Spec{.name = "vertex_ao_into",
+                                       .help = "Per-vertex AO as _AO (a float attribute) or COLOR_0 (multiplies the "
+                                               "base colour in any viewer)",
+                                       .example = "COLOR_0"},
+                                  &Request::vertex_ao_into),
+      ao::into_existing<Request>(Spec{.name = "vertex_existing_colors",
+                                      .help = "With COLOR_0, a primitive's own COLOR_0: multiply (kept, times AO; alpha "
+                                              "kept) or replace",
+                                      .example = "replace"},
+                                 "vertex_ao_into", &Request::vertex_ao_into),
       params::number<Request>(Spec{.name = "front",
                                    .help = "How far outside the low-poly the rays start: a fraction of its bounding-box "
                                            "diagonal (scene units with absolute_cage)",

@@ -6,12 +6,13 @@
 
 namespace matbake::gltf {
 
-void add_vertex_occlusion(Document& doc, std::span<const PlacedValues> placed, ao::Into into) {
-  Json& json = doc.json;
+namespace {
 
-  // The mesh each node writes into: the original for the first node placing it, a copy for every
-  // further one. The node's mesh is read from the document, which may have been pruned (meshes
-  // renumbered, nodes not) since the values were computed.
+// The mesh each node's values go into: the original for the first node placing it, a copy for every
+// further one (made here). The node's mesh is read from the document, which may have been pruned
+// (meshes renumbered, nodes not) since the values were computed.
+std::map<int, int> meshes_of_nodes(Document& doc, std::span<const PlacedValues> placed) {
+  Json& json = doc.json;
   std::map<int, int> owner_of_mesh;  // mesh → the node that keeps it
   std::map<int, int> mesh_of_node;   // node → the mesh its values go into
   for (const PlacedValues& p : placed) {
@@ -26,20 +27,35 @@ void add_vertex_occlusion(Document& doc, std::span<const PlacedValues> placed, a
     json["nodes"][std::size_t(p.node)]["mesh"] = copy;
     mesh_of_node[p.node] = copy;
   }
+  return mesh_of_node;
+}
 
+// The attributes of a primitive gaining per-vertex values: written uncompressed if it was Draco's.
+Json& attributes_of(Document& doc, int mesh, int primitive) {
+  if (uncompress_draco_primitive(doc, std::size_t(mesh), std::size_t(primitive))) {
+    doc.decoded.notes.push_back("mesh " + std::to_string(mesh) + " primitive " + std::to_string(primitive) +
+                                ": written uncompressed (KHR_draco_mesh_compression dropped), as its vertices gained values");
+  }
+  return doc.json["meshes"][std::size_t(mesh)]["primitives"][std::size_t(primitive)]["attributes"];
+}
+
+}  // namespace
+
+void add_vertex_scalars(Document& doc, std::span<const PlacedValues> placed, const std::string& attribute) {
+  const std::map<int, int> mesh_of_node = meshes_of_nodes(doc, placed);
+  for (const PlacedValues& p : placed) {
+    if (p.values.empty()) continue;
+    attributes_of(doc, mesh_of_node.at(p.node), p.primitive)[attribute] =
+        add_float_accessor(doc, {p.values.begin(), p.values.end()}, p.values.size(), "SCALAR");
+  }
+}
+
+void add_vertex_occlusion(Document& doc, std::span<const PlacedValues> placed, ao::Into into) {
+  if (into == ao::Into::attribute) return add_vertex_scalars(doc, placed, "_AO");
+  const std::map<int, int> mesh_of_node = meshes_of_nodes(doc, placed);
   for (const PlacedValues& p : placed) {
     const std::span<const float> w = p.values;
     if (w.empty()) continue;
-    const std::size_t mesh = std::size_t(mesh_of_node.at(p.node));
-    if (uncompress_draco_primitive(doc, mesh, std::size_t(p.primitive))) {
-      doc.decoded.notes.push_back("mesh " + std::to_string(mesh) + " primitive " + std::to_string(p.primitive) +
-                                  ": written uncompressed (KHR_draco_mesh_compression dropped), as its vertices gained occlusion");
-    }
-    Json& attributes = json["meshes"][std::size_t(mesh_of_node.at(p.node))]["primitives"][std::size_t(p.primitive)]["attributes"];
-    if (into == ao::Into::attribute) {
-      attributes["_AO"] = add_float_accessor(doc, {w.begin(), w.end()}, w.size(), "SCALAR");
-      continue;
-    }
     const bool multiply = into == ao::Into::color_multiply && !p.colors.empty();
     const bool alpha = multiply && p.colors_have_alpha;
     const std::size_t components = alpha ? 4 : 3;
@@ -48,7 +64,7 @@ void add_vertex_occlusion(Document& doc, std::span<const PlacedValues> placed, a
       for (std::size_t c = 0; c < 3; ++c) colors[v * components + c] = multiply ? p.colors[v][int(c)] * w[v] : w[v];
       if (alpha) colors[v * components + 3] = p.colors[v].a;
     }
-    attributes["COLOR_0"] = add_float_accessor(doc, colors, w.size(), alpha ? "VEC4" : "VEC3");
+    attributes_of(doc, mesh_of_node.at(p.node), p.primitive)["COLOR_0"] = add_float_accessor(doc, colors, w.size(), alpha ? "VEC4" : "VEC3");
   }
 }
 

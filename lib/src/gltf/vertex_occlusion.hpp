@@ -5,6 +5,7 @@
 #include <glm/vec4.hpp>
 
 #include <span>
+#include <string>
 
 #include "document.hpp"
 #include "matbake/ao.hpp"  // ao::Into: the option's public name
@@ -20,5 +21,8 @@ struct PlacedValues {
 };
 
 void add_vertex_occlusion(Document& doc, std::span<const PlacedValues> placed, ao::Into into);
+
+// The same placements' values as `attribute` (one float per vertex, "_THICKNESS"): its colours unused.
+void add_vertex_scalars(Document& doc, std::span<const PlacedValues> placed, const std::string& attribute);
 
 }  // namespace matbake::gltf

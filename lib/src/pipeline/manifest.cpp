@@ -520,11 +520,12 @@ Status read_scene_bake(const Reader& r, const toml::table& t, const std::string&
   if (!spec.bake || spec.bake->from.empty()) return r.at(*node, where + ".bake: from = \"high.glb\" is required");
   spec.bake->high = m.folder / spec.bake->from;
   spec.bake->cage = spec.bake->cage_file.empty() ? fs::path() : m.folder / spec.bake->cage_file;
-  const auto& maps = spec.bake->request.bake.maps;
-  if (spec.options.ao && std::find(maps.begin(), maps.end(), bake::Map::ao) != maps.end()) {
+  for (const auto* maps : {&spec.bake->request.bake.maps, &spec.bake->request.bake.vertex_maps}) {
+    if (!spec.options.ao || std::find(maps->begin(), maps->end(), bake::Map::ao) == maps->end()) continue;
+    const char* key = maps == &spec.bake->request.bake.maps ? "maps" : "vertex_maps";
     const toml::node* ao = t.get("ao");
     return r.at(ao ? *ao : *node, where + ": the export's ao and the bake's ao map would both make the occlusion; "
-                                  "keep one (drop `ao`, or ao from bake.maps)");
+                                  "keep one (drop `ao`, or ao from bake." + key + ")");
   }
   return success();
 }

@@ -169,7 +169,9 @@ nlohmann::json to_json(const bake::FileReport& r) {
   }
   return {{"front", r.front}, {"back", r.back}, {"textures", textures}, {"tangent_primitives", r.tangent_primitives},
           {"split_vertices", r.split_vertices}, {"seconds", r.seconds}, {"setup_seconds", r.setup_seconds},
-          {"trace_seconds", r.trace_seconds}, {"notes", r.notes}, {"written", r.written}, {"reused", r.reused}};
+          {"trace_seconds", r.trace_seconds}, {"notes", r.notes}, {"written", r.written}, {"reused", r.reused},
+          {"vertices", {{"vertices", r.vertices.vertices}, {"misses", r.vertices.misses},
+                        {"occlusion_rays", r.vertices.occlusion_rays}, {"attributes", r.vertices.attributes}}}};
 }
 
 }  // namespace matbake
