@@ -10,19 +10,23 @@
 //     compares each IMAGE with REFERENCE over the texels whose centre a triangle of LOW's UV set 0
 //     covers (padding and empty texels left out), every value rounded to 8 bits first (as it is
 //     delivered): normal maps by the angle between decoded directions (mean and 99th percentile,
-//     degrees), scalar maps (the first channel) by RMSE and the largest difference.
+//     degrees), scalar maps (the first channel) by RMSE and the largest difference;
+//   bake_pairs psnr REFERENCE.png RENDER.png
+//     the PSNR of a render against another over what either shows (the runtime tests' measure).
 #include <OpenImageIO/imageio.h>
 #include <glm/geometric.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <exception>
 #include <filesystem>
 #include <string>
 #include <vector>
 
 #include "matbake/scene.hpp"
 #include "tests/support/gltf_builder.hpp"
+#include "tests/support/render_psnr.hpp"
 #include "tests/support/shapes.hpp"
 
 namespace fs = std::filesystem;
@@ -226,6 +230,16 @@ int main(int argc, char** argv) {
   if (args.size() >= 5 && args[0] == "error" && (args[1] == "normal" || args[1] == "scalar")) {
     return compare(args[1] == "normal", args[2], args[3], {args.begin() + 4, args.end()});
   }
-  std::fprintf(stderr, "usage: bake_pairs write DIR | bake_pairs error normal|scalar LOW.gltf REFERENCE IMAGE...\n");
+  if (args.size() == 3 && args[0] == "psnr") {
+    try {
+      std::printf("%.2f\n", test::render_psnr(args[1], args[2]));
+      return 0;
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "bake_pairs: %s\n", e.what());
+      return 1;
+    }
+  }
+  std::fprintf(stderr, "usage: bake_pairs write DIR | bake_pairs error normal|scalar LOW.gltf REFERENCE IMAGE... | "
+                       "bake_pairs psnr REFERENCE.png RENDER.png\n");
   return 2;
 }

@@ -88,6 +88,40 @@ for p in "${pairs[@]}"; do
 done
 echo
 
+# In three.js (tests/runtime/render.mjs, as the runtime tests): the low-poly bare, with matbake's
+# one-ray and 4-position normal maps, and with Blender's (its EXR as the same 8-bit linear PNG, in a
+# copy of matbake's output: the same TANGENT, MikkTSpace as Blender's own), each render's PSNR
+# against the high-poly's, mean of the three views.
+if bash "$root/scripts/install-runtime.sh" >/dev/null 2>&1; then
+  echo "### In three.js: render PSNR against the high-poly's (dB, mean of three views), normal maps of 1024²"
+  echo
+  echo "| pair | low-poly bare | matbake, 1 ray | matbake, 4 positions | Blender, 1 sample |"
+  echo "|---|---|---|---|---|"
+  for p in "${pairs[@]}"; do
+    read -r pair front back <<<"$p"
+    rm -rf "${work:?}/${pair}_normal_blender_gltf" && cp -r "$work/${pair}_normal_m1" "$work/${pair}_normal_blender_gltf"
+    "$matbake" convert "$work/${pair}_normal_blender.exr" --from linear --to linear --bits 8 \
+      -o "$(ls "$work/${pair}_normal_blender_gltf"/*_normal.png)" >/dev/null
+    rm -rf "${work:?}/${pair}_renders"
+    node "$root/tests/runtime/render.mjs" --out "$work/${pair}_renders" --size 512 high="$work/${pair}_high.gltf" \
+      bare="$work/${pair}_low.gltf" m1="$work/${pair}_normal_m1/out.gltf" m4="$work/${pair}_normal_m4/out.gltf" \
+      blender="$work/${pair}_normal_blender_gltf/out.gltf" >/dev/null
+    row="| $pair"
+    for model in bare m1 m4 blender; do
+      sum=0
+      for view in fit near far; do
+        sum=$(echo "$sum $("$pairs_tool" psnr "$work/${pair}_renders/high-$view.png" "$work/${pair}_renders/$model-$view.png")" | awk '{print $1 + $2}')
+      done
+      row="$row | $(echo "$sum" | awk '{printf "%.2f", $1 / 3}')"
+    done
+    echo "$row |"
+  done
+  echo
+else
+  echo "(three.js in Chromium could not be installed here: no render comparison)"
+  echo
+fi
+
 echo "### Binary AO (distance $ao_distance), 256², against matbake at 16 positions × 4096 rays a texel"
 echo
 echo "| pair | rays a texel | matbake (s) | Blender (s) | faster | matbake error: RMSE, largest | Blender error |"

@@ -12,6 +12,8 @@
 #include <utility>
 #include <vector>
 
+#include "support/render_psnr.hpp"  // the renders compared
+
 namespace matbake::test {
 
 // One material slot as three.js loaded it.
@@ -40,10 +42,6 @@ inline const std::vector<std::string> kRuntimeViews = {"fit", "near", "far"};
 std::optional<std::map<std::string, RuntimeModel>> render_in_three(
     const std::filesystem::path& folder, const std::vector<std::pair<std::string, std::filesystem::path>>& models,
     std::string& why_not);
-
-// PSNR (dB) of render `test` against `reference` over the pixels where either is not the
-// background (the top-left pixel of the reference): 8-bit RGB, peak 255. Infinity when equal.
-double render_psnr(const std::filesystem::path& reference, const std::filesystem::path& test);
 
 // What Chromium shows of an HTML page (tests/runtime/check_page.mjs): console messages, each image's
 // src and natural size, section ids, headings, script count (also left beside the page as
