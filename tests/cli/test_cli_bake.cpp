@@ -254,6 +254,60 @@ TEST(CliBake, VertexMapsAreAttributesThatSplitVerticesCarryAndColoursMultiply) {
   EXPECT_LT(least_ao, 0.9) << "the wall occludes nothing: the COLOR_0 check tests nothing";
 }
 
+// --per-instance: one quad mesh placed by nodes A (at the origin) and B (moved by 10 along x) over a
+// high-poly plane at z = 0.02 under A and 0.05 under B. Each placement gets its own mesh and
+// material copy, TANGENT on both, and its own maps: every texel of A's height map and every
+// _HEIGHT of A's vertices 0.02, B's 0.05. Without it, one texture and one set of vertices hold
+// the placements' mean, 0.035. Tolerance: float32 at magnitude 10.
+TEST(CliBake, PerInstanceGivesEachPlacementItsOwnMapsAndVertexValues) {
+  TempDir dir;
+  {
+    GltfBuilder b;
+    const int quad = b.add_mesh(b.add_vec3({-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0}), b.add_indices({0, 1, 2, 0, 2, 3}), 4,
+                                b.add_vec3({0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1}));
+    auto& primitive = b.doc["meshes"][0]["primitives"][0];
+    primitive["attributes"]["TEXCOORD_0"] = b.add_floats({0, 1, 1, 1, 1, 0, 0, 0}, "VEC2", 2);
+    primitive["material"] = 0;
+    b.doc["materials"] = {{{"name", "quad"}}};
+    b.write(dir / "low.gltf", {b.add_node({{"mesh", quad}, {"name", "A"}}),
+                               b.add_node({{"mesh", quad}, {"name", "B"}, {"translation", {10, 0, 0}}})});
+  }
+  {
+    GltfBuilder b;
+    const int a = b.add_mesh(b.add_vec3({-2, -2, 0.02f, 2, -2, 0.02f, 2, 2, 0.02f, -2, 2, 0.02f}), b.add_indices({0, 1, 2, 0, 2, 3}));
+    const int c = b.add_mesh(b.add_vec3({8, -2, 0.05f, 12, -2, 0.05f, 12, 2, 0.05f, 8, 2, 0.05f}), b.add_indices({0, 1, 2, 0, 2, 3}));
+    b.write(dir / "high.gltf", {b.add_node({{"mesh", a}}), b.add_node({{"mesh", c}})});
+  }
+  for (const bool per_instance : {true, false}) {
+    const fs::path out = dir / (per_instance ? "each.gltf" : "mean.gltf");
+    std::vector<std::string> args = {"--json", "bake", (dir / "low.gltf").string(), "--from", (dir / "high.gltf").string(),
+                                     "--maps", "normal,height", "--vertex-maps", "height", "--front", "0.1", "--back", "0.1",
+                                     "--absolute-cage", "--size", "8", "-o", out.string()};
+    if (per_instance) args.push_back("--per-instance");
+    const auto r = matbake(args);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    MATBAKE_VALIDATE_OR_SKIP(validated, out);
+    EXPECT_EQ(validated->errors, 0) << validated->summary;
+    const auto report = nlohmann::json::parse(r.out);
+    const gltf::Document doc = read_output(out);
+    ASSERT_EQ(report["textures"].size(), per_instance ? 2u : 1u);
+    for (const auto& t : report["textures"]) {
+      const std::string name = t["name"];
+      const double want = !per_instance ? 0.035 : name == "quad" ? 0.02 : 0.05;
+      auto height = image::read_image(t["files"][1].get<std::string>(), color::Transfer::linear);
+      ASSERT_TRUE(height) << name;
+      for (float v : height->pixels) ASSERT_NEAR(v, want, 1e-6) << name;
+    }
+    for (const auto& node : doc.json["nodes"]) {
+      const auto& attributes = doc.json["meshes"][node["mesh"].get<std::size_t>()]["primitives"][0]["attributes"];
+      EXPECT_TRUE(attributes.contains("TANGENT")) << node["name"];
+      const double want = !per_instance ? 0.035 : node["name"] == "A" ? 0.02 : 0.05;
+      for (float v : float_accessor(doc, attributes["_HEIGHT"])) EXPECT_NEAR(v, want, 1e-6) << node["name"];
+    }
+    EXPECT_EQ(doc.json["meshes"].size(), per_instance ? 2u : 1u);
+  }
+}
+
 TEST(CliBake, BadRequestsAreOneErrorLineAndWriteNothing) {
   TempDir dir;
   const fs::path scene = kExamples / "showroom.gltf";

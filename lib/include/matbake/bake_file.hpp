@@ -18,6 +18,9 @@ struct Request {
   ao::TextureOptions texture{.width = 1024, .height = 1024, .padding = -1, .texel_samples = 4};
   ao::Request occlusion;  // the ao, bent_normal and thickness maps' estimator: its `options` (ao_params.hpp's estimator_params)
   ao::Into vertex_ao_into = ao::Into::attribute;  // where per-vertex AO goes (the other vertex maps: _THICKNESS, ...)
+  // A mesh placed by several nodes: its texels and vertices hold the mean of the placements (false),
+  // or each placement gets its own copy of the mesh and material and its own maps (true).
+  bool per_instance = false;
 };
 
 struct FileOptions {

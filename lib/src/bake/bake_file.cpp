@@ -8,6 +8,7 @@
 
 #include "../gltf/tangents.hpp"
 #include "../gltf/texture_files.hpp"
+#include "../gltf/placements.hpp"
 #include "../gltf/texture_transform.hpp"
 #include "../gltf/vertex_occlusion.hpp"
 #include "../scene/from_document.hpp"
@@ -25,6 +26,7 @@ using gltf::Json;
 struct Targets {
   std::vector<ao::TextureTarget> targets;
   std::vector<int> materials;  // each target's
+  std::vector<int> nodes;      // with per_instance, the node placing each target's instances; else -1
   std::vector<std::string> notes;
 };
 
@@ -34,14 +36,15 @@ int normal_texcoord(const Json& material) {
   return gltf::integer_in<int>(material["normalTexture"], "texCoord", 0, 0);
 }
 
-// One target per material the low-poly's instances use, when every one of them has its UV set.
-Result<Targets> material_targets(const gltf::Document& doc, const scene::Scene& low) {
+// One target per material the low-poly's instances use (per placing node too with `per_instance`),
+// when every one of them has its UV set.
+Result<Targets> material_targets(const gltf::Document& doc, const scene::Scene& low, bool per_instance) {
   const Json& materials = gltf::array_in(doc.json, "materials");
-  std::map<int, std::vector<std::size_t>> by_material;
+  std::map<std::pair<int, int>, std::vector<std::size_t>> by_material;  // (material, node or -1) → instances
   Targets out;
   for (std::size_t k = 0; k < low.instances.size(); ++k) {
     const int m = low.instances[k].material;
-    if (m >= 0 && std::size_t(m) < materials.size()) by_material[m].push_back(k);
+    if (m >= 0 && std::size_t(m) < materials.size()) by_material[{m, per_instance ? low.instances[k].node : -1}].push_back(k);
   }
   if (std::size_t without = low.instances.size() - [&] {
         std::size_t n = 0;
@@ -50,10 +53,12 @@ Result<Targets> material_targets(const gltf::Document& doc, const scene::Scene& 
       }()) {
     out.notes.push_back(std::to_string(without) + " placed primitives have no material: nothing baked onto them");
   }
-  for (const auto& [m, instances] : by_material) {
+  for (const auto& [key, instances] : by_material) {
+    const auto [m, node] = key;
     const Json& material = materials[std::size_t(m)];
     ao::TextureTarget target{instances, normal_texcoord(material)};
-    target.name = "material " + std::to_string(m) + " '" + gltf::name_in(material, "") + "'";
+    target.name = "material " + std::to_string(m) + " '" + gltf::name_in(material, "") + "'" +
+                  (node >= 0 ? " on node " + std::to_string(node) : "");
     const auto lacking = std::find_if(instances.begin(), instances.end(), [&](std::size_t k) {
       const auto& uv = low.instances[k].texcoords;
       return std::size_t(target.texcoord) >= uv.size() || uv[std::size_t(target.texcoord)].empty();
@@ -73,6 +78,7 @@ Result<Targets> material_targets(const gltf::Document& doc, const scene::Scene& 
       }
     }
     out.materials.push_back(m);
+    out.nodes.push_back(node);
     out.targets.push_back(std::move(target));
   }
   if (out.targets.empty()) return Error{doc.file, "no material of the low-poly can take baked maps (each needs its UV set on all its primitives)"};
@@ -140,10 +146,12 @@ Status write_tangents(gltf::Document& doc, const scene::Scene& low, const Target
   for (const ao::TextureTarget& target : targets.targets) {
     for (std::size_t k : target.instances) {
       const scene::Instance& inst = low.instances[k];
-      if (!inst.object.tangents.empty() || !done.insert({inst.mesh, inst.primitive}).second) continue;
+      // The node's mesh as the document has it now: a placement given its own (per_instance) too.
+      const int mesh = doc.json["nodes"][std::size_t(inst.node)]["mesh"].get<int>();
+      if (!inst.object.tangents.empty() || !done.insert({mesh, inst.primitive}).second) continue;
       auto tangents = corner_tangents(inst, target.texcoord);
       if (!tangents) return tangents.error();
-      gltf::PrimitiveTangents p{inst.mesh, inst.primitive, {}, {}, {}};
+      gltf::PrimitiveTangents p{mesh, inst.primitive, {}, {}, {}};
       const std::vector<glm::vec3> normals = corner_normals(inst);
       for (std::size_t t = 0; t < inst.triangles.size(); ++t) {
         p.triangles.push_back(file_triangle(inst, t));
@@ -163,8 +171,7 @@ Status write_tangents(gltf::Document& doc, const scene::Scene& low, const Target
 
 // The texture target `t`'s maps into the document and beside the output.
 Result<TextureReport> write_maps(gltf::Document& doc, const gltf::ImageCache& cache, const FileOptions& options,
-                                 const Targets& targets, std::size_t t, TextureBake& baked) {
-  const int m = targets.materials[t];
+                                 const Targets& targets, std::size_t t, int m, TextureBake& baked) {
   Json& material = doc.json["materials"][std::size_t(m)];
   TextureReport report;
   report.material = m;
@@ -210,13 +217,18 @@ Result<TextureReport> write_maps(gltf::Document& doc, const gltf::ImageCache& ca
 
 // The vertex maps into the low-poly's primitives (ao where Request::vertex_ao_into says, the others
 // as _THICKNESS, _CURVATURE, _HEIGHT): per mesh primitive the mean over the nodes placing it (as a
-// texel holds the mean of the placements), written through the first of them.
-void write_vertex_maps(gltf::Document& doc, const scene::Scene& low, const VertexBake& baked, ao::Into ao_into, FileReport& report) {
-  std::map<std::pair<int, int>, std::vector<std::size_t>> placements;  // (mesh, primitive) → instances
-  for (std::size_t k = 0; k < low.instances.size(); ++k) placements[{low.instances[k].mesh, low.instances[k].primitive}].push_back(k);
+// texel holds the mean of the placements), written through the first of them; with per_instance,
+// each placement's own (its mesh copied where another node placed it first).
+void write_vertex_maps(gltf::Document& doc, const scene::Scene& low, const VertexBake& baked, ao::Into ao_into, bool per_instance,
+                       FileReport& report) {
+  std::map<std::tuple<int, int, int>, std::vector<std::size_t>> placements;  // (mesh, primitive, node or -1) → instances
+  for (std::size_t k = 0; k < low.instances.size(); ++k) {
+    const scene::Instance& inst = low.instances[k];
+    placements[{inst.mesh, inst.primitive, per_instance ? inst.node : -1}].push_back(k);
+  }
   for (const auto& [primitive, instances] : placements) {
     if (instances.size() > 1) {
-      report.notes.push_back("mesh " + std::to_string(primitive.first) +
+      report.notes.push_back("mesh " + std::to_string(std::get<0>(primitive)) +
                              " is placed by several nodes; its vertices hold the mean of the placements");
     }
   }
@@ -285,7 +297,8 @@ Result<Bake> bake_or_reuse(const scene::Scene& low, const Targets& targets, cons
   const ao::TextureOptions& texture = options.request.texture;
   std::string targets_text;
   for (std::size_t t = 0; t < targets.targets.size(); ++t) {
-    targets_text += std::to_string(targets.materials[t]) + ":" + std::to_string(targets.targets[t].texcoord) + " ";
+    targets_text += std::to_string(targets.materials[t]) + "@" + std::to_string(targets.nodes[t]) + ":" +
+                    std::to_string(targets.targets[t].texcoord) + " ";
   }
   const bool keeping = !options.keep.empty() && !inputs.empty();
   const std::string trace_key = keeping ? map_key(inputs, std::nullopt, options.request, targets_text) : "";
@@ -368,12 +381,14 @@ Result<FileReport> bake_file(const fs::path& low_path, const FileOptions& option
     auto low = scene::scene_from_document(*doc, {.texcoords = true, .object_space = true});
     if (!low) return low.error();
     // Vertex maps alone need no UVs: no texture targets.
-    auto targets = options.request.bake.maps.empty() ? Result<Targets>(Targets{}) : material_targets(*doc, *low);
+    auto targets = options.request.bake.maps.empty() ? Result<Targets>(Targets{}) : material_targets(*doc, *low, options.request.per_instance);
     if (!targets) return targets.error();
 
+    // Each target's material: with per_instance, a placement's own copy (and its mesh's).
+    const std::vector<int> into = gltf::split_placements(*doc, *low, targets->materials, targets->nodes);
     std::vector<NamedOutput> outputs = {{options.output, "glTF output"}};
     const Json& materials = doc->json["materials"];
-    for (int m : targets->materials) {
+    for (int m : into) {
       for (Map map : options.request.bake.maps) {
         if (material_slot(map)) continue;
         outputs.push_back({float_map_file(options.output, gltf::material_file_name(materials[std::size_t(m)], m), map),
@@ -400,7 +415,7 @@ Result<FileReport> bake_file(const fs::path& low_path, const FileOptions& option
                         options.request.bake.maps.end();
     gltf::ImageCache cache(*doc, options.encoding, gltf::MadeFormat::png);
     for (std::size_t t = 0; t < targets->targets.size(); ++t) {
-      auto written = write_maps(*doc, cache, options, *targets, t, baked->textures[t]);
+      auto written = write_maps(*doc, cache, options, *targets, t, into[t], baked->textures[t]);
       if (!written) return written.error();
       for (std::size_t i = 0; i < options.request.bake.maps.size(); ++i) {
         if (material_slot(options.request.bake.maps[i])) continue;
@@ -410,7 +425,9 @@ Result<FileReport> bake_file(const fs::path& low_path, const FileOptions& option
       report.textures.push_back(std::move(*written));
     }
     // Before the tangents: a vertex they split gathers these attributes with the others.
-    if (!options.request.bake.vertex_maps.empty()) write_vertex_maps(*doc, *low, baked->vertices, options.request.vertex_ao_into, report);
+    if (!options.request.bake.vertex_maps.empty()) {
+      write_vertex_maps(*doc, *low, baked->vertices, options.request.vertex_ao_into, options.request.per_instance, report);
+    }
     if (normal) {
       if (Status s = write_tangents(*doc, *low, *targets, report); !s) return s.error();
     }

@@ -121,6 +121,11 @@ params::Group<Request> make_group() {
                                     .help = "Rays per texel, stratified over its footprint (anti-aliasing)",
                                     .min = 1, .max = 1024, .example = "16"},
                                [](auto& r) -> auto& { return r.texture.texel_samples; }),
+      params::flag<Request>(Spec{.name = "per_instance",
+                                 .help = "A mesh placed by several nodes: each placement its own mesh and material copy "
+                                         "and its own maps (default: averaged)",
+                                 .example = "true"},
+                            [](auto& r) -> auto& { return r.per_instance; }),
       params::integer<Request>(Spec{.name = "seed", .help = "Scrambling seed of the texel positions",
                                     .min = 0, .max = 9007199254740992.0, .example = "3"},
                                [](auto& r) -> auto& { return r.bake.seed; }),

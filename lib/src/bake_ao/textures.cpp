@@ -5,6 +5,7 @@
 #include <set>
 
 #include "../gltf/texture_files.hpp"
+#include "../gltf/placements.hpp"
 #include "../gltf/texture_transform.hpp"
 
 namespace matbake::bake_ao {
@@ -63,44 +64,6 @@ std::string primitive_without_uvs(const Json& json, int m, int texcoord) {
     }
   }
   return "";
-}
-
-// --per-instance: each target's node gets its own copy of the material (the first placement of a
-// material keeps the original), and its own copy of the mesh when an earlier node placed that mesh
-// (sharing every accessor), so that each placement's primitives name their own material. Returns
-// the material each target's texture goes into.
-std::vector<int> split_placements(gltf::Document& doc, const scene::Scene& scene, const OcclusionTargets& targets) {
-  Json& json = doc.json;
-  std::vector<int> into = targets.materials;
-  std::set<int> split_nodes(targets.nodes.begin(), targets.nodes.end());
-  split_nodes.erase(-1);
-  if (split_nodes.empty()) return into;
-  std::map<int, int> owner_of_mesh, mesh_of_node;
-  for (const scene::Instance& inst : scene.instances) {  // scene order: the first placement keeps the mesh
-    if (!split_nodes.contains(inst.node) || mesh_of_node.contains(inst.node)) continue;
-    const int mesh = json["nodes"][std::size_t(inst.node)]["mesh"].get<int>();
-    if (owner_of_mesh.try_emplace(mesh, inst.node).second) {
-      mesh_of_node[inst.node] = mesh;
-      continue;
-    }
-    json["meshes"].push_back(json["meshes"][std::size_t(mesh)]);
-    mesh_of_node[inst.node] = int(json["meshes"].size()) - 1;
-    json["nodes"][std::size_t(inst.node)]["mesh"] = mesh_of_node[inst.node];
-  }
-  std::set<int> kept;
-  for (std::size_t t = 0; t < into.size(); ++t) {
-    const int m = targets.materials[t], node = targets.nodes[t];
-    if (node < 0 || kept.insert(m).second) continue;
-    Json copy = json["materials"][std::size_t(m)];
-    const std::string node_name = gltf::name_in(json["nodes"][std::size_t(node)], "node " + std::to_string(node));
-    copy["name"] = gltf::name_in(copy, "material " + std::to_string(m)) + " (" + node_name + ")";
-    json["materials"].push_back(std::move(copy));
-    into[t] = int(json["materials"].size()) - 1;
-    for (Json& primitive : json["meshes"][std::size_t(mesh_of_node.at(node))]["primitives"]) {
-      if (gltf::integer_in<int>(primitive, "material", -1, -1) == m) primitive["material"] = into[t];
-    }
-  }
-  return into;
 }
 
 }  // namespace
@@ -183,7 +146,7 @@ Result<std::vector<TextureReport>> bake_occlusion_textures(gltf::Document& doc, 
     if (error.path.empty() && !error.usage) error.path = doc.file;
     return error;
   }
-  const std::vector<int> materials = split_placements(doc, scene, targets);
+  const std::vector<int> materials = gltf::split_placements(doc, scene, targets.materials, targets.nodes);
   std::vector<TextureReport> reports;
   for (std::size_t t = 0; t < targets.targets.size(); ++t) {
     const int m = materials[t];
