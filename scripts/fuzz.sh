@@ -13,7 +13,7 @@ set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 testdata=$root/../shared/testdata
 build=$root/build-fuzz
-targets=(image gltf glb manifest layout materials ktx2 state scripts)
+targets=(image gltf glb manifest layout materials ktx2 state cache scripts)
 
 if [ $# -lt 2 ]; then
   echo "usage: scripts/fuzz.sh TARGET|--smoke SECONDS [libFuzzer flags...]  (targets: ${targets[*]})" >&2
@@ -75,6 +75,8 @@ run() {  # target, seconds, extra flags
     ktx2) seeds=$(seed ktx2 -name '*.ktx2') ;;
     # State files as a build writes them (tests/fuzz/regressions/state: a stamp and a made.json).
     state) seeds=$(seed state -name '*.json' -path '*regressions*') ;;
+    # The caches' files (tests/fuzz/regressions/cache: an entry's header, a kept-map index).
+    cache) seeds=$(seed cache -path '*regressions/cache*') ;;
     scripts) seeds=$(seed scripts -name '*.txt' -path '*regressions*') ;;
     *) echo "scripts/fuzz.sh: unknown target '$target' (${targets[*]})" >&2; exit 2 ;;
   esac

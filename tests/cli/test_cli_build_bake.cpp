@@ -114,6 +114,12 @@ TEST(CliBuildBake, ASceneIsBakedThenExportedAndOnlyWhatAChangeDecidesIsTracedAga
   const Built garbled = build(dir.path(), "out", maps, 8);
   EXPECT_TRUE(reused(garbled).empty());
   EXPECT_TRUE(differing(garbled, fresh8).empty()) << differing(garbled, fresh8).front();
+  // An index of the wrong shape (JSON, but `maps` a number): the same (it failed the job before).
+  write_bytes(dir / "out/.matbake/bake/scene-s/kept/maps.json", "{\"form\": 1, \"maps\": 3, \"trace\": []}");
+  const Built shaped = build(dir.path(), "out", maps, 4);
+  EXPECT_TRUE(reused(shaped).empty());
+  EXPECT_TRUE(differing(shaped, first).empty()) << differing(shaped, first).front();
+  EXPECT_EQ(reused(build(dir.path(), "out", maps, 8)), (std::vector<std::string>{"normal", "height"}));
 
   // A change to the high-poly (here also the low-poly) traces every map again.
   write_bytes(dir / "showroom.gltf", read_bytes(dir / "showroom.gltf") + " ");

@@ -83,7 +83,8 @@ std::string map_key(const std::string& inputs, std::optional<Map> map, const Req
 std::optional<KeptMap> load_map(const fs::path& folder, Map map, const std::string& key, std::size_t targets, int width,
                                 int height) {
   const nlohmann::json index = read_index(folder);
-  const nlohmann::json entry = index.value("maps", nlohmann::json::object()).value(std::string(name_in(kMapNames, map)), nlohmann::json());
+  const nlohmann::json maps = index.value("maps", nlohmann::json::object());  // any JSON at all: checked before it is read
+  const nlohmann::json entry = maps.is_object() ? maps.value(std::string(name_in(kMapNames, map)), nlohmann::json()) : nlohmann::json();
   if (!text_at(entry, "key", key) || !entry.contains("files") || !entry["files"].is_array() || entry["files"].size() != targets) {
     return std::nullopt;
   }
