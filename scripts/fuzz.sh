@@ -4,7 +4,8 @@
 #   scripts/fuzz.sh --smoke SECONDS                        every target for SECONDS each (the test
 #                                                          command's smoke run)
 # Targets: image (our reader over OIIO), gltf and glb (document + flattened scene), manifest,
-# layout, materials, ktx2, state (stamps and made.json through the output gate), scripts (hostile
+# layout, materials, ktx2, state (stamps and made.json through the output gate), cache (the encode
+# cache's entries and the bake's kept-map index), scripts (hostile
 # words through the Ninja and Slurm writers). Seeds: the repository's presets and examples, plus ../shared/testdata when it
 # is there (pngsuite, libpng-testpngs, openexr, the Khronos models), and tests/fuzz/regressions/ (inputs
 # that once failed, and seeds made by other tools; replayed first by every run). The growing corpus stays in

@@ -43,7 +43,8 @@ nlohmann::json read_index(const fs::path& folder) {
   std::string text;
   if (ec || size > kIndexLimit || !read_whole_file(index_file(folder), text)) return nlohmann::json::object();
   nlohmann::json index = nlohmann::json::parse(text, nullptr, false);
-  if (!index.is_object() || index.value("form", 0) != kForm) return nlohmann::json::object();
+  // Compared as JSON: value("form", 0) throws on a form of another type (found by fuzz_cache).
+  if (!index.is_object() || !index.contains("form") || index["form"] != kForm) return nlohmann::json::object();
   return index;
 }
 
