@@ -444,15 +444,16 @@ TEST(CliBakeAo, TexturePerInstance) {
   EXPECT_EQ(doc->json["meshes"][2]["primitives"][0]["material"], 1);
   EXPECT_EQ(doc->json["meshes"][2]["primitives"][0]["attributes"], doc->json["meshes"][0]["primitives"][0]["attributes"]);
 
-  // A name that is not a string (the validator's TYPE_MISMATCH) is no reason to stop: the copy is
-  // named after the material's index.
+  // A name that is not a string (the validator's TYPE_MISMATCH) was copied into the output: the
+  // file is refused as it is read, naming the property (gltf/types.hpp).
   nlohmann::json numbered = nlohmann::json::parse(read_bytes(dir / "twice.gltf"));
   numbered["materials"][0]["name"] = 7;
   write_bytes(dir / "numbered.gltf", numbered.dump());
   args[2] = (dir / "numbered.gltf").string(), args[4] = (dir / "numbered.glb").string();
   r = matbake(args);
-  ASSERT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_EQ(nlohmann::json::parse(r.out)["textures"][1]["name"], "material 0 (open)");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_EQ(r.err, "matbake: error: " + (dir / "numbered.gltf").string() + ": /materials/0/name: 7 is not a string\n");
+  EXPECT_FALSE(fs::exists(dir / "numbered.glb"));
 
   MATBAKE_VALIDATE_OR_SKIP(validated, dir / "each.glb");
   EXPECT_EQ(validated->errors, 0) << validated->summary;

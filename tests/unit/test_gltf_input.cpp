@@ -130,7 +130,80 @@ TEST(GltfInput, EveryOutOfRangeReferenceIsOneErrorWithItsJsonPointer) {
   std::ofstream(dir / "bad.gltf") << doc.dump();
   auto read = gltf::read_document(dir / "bad.gltf");
   ASSERT_FALSE(read);
-  EXPECT_EQ(read.error().message, "/nodes/0/mesh: -1 is not an index (a whole number from 0)");
+  EXPECT_EQ(read.error().message, "/nodes/0/mesh: -1 is not a whole number from 0");  // types.hpp, before the references
+}
+
+// every_kind with the other core properties matbake passes through: a material's factors, modes
+// and texture infos, a node's transform, a sampler's filters, a camera.
+json every_property(const fs::path& folder) {
+  json doc = every_kind(folder);
+  doc["materials"][0].update({{"alphaMode", "MASK"}, {"alphaCutoff", 0.5}, {"doubleSided", true}, {"emissiveFactor", {0, 0.5, 0}},
+                              {"normalTexture", {{"index", 0}, {"scale", 1}, {"texCoord", 0}}}, {"name", "m"}});
+  doc["materials"][0]["pbrMetallicRoughness"].update({{"baseColorFactor", {1, 0.5, 1, 1}}, {"metallicFactor", 0}});
+  doc["nodes"][0].update({{"translation", {1, 2, 3}}, {"rotation", {0, 0, 0, 1}}, {"scale", {1, 1, 1}}, {"camera", 0}});
+  doc["samplers"][0] = {{"magFilter", 9729}, {"minFilter", 9987}, {"wrapS", 33648}, {"wrapT", 10497}};
+  doc["cameras"] = {{{"type", "perspective"}, {"perspective", {{"yfov", 0.8}, {"znear", 0.1}}}}};
+  doc["extensionsUsed"] = json::array();
+  return doc;
+}
+
+// Every place of `j` below the root, as JSON pointers, with where each holds.
+void places_in(const json& j, const json::json_pointer& at, std::vector<json::json_pointer>& out) {
+  if (!at.empty()) out.push_back(at);
+  if (j.is_object()) {
+    for (const auto& [key, value] : j.items()) places_in(value, at / key, out);
+  } else if (j.is_array()) {
+    for (std::size_t i = 0; i < j.size(); ++i) places_in(j[i], at / i, out);
+  }
+}
+
+// Each core property has one JSON type; another there was copied into outputs the validator rejects
+// (TYPE_MISMATCH) or threw from a reader (a material's pbrMetallicRoughness a number).
+TEST(GltfInput, EveryCorePropertyOfAnotherTypeIsOneErrorWithItsJsonPointer) {
+  TempDir dir;
+  const json valid = every_property(dir.path());
+  std::ofstream(dir / "valid.gltf") << valid.dump();
+  auto read = gltf::read_document(dir / "valid.gltf");
+  ASSERT_TRUE(read) << read.error().to_string();
+  std::vector<json::json_pointer> places;
+  places_in(valid, json::json_pointer(), places);
+  const json others[] = {nullptr, true, 2, "x", json::array(), json::object()};
+  std::size_t refused = 0;
+  for (const json::json_pointer& place : places) {
+    const json& was = valid[place];
+    for (const json& other : others) {
+      if (other.type() == was.type() || (other.is_number() && was.is_number())) continue;
+      json doc = valid;
+      doc[place] = other;
+      std::ofstream(dir / "bad.gltf", std::ios::trunc) << doc.dump();
+      read = gltf::read_document(dir / "bad.gltf");
+      ASSERT_FALSE(read) << place.to_string() << " = " << other.dump();
+      EXPECT_EQ(read.error().message.rfind(place.to_string() + ": ", 0), 0u) << read.error().message;
+      ++refused;
+    }
+  }
+  EXPECT_GT(refused, 5 * 60u);
+  // Values of the right type that glTF does not allow: each refused, and the validator agrees.
+  const std::vector<std::pair<std::string, json>> cases = {
+      {"/materials/0/alphaMode", "SHINY"},     {"/samplers/0/wrapS", 5},        {"/nodes/0/translation", {1, 2}},
+      {"/accessors/0/count", 1.5},             {"/accessors/0/componentType", 5124}, {"/cameras/0/type", "fisheye"},
+      {"/materials/0/emissiveFactor", {0, 0, 0, 0}}};
+  for (const auto& [pointer, value] : cases) {
+    json doc = valid;
+    doc[json::json_pointer(pointer)] = value;
+    std::ofstream(dir / "bad.gltf", std::ios::trunc) << doc.dump();
+    read = gltf::read_document(dir / "bad.gltf");
+    ASSERT_FALSE(read) << pointer;
+    EXPECT_EQ(read.error().message.rfind(pointer + ": ", 0), 0u) << read.error().message;
+  }
+  EXPECT_EQ(read.error().message, "/materials/0/emissiveFactor: an array of 4 where glTF has 3");
+  for (const auto& [pointer, value] : cases) {
+    json doc = valid;
+    doc[json::json_pointer(pointer)] = value;
+    std::ofstream(dir / "bad.gltf", std::ios::trunc) << doc.dump();
+    MATBAKE_VALIDATE_OR_SKIP(report, dir / "bad.gltf");
+    EXPECT_GT(report->errors, 0) << pointer << ": " << report->summary;
+  }
 }
 
 TEST(GltfInput, ControlCharactersInMessagesAreEscaped) {

@@ -11,6 +11,7 @@
 #include "json_text.hpp"
 #include "load_model.hpp"
 #include "references.hpp"
+#include "types.hpp"
 #include "matbake/output_check.hpp"
 #include "matbake/read_file.hpp"
 #include "matbake/atomic_file.hpp"
@@ -385,6 +386,7 @@ Result<Document> read_document(const fs::path& path) {
       if (!json) return json.error();
       doc.json = std::move(*json);
     }
+    if (Status s = check_types(doc.file, doc.json); !s) return s.error();
     if (Status s = check_references(doc.file, doc.json); !s) return s.error();
     tinygltf::Model model;  // tinygltf reads the buffers: data: URIs, files beside the glTF, sizes
     if (Status loaded = load_model_json(path, for_tinygltf(doc.json, path.extension() == ".glb", glb_bin).dump(), glb_bin, model);

@@ -40,10 +40,10 @@ struct Document {
   DecodedGeometry decoded;
 };
 
-// .gltf or .glb, read once. Every index is checked first (references.hpp); buffer and image URIs
-// must stay inside the file's folder; image files must exist (they are copied or embedded on write);
-// compressed and sparse geometry is decoded (decode.hpp); every accessor lies within its buffer view
-// and every view within its buffer.
+// .gltf or .glb, read once. Every core property's type is checked first (types.hpp), then every
+// index (references.hpp); buffer and image URIs must stay inside the file's folder; image files must
+// exist (they are copied or embedded on write); compressed and sparse geometry is decoded
+// (decode.hpp); every accessor lies within its buffer view and every view within its buffer.
 Result<Document> read_document(const std::filesystem::path& path);
 
 // Where accessor `index`'s elements lie: its decoded elements (Draco, sparse) when it has them, else
