@@ -9,6 +9,7 @@
 #include <set>
 
 #include "lib/src/gltf/document.hpp"
+#include "support/expect_error.hpp"
 #include "support/files.hpp"
 #include "support/gltf_validator.hpp"
 #include "support/run.hpp"
@@ -237,6 +238,32 @@ TEST(CliBuildBake, BadBakesFailTheirJobNamingTheManifestsLine) {
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find("glTF material 'wood' is baked and also given a manifest material"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir / "out/s.glb"));
+}
+
+// The bake's work folder (OUT/.matbake/bake/scene-NAME, its kept maps) is written to and emptied by
+// the build: a link planted there to another folder, at any depth, is refused before any job runs,
+// and the folder it points to is left as it was (it held the bake's files and lost them before).
+TEST(CliBuildBake, ALinkPlantedInTheBakesWorkFolderIsRefused) {
+  TempDir dir;
+  for (const char* f : {"showroom.gltf", "showroom.bin"}) fs::copy_file(kExamples / f, dir / f);
+  build(dir.path(), "out", "[\"height\"]", 4);
+  const fs::path work = dir / "out/.matbake/bake/scene-s";
+  ASSERT_TRUE(fs::exists(work / "kept/maps.json"));
+  for (const fs::path& planted : {work / "kept", work, work.parent_path()}) {
+    fs::remove_all(planted);
+    fs::create_directories(dir / "elsewhere");
+    write_bytes(dir / "elsewhere/mine.txt", "not matbake's");
+    fs::create_directory_symlink(dir / "elsewhere", planted);
+    write_bytes(dir / "m.toml", manifest_text("out", "[\"height\"]", 8));
+    const RunResult r = matbake({"build", (dir / "m.toml").string()});
+    EXPECT_EQ(r.exit_code, 1) << planted;
+    expect_one_error_line(r, planted.string(), "is a link out of the output folder");
+    std::vector<std::string> left;
+    for (const auto& e : fs::directory_iterator(dir / "elsewhere")) left.push_back(e.path().filename().string());
+    EXPECT_EQ(left, std::vector<std::string>{"mine.txt"}) << planted;
+    fs::remove(planted);
+    fs::remove_all(dir / "elsewhere");
+  }
 }
 
 }  // namespace

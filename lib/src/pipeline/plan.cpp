@@ -7,6 +7,7 @@
 #include <unordered_map>
 
 #include "../gltf/document.hpp"
+#include "scene_bake.hpp"
 #include "state.hpp"
 #include "matbake/join.hpp"
 #include "matbake/delivery.hpp"
@@ -339,8 +340,14 @@ Result<Plan> make_plan(const Manifest& manifest) {
     std::vector<fs::path> inputs{manifest.file};
     for (const Job& job : plan.jobs) inputs.insert(inputs.end(), job.inputs.begin(), job.inputs.end());
     const OutputGate gate(manifest.output, inputs);
-    if (!gate.holds(plan.state_folder)) {
-      return Error{plan.state_folder.string(), "is a link out of the output folder; matbake writes only inside it"};
+    std::vector<fs::path> state_folders{plan.state_folder};
+    for (const Job& job : plan.jobs) {
+      if (job.kind == JobKind::scene && manifest.scenes[job.spec].bake) {
+        for (fs::path& folder : bake_folders(plan.state_folder, job)) state_folders.push_back(std::move(folder));
+      }
+    }
+    for (const fs::path& folder : state_folders) {
+      if (!gate.holds(folder)) return Error{folder.string(), "is a link out of the output folder; matbake writes only inside it"};
     }
     std::unordered_map<std::string, std::string> writers;
     for (const Job& job : plan.jobs) {

@@ -9,15 +9,21 @@
 namespace matbake::pipeline {
 namespace fs = std::filesystem;
 
-Result<BakedScene> bake_scene(const Job& job, const SceneSpec& s, const fs::path& state_folder, const image::Encoding& encoding) {
+std::vector<fs::path> bake_folders(const fs::path& state_folder, const Job& job) {
   const fs::path work = state_folder / "bake" / job_file_stem(job.name);
+  return {work.parent_path(), work, work / "kept"};
+}
+
+Result<BakedScene> bake_scene(const Job& job, const SceneSpec& s, const fs::path& state_folder, const image::Encoding& encoding) {
+  const std::vector<fs::path> folders = bake_folders(state_folder, job);
+  const fs::path& work = folders[1];
   std::error_code ec;
   fs::create_directories(work, ec);
   if (ec) return Error{work.string(), "cannot make the bake's folder: " + ec.message()};
   // Named as the scene's output, so that the float maps are named as `matbake bake` names them.
   BakedScene baked{work / (job.outputs.scene.stem().string() + ".glb"), {}};
   // The maps are kept there too: a change to some parameters re-traces only the maps they decide.
-  bake::FileOptions options{s.bake->high, s.bake->cage, baked.gltf, s.bake->request, encoding, work / "kept"};
+  bake::FileOptions options{s.bake->high, s.bake->cage, baked.gltf, s.bake->request, encoding, folders[2]};
   auto report = bake::bake_file(s.input, options);
   if (!report) return Error{s.origins.of("bake"), "scenes." + s.name + ".bake: " + report.error().to_string()};
   baked.report = std::move(*report);

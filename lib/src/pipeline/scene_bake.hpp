@@ -16,6 +16,11 @@ struct BakedScene {
   bake::FileReport report;
 };
 
+// The folders a scene job's bake writes in and empties: OUT/.matbake/bake, its own folder there
+// (BakedScene::gltf's) and its kept maps', outermost first. make_plan checks each is no link out of
+// the output folder.
+std::vector<std::filesystem::path> bake_folders(const std::filesystem::path& state_folder, const Job& job);
+
 Result<BakedScene> bake_scene(const Job& job, const SceneSpec& s, const std::filesystem::path& state_folder,
                               const image::Encoding& encoding);
 
