@@ -9,6 +9,7 @@
 #include <set>
 
 #include "lib/src/gltf/document.hpp"
+#include "matbake/image.hpp"
 #include "support/expect_error.hpp"
 #include "support/files.hpp"
 #include "support/gltf_validator.hpp"
@@ -231,13 +232,60 @@ TEST(CliBuildBake, BadBakesFailTheirJobNamingTheManifestsLine) {
   EXPECT_NE(r.err.find("scenes.s.bake.cage"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir / "out/s.glb"));
 
-  // A manifest material given to a baked material would replace the baked AO: refused, naming both.
-  write_bytes(dir / "m.toml", "output = \"out\"\n[materials.wood]\nsources = { base_color = 0.5, metallic = 0, roughness = 0.5 }\n"
+  // A manifest material with its own occlusion given to a baked material would replace the baked
+  // AO: refused, naming both.
+  write_bytes(dir / "m.toml", "output = \"out\"\n[materials.wood]\nsources = { base_color = 0.5, metallic = 0, roughness = 0.5, occlusion = 0.8 }\n"
                               "[scenes.s]\ninput = \"showroom.gltf\"\nbake = { from = \"showroom.gltf\", maps = \"ao\", size = 16 }\n");
   r = matbake({"build", (dir / "m.toml").string()});
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find("glTF material 'wood' is baked and also given a manifest material"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir / "out/s.glb"));
+}
+
+// A manifest material without occlusion of its own, given to a material the bake puts AO on: its
+// metal-rough maps (here constants: factors) replace the material's, the baked AO stays its
+// occlusionTexture (it was refused). The scene's other materials keep theirs.
+TEST(CliBuildBake, BakedAoStaysWithAManifestMaterialWithoutOcclusion) {
+  TempDir dir;
+  for (const char* f : {"showroom.gltf", "showroom.bin"}) fs::copy_file(kExamples / f, dir / f);
+  const std::string bake = "[scenes.s]\ninput = \"showroom.gltf\"\noutput = \"s.gltf\"\n"
+                           "bake = { from = \"showroom.gltf\", maps = \"ao\", size = 16, ao = { samples = 8 } }\n";
+  write_bytes(dir / "alone.toml", "output = \"alone\"\n" + bake);
+  RunResult r = matbake({"build", (dir / "alone.toml").string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  write_bytes(dir / "m.toml", "output = \"out\"\n[materials.wood]\nsources = { base_color = 0.5, metallic = 0.25, roughness = 0.75 }\n" + bake);
+  r = matbake({"build", (dir / "m.toml").string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto alone = gltf::read_document(dir / "alone/s.gltf");
+  const auto given = gltf::read_document(dir / "out/s.gltf");
+  ASSERT_TRUE(alone && given);
+  // A material's occlusion image, decoded.
+  const auto occlusion = [](const gltf::Document& doc, std::size_t m) -> std::vector<float> {
+    const auto& material = doc.json["materials"][m];
+    if (!material.contains("occlusionTexture")) return {};
+    const std::size_t texture = material["occlusionTexture"]["index"].get<std::size_t>();
+    const auto bytes = gltf::image_bytes(doc, doc.json["textures"][texture]["source"].get<std::size_t>());
+    if (!bytes) return {};
+    const auto image = image::decode_image({reinterpret_cast<const unsigned char*>(bytes->data()), bytes->size()}, "ao.png",
+                                           color::Transfer::linear);
+    return image ? image->pixels : std::vector<float>{};
+  };
+  ASSERT_EQ(given->json["materials"].size(), alone->json["materials"].size());
+  for (std::size_t m = 0; m < alone->json["materials"].size(); ++m) {
+    const auto& material = given->json["materials"][m];
+    EXPECT_EQ(occlusion(*given, m), occlusion(*alone, m)) << material.dump();
+    EXPECT_FALSE(occlusion(*alone, m).empty());
+    if (material["name"] != "wood") {
+      EXPECT_EQ(material["pbrMetallicRoughness"], alone->json["materials"][m]["pbrMetallicRoughness"]);
+      continue;
+    }
+    EXPECT_EQ(material["pbrMetallicRoughness"]["metallicFactor"], 0.25);
+    EXPECT_EQ(material["pbrMetallicRoughness"]["roughnessFactor"], 0.75);
+    const std::vector<float> ao = occlusion(*given, m);
+    EXPECT_LT(*std::min_element(ao.begin(), ao.end()), 0.9f) << "the bake occludes somewhere";
+  }
+  MATBAKE_VALIDATE_OR_SKIP(report, dir / "out/s.gltf");
+  EXPECT_EQ(report->errors, 0) << report->summary;
 }
 
 // The bake's work folder (OUT/.matbake/bake/scene-NAME, its kept maps) is written to and emptied by

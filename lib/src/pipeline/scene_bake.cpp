@@ -36,10 +36,12 @@ Status check_baked_materials(const SceneSpec& s, const BakedScene& baked, const 
   for (const bake::TextureReport& t : baked.report.textures) {
     for (const exporter::MaterialMaps& g : given) {
       if (g.material != t.name) continue;
-      const char* lost = asks(bake::Map::ao)                                    ? "ao"
-                         : asks(bake::Map::transfer)                            ? "transfer"
+      // Without occlusion of its own, the manifest material's metal-rough maps keep the baked
+      // occlusionTexture (export packs them into one ORM).
+      const char* lost = asks(bake::Map::transfer)                                  ? "transfer"
+                         : asks(bake::Map::ao) && g.maps.find(material::kOcclusion)   ? "ao"
                          : asks(bake::Map::normal) && g.maps.find(material::kNormal) ? "normal"
-                                                                                 : nullptr;
+                                                                                     : nullptr;
       if (!lost) continue;
       return Error{s.origins.of("bake"), "scenes." + s.name + ": glTF material '" + t.name +
                                              "' is baked and also given a manifest material, whose maps would replace the "

@@ -25,7 +25,7 @@ Result<BakedScene> bake_scene(const Job& job, const SceneSpec& s, const std::fil
                               const image::Encoding& encoding);
 
 // A baked material that the manifest also gives a material: its maps would replace the baked ones
-// (base colour and ORM always, the normal map when it has one), which is refused, naming both.
+// (base colour always, the occlusion and normal map when it has them), which is refused, naming both.
 Status check_baked_materials(const SceneSpec& s, const BakedScene& baked, const std::vector<exporter::MaterialMaps>& given);
 
 // After the export: the float maps moved beside the scene's output (never onto an input), the rest
