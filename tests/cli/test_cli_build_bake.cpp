@@ -288,6 +288,49 @@ TEST(CliBuildBake, BakedAoStaysWithAManifestMaterialWithoutOcclusion) {
   EXPECT_EQ(report->errors, 0) << report->summary;
 }
 
+// The kept maps of a scene that no longer bakes (renamed, its bake dropped) are removed by the next
+// full build (they stayed for ever), and only they: another file in its folder, and a link there
+// with what it points to, are left.
+TEST(CliBuildBake, TheKeptMapsOfASceneThatNoLongerBakesAreRemoved) {
+  TempDir dir;
+  for (const char* f : {"showroom.gltf", "showroom.bin"}) fs::copy_file(kExamples / f, dir / f);
+  const fs::path bakes = dir / "out/.matbake/bake";
+  const auto run = [&](const std::string& manifest) {
+    write_bytes(dir / "m.toml", manifest);
+    const RunResult r = matbake({"build", (dir / "m.toml").string()});
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+  };
+  const std::string as_s = manifest_text("out", "[\"height\"]", 4);
+  std::string as_t = as_s;
+  as_t.replace(as_t.find("[scenes.s]"), 10, "[scenes.t]");
+  run(as_s);
+  ASSERT_TRUE(fs::exists(bakes / "scene-s/kept/maps.json"));
+  write_bytes(bakes / "scene-s/notes.txt", "mine");
+  fs::create_directories(dir / "elsewhere");
+  for (const char* f : {"maps.json", "0_height.f32", "s.glb"}) write_bytes(dir / "elsewhere" / f, "not matbake's");
+  fs::create_directory_symlink(dir / "elsewhere", bakes / "scene-x");
+  run(as_t);
+  EXPECT_TRUE(fs::exists(bakes / "scene-t/kept/maps.json"));
+  EXPECT_FALSE(fs::exists(bakes / "scene-s/kept"));
+  EXPECT_EQ(read_bytes(bakes / "scene-s/notes.txt"), "mine");
+  EXPECT_EQ(fs::directory_iterator(bakes / "scene-s")->path().filename(), "notes.txt");
+  EXPECT_TRUE(fs::is_symlink(bakes / "scene-x"));
+  for (const char* f : {"maps.json", "0_height.f32", "s.glb"}) EXPECT_EQ(read_bytes(dir / "elsewhere" / f), "not matbake's") << f;
+  // The bake dropped: its folder goes; the scene is exported as it is.
+  const std::string unbaked = as_t.substr(0, as_t.find("bake = "));
+  run(unbaked);
+  EXPECT_FALSE(fs::exists(bakes / "scene-t"));
+  EXPECT_TRUE(fs::exists(dir / "out/s.glb"));
+  // OUT/.matbake/bake itself a link (no scene bakes, so the plan does not look): not followed.
+  fs::remove_all(bakes);
+  fs::create_directories(dir / "elsewhere/scene-q/kept");
+  write_bytes(dir / "elsewhere/scene-q/kept/maps.json", "not matbake's");
+  fs::create_directory_symlink(dir / "elsewhere", bakes);
+  write_bytes(dir / "showroom.gltf", read_bytes(dir / "showroom.gltf") + " ");  // a build that runs
+  run(unbaked);
+  EXPECT_EQ(read_bytes(dir / "elsewhere/scene-q/kept/maps.json"), "not matbake's");
+}
+
 // The bake's work folder (OUT/.matbake/bake/scene-NAME, its kept maps) is written to and emptied by
 // the build: a link planted there to another folder, at any depth, is refused before any job runs,
 // and the folder it points to is left as it was (it held the bake's files and lost them before).

@@ -414,6 +414,7 @@ Status finish_run(const Manifest& manifest, const Plan& plan, const RunOptions& 
   const bool prune = options.prune || manifest.prune;
   const bool too_many = log.stale.size() > kPruneMinimum && double(log.stale.size()) > kPruneShare * double(made);
   report.stale = clean_stale(log, output_gate(manifest, plan), roots, full && !options.keep_stale && (prune || !too_many));
+  if (full && !options.keep_stale) remove_stale_bakes(plan, manifest);
   if (full && !options.keep_stale && !prune && too_many && !report.stale.kept.empty()) {
     report.stale.held_back = "this run would remove " + std::to_string(report.stale.kept.size()) + " of the " + std::to_string(made) +
                              " files the build made (more than half: a renamed folder or a lost input looks like this); "

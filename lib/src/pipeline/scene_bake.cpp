@@ -1,6 +1,7 @@
 #include "scene_bake.hpp"
 
 #include <algorithm>
+#include <set>
 #include <system_error>
 
 #include "matbake/output_check.hpp"
@@ -12,6 +13,49 @@ namespace fs = std::filesystem;
 std::vector<fs::path> bake_folders(const fs::path& state_folder, const Job& job) {
   const fs::path work = state_folder / "bake" / job_file_stem(job.name);
   return {work.parent_path(), work, work / "kept"};
+}
+
+namespace {
+
+// A file a bake writes in its work folder (the baked glTF, its maps) or in kept/ (maps.json and
+// "N_map.f32").
+bool made_by_a_bake(const fs::path& file, bool kept) {
+  const std::string name = file.filename().string(), extension = file.extension().string();
+  if (!kept) return extension == ".glb" || extension == ".gltf" || extension == ".bin" || extension == ".exr";
+  const std::size_t underscore = name.find('_');
+  const bool numbered = underscore > 0 && underscore != std::string::npos &&
+                        std::all_of(name.begin(), name.begin() + std::ptrdiff_t(underscore), [](char c) { return c >= '0' && c <= '9'; });
+  return name == "maps.json" || (numbered && extension == ".f32");
+}
+
+// Removes `folder`'s regular files a bake makes (not following links), and the folder when empty.
+void empty_bake_folder(const fs::path& folder, bool kept) {
+  std::error_code ec;
+  for (const fs::directory_entry& entry : fs::directory_iterator(folder, ec)) {
+    if (entry.symlink_status(ec).type() == fs::file_type::regular && made_by_a_bake(entry.path(), kept)) fs::remove(entry.path(), ec);
+  }
+  fs::remove(folder, ec);  // only when empty
+}
+
+}  // namespace
+
+std::vector<fs::path> remove_stale_bakes(const Plan& plan, const Manifest& manifest) {
+  std::set<fs::path> baking;
+  for (const Job& job : plan.jobs) {
+    if (job.kind == JobKind::scene && manifest.scenes[job.spec].bake) baking.insert(bake_folders(plan.state_folder, job)[1]);
+  }
+  std::vector<fs::path> removed;
+  std::error_code ec;
+  // Not through a link (make_plan checks it only when a scene bakes).
+  if (fs::symlink_status(plan.state_folder / "bake", ec).type() != fs::file_type::directory) return removed;
+  for (const fs::directory_entry& entry : fs::directory_iterator(plan.state_folder / "bake", ec)) {
+    const fs::path work = entry.path();
+    if (baking.count(work) || entry.symlink_status(ec).type() != fs::file_type::directory) continue;
+    if (fs::symlink_status(work / "kept", ec).type() == fs::file_type::directory) empty_bake_folder(work / "kept", true);
+    empty_bake_folder(work, false);
+    if (!fs::exists(fs::symlink_status(work, ec))) removed.push_back(work);
+  }
+  return removed;
 }
 
 Result<BakedScene> bake_scene(const Job& job, const SceneSpec& s, const fs::path& state_folder, const image::Encoding& encoding) {

@@ -21,6 +21,12 @@ struct BakedScene {
 // the output folder.
 std::vector<std::filesystem::path> bake_folders(const std::filesystem::path& state_folder, const Job& job);
 
+// After a full build: the work folders under OUT/.matbake/bake of scenes that bake no longer
+// (removed, renamed, their bake dropped) emptied of what a bake leaves there (its kept maps and
+// their index; a failed bake's glTF and maps), then removed when empty. A link is never followed,
+// and a file of another name is left, with its folder. Returns the folders removed.
+std::vector<std::filesystem::path> remove_stale_bakes(const Plan& plan, const Manifest& manifest);
+
 Result<BakedScene> bake_scene(const Job& job, const SceneSpec& s, const std::filesystem::path& state_folder,
                               const image::Encoding& encoding);
 
