@@ -288,6 +288,38 @@ TEST(CliBuildBake, BakedAoStaysWithAManifestMaterialWithoutOcclusion) {
   EXPECT_EQ(report->errors, 0) << report->summary;
 }
 
+// With per_instance, a manifest material given to a glTF material reaches every placement's copy
+// of it (it reached the first placement's only), and each keeps its own baked AO.
+TEST(CliBuildBake, AManifestMaterialReachesEveryPlacementsCopy) {
+  TempDir dir;
+  for (const char* f : {"showroom.gltf", "showroom.bin"}) fs::copy_file(kExamples / f, dir / f);
+  write_bytes(dir / "m.toml", "output = \"out\"\n[materials.wood]\nsources = { base_color = 0.5, metallic = 0.25, roughness = 0.75 }\n"
+                              "[scenes.s]\ninput = \"showroom.gltf\"\noutput = \"s.gltf\"\nbake = { from = \"showroom.gltf\", "
+                              "maps = \"ao\", size = 16, per_instance = true, ao = { samples = 4 } }\n");
+  const RunResult r = matbake({"--json", "build", (dir / "m.toml").string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto doc = gltf::read_document(dir / "out/s.gltf");
+  ASSERT_TRUE(doc);
+  std::vector<std::string> woods;
+  std::set<int> occlusions;
+  for (const auto& m : doc->json["materials"]) {
+    const std::string name = m.value("name", "");
+    if (name.rfind("wood", 0) != 0) continue;
+    woods.push_back(name);
+    EXPECT_EQ(m["pbrMetallicRoughness"]["metallicFactor"], 0.25) << name;
+    EXPECT_EQ(m["pbrMetallicRoughness"]["roughnessFactor"], 0.75) << name;
+    occlusions.insert(m["occlusionTexture"]["index"].get<int>());
+  }
+  EXPECT_EQ(woods, (std::vector<std::string>{"wood", "wood (pillar right)"}));
+  EXPECT_EQ(occlusions.size(), 2u) << "each placement its own AO";
+  const json report = json::parse(r.out);
+  std::vector<std::string> copies;
+  for (const auto& t : report["jobs"][1]["details"]["bake"]["textures"]) {
+    if (t.contains("copy_of")) copies.push_back(t["copy_of"].get<std::string>() + " <- " + t["name"].get<std::string>());
+  }
+  EXPECT_NE(std::find(copies.begin(), copies.end(), "wood <- wood (pillar right)"), copies.end()) << report.dump();
+}
+
 // The kept maps of a scene that no longer bakes (renamed, its bake dropped) are removed by the next
 // full build (they stayed for ever), and only they: another file in its folder, and a link there
 // with what it points to, are left.

@@ -37,6 +37,7 @@ struct FileOptions {
 struct TextureReport {
   int material = -1;
   std::string name;                // the material's
+  std::string copy_of;             // per_instance: the name of the material a placement's copy copies
   int width = 0, height = 0, texcoord = 0;
   std::size_t texels = 0, samples = 0, misses = 0, missed_texels = 0, padded = 0, occlusion_rays = 0;
   double height_min = 0, height_max = 0;

@@ -31,6 +31,7 @@ struct MaterialMaps {
   std::string material;  // the glTF material's name (or its index, as a number)
   material::Maps maps;  // kd, ks, gloss (Schüler) or base_color, metallic, roughness; mask, occlusion optional
   std::optional<workflow::RoughnessMapping> mapping;  // for Schüler maps; unset: Options::mapping
+  std::vector<std::string> copies;  // other glTF materials that take the same maps (a bake's per-placement copies)
 };
 
 // How a converted dielectric whose F0 is not 0.04 says so: KHR_materials_specular's

@@ -473,6 +473,11 @@ Result<Report> export_scene(const fs::path& input, const fs::path& output, const
 
     std::map<int, const MaterialMaps*> given;
     for (const MaterialMaps& m : options.materials) {
+      for (const std::string& name : m.copies) {
+        auto index = material_index(*doc, name);
+        if (!index) return index.error();
+        given[*index] = &m;
+      }
       auto index = material_index(*doc, m.material);
       if (!index) return index.error();
       given[*index] = &m;

@@ -279,6 +279,11 @@ Result<std::vector<fs::path>> run_scene(const Job& job, const JobContext& ctx, c
       auto made = bake_scene(job, s, state_folder, options.encoding);
       if (!made) return made.error();
       if (Status st = check_baked_materials(s, *made, options.materials); !st) return st.error();
+      for (const bake::TextureReport& t : made->report.textures) {  // a placement's copy takes its original's
+        for (exporter::MaterialMaps& g : options.materials) {
+          if (!t.copy_of.empty() && g.material == t.copy_of) g.copies.push_back(t.name);
+        }
+      }
       baked = std::move(*made);
     }
     auto exported = exporter::export_scene(baked ? baked->gltf : s.input, output, options);

@@ -79,7 +79,7 @@ Status check_baked_materials(const SceneSpec& s, const BakedScene& baked, const 
   const auto asks = [&](bake::Map m) { return std::find(maps.begin(), maps.end(), m) != maps.end(); };
   for (const bake::TextureReport& t : baked.report.textures) {
     for (const exporter::MaterialMaps& g : given) {
-      if (g.material != t.name) continue;
+      if (g.material != t.name && g.material != t.copy_of) continue;
       // Without occlusion of its own, the manifest material's metal-rough maps keep the baked
       // occlusionTexture (export packs them into one ORM).
       const char* lost = asks(bake::Map::transfer)                                  ? "transfer"
