@@ -71,6 +71,18 @@ bool ended_by(pid_t pid, std::chrono::steady_clock::time_point deadline) {
   return true;
 }
 
+// What the pipe holds now, read without waiting for more (a process the child left behind may hold
+// it open), until the deadline.
+void drain(int fd, std::chrono::steady_clock::time_point deadline, std::string& tail, std::size_t limit) {
+  char buffer[16384];
+  pollfd p{fd, POLLIN, 0};
+  while (std::chrono::steady_clock::now() < deadline && ::poll(&p, 1, 0) > 0 && (p.revents & POLLIN)) {
+    const ssize_t n = ::read(fd, buffer, sizeof buffer);
+    if (n <= 0) return;
+    keep_tail(tail, buffer, std::size_t(n), limit);
+  }
+}
+
 // Reads the child's output until the child has ended and the pipe is drained or closed (a process
 // it left behind may hold the pipe open), or the deadline passes: false then.
 bool read_until_ended(int fd, pid_t pid, std::chrono::steady_clock::time_point deadline, std::string& tail, std::size_t limit) {
@@ -82,8 +94,11 @@ bool read_until_ended(int fd, pid_t pid, std::chrono::steady_clock::time_point d
     const int ready = ::poll(&p, 1, int(std::min<long long>(left.count(), 50)));
     if (ready < 0 && errno != EINTR) return true;
     if (ready == 0) {
-      if (has_ended(pid)) return true;
-      continue;
+      // The child may have written its last output and ended since poll gave up: read it (a basisu
+      // probe lost its "Compressor v" line so under load and failed).
+      if (!has_ended(pid)) continue;
+      drain(fd, deadline, tail, limit);
+      return true;
     }
     if (ready < 0) continue;
     const ssize_t n = ::read(fd, buffer, sizeof buffer);
