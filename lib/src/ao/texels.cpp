@@ -2,9 +2,11 @@
 
 #include <glm/geometric.hpp>
 
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <limits>
@@ -110,43 +112,7 @@ glm::dvec3 nearest_weights(const UvTriangle& t, const dvec2& p) {
 
 namespace {
 
-// A run of one instance's triangles: coverage is worked out per chunk in parallel and merged in
-// chunk order, so the result (and the order of points within a texel) is the serial one for any
-// number of threads. A chunk ends at kChunkTriangles or at kChunkCells texels of UV area, whichever
-// comes first: a low-poly of a few hundred triangles over a 2048² texture is many chunks, not one.
-constexpr std::size_t kChunkTriangles = 2048;
-constexpr double kChunkCells = 65536;
-struct Chunk {
-  std::uint32_t instance;
-  std::size_t first, last;
-  double cells;  // the triangles' UV area in texels (those within max_cells): what to reserve
-};
-
-struct Touch {
-  double distance;
-  SurfacePoint point;
-};
-
-// What one chunk found: its centres (first pass), its touches (second), its triangles' tallies.
-struct ChunkCoverage {
-  std::vector<SurfacePoint> points;
-  std::vector<Touch> touches;
-  std::size_t triangles = 0, degenerate_uv = 0, wrapped = 0, too_large = 0;
-};
-
-// Stops every chunk once the chunks together hold more than `limit` points: each adds its count in
-// batches, so the shared total never exceeds the true one and the decision is the serial one.
-class PointBudget {
- public:
-  explicit PointBudget(std::size_t limit) : limit_(limit) {}
-  bool add(std::size_t n) { return (total_ += n) <= limit_; }
-  bool exhausted() const { return total_.load(std::memory_order_relaxed) > limit_; }
-
- private:
-  std::size_t limit_;
-  std::atomic<std::size_t> total_{0};
-};
-constexpr std::size_t kBudgetBatch = 4096;
+const double kReach = std::sqrt(0.5);  // half a texel diagonal: how far a touched texel's centre may be
 
 // The cross-section of a positively oriented triangle with the line y: [lo, hi] (empty when
 // lo > hi), from its edges' half-planes. on_edge: a horizontal edge lies on the line.
@@ -173,214 +139,261 @@ Span span_at(const UvTriangle& tri, double y) {
 }
 
 // Which cells of a triangle for_each_cell visits: those whose centre is inside (with the tie
-// rule), or those outside it that may lie within half a texel diagonal of it (a superset).
+// rule), or those outside it that may lie within reach of it (a superset).
 enum class Cells { inside, near };
 constexpr double kNarrow = 8;  // texels: narrower triangles are scanned over their bounding box
 
-struct Raster {
-  const scene::Scene& scene;
-  const TextureTarget& target;
-  int width, height;
-  double max_cells;  // of a triangle's bounding box (kMaxCopies textures)
+struct Box {
+  double x0, x1, y0, y1;
+};
+Box bounds(const UvTriangle& t) {
+  return {std::min({t.a.x, t.b.x, t.c.x}), std::max({t.a.x, t.b.x, t.c.x}), std::min({t.a.y, t.b.y, t.c.y}),
+          std::max({t.a.y, t.b.y, t.c.y})};
+}
 
-  std::uint32_t texel_at(double i, double j) const {
-    return std::uint32_t(wrapped_index((long long)j, height, target.wrap_t) * width + wrapped_index((long long)i, width, target.wrap_s));
-  }
-
-  // The chunk's usable triangles, positively oriented in texel space, and their `cells`, row by
-  // row. A row's cells a texel or more inside its cross-section are inside however the crossings
-  // round: only the few near its ends are tested, so a triangle costs its perimeter, not its
-  // bounding box. `tally` counts the triangles (first pass only). visit returns false to stop.
-  template <class Visit>
-  bool for_each_cell(const Chunk& chunk, Cells cells, ChunkCoverage* tally, Visit&& visit) const {
-    constexpr double kInf = std::numeric_limits<double>::infinity();
-    const double reach = std::sqrt(0.5);
-    const scene::Instance& inst = scene.instances[chunk.instance];
-    for (std::size_t t = chunk.first; t < chunk.last; ++t) {
-      const UvTriangle uv = uv_triangle(inst, target.texcoord, t, width, height);
-      const double area2 = cross(uv.b - uv.a, uv.c - uv.a);
-      const double longest2 = std::max({glm::dot(uv.b - uv.a, uv.b - uv.a), glm::dot(uv.c - uv.a, uv.c - uv.a),
-                                        glm::dot(uv.c - uv.b, uv.c - uv.b)});
-      if (!std::isfinite(area2) || !(std::abs(area2) > 1e-12 * longest2)) {
-        if (tally) ++tally->degenerate_uv;
-        continue;
-      }
-      const UvTriangle tri = area2 > 0 ? uv : UvTriangle{uv.a, uv.c, uv.b};
-      const double x0 = std::min({tri.a.x, tri.b.x, tri.c.x}), x1 = std::max({tri.a.x, tri.b.x, tri.c.x});
-      const double y0 = std::min({tri.a.y, tri.b.y, tri.c.y}), y1 = std::max({tri.a.y, tri.b.y, tri.c.y});
-      const double i0 = std::ceil(x0 - reach), i1 = std::floor(x1 + reach);
-      const double j0 = std::ceil(y0 - reach), j1 = std::floor(y1 + reach);
-      if ((i1 - i0 + 1) * (j1 - j0 + 1) > max_cells) {
-        if (tally) ++tally->too_large;
-        continue;
-      }
-      if (tally) {
-        ++tally->triangles;
-        if (x0 < -0.5 || y0 < -0.5 || x1 > width - 0.5 || y1 > height - 0.5) ++tally->wrapped;
-      }
-      if (x1 - x0 < kNarrow) {  // a few cells a row: their tests cost less than the crossings
-        const double margin = cells == Cells::inside ? 0.0 : reach;
-        for (double j = std::ceil(y0 - margin); j <= y1 + margin; ++j) {
-          for (double i = std::ceil(x0 - margin); i <= x1 + margin; ++i) {
-            if (cells == Cells::inside && !inside(tri, dvec2(i, j))) continue;
-            if (!visit(t, tri, i, j)) return false;
-          }
-        }
-        continue;
-      }
-      if (cells == Cells::inside) {
-        for (double j = std::ceil(y0); j <= y1; ++j) {
-          const Span row = span_at(tri, j);
-          const double first = std::max(std::ceil(x0), std::ceil(row.lo - 1)), last = std::min(x1, row.hi + 1);
-          for (double i = first; i <= last; ++i) {
-            const bool sure = !row.on_edge && i >= row.lo + 1 && i <= row.hi - 1;
-            if ((sure || inside(tri, dvec2(i, j))) && !visit(t, tri, i, j)) return false;
-          }
-        }
-        continue;
-      }
-      for (double j = j0; j <= j1; ++j) {
-        // The cross-section of the band of rows within reach (at its two sides, and the vertices
-        // in it), widened by the reach and half a texel against rounding; the row's sure inside
-        // (covered by the first pass) skipped.
-        const double band = reach + 0.01;
-        double lo = kInf, hi = -kInf;
-        for (double y : {j - band, j + band}) {
-          const Span side = span_at(tri, y);
-          if (side.lo <= side.hi) lo = std::min(lo, side.lo), hi = std::max(hi, side.hi);
-        }
-        for (const dvec2& v : {tri.a, tri.b, tri.c}) {
-          if (std::abs(v.y - j) <= band) lo = std::min(lo, v.x), hi = std::max(hi, v.x);
-        }
-        const Span row = span_at(tri, j);
-        const double sure_first = row.on_edge ? kInf : std::ceil(row.lo + 1), sure_last = std::floor(row.hi - 1);
-        const double first = std::max(i0, std::ceil(lo - reach - 0.5)), last = std::min(i1, hi + reach + 0.5);
-        for (double i = first; i <= last; ++i) {
-          if (i >= sure_first && i <= sure_last) {
-            i = sure_last;
-            continue;
-          }
-          if (!visit(t, tri, i, j)) return false;
-        }
+// Calls visit(i, j) for the `cells` of triangle `tri` (positively oriented, texel space) within the
+// unwrapped cells `rect`, row by row. A row's cells a texel or more inside its cross-section are
+// inside however the crossings round: only the few near its ends are tested, so a triangle costs
+// its perimeter, not its bounding box.
+template <class Visit>
+void for_each_cell(const UvTriangle& tri, const CellRect& rect, Cells cells, Visit&& visit) {
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  const Box box = bounds(tri);
+  if (box.x1 - box.x0 < kNarrow) {  // a few cells a row: their tests cost less than the crossings
+    const double margin = cells == Cells::inside ? 0.0 : kReach;
+    const double j_last = std::min(box.y1 + margin, rect.j1), i_last = std::min(box.x1 + margin, rect.i1);
+    for (double j = std::max(std::ceil(box.y0 - margin), rect.j0); j <= j_last; ++j) {
+      for (double i = std::max(std::ceil(box.x0 - margin), rect.i0); i <= i_last; ++i) {
+        if (cells == Cells::near || inside(tri, dvec2(i, j))) visit(i, j);
       }
     }
-    return true;
+    return;
   }
+  if (cells == Cells::inside) {
+    const double j_last = std::min(box.y1, rect.j1);
+    for (double j = std::max(std::ceil(box.y0), rect.j0); j <= j_last; ++j) {
+      const Span row = span_at(tri, j);
+      const double first = std::max({std::ceil(box.x0), std::ceil(row.lo - 1), rect.i0});
+      const double last = std::min({box.x1, row.hi + 1, rect.i1});
+      for (double i = first; i <= last; ++i) {
+        const bool sure = !row.on_edge && i >= row.lo + 1 && i <= row.hi - 1;
+        if (sure || inside(tri, dvec2(i, j))) visit(i, j);
+      }
+    }
+    return;
+  }
+  const double j_last = std::min(std::floor(box.y1 + kReach), rect.j1);
+  for (double j = std::max(std::ceil(box.y0 - kReach), rect.j0); j <= j_last; ++j) {
+    // The cross-section of the band of rows within reach (at its two sides, and the vertices in
+    // it), widened by the reach and half a texel against rounding; the row's sure inside (covered
+    // by the first pass) skipped.
+    const double band = kReach + 0.01;
+    double lo = kInf, hi = -kInf;
+    for (double y : {j - band, j + band}) {
+      const Span side = span_at(tri, y);
+      if (side.lo <= side.hi) lo = std::min(lo, side.lo), hi = std::max(hi, side.hi);
+    }
+    for (const dvec2& v : {tri.a, tri.b, tri.c}) {
+      if (std::abs(v.y - j) <= band) lo = std::min(lo, v.x), hi = std::max(hi, v.x);
+    }
+    const Span row = span_at(tri, j);
+    const double sure_first = row.on_edge ? kInf : std::ceil(row.lo + 1), sure_last = std::floor(row.hi - 1);
+    const double first = std::max({std::ceil(box.x0 - kReach), rect.i0, std::ceil(lo - kReach - 0.5)});
+    const double last = std::min({std::floor(box.x1 + kReach), rect.i1, hi + kReach + 0.5});
+    for (double i = first; i <= last; ++i) {
+      if (i >= sure_first && i <= sure_last) {
+        i = sure_last;
+        continue;
+      }
+      visit(i, j);
+    }
+  }
+}
+
+// The runs of unwrapped cells first..last of an axis (n texels, wrapped by `wrap`) each of whose
+// cells wraps into the same tile, in order: a run ends at a tile's edge and where the wrapped
+// index turns (a period's end, a mirror); clamped cells beyond the texture are one run.
+struct AxisRun {
+  double first, last;
+  std::size_t tile;
 };
+void axis_runs(double first, double last, int n, Wrap wrap, std::vector<AxisRun>& runs) {
+  runs.clear();
+  const long long size = n, end = (long long)last;
+  for (auto p = (long long)first; p <= end;) {
+    const long long q = wrapped_index(p, size, wrap);
+    long long run_end = end;
+    if (wrap != Wrap::clamp_to_edge || (p >= 0 && p < size)) {
+      const bool down = wrap == Wrap::mirrored_repeat && ((p % (2 * size)) + 2 * size) % (2 * size) >= size;
+      const long long tile_first = q / kTile * kTile, tile_last = std::min(tile_first + kTile, size) - 1;
+      run_end = std::min(run_end, p + (down ? q - tile_first : tile_last - q));
+    } else if (p < 0) {
+      run_end = std::min(run_end, -1LL);
+    }
+    runs.push_back({double(p), double(run_end), std::size_t(q / kTile)});
+    p = run_end + 1;
+  }
+}
+
+// Farther from the origin (in texels) a triangle's copies wrap by whole numbers no double holds.
+constexpr double kFarthest = 1e15;
 
 }  // namespace
 
-Result<Coverage> cover(const scene::Scene& scene, const TextureTarget& target, int width, int height,
-                       std::size_t max_points) {
-  Coverage out;
-  const double reach = std::sqrt(0.5);  // half a texel diagonal
+Tiling tile(const scene::Scene& scene, const TextureTarget& target, int width, int height) {
+  Tiling out;
+  out.width = width, out.height = height;
+  out.columns = (width + kTile - 1) / kTile, out.rows = (height + kTile - 1) / kTile;
+  out.fragments.resize(std::size_t(out.columns) * std::size_t(out.rows));
   // A triangle's bounding box may cover the texture several times over (a tiled floor); beyond
   // kMaxCopies it would cost unbounded time for a texture no viewer could show.
-  const Raster raster{scene, target, width, height, double(kMaxCopies) * double(width) * double(height) + 1024};
-  std::vector<Chunk> chunks;
+  const double max_cells = double(kMaxCopies) * double(width) * double(height) + 1024;
+  std::vector<AxisRun> columns, rows;
   for (std::size_t k : target.instances) {
     const scene::Instance& inst = scene.instances[k];
     if (std::size_t(target.texcoord) >= inst.texcoords.size() || inst.texcoords[std::size_t(target.texcoord)].empty()) {
       ++out.instances_without_uv;
       continue;
     }
-    std::size_t first = 0;
-    double cells = 0;
     for (std::size_t t = 0; t < inst.triangles.size(); ++t) {
       const UvTriangle uv = uv_triangle(inst, target.texcoord, t, width, height);
-      const double area = std::abs(cross(uv.b - uv.a, uv.c - uv.a)) / 2;
-      if (area <= raster.max_cells) cells += area;  // false for NaN
-      if (t + 1 - first == kChunkTriangles || cells >= kChunkCells || t + 1 == inst.triangles.size()) {
-        chunks.push_back({std::uint32_t(k), first, t + 1, cells});
-        first = t + 1, cells = 0;
+      const double area2 = cross(uv.b - uv.a, uv.c - uv.a);
+      const double longest2 = std::max({glm::dot(uv.b - uv.a, uv.b - uv.a), glm::dot(uv.c - uv.a, uv.c - uv.a),
+                                        glm::dot(uv.c - uv.b, uv.c - uv.b)});
+      if (!std::isfinite(area2) || !(std::abs(area2) > 1e-12 * longest2)) {
+        ++out.degenerate_uv;
+        continue;
+      }
+      const Box box = bounds(uv);
+      const CellRect cells{std::ceil(box.x0 - kReach), std::floor(box.x1 + kReach), std::ceil(box.y0 - kReach),
+                           std::floor(box.y1 + kReach)};
+      if ((cells.i1 - cells.i0 + 1) * (cells.j1 - cells.j0 + 1) > max_cells ||
+          std::max({std::abs(box.x0), std::abs(box.x1), std::abs(box.y0), std::abs(box.y1)}) > kFarthest) {
+        ++out.too_large;
+        continue;
+      }
+      ++out.triangles;
+      if (box.x0 < -0.5 || box.y0 < -0.5 || box.x1 > width - 0.5 || box.y1 > height - 0.5) ++out.wrapped;
+      axis_runs(cells.i0, cells.i1, width, target.wrap_s, columns);
+      axis_runs(cells.j0, cells.j1, height, target.wrap_t, rows);
+      for (const AxisRun& row : rows) {
+        for (const AxisRun& column : columns) {
+          out.fragments[row.tile * std::size_t(out.columns) + column.tile].push_back(
+              {std::uint32_t(k), std::uint32_t(t), {column.first, column.last, row.first, row.last}});
+        }
       }
     }
   }
-  std::vector<ChunkCoverage> parts(chunks.size());
-  PointBudget budget(max_points);
-  const auto each_chunk = [&](auto&& work) {
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks.size(), 1), [&](const tbb::blocked_range<std::size_t>& range) {
-      for (std::size_t c = range.begin(); c != range.end() && !budget.exhausted(); ++c) work(chunks[c], parts[c]);
-    });
+  return out;
+}
+
+void cover_tile(const scene::Scene& scene, const TextureTarget& target, const Tiling& tiling, std::size_t tile,
+                TilePoints& out) {
+  const long long x0 = (long long)(tile % std::size_t(tiling.columns)) * kTile;
+  const long long y0 = (long long)(tile / std::size_t(tiling.columns)) * kTile;
+  const auto texel_of = [&](double i, double j, std::size_t& local) {
+    const long long x = wrapped_index((long long)i, tiling.width, target.wrap_s);
+    const long long y = wrapped_index((long long)j, tiling.height, target.wrap_t);
+    local = std::size_t((y - y0) * kTile + (x - x0));
+    return std::uint32_t(y * tiling.width + x);
   };
+  const auto oriented = [&](const Fragment& f) {
+    const UvTriangle uv = uv_triangle(scene.instances[f.instance], target.texcoord, f.triangle, tiling.width, tiling.height);
+    return cross(uv.b - uv.a, uv.c - uv.a) > 0 ? uv : UvTriangle{uv.a, uv.c, uv.b};
+  };
+  out.found.clear();
+  out.count.assign(std::size_t(kTile) * kTile, 0);
+  out.covered = out.touched = out.overlapped = 0;
+  const std::vector<Fragment>& fragments = tiling.fragments[tile];
   // Centres inside a triangle (the tie rule takes each shared edge's once).
-  each_chunk([&](const Chunk& chunk, ChunkCoverage& part) {
-    std::size_t unbudgeted = 0;
-    part.points.reserve(std::size_t(std::min(chunk.cells, kChunkCells)) + 64);  // a chunk's centres ≈ its area
-    raster.for_each_cell(chunk, Cells::inside, &part, [&](std::size_t t, const UvTriangle&, double i, double j) {
-      part.points.push_back({raster.texel_at(i, j), chunk.instance, std::uint32_t(t), float(i), float(j)});
-      if (++unbudgeted < kBudgetBatch) return true;
-      unbudgeted = 0;
-      return budget.add(kBudgetBatch);
+  for (const Fragment& f : fragments) {
+    for_each_cell(oriented(f), f.cells, Cells::inside, [&](double i, double j) {
+      std::size_t local;
+      out.found.push_back({texel_of(i, j, local), f.instance, f.triangle, float(i), float(j)});
+      ++out.count[local];
     });
-  });
-  std::size_t centres = 0;
-  for (const ChunkCoverage& part : parts) centres += part.points.size();
-  const auto too_many = [&](const std::string& what) {
-    return Error{"", "its UV layout " + what + " more than " + std::to_string(max_points) + " surface points into the " +
-                         std::to_string(width) + "x" + std::to_string(height) +
-                         " texture (placements or UV copies stacked on the same texels): give each placement its own "
-                         "texture, or bake a smaller one"};
-  };
-  if (budget.exhausted() || centres > max_points) return too_many("maps");
-  std::vector<std::uint32_t> count(std::size_t(width) * std::size_t(height), 0);
-  for (const ChunkCoverage& part : parts) {
-    for (const SurfacePoint& p : part.points) ++count[p.texel];
-    out.triangles += part.triangles, out.degenerate_uv += part.degenerate_uv;
-    out.wrapped += part.wrapped, out.too_large += part.too_large;
   }
-  for (std::uint32_t c : count) {
-    out.covered += c > 0;
-    out.overlapped += c > 1;
-  }
+  for (std::uint32_t c : out.count) out.covered += c > 0, out.overlapped += c > 1;
   // Texels no centre covers, within reach of a triangle: its nearest point (the nearest triangle's;
   // on a tie, the first in scene order).
-  each_chunk([&](const Chunk& chunk, ChunkCoverage& part) {
-    std::size_t unbudgeted = 0;
-    raster.for_each_cell(chunk, Cells::near, nullptr, [&](std::size_t t, const UvTriangle& tri, double i, double j) {
-      const std::uint32_t texel = raster.texel_at(i, j);
-      if (count[texel]) return true;
+  constexpr double kNone = std::numeric_limits<double>::infinity();
+  out.nearest.assign(out.count.size(), {kNone, {}});
+  for (const Fragment& f : fragments) {
+    const UvTriangle tri = oriented(f);
+    for_each_cell(tri, f.cells, Cells::near, [&](double i, double j) {
+      std::size_t local;
+      const std::uint32_t texel = texel_of(i, j, local);
+      if (out.count[local]) return;
       const dvec2 centre(i, j);
       const glm::dvec3 w = nearest_weights(tri, centre);
       const dvec2 q = w.x * tri.a + w.y * tri.b + w.z * tri.c;
       const double distance = glm::length(q - centre);
-      if (distance > reach) return true;
-      part.touches.push_back({distance, {texel, chunk.instance, std::uint32_t(t), float(q.x), float(q.y)}});
-      if (++unbudgeted < kBudgetBatch) return true;
-      unbudgeted = 0;
-      return budget.add(kBudgetBatch);
+      if (distance <= kReach && distance < out.nearest[local].distance) {
+        out.nearest[local] = {distance, {texel, f.instance, f.triangle, float(q.x), float(q.y)}};
+      }
     });
-  });
-  std::vector<Touch> touches;
-  for (ChunkCoverage& part : parts) {
-    touches.insert(touches.end(), part.touches.begin(), part.touches.end());
-    std::vector<Touch>().swap(part.touches);
   }
-  if (budget.exhausted() || centres + touches.size() > max_points) return too_many("maps and touches");
-  std::stable_sort(touches.begin(), touches.end(), [](const Touch& a, const Touch& b) {
-    return a.point.texel < b.point.texel || (a.point.texel == b.point.texel && a.distance < b.distance);
-  });
-  for (std::size_t first = 0; first < touches.size(); ++first) {
-    if (first > 0 && touches[first].point.texel == touches[first - 1].point.texel) continue;
-    ++count[touches[first].point.texel];
+  for (std::size_t local = 0; local < out.count.size(); ++local) {
+    if (out.nearest[local].distance == kNone) continue;
+    out.count[local] = 1;
     ++out.touched;
   }
-  // Counting sort by texel: stable (scene order within a texel; a touched texel has one point) and
-  // linear in the points.
+  // Counting sort by texel (within the tile, texel order is local order): stable, so scene order
+  // within a texel.
   std::uint32_t offset = 0;
-  for (std::uint32_t& c : count) {
+  for (std::uint32_t& c : out.count) {
     const std::uint32_t n = c;
     c = offset;
     offset += n;
   }
   out.points.resize(offset);
-  for (ChunkCoverage& part : parts) {
-    for (const SurfacePoint& p : part.points) out.points[count[p.texel]++] = p;
-    std::vector<SurfacePoint>().swap(part.points);  // the peak: all points once, and one chunk's
+  for (const SurfacePoint& p : out.found) {
+    const auto local = std::size_t((long long)(p.texel / std::uint32_t(tiling.width)) - y0) * kTile +
+                       std::size_t((long long)(p.texel % std::uint32_t(tiling.width)) - x0);
+    out.points[out.count[local]++] = p;
   }
-  for (std::size_t first = 0; first < touches.size(); ++first) {
-    if (first > 0 && touches[first].point.texel == touches[first - 1].point.texel) continue;
-    out.points[count[touches[first].point.texel]++] = touches[first].point;
+  for (std::size_t local = 0; local < out.count.size(); ++local) {
+    if (out.nearest[local].distance != kNone) out.points[out.count[local]++] = out.nearest[local].point;
+  }
+}
+
+std::string too_many_points(std::size_t max_points, int width, int height) {
+  return "its UV layout maps more than " + std::to_string(max_points) + " surface points into the " + std::to_string(width) +
+         "x" + std::to_string(height) +
+         " texture (placements or UV copies stacked on the same texels): give each placement its own texture, or bake a "
+         "smaller one";
+}
+
+Result<Coverage> cover(const scene::Scene& scene, const TextureTarget& target, int width, int height,
+                       std::size_t max_points) {
+  const Tiling tiling = tile(scene, target, width, height);
+  Coverage out;
+  out.triangles = tiling.triangles, out.degenerate_uv = tiling.degenerate_uv, out.wrapped = tiling.wrapped;
+  out.too_large = tiling.too_large, out.instances_without_uv = tiling.instances_without_uv;
+  std::vector<std::vector<SurfacePoint>> tile_points(tiling.fragments.size());
+  std::vector<std::array<std::size_t, 3>> tile_counts(tiling.fragments.size());
+  std::atomic<std::size_t> total{0};
+  tbb::enumerable_thread_specific<TilePoints> scratch;
+  tbb::parallel_for(std::size_t{0}, tiling.fragments.size(), [&](std::size_t t) {
+    if (tiling.fragments[t].empty() || total.load(std::memory_order_relaxed) > max_points) return;
+    TilePoints& found = scratch.local();
+    cover_tile(scene, target, tiling, t, found);
+    total += found.points.size();
+    tile_points[t] = found.points;
+    tile_counts[t] = {found.covered, found.touched, found.overlapped};
+  });
+  if (total > max_points) {
+    return Error{"", too_many_points(max_points, width, height)};
+  }
+  std::vector<std::uint32_t> first(std::size_t(width) * std::size_t(height) + 1, 0);
+  for (std::size_t t = 0; t < tile_points.size(); ++t) {
+    for (const SurfacePoint& p : tile_points[t]) ++first[p.texel + 1];
+    out.covered += tile_counts[t][0], out.touched += tile_counts[t][1], out.overlapped += tile_counts[t][2];
+  }
+  for (std::size_t i = 1; i < first.size(); ++i) first[i] += first[i - 1];
+  out.points.resize(total);
+  for (const std::vector<SurfacePoint>& points : tile_points) {
+    for (const SurfacePoint& p : points) out.points[first[p.texel]++] = p;
   }
   return out;
 }

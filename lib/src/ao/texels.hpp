@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "matbake/ao.hpp"
@@ -27,11 +28,50 @@ struct Coverage {
 };
 constexpr int kMaxCopies = 64;  // of the texture a triangle's UVs may span (wrapping)
 
-// Triangles are rasterized in parallel; the result is the same for any number of threads.
+// Every texel's points at once, for the whole texture: a bake that traces as it goes takes them
+// tile by tile instead (tile, cover_tile). The result is the same for any number of threads.
 // Errors: a layout mapping more than max_points surface points (hundreds of stacked copies).
 constexpr std::size_t kMaxSurfacePoints = std::size_t{1} << 27;  // 2.7 GB of points
 Result<Coverage> cover(const scene::Scene& scene, const TextureTarget& target, int width, int height,
                        std::size_t max_points = kMaxSurfacePoints);
+std::string too_many_points(std::size_t max_points, int width, int height);  // that error's message
+
+// Unwrapped cells [i0, i1] × [j0, j1] (whole numbers, inclusive).
+struct CellRect {
+  double i0, i1, j0, j1;
+};
+// A triangle's cells that wrap into one tile (a triangle over several tiles, or over copies of the
+// texture, has a fragment in each).
+struct Fragment {
+  std::uint32_t instance, triangle;
+  CellRect cells;
+};
+// The texture in kTile × kTile tiles (the last row and column cut), each with the fragments of the
+// triangles that may cover or touch its texels, in scene order: a tile's coverage needs only its
+// own, so tiles are covered (and traced) one at a time, in parallel.
+constexpr int kTile = 32;
+struct Tiling {
+  int width = 0, height = 0, columns = 0, rows = 0;  // texels; tiles
+  std::vector<std::vector<Fragment>> fragments;      // per tile, row × columns + column
+  std::size_t triangles = 0, degenerate_uv = 0, wrapped = 0, too_large = 0, instances_without_uv = 0;
+};
+Tiling tile(const scene::Scene& scene, const TextureTarget& target, int width, int height);
+
+// One tile's points (as Coverage's: sorted by texel, within a texel in scene order) and counts;
+// the rest is scratch, reused from tile to tile.
+struct TilePoints {
+  std::vector<SurfacePoint> points;
+  std::size_t covered = 0, touched = 0, overlapped = 0;
+  struct Touch {
+    double distance;
+    SurfacePoint point;
+  };
+  std::vector<SurfacePoint> found;
+  std::vector<std::uint32_t> count;
+  std::vector<Touch> nearest;
+};
+void cover_tile(const scene::Scene& scene, const TextureTarget& target, const Tiling& tiling, std::size_t tile,
+                TilePoints& out);
 
 // A triangle's UVs in texel space.
 struct UvTriangle {

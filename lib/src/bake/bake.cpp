@@ -4,11 +4,14 @@
 
 #include <glm/geometric.hpp>
 #include <glm/mat3x3.hpp>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <tuple>
 
@@ -79,12 +82,6 @@ struct TexelSum {
 };
 
 // What the report keeps of a traced texel.
-struct TexelTally {
-  double height = 0;
-  std::uint64_t occlusion_rays = 0;  // and thickness rays
-  int hits = 0, rays = 0;
-};
-
 // What every cage ray and the maps at its hit need, for texels and vertices alike.
 struct Rays {
   const scene::Scene& low;
@@ -528,45 +525,51 @@ Result<std::vector<std::vector<CornerFrame>>> target_frames(const scene::Scene& 
   return frames;
 }
 
-// The counts of a texture's traced texels into its report; marks `hit` and `traced`.
-void tally(const std::vector<TexelTally>& tallies, const std::vector<std::size_t>& runs,
-           const std::vector<ao::texels::SurfacePoint>& points, TextureBake& out, std::vector<bool>& hit, std::vector<bool>& traced) {
-  bool first = true;
-  for (std::size_t r = 0; r < tallies.size(); ++r) {
-    const std::size_t texel = points[runs[r]].texel;
-    traced[texel] = true;
-    out.samples += std::size_t(tallies[r].rays);
-    out.occlusion_rays += tallies[r].occlusion_rays;
-    out.misses += std::size_t(tallies[r].rays - tallies[r].hits);
-    if (tallies[r].hits == 0) {
-      ++out.missed_texels;
+// The counts of one tile's texels for the report (summed over tiles, in any order).
+struct TileTally {
+  std::size_t texels = 0, samples = 0, occlusion_rays = 0, misses = 0, missed_texels = 0, points = 0;
+  double height_min = std::numeric_limits<double>::infinity(), height_max = -std::numeric_limits<double>::infinity();
+  void add(const TileTally& o) {
+    texels += o.texels, samples += o.samples, occlusion_rays += o.occlusion_rays, misses += o.misses;
+    missed_texels += o.missed_texels, points += o.points;
+    height_min = std::min(height_min, o.height_min), height_max = std::max(height_max, o.height_max);
+  }
+};
+
+// One tile's texels traced into `out`'s maps: each texel's points into one sum; marks `traced` and
+// out.hit (bytes: tiles write their own texels in parallel).
+void trace_tile(const TraceContext& context, const Options& options, const ao::texels::TilePoints& tile,
+                TextureBake& out, std::vector<std::uint8_t>& traced, TileTally& tally) {
+  const auto& points = tile.points;
+  tally.points += points.size();
+  for (std::size_t first = 0, last = 0; first < points.size(); first = last) {
+    const std::uint32_t texel = points[first].texel;
+    TexelSum sum;
+    for (last = first; last < points.size() && points[last].texel == texel; ++last) {
+      const std::uint64_t key = ao::sample_key(options.seed, context.target_index, texel) ^ (std::uint64_t(last - first) << 32);
+      trace_point(context, points[last], key, sum);
+    }
+    ++tally.texels;
+    traced[texel] = 1;
+    tally.samples += std::size_t(sum.rays);
+    tally.occlusion_rays += sum.occlusion_rays + sum.thickness_rays;
+    tally.misses += std::size_t(sum.rays - sum.hits);
+    if (sum.hits == 0) {
+      ++tally.missed_texels;
       continue;
     }
-    hit[texel] = true;
+    store(sum, options, texel, out);
     out.hit[texel] = 1;
-    const double h = tallies[r].height / tallies[r].hits;
-    out.height_min = first ? h : std::min(out.height_min, h);
-    out.height_max = first ? h : std::max(out.height_max, h);
-    first = false;
+    const double height = sum.height / sum.hits;
+    tally.height_min = std::min(tally.height_min, height), tally.height_max = std::max(tally.height_max, height);
   }
 }
 
-// Options::maps over one texture target: its texels traced, misses filled, padded.
+// Options::maps over one texture target: its texels traced tile by tile as each tile's coverage is
+// found (no list of every texel's points), misses filled, padded.
 Result<TextureBake> trace_target(const TraceContext& context, const Options& options) {
   const ao::TextureOptions& texture = context.texture;
-  const std::size_t index = context.target_index;
-  auto coverage = ao::texels::cover(context.rays.low, context.target, texture.width, texture.height);
-  if (!coverage) {
-    return Error{"", (context.target.name.empty() ? "texture " + std::to_string(index) : context.target.name) + ": " +
-                         coverage.error().message};
-  }
-  const auto& points = coverage->points;
-  std::vector<std::size_t> runs;  // where each mapped texel's points begin, and the end
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    if (i == 0 || points[i].texel != points[i - 1].texel) runs.push_back(i);
-  }
-  runs.push_back(points.size());
-
+  const ao::texels::Tiling tiling = ao::texels::tile(context.rays.low, context.target, texture.width, texture.height);
   TextureBake out;
   const std::size_t texel_count = std::size_t(texture.width) * std::size_t(texture.height);
   out.width = texture.width, out.height = texture.height;
@@ -577,29 +580,33 @@ Result<TextureBake> trace_target(const TraceContext& context, const Options& opt
     background(image);
   }
   out.hit.assign(texel_count, 0);
-  out.texels = runs.size() - 1;
-  // A texel's sums live only while it is traced (a map's worth of doubles per texel, kept for
-  // all, cost more to clear than the one-ray trace itself); its counts are kept for the report.
-  std::vector<TexelTally> tallies(runs.size() - 1);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, tallies.size(), 64), [&](const tbb::blocked_range<std::size_t>& range) {
-    for (std::size_t r = range.begin(); r != range.end(); ++r) {
-      TexelSum sum;
-      for (std::size_t i = runs[r]; i < runs[r + 1]; ++i) {
-        const std::uint64_t key = ao::sample_key(options.seed, index, points[i].texel) ^ (std::uint64_t(i - runs[r]) << 32);
-        trace_point(context, points[i], key, sum);
-      }
-      if (sum.hits > 0) store(sum, options, points[runs[r]].texel, out);
-      tallies[r] = {sum.height, sum.occlusion_rays + sum.thickness_rays, sum.hits, sum.rays};
-    }
+  std::vector<std::uint8_t> traced(texel_count, 0);
+  std::vector<TileTally> tallies(tiling.fragments.size());
+  std::atomic<std::size_t> points{0};
+  tbb::enumerable_thread_specific<ao::texels::TilePoints> scratch;
+  tbb::parallel_for(std::size_t{0}, tiling.fragments.size(), [&](std::size_t t) {
+    if (tiling.fragments[t].empty() || points.load(std::memory_order_relaxed) > ao::texels::kMaxSurfacePoints) return;
+    ao::texels::TilePoints& tile = scratch.local();
+    ao::texels::cover_tile(context.rays.low, context.target, tiling, t, tile);
+    points += tile.points.size();
+    trace_tile(context, options, tile, out, traced, tallies[t]);
   });
-  std::vector<bool> hit(texel_count, false), traced(texel_count, false);
-  tally(tallies, runs, points, out, hit, traced);
+  if (points > ao::texels::kMaxSurfacePoints) {
+    return Error{"", (context.target.name.empty() ? "texture " + std::to_string(context.target_index) : context.target.name) +
+                         ": " + ao::texels::too_many_points(ao::texels::kMaxSurfacePoints, texture.width, texture.height)};
+  }
+  TileTally total;
+  for (const TileTally& t : tallies) total.add(t);
+  out.texels = total.texels, out.samples = total.samples, out.occlusion_rays = total.occlusion_rays;
+  out.misses = total.misses, out.missed_texels = total.missed_texels;
+  if (total.height_min <= total.height_max) out.height_min = total.height_min, out.height_max = total.height_max;
+  const std::vector<bool> hit(out.hit.begin(), out.hit.end()), was_traced(traced.begin(), traced.end());
   // Only where a texel missed every ray: the nearest-hit transform is over the whole texture.
   const std::vector<std::int64_t> nearest_hit =
       out.missed_texels ? ao::texels::nearest_mapped(hit, texture.width, texture.height) : std::vector<std::int64_t>{};
   for (MapImage& image : out.maps) {
-    fill_missed(image, nearest_hit, hit, traced);
-    out.padded = ao::texels::pad_channels(image.values, image.channels, traced, texture.width, texture.height,
+    fill_missed(image, nearest_hit, hit, was_traced);
+    out.padded = ao::texels::pad_channels(image.values, image.channels, was_traced, texture.width, texture.height,
                                           ao::padding_for(texture));
   }
   return out;
