@@ -1,6 +1,7 @@
-// The texture bake: coverage (texels.cpp), then the estimator of the per-vertex bake (tracer.cpp) at
-// each mapped texel's surface points, then padding.
+// The texture bake: tile by tile, coverage (texels.cpp), then the estimator of the per-vertex bake
+// (tracer.cpp) at each mapped texel's surface points; then padding.
 #include <glm/geometric.hpp>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -116,77 +117,76 @@ Result<TextureBakes> bake_textures(const scene::Scene& scene, const Options& opt
     report_stage(stage, Phase::ao, "AO texture " + std::to_string(index + 1) + " of " + std::to_string(targets.size()) + ", " +
                                        std::to_string(options.samples) + " rays a texel", double(index) / double(targets.size()));
     auto texel_start = Clock::now();
-    auto coverage = texels::cover(scene, target, texture.width, texture.height);
-    if (!coverage) {
-      const std::string name = target.name.empty() ? "texture " + std::to_string(index) : target.name;
-      return Error{"", name + ": " + coverage.error().message};
-    }
-    const std::vector<texels::SurfacePoint>& points = coverage->points;
-    std::vector<std::size_t> runs;  // where each mapped texel's points begin, and the end
-    for (std::size_t i = 0; i < points.size(); ++i) {
-      if (i == 0 || points[i].texel != points[i - 1].texel) runs.push_back(i);
-    }
-    runs.push_back(points.size());
+    const texels::Tiling tiling = texels::tile(scene, target, texture.width, texture.height);
     result.texel_seconds += seconds_since(texel_start);
 
     TextureBake& out = result.textures.emplace_back();
     out.width = texture.width, out.height = texture.height;
     out.values.assign(texel_count, 1.0f);
-    out.covered = coverage->covered, out.touched = coverage->touched, out.overlapped = coverage->overlapped;
-    out.triangles = coverage->triangles, out.degenerate_uv = coverage->degenerate_uv, out.wrapped = coverage->wrapped;
-    out.too_large = coverage->too_large;
-    out.instances_without_uv = coverage->instances_without_uv;
-
-    texel_start = Clock::now();
-    // Texels in 8 × 8 tiles, row by row within a tile: neighbours on the texture (mostly neighbours on
-    // the surface) are traced together, so their rays walk the same part of the BVH. Linear time.
-    std::vector<std::uint32_t> run_of(texel_count, UINT32_MAX);
-    for (std::size_t r = 0; r + 1 < runs.size(); ++r) run_of[points[runs[r]].texel] = std::uint32_t(r);
-    std::vector<std::uint32_t> order;
-    order.reserve(runs.size() - 1);
-    constexpr int kTile = 8;
-    for (int ty = 0; ty < texture.height; ty += kTile) {
-      for (int tx = 0; tx < texture.width; tx += kTile) {
-        for (int y = ty; y < std::min(ty + kTile, texture.height); ++y) {
-          for (int x = tx; x < std::min(tx + kTile, texture.width); ++x) {
-            const std::uint32_t r = run_of[std::size_t(y) * std::size_t(texture.width) + std::size_t(x)];
-            if (r != UINT32_MAX) order.push_back(r);
-          }
-        }
-      }
-    }
-    result.texel_seconds += seconds_since(texel_start);
+    out.triangles = tiling.triangles, out.degenerate_uv = tiling.degenerate_uv, out.wrapped = tiling.wrapped;
+    out.too_large = tiling.too_large;
+    out.instances_without_uv = tiling.instances_without_uv;
+    std::vector<std::uint8_t> mapped(texel_count, 0);
+    // Per tile: its coverage, then its texels traced (neighbours on the texture, mostly neighbours
+    // on the surface, together: their rays walk the same part of the BVH). The tile's counts and
+    // the seconds each part took (on its thread) are kept for the report.
+    struct TileTally {
+      std::size_t covered = 0, touched = 0, overlapped = 0, points = 0;
+      std::uint64_t rays = 0;
+      double sum = 0, cover_seconds = 0, ray_seconds = 0;
+    };
+    std::vector<TileTally> tallies(tiling.fragments.size());
     const auto ray_start = Clock::now();
-    std::atomic<std::uint64_t> rays{0};
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, order.size(), 16), [&](const tbb::blocked_range<std::size_t>& range) {
-      std::vector<RTCRayHit> scratch(std::size_t(options.samples));
-      std::uint64_t cast = 0;
-      for (std::size_t o = range.begin(); o != range.end(); ++o) {
-        const std::size_t r = order[o];
+    std::atomic<std::size_t> points{0};
+    tbb::enumerable_thread_specific<texels::TilePoints> tile_points;
+    tbb::enumerable_thread_specific<std::vector<RTCRayHit>> scratch(std::size_t(options.samples));
+    tbb::parallel_for(std::size_t{0}, tiling.fragments.size(), [&](std::size_t t) {
+      if (tiling.fragments[t].empty() || points.load(std::memory_order_relaxed) > texels::kMaxSurfacePoints) return;
+      TileTally& tally = tallies[t];
+      const auto cover_start = Clock::now();
+      texels::TilePoints& tile = tile_points.local();
+      texels::cover_tile(scene, target, tiling, t, tile);
+      points += tile.points.size();
+      tally.covered = tile.covered, tally.touched = tile.touched, tally.overlapped = tile.overlapped;
+      const auto trace_start = Clock::now();
+      tally.cover_seconds = std::chrono::duration<double>(trace_start - cover_start).count();
+      for (std::size_t first = 0, last = 0; first < tile.points.size(); first = last) {
+        const std::uint32_t texel = tile.points[first].texel;
         double sum = 0;
-        for (std::size_t i = runs[r]; i < runs[r + 1]; ++i) {
+        for (last = first; last < tile.points.size() && tile.points[last].texel == texel; ++last) {
           // Each surface of a texel its own stream: overlapping copies are independent estimates.
           // Keyed apart from the per-vertex bake's streams (instance k, vertex v): texel j × W + i of
           // a texture laid over a grid would otherwise repeat vertex j × W + i's rays exactly.
-          const std::uint64_t key = sample_key(options.seed, kTextureGroup + index, points[i].texel) ^
-                                    (std::uint64_t(i - runs[r]) << 32);
-          sum += point_occlusion(tracer, scene, points[i], target, texture, options.samples, key, scratch, cast);
+          const std::uint64_t key = sample_key(options.seed, kTextureGroup + index, texel) ^ (std::uint64_t(last - first) << 32);
+          sum += point_occlusion(tracer, scene, tile.points[last], target, texture, options.samples, key, scratch.local(), tally.rays);
         }
-        out.values[points[runs[r]].texel] = float(sum / double(runs[r + 1] - runs[r]));
+        out.values[texel] = float(sum / double(last - first));
+        tally.sum += out.values[texel];
+        mapped[texel] = 1;
       }
-      rays += cast;
+      tally.ray_seconds = seconds_since(trace_start);
     });
-    out.rays = rays;
-    double sum = 0;
-    for (std::size_t r = 0; r + 1 < runs.size(); ++r) sum += out.values[points[runs[r]].texel];
-    out.mean = runs.size() > 1 ? sum / double(runs.size() - 1) : 0.0;
+    if (points > texels::kMaxSurfacePoints) {
+      const std::string name = target.name.empty() ? "texture " + std::to_string(index) : target.name;
+      return Error{"", name + ": " + texels::too_many_points(texels::kMaxSurfacePoints, texture.width, texture.height)};
+    }
+    double sum = 0, cover_seconds = 0, ray_seconds = 0;
+    for (const TileTally& tally : tallies) {
+      out.covered += tally.covered, out.touched += tally.touched, out.overlapped += tally.overlapped;
+      out.rays += tally.rays;
+      sum += tally.sum, cover_seconds += tally.cover_seconds, ray_seconds += tally.ray_seconds;
+    }
+    const std::size_t texels_mapped = out.covered + out.touched;
+    out.mean = texels_mapped ? sum / double(texels_mapped) : 0.0;
     result.rays += out.rays;
-    result.ray_seconds += seconds_since(ray_start);
+    // The tiles' coverage and tracing interleave: the wall time split between them as their threads' was.
+    const double wall = seconds_since(ray_start);
+    const double covering = cover_seconds + ray_seconds > 0 ? wall * cover_seconds / (cover_seconds + ray_seconds) : 0.0;
+    result.texel_seconds += covering;
+    result.ray_seconds += wall - covering;
 
     texel_start = Clock::now();
-    std::vector<bool> mapped(texel_count, false);
-    for (const texels::SurfacePoint& p : points) mapped[p.texel] = true;
-    out.padded = texels::pad(out.values, mapped, texture.width, texture.height, padding);
+    out.padded = texels::pad(out.values, std::vector<bool>(mapped.begin(), mapped.end()), texture.width, texture.height, padding);
     result.texel_seconds += seconds_since(texel_start);
   }
   return result;
