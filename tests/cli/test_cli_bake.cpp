@@ -6,14 +6,17 @@
 #include <nlohmann/json.hpp>
 
 #include <fstream>
+#include <set>
 
 #include "lib/src/bake/frames.hpp"
 #include "lib/src/gltf/document.hpp"
+#include "lib/src/gltf/texture_files.hpp"
 #include "matbake/bake.hpp"
 #include "matbake/image.hpp"
 #include "matbake/scene.hpp"
 #include "support/expect_error.hpp"
 #include "support/files.hpp"
+#include "support/gltf_builder.hpp"
 #include "support/gltf_files.hpp"
 #include "support/gltf_validator.hpp"
 #include "support/run.hpp"
@@ -178,6 +181,69 @@ TEST(CliBake, TheExampleOntoItselfGivesTheFlatNormalMapAndAoAndTheSameBytesForAn
   EXPECT_TRUE(file_bytes(dir / "one/baked.glb") == file_bytes(dir / "two/baked.glb"));
   EXPECT_TRUE(file_bytes(dir / "one/baked_wood_height.exr") == file_bytes(dir / "two/baked_wood_height.exr"));
   EXPECT_TRUE(file_bytes(dir / "one/baked_wood_bent_normal.exr") == file_bytes(dir / "two/baked_wood_bent_normal.exr"));
+}
+
+// A bake removes what it leaves unused, as gltf-transform's prune would, and nothing else: the
+// low-poly's material has a normal map and an occlusion map (one sampler each), and the file also
+// holds a texture no material uses (its image and sampler too). Baking normal and ao replaces the
+// two maps: their textures, images and samplers go (they stayed, the validator's UNUSED_OBJECT), the
+// file's own unused texture stays as it came, and every texture and image left is the baked ones'
+// or that one. Validator-clean.
+TEST(CliBake, WhatTheBakeReplacedIsRemovedAndTheFilesOwnUnusedObjectsStay) {
+  TempDir dir;
+  const Icosphere fine = icosphere(3);
+  write_grey_mesh(dir / "high.gltf", fine.vertices, fine.vertices, {}, fine.triangles);
+  const AtlasMesh low = icosphere_atlas(1, true);
+  write_grey_mesh(dir / "low.gltf", low.positions, low.normals, low.texcoords, low.triangles);
+  image::Image grey = gltf::blank(4, 4, 3);
+  image::WriteOptions png;
+  png.type = image::SampleType::u8;
+  for (const char* name : {"old_normal", "old_occlusion", "spare"}) {
+    ASSERT_TRUE(image::write_image(grey, dir / (std::string(name) + ".png"), png));
+  }
+  auto file = nlohmann::json::parse(std::ifstream(dir / "low.gltf"));
+  file["samplers"] = {{{"magFilter", 9729}}, {{"magFilter", 9728}}, {{"wrapS", 33071}}};
+  file["images"] = {{{"uri", "old_normal.png"}}, {{"uri", "old_occlusion.png"}}, {{"uri", "spare.png"}}};
+  file["textures"] = {{{"source", 0}, {"sampler", 0}, {"name", "old normal"}},
+                      {{"source", 1}, {"sampler", 1}, {"name", "old occlusion"}},
+                      {{"source", 2}, {"sampler", 2}, {"name", "spare"}}};
+  file["materials"][0]["normalTexture"] = {{"index", 0}};
+  file["materials"][0]["occlusionTexture"] = {{"index", 1}};
+  std::ofstream(dir / "low.gltf") << file.dump();
+  fs::create_directories(dir / "out");
+  const auto r = matbake({"--json", "bake", (dir / "low.gltf").string(), "--from", (dir / "high.gltf").string(), "-o",
+                          (dir / "out" / "baked.gltf").string(), "--maps", "normal,ao", "--size", "64", "--front", "0.3",
+                          "--back", "0.3", "--absolute-cage", "--ao-samples", "4"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto report = nlohmann::json::parse(r.out);
+  const auto written = nlohmann::json::parse(std::ifstream(dir / "out" / "baked.gltf"));
+  std::set<std::string> texture_names, image_uris;
+  for (const auto& t : written["textures"]) texture_names.insert(t.value("name", ""));
+  for (const auto& i : written["images"]) image_uris.insert(i["uri"].get<std::string>());
+  EXPECT_EQ(texture_names.count("old normal") + texture_names.count("old occlusion"), 0u) << written["textures"];
+  EXPECT_EQ(texture_names.count("spare"), 1u);
+  EXPECT_EQ(image_uris.count("spare.png"), 1u);
+  EXPECT_EQ(image_uris.count("old_normal.png") + image_uris.count("old_occlusion.png"), 0u) << written["images"];
+  EXPECT_EQ(written["textures"].size(), 3u);  // the baked normal map, the baked occlusion, spare
+  EXPECT_EQ(written["images"].size(), 3u);
+  const auto& material = written["materials"][0];
+  const auto source = [&](const char* slot) {
+    const auto& texture = written["textures"][material[slot]["index"].get<std::size_t>()];
+    return written["images"][texture["source"].get<std::size_t>()]["uri"].get<std::string>();
+  };
+  EXPECT_EQ(source("normalTexture"), report["textures"][0]["files"][0]);
+  EXPECT_EQ(source("occlusionTexture"), report["textures"][0]["files"][1]);
+  // The spare texture kept its own image and sampler.
+  for (const auto& t : written["textures"]) {
+    if (t.value("name", "") != "spare") continue;
+    EXPECT_EQ(written["images"][t["source"].get<std::size_t>()]["uri"], "spare.png");
+    EXPECT_EQ(written["samplers"][t["sampler"].get<std::size_t>()], nlohmann::json({{"wrapS", 33071}}));
+  }
+  bool noted = false;
+  for (const auto& note : report["notes"]) noted |= note.get<std::string>().starts_with("removed what the bake left unused: ");
+  EXPECT_TRUE(noted) << report["notes"];
+  MATBAKE_VALIDATE_OR_SKIP(validated, dir / "out" / "baked.gltf");
+  EXPECT_EQ(validated->errors + validated->warnings, 0) << validated->summary;
 }
 
 // Per-vertex maps through the file. The low-poly: a 3 × 2 grid of the plane z = 0 over

@@ -186,6 +186,47 @@ TEST(GltfPrune, ExtensionReferencesSurviveAndFollowTheirObjects) {
   EXPECT_EQ(s->instances[0].positions.size(), 5u);
 }
 
+// An edit's prune (`before`: what the file reached as read) removes only what the edit left unused,
+// and never what a kept object still names: material 1 (used by no mesh, so kept as it came) names
+// texture 0, which the edit took from material 0; texture 1 goes, as do its image and sampler;
+// texture 2 (unused as read) stays. Then everything kept names only what exists.
+TEST(GltfPrune, AnEditsPruneRemovesWhatTheEditLeftUnusedAndNothingAKeptObjectNames) {
+  TempDir dir;
+  GltfBuilder b;
+  const int mesh = b.add_mesh(b.add_vec3(kFloor), b.add_indices(kFan));
+  b.doc["meshes"][std::size_t(mesh)]["primitives"][0]["material"] = 0;
+  b.doc["materials"] = {{{"name", "Used"}, {"normalTexture", {{"index", 1}}}, {"occlusionTexture", {{"index", 0}}}},
+                        {{"name", "Unused"}, {"emissiveTexture", {{"index", 0}}}}};
+  b.doc["samplers"] = {{{"wrapS", 33071}}, {{"wrapT", 33071}}, {{"magFilter", 9728}}};
+  b.doc["images"] = {{{"uri", "a.png"}}, {{"uri", "b.png"}}, {{"uri", "c.png"}}};
+  b.doc["textures"] = {{{"source", 0}, {"sampler", 0}}, {{"source", 1}, {"sampler", 1}}, {{"source", 2}, {"sampler", 2}}};
+  b.add_node({{"mesh", mesh}});
+  b.write(dir / "in.gltf", {0});
+  auto doc = gltf::read_document(dir / "in.gltf");
+  ASSERT_TRUE(doc) << doc.error().to_string();
+  const gltf::Reachable as_read = gltf::reachable(doc->json);
+  EXPECT_EQ(as_read.textures, (std::vector<bool>{true, true, false}));
+  EXPECT_EQ(as_read.materials, (std::vector<bool>{true, false}));
+  // The edit: material 0's maps become a new texture of image 0 (appended).
+  doc->json["textures"].push_back({{"source", 0}});
+  doc->json["materials"][0]["normalTexture"]["index"] = 3;
+  doc->json["materials"][0].erase("occlusionTexture");
+  const std::vector<std::string> removed = gltf::prune_unreachable(*doc, nullptr, &as_read);
+  EXPECT_EQ(removed, (std::vector<std::string>{"texture 1", "image 1", "sampler 1"}));
+  const gltf::Json& json = doc->json;
+  ASSERT_EQ(json["textures"].size(), 3u);
+  EXPECT_EQ(json["materials"][1]["emissiveTexture"]["index"], 0);  // still texture 0: image a, sampler 0
+  const auto source_and_sampler = [&](std::size_t t) { return std::pair{json["textures"][t]["source"].get<int>(), json["textures"][t]["sampler"].get<int>()}; };
+  EXPECT_EQ(source_and_sampler(0), std::pair(0, 0));
+  EXPECT_EQ(source_and_sampler(1), std::pair(1, 1));  // texture 2 as read: image c, sampler 2
+  EXPECT_EQ(json["images"][1]["uri"], "c.png");
+  EXPECT_EQ(json["samplers"][1]["magFilter"], 9728);
+  EXPECT_EQ(json["materials"][0]["normalTexture"]["index"], 2);
+  // Without `before`, the unused material goes, and texture 0 with it only if nothing else names it.
+  const std::vector<std::string> rest = gltf::prune_unreachable(*doc);
+  EXPECT_EQ(rest, (std::vector<std::string>{"material 1 'Unused'", "texture 0", "texture 1", "image 1", "sampler 0", "sampler 1"}));
+}
+
 // A quad under a roof and the same mesh placed again in the open; the floor has its own colours.
 fs::path write_instanced_scene(const fs::path& folder) {
   GltfBuilder b;

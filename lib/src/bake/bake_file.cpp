@@ -9,12 +9,14 @@
 #include "../gltf/tangents.hpp"
 #include "../gltf/texture_files.hpp"
 #include "../gltf/placements.hpp"
+#include "../gltf/prune.hpp"
 #include "../gltf/texture_transform.hpp"
 #include "../gltf/vertex_occlusion.hpp"
 #include "../scene/from_document.hpp"
 #include "frames.hpp"
 #include "map_cache.hpp"
 #include "matbake/bake_file.hpp"
+#include "matbake/join.hpp"
 #include "matbake/output_check.hpp"
 
 namespace matbake::bake {
@@ -356,6 +358,17 @@ Result<Bake> bake_or_reuse(const scene::Scene& low, const Targets& targets, cons
   return out;
 }
 
+// What of a document a bake may remove once it has written its maps: what the scene reached as
+// read and no longer does (a texture the baked one replaced, its image and sampler; the accessors
+// the tangents' split vertices replaced). The file's own unused objects stay, and so does every
+// material and mesh (the report names them by index).
+gltf::Reachable reach_before_bake(Json& json) {
+  gltf::Reachable reached = gltf::reachable(json);
+  std::fill(reached.materials.begin(), reached.materials.end(), false);
+  std::fill(reached.meshes.begin(), reached.meshes.end(), false);
+  return reached;
+}
+
 }  // namespace
 
 Result<FileReport> bake_file(const fs::path& low_path, const FileOptions& options) {
@@ -378,6 +391,7 @@ Result<FileReport> bake_file(const fs::path& low_path, const FileOptions& option
     }
     auto doc = gltf::read_document(low_path);
     if (!doc) return doc.error();
+    const gltf::Reachable as_read = reach_before_bake(doc->json);
     auto low = scene::scene_from_document(*doc, {.texcoords = true, .object_space = true});
     if (!low) return low.error();
     // Vertex maps alone need no UVs: no texture targets.
@@ -431,6 +445,9 @@ Result<FileReport> bake_file(const fs::path& low_path, const FileOptions& option
     }
     if (normal) {
       if (Status s = write_tangents(*doc, *low, *targets, report); !s) return s.error();
+    }
+    if (const auto removed = gltf::prune_unreachable(*doc, nullptr, &as_read); !removed.empty()) {
+      report.notes.push_back("removed what the bake left unused: " + join(removed, ", "));
     }
     auto written = gltf::write_document(*doc, options.output);
     if (!written) return written.error();

@@ -174,10 +174,25 @@ void for_each_texture_index(Json& material, const std::function<void(Json&)>& f)
   for_each_texture_info(material, [&](Json& info) { f(info["index"]); });
 }
 
-std::vector<std::string> prune_unreachable(Document& doc, std::vector<int>* texture_remap_out) {
-  Json& json = doc.json;
-  std::vector<std::string> removed;
+namespace {
 
+// The reachable-or-not flags of every top-level array prune_unreachable may shorten.
+struct AllMarks {
+  Marks meshes, materials, accessors, textures, images, samplers, views;
+};
+
+// Marks `marks` every item `before` held unreachable (the same index: edits only append).
+void keep_unreachable(Marks& marks, const std::vector<bool>* before) {
+  if (!before) return;
+  for (std::size_t i = 0; i < std::min(before->size(), marks.keep.size()); ++i) {
+    if (!(*before)[i]) marks.keep[i] = true;
+  }
+}
+
+// What the default scene reaches and, with `before`, what was unreachable then, and all that these
+// reference: each kind's kept items are added before what they reference is marked, so nothing
+// kept loses a reference.
+AllMarks mark_reachable(Json& json, const Reachable* before) {
   // Nodes of the default scene (scene 0 when none is named), with a stack rather than recursion (a
   // hostile file may nest a million nodes); cycles stop.
   std::vector<bool> in_scene(count_of(json, "nodes"), false);
@@ -195,50 +210,70 @@ std::vector<std::string> prune_unreachable(Document& doc, std::vector<int>* text
     pending.pop_back();
     for_each_in(json["nodes"][std::size_t(i)], "children", reach);
   }
-
-  Marks meshes{"meshes", std::vector<bool>(count_of(json, "meshes"))};
+  const auto marks = [&](const char* key) { return Marks{key, std::vector<bool>(count_of(json, key))}; };
+  AllMarks m{marks("meshes"), marks("materials"), marks("accessors"), marks("textures"),
+             marks("images"), marks("samplers"), marks("bufferViews")};
+  const auto also = [&](Marks& kind, std::vector<bool> Reachable::*field) {
+    keep_unreachable(kind, before ? &(before->*field) : nullptr);
+  };
   for (std::size_t n = 0; n < in_scene.size(); ++n) {
-    if (in_scene[n] && json["nodes"][n].contains("mesh")) meshes.mark(json, json["nodes"][n]["mesh"]);
+    if (in_scene[n] && json["nodes"][n].contains("mesh")) m.meshes.mark(json, json["nodes"][n]["mesh"]);
   }
-  Marks materials{"materials", std::vector<bool>(count_of(json, "materials"))};
-  Marks accessors{"accessors", std::vector<bool>(count_of(json, "accessors"))};
-  for (std::size_t m = 0; m < meshes.keep.size(); ++m) {
-    if (!meshes.keep[m]) continue;
-    for_each_in(json["meshes"][m], "primitives", [&](Json& p) {
-      if (p.contains("material")) materials.mark(json, p["material"]);
-      for_each_variant_material(p, [&](Json& material) { materials.mark(json, material); });
-      for_each_primitive_accessor(p, [&](Json& a) { accessors.mark(json, a); });
+  also(m.meshes, &Reachable::meshes);
+  for (std::size_t i = 0; i < m.meshes.keep.size(); ++i) {
+    if (!m.meshes.keep[i]) continue;
+    for_each_in(json["meshes"][i], "primitives", [&](Json& p) {
+      if (p.contains("material")) m.materials.mark(json, p["material"]);
+      for_each_variant_material(p, [&](Json& material) { m.materials.mark(json, material); });
+      for_each_primitive_accessor(p, [&](Json& a) { m.accessors.mark(json, a); });
     });
   }
   for (std::size_t n = 0; n < in_scene.size(); ++n) {
-    if (in_scene[n]) for_each_node_accessor(json["nodes"][n], [&](Json& a) { accessors.mark(json, a); });
+    if (in_scene[n]) for_each_node_accessor(json["nodes"][n], [&](Json& a) { m.accessors.mark(json, a); });
   }
-  for_each_other_accessor(json, [&](Json& a) { accessors.mark(json, a); });
-  Marks textures{"textures", std::vector<bool>(count_of(json, "textures"))};
-  for (std::size_t m = 0; m < materials.keep.size(); ++m) {
-    if (materials.keep[m]) for_each_texture_index(json["materials"][m], [&](Json& t) { textures.mark(json, t); });
+  for_each_other_accessor(json, [&](Json& a) { m.accessors.mark(json, a); });
+  also(m.materials, &Reachable::materials);
+  also(m.accessors, &Reachable::accessors);
+  for (std::size_t i = 0; i < m.materials.keep.size(); ++i) {
+    if (m.materials.keep[i]) for_each_texture_index(json["materials"][i], [&](Json& t) { m.textures.mark(json, t); });
   }
-  Marks images{"images", std::vector<bool>(count_of(json, "images"))};
-  Marks samplers{"samplers", std::vector<bool>(count_of(json, "samplers"))};
-  for (std::size_t t = 0; t < textures.keep.size(); ++t) {
-    if (!textures.keep[t]) continue;
+  also(m.textures, &Reachable::textures);
+  for (std::size_t t = 0; t < m.textures.keep.size(); ++t) {
+    if (!m.textures.keep[t]) continue;
     Json& texture = json["textures"][t];
-    for_each_texture_source(texture, [&](Json& i) { images.mark(json, i); });
-    if (texture.contains("sampler")) samplers.mark(json, texture["sampler"]);
+    for_each_texture_source(texture, [&](Json& i) { m.images.mark(json, i); });
+    if (texture.contains("sampler")) m.samplers.mark(json, texture["sampler"]);
   }
-  Marks views{"bufferViews", std::vector<bool>(count_of(json, "bufferViews"))};
-  for (std::size_t a = 0; a < accessors.keep.size(); ++a) {
-    if (!accessors.keep[a]) continue;
+  also(m.images, &Reachable::images);
+  also(m.samplers, &Reachable::samplers);
+  for (std::size_t a = 0; a < m.accessors.keep.size(); ++a) {
+    if (!m.accessors.keep[a]) continue;
     Json& accessor = json["accessors"][a];
-    if (accessor.contains("bufferView")) views.mark(json, accessor["bufferView"]);
-    for_each_sparse_view(accessor, [&](Json& v) { views.mark(json, v); });
+    if (accessor.contains("bufferView")) m.views.mark(json, accessor["bufferView"]);
+    for_each_sparse_view(accessor, [&](Json& v) { m.views.mark(json, v); });
   }
-  for (std::size_t i = 0; i < images.keep.size(); ++i) {
-    if (images.keep[i] && json["images"][i].contains("bufferView")) views.mark(json, json["images"][i]["bufferView"]);
+  for (std::size_t i = 0; i < m.images.keep.size(); ++i) {
+    if (m.images.keep[i] && json["images"][i].contains("bufferView")) m.views.mark(json, json["images"][i]["bufferView"]);
   }
-  for (std::size_t m = 0; m < meshes.keep.size(); ++m) {
-    if (meshes.keep[m]) for_each_in(json["meshes"][m], "primitives", [&](Json& p) { for_each_draco_view(p, [&](Json& v) { views.mark(json, v); }); });
+  for (std::size_t i = 0; i < m.meshes.keep.size(); ++i) {
+    if (m.meshes.keep[i]) for_each_in(json["meshes"][i], "primitives", [&](Json& p) { for_each_draco_view(p, [&](Json& v) { m.views.mark(json, v); }); });
   }
+  also(m.views, &Reachable::views);
+  return m;
+}
+
+}  // namespace
+
+Reachable reachable(Json& json) {
+  const AllMarks m = mark_reachable(json, nullptr);
+  return {m.meshes.keep, m.materials.keep, m.accessors.keep, m.textures.keep, m.images.keep, m.samplers.keep, m.views.keep};
+}
+
+std::vector<std::string> prune_unreachable(Document& doc, std::vector<int>* texture_remap_out, const Reachable* before) {
+  Json& json = doc.json;
+  std::vector<std::string> removed;
+  AllMarks marks = mark_reachable(json, before);
+  auto& [meshes, materials, accessors, textures, images, samplers, views] = marks;
 
   // Remove, then point every reference at the new indices.
   const auto mesh_remap = keep_marked(json, meshes, "mesh", removed);

@@ -12,9 +12,18 @@
 
 namespace matbake::gltf {
 
+// What the default scene reaches, per top-level array prune_unreachable shortens.
+struct Reachable {
+  std::vector<bool> meshes, materials, accessors, textures, images, samplers, views;
+};
+Reachable reachable(Json& json);
+
 // Returns one line per removed object ("material 2 'Unused'"), for the report; `texture_remap`, when
-// given, receives each old texture index's new one (−1: removed).
-std::vector<std::string> prune_unreachable(Document& doc, std::vector<int>* texture_remap = nullptr);
+// given, receives each old texture index's new one (−1: removed). With `before` (reachable() of the
+// document before an edit that only appended), what was unreachable then stays: only what the edit
+// left unused goes (a bake's replaced textures), not the file's own unused objects.
+std::vector<std::string> prune_unreachable(Document& doc, std::vector<int>* texture_remap = nullptr,
+                                           const Reachable* before = nullptr);
 
 // Images with the same bytes become one: every texture's reference moves to the first of them; then
 // textures that are the same (name aside) become one likewise, for every material. What is left
