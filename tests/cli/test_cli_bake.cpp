@@ -183,6 +183,15 @@ TEST(CliBake, TheExampleOntoItselfGivesTheFlatNormalMapAndAoAndTheSameBytesForAn
   EXPECT_TRUE(file_bytes(dir / "one/baked_wood_bent_normal.exr") == file_bytes(dir / "two/baked_wood_bent_normal.exr"));
 }
 
+// high.gltf: a smooth icosphere of `fine` subdivisions (normals radial); low.gltf: a flat-shaded
+// one of `coarse`, each triangle its own UV island.
+void write_icosphere_pair(const fs::path& folder, int fine, int coarse) {
+  const Icosphere high = icosphere(fine);
+  write_grey_mesh(folder / "high.gltf", high.vertices, high.vertices, {}, high.triangles);
+  const AtlasMesh low = icosphere_atlas(coarse, true);
+  write_grey_mesh(folder / "low.gltf", low.positions, low.normals, low.texcoords, low.triangles);
+}
+
 // A bake removes what it leaves unused, as gltf-transform's prune would, and nothing else: the
 // low-poly's material has a normal map and an occlusion map (one sampler each), and the file also
 // holds a texture no material uses (its image and sampler too). Baking normal and ao replaces the
@@ -191,10 +200,7 @@ TEST(CliBake, TheExampleOntoItselfGivesTheFlatNormalMapAndAoAndTheSameBytesForAn
 // or that one. Validator-clean.
 TEST(CliBake, WhatTheBakeReplacedIsRemovedAndTheFilesOwnUnusedObjectsStay) {
   TempDir dir;
-  const Icosphere fine = icosphere(3);
-  write_grey_mesh(dir / "high.gltf", fine.vertices, fine.vertices, {}, fine.triangles);
-  const AtlasMesh low = icosphere_atlas(1, true);
-  write_grey_mesh(dir / "low.gltf", low.positions, low.normals, low.texcoords, low.triangles);
+  write_icosphere_pair(dir.path(), 3, 1);
   image::Image grey = gltf::blank(4, 4, 3);
   image::WriteOptions png;
   png.type = image::SampleType::u8;
@@ -417,10 +423,7 @@ TEST(CliBake, BadRequestsAreOneErrorLineAndWriteNothing) {
 // its sign is wrong).
 TEST(CliBake, ABakedIcosphereRendersInThreeJsCloserToTheSphereThanItself) {
   TempDir dir;
-  const Icosphere fine = icosphere(4);
-  write_grey_mesh(dir / "high.gltf", fine.vertices, fine.vertices, {}, fine.triangles);
-  const AtlasMesh low = icosphere_atlas(2, true);
-  write_grey_mesh(dir / "low.gltf", low.positions, low.normals, low.texcoords, low.triangles);
+  write_icosphere_pair(dir.path(), 4, 2);
   for (const std::string green : {"opengl", "directx"}) {
     const auto r = matbake({"bake", (dir / "low.gltf").string(), "--from", (dir / "high.gltf").string(), "-o",
                             (dir / (green + ".glb")).string(), "--size", "512", "--front", "0.3", "--back", "0.3",
