@@ -366,6 +366,7 @@ TEST(CliBake, PerInstanceGivesEachPlacementItsOwnMapsAndVertexValues) {
     for (const auto& t : report["textures"]) {
       const std::string name = t["name"];
       const double want = !per_instance ? 0.035 : name == "quad" ? 0.02 : 0.05;
+      EXPECT_EQ(t.value("copy_of_material", -1), per_instance && name != "quad" ? 0 : -1) << name;
       auto height = image::read_image(t["files"][1].get<std::string>(), color::Transfer::linear);
       ASSERT_TRUE(height) << name;
       for (float v : height->pixels) ASSERT_NEAR(v, want, 1e-6) << name;

@@ -38,6 +38,7 @@ struct TextureReport {
   int material = -1;
   std::string name;                // the material's
   std::string copy_of;             // per_instance: the name of the material a placement's copy copies
+  int copy_of_material = -1;       // and its index (−1: not a copy)
   int width = 0, height = 0, texcoord = 0;
   std::size_t texels = 0, samples = 0, misses = 0, missed_texels = 0, padded = 0, occlusion_rays = 0;
   double height_min = 0, height_max = 0;

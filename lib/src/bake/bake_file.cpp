@@ -431,7 +431,10 @@ Result<FileReport> bake_file(const fs::path& low_path, const FileOptions& option
     for (std::size_t t = 0; t < targets->targets.size(); ++t) {
       auto written = write_maps(*doc, cache, options, *targets, t, into[t], baked->textures[t]);
       if (!written) return written.error();
-      if (into[t] != targets->materials[t]) written->copy_of = gltf::name_in(doc->json["materials"][std::size_t(targets->materials[t])], "");
+      if (into[t] != targets->materials[t]) {
+        written->copy_of = gltf::name_in(doc->json["materials"][std::size_t(targets->materials[t])], "");
+        written->copy_of_material = targets->materials[t];
+      }
       for (std::size_t i = 0; i < options.request.bake.maps.size(); ++i) {
         if (material_slot(options.request.bake.maps[i])) continue;
         report.written.push_back(written->files[i]);
