@@ -147,8 +147,8 @@ struct TextureBakes {
   std::uint64_t rays = 0;
   double max_distance = 0;
   double setup_seconds = 0;   // normals, edge lengths and Embree's BVH
-  double texel_seconds = 0;   // rasterizing the UVs, padding (the tiles' coverage and tracing
-  double ray_seconds = 0;     // interleave: their wall time split as their threads' time was)
+  double texel_seconds = 0;   // cutting the UVs into tiles, padding
+  double ray_seconds = 0;     // the tiles: each one's coverage, then its rays
 };
 
 // Deterministic for a given seed whatever the thread count. options.targets is ignored (every

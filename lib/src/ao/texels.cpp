@@ -364,6 +364,21 @@ std::string too_many_points(std::size_t max_points, int width, int height) {
          "smaller one";
 }
 
+Status cover_tiles(const scene::Scene& scene, const TextureTarget& target, const Tiling& tiling, std::size_t max_points,
+                   const std::function<void(std::size_t tile, const TilePoints& points)>& visit) {
+  std::atomic<std::size_t> total{0};
+  tbb::enumerable_thread_specific<TilePoints> scratch;
+  tbb::parallel_for(std::size_t{0}, tiling.fragments.size(), [&](std::size_t t) {
+    if (tiling.fragments[t].empty() || total.load(std::memory_order_relaxed) > max_points) return;
+    TilePoints& found = scratch.local();
+    cover_tile(scene, target, tiling, t, found);
+    total += found.points.size();
+    visit(t, found);
+  });
+  if (total > max_points) return Error{"", too_many_points(max_points, tiling.width, tiling.height)};
+  return success();
+}
+
 Result<Coverage> cover(const scene::Scene& scene, const TextureTarget& target, int width, int height,
                        std::size_t max_points) {
   const Tiling tiling = tile(scene, target, width, height);
@@ -372,19 +387,13 @@ Result<Coverage> cover(const scene::Scene& scene, const TextureTarget& target, i
   out.too_large = tiling.too_large, out.instances_without_uv = tiling.instances_without_uv;
   std::vector<std::vector<SurfacePoint>> tile_points(tiling.fragments.size());
   std::vector<std::array<std::size_t, 3>> tile_counts(tiling.fragments.size());
-  std::atomic<std::size_t> total{0};
-  tbb::enumerable_thread_specific<TilePoints> scratch;
-  tbb::parallel_for(std::size_t{0}, tiling.fragments.size(), [&](std::size_t t) {
-    if (tiling.fragments[t].empty() || total.load(std::memory_order_relaxed) > max_points) return;
-    TilePoints& found = scratch.local();
-    cover_tile(scene, target, tiling, t, found);
-    total += found.points.size();
+  const Status covered = cover_tiles(scene, target, tiling, max_points, [&](std::size_t t, const TilePoints& found) {
     tile_points[t] = found.points;
     tile_counts[t] = {found.covered, found.touched, found.overlapped};
   });
-  if (total > max_points) {
-    return Error{"", too_many_points(max_points, width, height)};
-  }
+  if (!covered) return covered.error();
+  std::size_t total = 0;
+  for (const auto& points : tile_points) total += points.size();
   std::vector<std::uint32_t> first(std::size_t(width) * std::size_t(height) + 1, 0);
   for (std::size_t t = 0; t < tile_points.size(); ++t) {
     for (const SurfacePoint& p : tile_points[t]) ++first[p.texel + 1];

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -72,6 +73,11 @@ struct TilePoints {
 };
 void cover_tile(const scene::Scene& scene, const TextureTarget& target, const Tiling& tiling, std::size_t tile,
                 TilePoints& out);
+
+// Every tile with fragments covered, in parallel, and visit(tile, its points) called on the thread
+// that covered it. Errors: the tiles together map more than max_points surface points (too_many_points).
+Status cover_tiles(const scene::Scene& scene, const TextureTarget& target, const Tiling& tiling, std::size_t max_points,
+                   const std::function<void(std::size_t tile, const TilePoints& points)>& visit);
 
 // A triangle's UVs in texel space.
 struct UvTriangle {

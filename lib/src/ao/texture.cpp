@@ -128,28 +128,18 @@ Result<TextureBakes> bake_textures(const scene::Scene& scene, const Options& opt
     out.instances_without_uv = tiling.instances_without_uv;
     std::vector<std::uint8_t> mapped(texel_count, 0);
     // Per tile: its coverage, then its texels traced (neighbours on the texture, mostly neighbours
-    // on the surface, together: their rays walk the same part of the BVH). The tile's counts and
-    // the seconds each part took (on its thread) are kept for the report.
+    // on the surface, together: their rays walk the same part of the BVH); its counts kept.
     struct TileTally {
-      std::size_t covered = 0, touched = 0, overlapped = 0, points = 0;
+      std::size_t covered = 0, touched = 0, overlapped = 0;
       std::uint64_t rays = 0;
-      double sum = 0, cover_seconds = 0, ray_seconds = 0;
+      double sum = 0;
     };
     std::vector<TileTally> tallies(tiling.fragments.size());
     const auto ray_start = Clock::now();
-    std::atomic<std::size_t> points{0};
-    tbb::enumerable_thread_specific<texels::TilePoints> tile_points;
     tbb::enumerable_thread_specific<std::vector<RTCRayHit>> scratch(std::size_t(options.samples));
-    tbb::parallel_for(std::size_t{0}, tiling.fragments.size(), [&](std::size_t t) {
-      if (tiling.fragments[t].empty() || points.load(std::memory_order_relaxed) > texels::kMaxSurfacePoints) return;
+    const Status covered = texels::cover_tiles(scene, target, tiling, texels::kMaxSurfacePoints, [&](std::size_t t, const texels::TilePoints& tile) {
       TileTally& tally = tallies[t];
-      const auto cover_start = Clock::now();
-      texels::TilePoints& tile = tile_points.local();
-      texels::cover_tile(scene, target, tiling, t, tile);
-      points += tile.points.size();
       tally.covered = tile.covered, tally.touched = tile.touched, tally.overlapped = tile.overlapped;
-      const auto trace_start = Clock::now();
-      tally.cover_seconds = std::chrono::duration<double>(trace_start - cover_start).count();
       for (std::size_t first = 0, last = 0; first < tile.points.size(); first = last) {
         const std::uint32_t texel = tile.points[first].texel;
         double sum = 0;
@@ -164,26 +154,21 @@ Result<TextureBakes> bake_textures(const scene::Scene& scene, const Options& opt
         tally.sum += out.values[texel];
         mapped[texel] = 1;
       }
-      tally.ray_seconds = seconds_since(trace_start);
     });
-    if (points > texels::kMaxSurfacePoints) {
+    if (!covered) {
       const std::string name = target.name.empty() ? "texture " + std::to_string(index) : target.name;
-      return Error{"", name + ": " + texels::too_many_points(texels::kMaxSurfacePoints, texture.width, texture.height)};
+      return Error{"", name + ": " + covered.error().message};
     }
-    double sum = 0, cover_seconds = 0, ray_seconds = 0;
+    double sum = 0;
     for (const TileTally& tally : tallies) {
       out.covered += tally.covered, out.touched += tally.touched, out.overlapped += tally.overlapped;
       out.rays += tally.rays;
-      sum += tally.sum, cover_seconds += tally.cover_seconds, ray_seconds += tally.ray_seconds;
+      sum += tally.sum;
     }
     const std::size_t texels_mapped = out.covered + out.touched;
     out.mean = texels_mapped ? sum / double(texels_mapped) : 0.0;
     result.rays += out.rays;
-    // The tiles' coverage and tracing interleave: the wall time split between them as their threads' was.
-    const double wall = seconds_since(ray_start);
-    const double covering = cover_seconds + ray_seconds > 0 ? wall * cover_seconds / (cover_seconds + ray_seconds) : 0.0;
-    result.texel_seconds += covering;
-    result.ray_seconds += wall - covering;
+    result.ray_seconds += seconds_since(ray_start);  // each tile's coverage with its rays (a few %)
 
     texel_start = Clock::now();
     out.padded = texels::pad(out.values, std::vector<bool>(mapped.begin(), mapped.end()), texture.width, texture.height, padding);

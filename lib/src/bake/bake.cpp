@@ -529,11 +529,11 @@ Result<std::vector<std::vector<CornerFrame>>> target_frames(const scene::Scene& 
 
 // The counts of one tile's texels for the report (summed over tiles, in any order).
 struct TileTally {
-  std::size_t texels = 0, samples = 0, occlusion_rays = 0, misses = 0, missed_texels = 0, points = 0;
+  std::size_t texels = 0, samples = 0, occlusion_rays = 0, misses = 0, missed_texels = 0;
   double height_min = std::numeric_limits<double>::infinity(), height_max = -std::numeric_limits<double>::infinity();
   void add(const TileTally& o) {
     texels += o.texels, samples += o.samples, occlusion_rays += o.occlusion_rays, misses += o.misses;
-    missed_texels += o.missed_texels, points += o.points;
+    missed_texels += o.missed_texels;
     height_min = std::min(height_min, o.height_min), height_max = std::max(height_max, o.height_max);
   }
 };
@@ -543,7 +543,6 @@ struct TileTally {
 void trace_tile(const TraceContext& context, const Options& options, const ao::texels::TilePoints& tile,
                 TextureBake& out, std::vector<std::uint8_t>& traced, TileTally& tally) {
   const auto& points = tile.points;
-  tally.points += points.size();
   for (std::size_t first = 0, last = 0; first < points.size(); first = last) {
     const std::uint32_t texel = points[first].texel;
     TexelSum sum;
@@ -585,18 +584,13 @@ Result<TextureBake> trace_target(const TraceContext& context, const Options& opt
   out.hit.assign(texel_count, 0);
   std::vector<std::uint8_t> traced(texel_count, 0);
   std::vector<TileTally> tallies(tiling.fragments.size());
-  std::atomic<std::size_t> points{0};
-  tbb::enumerable_thread_specific<ao::texels::TilePoints> scratch;
-  tbb::parallel_for(std::size_t{0}, tiling.fragments.size(), [&](std::size_t t) {
-    if (tiling.fragments[t].empty() || points.load(std::memory_order_relaxed) > ao::texels::kMaxSurfacePoints) return;
-    ao::texels::TilePoints& tile = scratch.local();
-    ao::texels::cover_tile(context.rays.low, context.target, tiling, t, tile);
-    points += tile.points.size();
-    trace_tile(context, options, tile, out, traced, tallies[t]);
-  });
-  if (points > ao::texels::kMaxSurfacePoints) {
+  const Status covered = ao::texels::cover_tiles(context.rays.low, context.target, tiling, ao::texels::kMaxSurfacePoints,
+                                                  [&](std::size_t t, const ao::texels::TilePoints& tile) {
+                                                    trace_tile(context, options, tile, out, traced, tallies[t]);
+                                                  });
+  if (!covered) {
     return Error{"", (context.target.name.empty() ? "texture " + std::to_string(context.target_index) : context.target.name) +
-                         ": " + ao::texels::too_many_points(ao::texels::kMaxSurfacePoints, texture.width, texture.height)};
+                         ": " + covered.error().message};
   }
   TileTally total;
   for (const TileTally& t : tallies) total.add(t);
