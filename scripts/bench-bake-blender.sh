@@ -8,7 +8,8 @@
 # Each time is the fastest of BENCH_BAKE_REPEATS runs (3; this VM's speed drifts by a third from one
 # minute to the next), the references' one run. Markdown on stdout.
 # Usage: scripts/bench-bake-blender.sh   (about 20 minutes on 2 cores)
-# BENCH_BAKE_WORK=DIR keeps the pairs and every image there.
+# BENCH_BAKE_WORK=DIR keeps the pairs and every image there; BENCH_BAKE_SECTIONS="normal ao" (the
+# default) names the tables to make (normal: the normal maps and their renders; ao: binary AO).
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 bash "$root/scripts/apt-install.sh" "the bake bench needs Blender" blender:blender python3-numpy
@@ -25,6 +26,7 @@ mkdir -p "$work"
 threads=2
 ao_distance=0.5
 repeats=${BENCH_BAKE_REPEATS:-3}
+sections=" ${BENCH_BAKE_SECTIONS:-normal ao} "
 
 now() { date +%s.%N; }
 elapsed() { echo "$1 $(now)" | awk '{printf "%.2f", $2 - $1}'; }
@@ -77,59 +79,62 @@ echo
 # pair, cage front and back (scene units).
 pairs=("sphere 0.3 0.3" "bump 0.6 0.05" "sculpt 0.15 0.15" "rivets 0.05 0.02")
 
-echo "### Tangent-space normal map, 1024², against matbake at 64 positions a texel"
-echo
-echo "| pair | rays a texel | matbake (s) | Blender (s) | faster | matbake error: mean, 99th pct (°) | Blender error (°) |"
-echo "|---|---|---|---|---|---|---|"
-for p in "${pairs[@]}"; do
-  read -r pair front back <<<"$p"
-  matbake_bake 1 "$pair" "$front" "$back" normal 1024 "${pair}_normal_ref" --texel-samples 64
-  matbake_bake "$repeats" "$pair" "$front" "$back" normal 1024 "${pair}_normal_m1" --texel-samples 1
-  m_seconds=$seconds m_run=$run_seconds
-  read -r m_mean m_p99 <<<"$(error normal "$pair" "${pair}_normal_ref.png" "${pair}_normal_m1.png")"
-  blender_bake "$pair" "$front" "$back" normal 1024 1 "${pair}_normal_blender"
-  read -r b_mean b_p99 <<<"$(error normal "$pair" "${pair}_normal_ref.png" "${pair}_normal_blender.exr")"
-  echo "| $pair | 1 | $m_seconds ($m_run) | $seconds | $(ratio "$seconds" "$m_seconds") | $m_mean, $m_p99 | $b_mean, $b_p99 |"
-  matbake_bake "$repeats" "$pair" "$front" "$back" normal 1024 "${pair}_normal_m4" --texel-samples 4
-  read -r m_mean m_p99 <<<"$(error normal "$pair" "${pair}_normal_ref.png" "${pair}_normal_m4.png")"
-  echo "| $pair | 4 | $seconds ($run_seconds) | — | | $m_mean, $m_p99 | (no anti-aliasing) |"
-done
-echo
-
-# In three.js (tests/runtime/render.mjs, as the runtime tests): the low-poly bare, with matbake's
-# one-ray and 4-position normal maps, and with Blender's (its EXR as the same 8-bit linear PNG, in a
-# copy of matbake's output: the same TANGENT, MikkTSpace as Blender's own), each render's PSNR
-# against the high-poly's, mean of the three views.
-if bash "$root/scripts/install-runtime.sh" >/dev/null 2>&1; then
-  echo "### In three.js: render PSNR against the high-poly's (dB, mean of three views), normal maps of 1024²"
+if [[ "$sections" == *" normal "* ]]; then
+  echo "### Tangent-space normal map, 1024², against matbake at 64 positions a texel"
   echo
-  echo "| pair | low-poly bare | matbake, 1 ray | matbake, 4 positions | Blender, 1 sample |"
-  echo "|---|---|---|---|---|"
+  echo "| pair | rays a texel | matbake (s) | Blender (s) | faster | matbake error: mean, 99th pct (°) | Blender error (°) |"
+  echo "|---|---|---|---|---|---|---|"
   for p in "${pairs[@]}"; do
     read -r pair front back <<<"$p"
-    rm -rf "${work:?}/${pair}_normal_blender_gltf" && cp -r "$work/${pair}_normal_m1" "$work/${pair}_normal_blender_gltf"
-    "$matbake" convert "$work/${pair}_normal_blender.exr" --from linear --to linear --bits 8 \
-      -o "$(ls "$work/${pair}_normal_blender_gltf"/*_normal.png)" >/dev/null
-    rm -rf "${work:?}/${pair}_renders"
-    node "$root/tests/runtime/render.mjs" --out "$work/${pair}_renders" --size 512 high="$work/${pair}_high.gltf" \
-      bare="$work/${pair}_low.gltf" m1="$work/${pair}_normal_m1/out.gltf" m4="$work/${pair}_normal_m4/out.gltf" \
-      blender="$work/${pair}_normal_blender_gltf/out.gltf" >/dev/null
-    row="| $pair"
-    for model in bare m1 m4 blender; do
-      sum=0
-      for view in fit near far; do
-        sum=$(echo "$sum $("$pairs_tool" psnr "$work/${pair}_renders/high-$view.png" "$work/${pair}_renders/$model-$view.png")" | awk '{print $1 + $2}')
-      done
-      row="$row | $(echo "$sum" | awk '{printf "%.2f", $1 / 3}')"
-    done
-    echo "$row |"
+    matbake_bake 1 "$pair" "$front" "$back" normal 1024 "${pair}_normal_ref" --texel-samples 64
+    matbake_bake "$repeats" "$pair" "$front" "$back" normal 1024 "${pair}_normal_m1" --texel-samples 1
+    m_seconds=$seconds m_run=$run_seconds
+    read -r m_mean m_p99 <<<"$(error normal "$pair" "${pair}_normal_ref.png" "${pair}_normal_m1.png")"
+    blender_bake "$pair" "$front" "$back" normal 1024 1 "${pair}_normal_blender"
+    read -r b_mean b_p99 <<<"$(error normal "$pair" "${pair}_normal_ref.png" "${pair}_normal_blender.exr")"
+    echo "| $pair | 1 | $m_seconds ($m_run) | $seconds | $(ratio "$seconds" "$m_seconds") | $m_mean, $m_p99 | $b_mean, $b_p99 |"
+    matbake_bake "$repeats" "$pair" "$front" "$back" normal 1024 "${pair}_normal_m4" --texel-samples 4
+    read -r m_mean m_p99 <<<"$(error normal "$pair" "${pair}_normal_ref.png" "${pair}_normal_m4.png")"
+    echo "| $pair | 4 | $seconds ($run_seconds) | — | | $m_mean, $m_p99 | (no anti-aliasing) |"
   done
   echo
-else
-  echo "(three.js in Chromium could not be installed here: no render comparison)"
-  echo
+
+  # In three.js (tests/runtime/render.mjs, as the runtime tests): the low-poly bare, with matbake's
+  # one-ray and 4-position normal maps, and with Blender's (its EXR as the same 8-bit linear PNG, in a
+  # copy of matbake's output: the same TANGENT, MikkTSpace as Blender's own), each render's PSNR
+  # against the high-poly's, mean of the three views.
+  if bash "$root/scripts/install-runtime.sh" >/dev/null 2>&1; then
+    echo "### In three.js: render PSNR against the high-poly's (dB, mean of three views), normal maps of 1024²"
+    echo
+    echo "| pair | low-poly bare | matbake, 1 ray | matbake, 4 positions | Blender, 1 sample |"
+    echo "|---|---|---|---|---|"
+    for p in "${pairs[@]}"; do
+      read -r pair front back <<<"$p"
+      rm -rf "${work:?}/${pair}_normal_blender_gltf" && cp -r "$work/${pair}_normal_m1" "$work/${pair}_normal_blender_gltf"
+      "$matbake" convert "$work/${pair}_normal_blender.exr" --from linear --to linear --bits 8 \
+        -o "$(ls "$work/${pair}_normal_blender_gltf"/*_normal.png)" >/dev/null
+      rm -rf "${work:?}/${pair}_renders"
+      node "$root/tests/runtime/render.mjs" --out "$work/${pair}_renders" --size 512 high="$work/${pair}_high.gltf" \
+        bare="$work/${pair}_low.gltf" m1="$work/${pair}_normal_m1/out.gltf" m4="$work/${pair}_normal_m4/out.gltf" \
+        blender="$work/${pair}_normal_blender_gltf/out.gltf" >/dev/null
+      row="| $pair"
+      for model in bare m1 m4 blender; do
+        sum=0
+        for view in fit near far; do
+          sum=$(echo "$sum $("$pairs_tool" psnr "$work/${pair}_renders/high-$view.png" "$work/${pair}_renders/$model-$view.png")" | awk '{print $1 + $2}')
+        done
+        row="$row | $(echo "$sum" | awk '{printf "%.2f", $1 / 3}')"
+      done
+      echo "$row |"
+    done
+    echo
+  else
+    echo "(three.js in Chromium could not be installed here: no render comparison)"
+    echo
+  fi
 fi
 
+[[ "$sections" == *" ao "* ]] || exit 0
 echo "### Binary AO (distance $ao_distance), 256², against matbake at 16 positions × 4096 rays a texel"
 echo
 echo "| pair | rays a texel | matbake (s) | Blender (s) | faster | matbake error: RMSE, largest | Blender error |"

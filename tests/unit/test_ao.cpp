@@ -6,10 +6,13 @@
 
 #include <glm/geometric.hpp>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <numbers>
+#include <vector>
 
+#include "lib/src/ao/sequence.hpp"
 #include "matbake/ao.hpp"
 #include "support/ao_scenes.hpp"
 
@@ -264,6 +267,66 @@ TEST(AmbientOcclusion, BadOptions) {
   o = Options{};
   o.samples = kMaxSamples + 1;
   EXPECT_FALSE(bake(s, o));
+}
+
+// Sobol's second dimension has the Pascal matrix mod 2 as generator (Joe and Kuo): bit k of the
+// index adds the bits 31 − j of the result for every j ≤ k with C(k, j) odd, that is j ⊆ k (Lucas).
+// Every single bit, and indices that use all four bytes, against that definition.
+std::uint32_t sobol_second_from_pascal(std::uint32_t i) {
+  std::uint32_t r = 0;
+  for (std::uint32_t k = 0; k < 32; ++k) {
+    if (!((i >> k) & 1)) continue;
+    for (std::uint32_t j = 0; j <= k; ++j) {
+      if ((j & k) == j) r ^= 1u << (31 - j);
+    }
+  }
+  return r;
+}
+
+TEST(AoSequence, SobolSecondDimensionIsThePascalMatrix) {
+  std::vector<std::uint32_t> indices = {0, 0xffffffffu, 0x80000001u, 0x12345678u, 0xdeadbeefu, 0x00ff00ffu};
+  for (std::uint32_t k = 0; k < 32; ++k) indices.push_back(1u << k);
+  for (std::uint32_t i = 0; i < 4096; ++i) indices.push_back(i * 0x9e3779b9u);
+  for (std::uint32_t i : indices) ASSERT_EQ(sobol_second(i), sobol_second_from_pascal(i)) << i;
+}
+
+// The first 2^m samples of any scramble are a (0, m, 2)-net: every box [a/2^k, (a+1)/2^k) ×
+// [b/2^(m−k), (b+1)/2^(m−k)) holds exactly one (a scramble XORs the same bits into every
+// sample, which permutes the boxes); and a point's Sequence gives sample()'s values.
+TEST(AoSequence, SobolSamplesAreZeroMTwoNetsWhateverTheScramble) {
+  constexpr int m = 10, n = 1 << m;
+  for (std::uint64_t key : {0ull, 1ull, 0x9e3779b97f4a7c15ull}) {
+    const Sequence sequence(Sampler::sobol, key);
+    for (int k = 0; k <= m; ++k) {
+      std::vector<int> boxes(n, 0);
+      for (std::uint32_t i = 0; i < std::uint32_t(n); ++i) {
+        const Sample2 u = sequence[i];
+        ASSERT_EQ(u.u, sample(Sampler::sobol, i, key).u);
+        ASSERT_EQ(u.v, sample(Sampler::sobol, i, key).v);
+        const int a = int(u.u * float(1 << k)), b = int(u.v * float(1 << (m - k)));
+        ++boxes[std::size_t(a * (1 << (m - k)) + b)];
+      }
+      EXPECT_EQ(*std::max_element(boxes.begin(), boxes.end()), 1) << "key " << key << ", k " << k;
+    }
+  }
+}
+
+// unit_circle against cos and sin in double at 2^20 + 1 points over [0, 1) and next to each
+// quarter turn (where the reduction switches), within the bound its header states.
+TEST(AoSequence, UnitCircleIsWithinTwoTenMillionthsOfCosAndSin) {
+  std::vector<float> at;
+  for (int i = 0; i < (1 << 20); ++i) at.push_back(float(i) / float(1 << 20));
+  for (float quarter : {0.125f, 0.25f, 0.375f, 0.5f, 0.625f, 0.75f, 0.875f, 1.0f}) {
+    at.push_back(std::nextafter(quarter, 0.0f));
+    if (quarter < 1) at.push_back(std::nextafter(quarter, 1.0f));
+  }
+  double worst = 0;
+  for (float v : at) {
+    const auto [c, s] = unit_circle(v);
+    const double angle = 2 * std::numbers::pi * double(v);
+    worst = std::max({worst, std::abs(double(c) - std::cos(angle)), std::abs(double(s) - std::sin(angle))});
+  }
+  EXPECT_LT(worst, 2e-7);
 }
 
 }  // namespace

@@ -9,50 +9,8 @@
 #include "tracer.hpp"
 
 namespace matbake::ao {
-namespace {
-
-// --- Sequences -------------------------------------------------------------------------------------
-std::uint64_t mix(std::uint64_t x) {  // splitmix64's finalizer: a well-spread 64-bit hash
-  x += 0x9e3779b97f4a7c15ull;
-  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
-  x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
-  return x ^ (x >> 31);
-}
-
-std::uint32_t reverse_bits(std::uint32_t x) {
-  x = ((x >> 1) & 0x55555555u) | ((x & 0x55555555u) << 1);
-  x = ((x >> 2) & 0x33333333u) | ((x & 0x33333333u) << 2);
-  x = ((x >> 4) & 0x0f0f0f0fu) | ((x & 0x0f0f0f0fu) << 4);
-  x = ((x >> 8) & 0x00ff00ffu) | ((x & 0x00ff00ffu) << 8);
-  return (x >> 16) | (x << 16);
-}
-
-// Sobol's second dimension (primitive polynomial x + 1): with the van der Corput first dimension
-// a (0, 2)-sequence in base 2.
-std::uint32_t sobol_second(std::uint32_t i) {
-  std::uint32_t r = 0;
-  for (std::uint32_t v = 1u << 31; i; i >>= 1, v ^= v >> 1) {
-    if (i & 1) r ^= v;
-  }
-  return r;
-}
-
-constexpr float kTwoToMinus32 = 2.3283064365386963e-10f;
-
-float unit(std::uint32_t bits) { return std::min(float(bits) * kTwoToMinus32, 0x1.fffffep-1f); }
-
-}  // namespace
 
 using scene::Vec3;
-
-Sample2 sample(Sampler sampler, std::uint32_t i, std::uint64_t key) {
-  if (sampler == Sampler::sobol) {
-    const std::uint64_t scramble = mix(key);
-    return {unit(reverse_bits(i) ^ std::uint32_t(scramble)), unit(sobol_second(i) ^ std::uint32_t(scramble >> 32))};
-  }
-  const std::uint64_t bits = mix(key ^ mix(i));
-  return {unit(std::uint32_t(bits)), unit(std::uint32_t(bits >> 32))};
-}
 
 Status check(const Options& options) {
   if (options.samples < 1 || options.samples > kMaxSamples) {
@@ -100,7 +58,7 @@ Result<Bake> bake(const scene::Scene& scene, const Options& options) {
 
   const Tracer& rays_from = **tracer;
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, first.back(), 64), [&](const tbb::blocked_range<std::size_t>& range) {
-    std::vector<RTCRayHit> rays(std::size_t(options.samples));
+    RayPackets rays(packets_for(options.samples));
     std::uint64_t cast = 0;
     std::size_t k = std::size_t(std::upper_bound(first.begin(), first.end(), range.begin()) - first.begin()) - 1;
     for (std::size_t flat = range.begin(); flat != range.end(); ++flat) {

@@ -29,7 +29,7 @@ double seconds_since(Clock::time_point start) { return std::chrono::duration<dou
 // among them: position j casts rays j, j + K, ... of the point's sequence.
 double point_occlusion(const Tracer& tracer, const scene::Scene& scene, const texels::SurfacePoint& point,
                        const TextureTarget& target, const TextureOptions& texture, int samples, std::uint64_t key,
-                       std::span<RTCRayHit> rays, std::uint64_t& cast) {
+                       std::span<RTCRayHit16> rays, std::uint64_t& cast) {
   const scene::Instance& inst = scene.instances[point.instance];
   const auto& corners = inst.triangles[point.triangle];
   const texels::UvTriangle uv = texels::uv_triangle(inst, target.texcoord, point.triangle, texture.width, texture.height);
@@ -136,7 +136,7 @@ Result<TextureBakes> bake_textures(const scene::Scene& scene, const Options& opt
     };
     std::vector<TileTally> tallies(tiling.fragments.size());
     const auto ray_start = Clock::now();
-    tbb::enumerable_thread_specific<std::vector<RTCRayHit>> scratch(std::size_t(options.samples));
+    tbb::enumerable_thread_specific<RayPackets> scratch(packets_for(options.samples));
     const Status covered = texels::cover_tiles(scene, target, tiling, texels::kMaxSurfacePoints, [&](std::size_t t, const texels::TilePoints& tile) {
       TileTally& tally = tallies[t];
       tally.covered = tile.covered, tally.touched = tile.touched, tally.overlapped = tile.overlapped;

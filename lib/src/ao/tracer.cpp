@@ -5,7 +5,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numbers>
+
+#include "sequence.hpp"
 
 namespace matbake::ao {
 namespace {
@@ -139,66 +140,81 @@ float Tracer::origin_offset(const Vec3& p, float scale) const {
   return std::max(std::min(float(options_.bias) * scale, 1e-4f * radius_), 1e-6f * magnitude);
 }
 
-unsigned Tracer::aim(const Vec3& origin, const Vec3& n, std::uint64_t key, int first, int step, std::span<RTCRayHit> rays) const {
+unsigned Tracer::aim(const Vec3& origin, const Vec3& n, std::uint64_t key, int first, int step, std::span<RTCRayHit16> rays) const {
   Vec3 t, b;
   basis(n, t, b);
   const float far = float(d_max_);
+  const Sequence sequence(options_.sampler, key);
   unsigned count = 0;
-  for (int s = first; s < options_.samples; s += step) {
-    const Sample2 u = sample(options_.sampler, std::uint32_t(s), key);
+  for (int s = first; s < options_.samples; s += step, ++count) {
+    const Sample2 u = sequence[std::uint32_t(s)];
     // Cosine-weighted: r = √u, φ = 2π v.
-    const float r = std::sqrt(u.u), phi = 2 * std::numbers::pi_v<float> * u.v;
-    const Vec3 d = t * (r * std::cos(phi)) + b * (r * std::sin(phi)) + n * std::sqrt(std::max(0.0f, 1 - u.u));
-    RTCRayHit& rh = rays[count++];
-    rh.ray.org_x = origin.x, rh.ray.org_y = origin.y, rh.ray.org_z = origin.z;
-    rh.ray.dir_x = d.x, rh.ray.dir_y = d.y, rh.ray.dir_z = d.z;
-    rh.ray.tnear = 0, rh.ray.tfar = far, rh.ray.time = 0;
-    rh.ray.mask = ~0u, rh.ray.id = unsigned(s), rh.ray.flags = 0;
-    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    const float r = std::sqrt(u.u);
+    const auto [cos_phi, sin_phi] = unit_circle(u.v);
+    const Vec3 d = t * (r * cos_phi) + b * (r * sin_phi) + n * std::sqrt(std::max(0.0f, 1 - u.u));
+    RTCRayHit16& packet = rays[count / 16];
+    const unsigned k = count % 16;
+    packet.ray.org_x[k] = origin.x, packet.ray.org_y[k] = origin.y, packet.ray.org_z[k] = origin.z;
+    packet.ray.dir_x[k] = d.x, packet.ray.dir_y[k] = d.y, packet.ray.dir_z[k] = d.z;
+    packet.ray.tnear[k] = 0, packet.ray.tfar[k] = far, packet.ray.time[k] = 0;
+    packet.ray.mask[k] = ~0u, packet.ray.id[k] = unsigned(s), packet.ray.flags[k] = 0;
+    packet.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
   }
   return count;
 }
 
-double Tracer::sum_of_depths(const Vec3& origin, const Vec3& n, std::uint64_t key, int first, int step,
-                             std::span<RTCRayHit> rays, std::uint64_t& cast) const {
-  const unsigned count = aim(origin, n, key, first, step, rays);
-  if (count == 0) return 0;
+void Tracer::trace(unsigned count, std::span<RTCRayHit16> rays, bool occlusion_only) const {
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
-  rtcIntersect1M(scene_.get(), &context, rays.data(), count, sizeof(RTCRayHit));
+  for (unsigned first = 0; first < count; first += 16) {
+    alignas(64) int valid[16];
+    for (unsigned k = 0; k < 16; ++k) valid[k] = first + k < count ? -1 : 0;
+    RTCRayHit16& packet = rays[first / 16];
+    if (occlusion_only) {
+      rtcOccluded16(valid, scene_.get(), &context, &packet.ray);
+    } else {
+      rtcIntersect16(valid, scene_.get(), &context, &packet);
+    }
+  }
+}
+
+namespace {
+
+Vec3 direction(const RTCRay16& rays, unsigned k) { return Vec3(rays.dir_x[k], rays.dir_y[k], rays.dir_z[k]); }
+
+}  // namespace
+
+double Tracer::sum_of_depths(const Vec3& origin, const Vec3& n, std::uint64_t key, int first, int step,
+                             std::span<RTCRayHit16> rays, std::uint64_t& cast) const {
+  const unsigned count = aim(origin, n, key, first, step, rays);
+  trace(count, rays, false);
   double sum = 0;
   for (unsigned i = 0; i < count; ++i) {
-    const RTCRayHit& rh = rays[i];  // a miss keeps tfar = d_max
-    sum += double(rh.ray.tfar) * double(glm::dot(Vec3(rh.ray.dir_x, rh.ray.dir_y, rh.ray.dir_z), n));
+    const RTCRay16& packet = rays[i / 16].ray;  // a miss keeps tfar = d_max
+    sum += double(packet.tfar[i % 16]) * double(glm::dot(direction(packet, i % 16), n));
   }
   cast += count;
   return sum;
 }
 
 double Tracer::sum_over_rays(const Vec3& origin, const Vec3& n, std::uint64_t key, int first, int step,
-                             std::span<RTCRayHit> rays, std::uint64_t& cast, Vec3* bent) const {
+                             std::span<RTCRayHit16> rays, std::uint64_t& cast, Vec3* bent) const {
   const unsigned count = aim(origin, n, key, first, step, rays);
-  if (count == 0) return 0;
-  RTCIntersectContext context;
-  rtcInitIntersectContext(&context);
-  // The rays of one point as a stream: they share an origin, and Embree packs them itself.
   const bool binary = options_.falloff == Falloff::none;
-  if (binary) {
-    rtcOccluded1M(scene_.get(), &context, &rays[0].ray, count, sizeof(RTCRayHit));
-  } else {
-    rtcIntersect1M(scene_.get(), &context, rays.data(), count, sizeof(RTCRayHit));
-  }
+  trace(count, rays, binary);
   double sum = 0;
   for (unsigned i = 0; i < count; ++i) {
-    const RTCRayHit& rh = rays[i];
+    const RTCRayHit16& packet = rays[i / 16];
+    const unsigned k = i % 16;
     double mu = 0;
     if (binary) {
-      mu = rh.ray.tfar >= 0 ? 1.0 : 0.0;  // occluded: tfar = −inf
+      mu = packet.ray.tfar[k] >= 0 ? 1.0 : 0.0;  // occluded: tfar = −inf
     } else {
-      mu = rh.hit.geomID == RTC_INVALID_GEOMETRY_ID ? 1.0 : std::min(1.0, (1.0 - std::exp(-tau_ * rh.ray.tfar)) * normalization_);
+      mu = packet.hit.geomID[k] == RTC_INVALID_GEOMETRY_ID ? 1.0
+                                                            : std::min(1.0, (1.0 - std::exp(-tau_ * packet.ray.tfar[k])) * normalization_);
     }
     sum += mu;
-    if (bent) *bent += float(mu) * Vec3(rh.ray.dir_x, rh.ray.dir_y, rh.ray.dir_z);
+    if (bent) *bent += float(mu) * direction(packet.ray, k);
   }
   cast += count;
   return sum;

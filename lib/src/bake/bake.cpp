@@ -135,8 +135,8 @@ glm::dvec4 base_color(const std::vector<BaseColor>& colors, const scene::Instanc
 // once through); `scale` is the surface's local length (ao::Tracer::origin_offset).
 void trace_from_hit(const Rays& c, const Hit& hit, const LowPoint& low, float scale, int j, int positions, std::uint64_t key,
                     TexelSum& sum) {
-  thread_local std::vector<RTCRayHit> rays;  // scratch: a texel's worth of rays, reused
-  rays.resize(std::size_t(c.occlusion_samples / positions + 1));
+  thread_local ao::RayPackets rays;  // scratch: a texel's worth of rays, reused
+  rays.resize(ao::packets_for(c.occlusion_samples / positions + 1));
   if (c.occlusion) {
     const glm::vec3 origin = hit.position + hit.normal * c.occlusion->origin_offset(hit.position, scale);
     glm::vec3 bent(0);
