@@ -6,6 +6,9 @@
 # being replaced: it must not occlude the high-poly's AO). Bakes REPEATS times (default 1) and prints
 # one line `seconds=T`: the fastest bake call alone (not Blender's start, the imports or the image
 # write).
+# Kind ao_self (scripts/bench-ao-blender.sh): a scene's AO onto its own UVs, as `matbake bake-ao
+# --texture`: LOW.gltf is the scene, HIGH.gltf is ignored, every mesh object is baked, each material
+# into its own SIZE² image; OUT.exr is the first material's (EXTRUSION and MAX_RAY_DISTANCE unused).
 import sys
 import time
 
@@ -40,19 +43,38 @@ def import_mesh(path):
     return bpy.context.view_layer.objects.active
 
 
-high = import_mesh(high_path)
-low = import_mesh(low_path)
-for attribute in ("visible_camera", "visible_diffuse", "visible_glossy", "visible_transmission",
-                  "visible_volume_scatter", "visible_shadow"):
-    setattr(low, attribute, False)
-
-image = bpy.data.images.new("bake", size, size, float_buffer=True, alpha=False)
-image.colorspace_settings.name = "Non-Color"
-for slot in low.material_slots:
-    nodes = slot.material.node_tree.nodes
+def bake_into(material, image):
+    """Makes a new image node holding `image` the material's active node: the bake's target."""
+    nodes = material.node_tree.nodes
     node = nodes.new("ShaderNodeTexImage")
     node.image = image
     nodes.active = node
+
+
+def new_image(name):
+    image = bpy.data.images.new(name, size, size, float_buffer=True, alpha=False)
+    image.colorspace_settings.name = "Non-Color"
+    return image
+
+
+if kind == "ao_self":
+    bpy.ops.import_scene.gltf(filepath=low_path)
+    baked = [o for o in bpy.context.scene.objects if o.type == "MESH"]
+    materials = list(dict.fromkeys(slot.material for o in baked for slot in o.material_slots if slot.material))
+    images = [new_image(f"bake{i}") for i in range(len(materials))]
+    for material, material_image in zip(materials, images):
+        bake_into(material, material_image)
+    image = images[0]
+else:
+    high = import_mesh(high_path)
+    low = import_mesh(low_path)
+    for attribute in ("visible_camera", "visible_diffuse", "visible_glossy", "visible_transmission",
+                      "visible_volume_scatter", "visible_shadow"):
+        setattr(low, attribute, False)
+    image = new_image("bake")
+    for slot in low.material_slots:
+        bake_into(slot.material, image)
+    baked = [high, low]
 
 scene = bpy.context.scene
 scene.render.engine = "CYCLES"
@@ -65,7 +87,7 @@ scene.render.threads = threads
 scene.world = bpy.data.worlds.new("world")
 scene.world.light_settings.distance = ao_distance
 bake = scene.render.bake
-bake.use_selected_to_active = True
+bake.use_selected_to_active = kind != "ao_self"
 bake.use_cage = False
 bake.cage_extrusion = extrusion
 bake.max_ray_distance = max_ray
@@ -74,13 +96,13 @@ bake.normal_space = "TANGENT"
 bake.normal_r, bake.normal_g, bake.normal_b = "POS_X", "POS_Y", "POS_Z"
 
 bpy.ops.object.select_all(action="DESELECT")
-high.select_set(True)
-low.select_set(True)
-bpy.context.view_layer.objects.active = low
+for o in baked:
+    o.select_set(True)
+bpy.context.view_layer.objects.active = baked[-1]
 seconds = float("inf")
 for _ in range(repeats):
     started = time.perf_counter()
-    bpy.ops.object.bake(type={"normal": "NORMAL", "ao": "AO"}[kind])
+    bpy.ops.object.bake(type={"normal": "NORMAL", "ao": "AO", "ao_self": "AO"}[kind])
     seconds = min(seconds, time.perf_counter() - started)
 
 image.filepath_raw = out_path

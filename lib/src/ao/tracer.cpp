@@ -146,19 +146,32 @@ unsigned Tracer::aim(const Vec3& origin, const Vec3& n, std::uint64_t key, int f
   const float far = float(d_max_);
   const Sequence sequence(options_.sampler, key);
   unsigned count = 0;
-  for (int s = first; s < options_.samples; s += step, ++count) {
-    const Sample2 u = sequence[std::uint32_t(s)];
-    // Cosine-weighted: r = √u, φ = 2π v.
-    const float r = std::sqrt(u.u);
-    const auto [cos_phi, sin_phi] = unit_circle(u.v);
-    const Vec3 d = t * (r * cos_phi) + b * (r * sin_phi) + n * std::sqrt(std::max(0.0f, 1 - u.u));
+  for (int s = first; s < options_.samples; count += 16) {
     RTCRayHit16& packet = rays[count / 16];
-    const unsigned k = count % 16;
-    packet.ray.org_x[k] = origin.x, packet.ray.org_y[k] = origin.y, packet.ray.org_z[k] = origin.z;
-    packet.ray.dir_x[k] = d.x, packet.ray.dir_y[k] = d.y, packet.ray.dir_z[k] = d.z;
-    packet.ray.tnear[k] = 0, packet.ray.tfar[k] = far, packet.ray.time[k] = 0;
-    packet.ray.mask[k] = ~0u, packet.ray.id[k] = unsigned(s), packet.ray.flags[k] = 0;
-    packet.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+    // The packet's samples, then their directions lane by lane with no call or branch (a loop
+    // the compiler can turn into vector code).
+    float u[16], v[16];
+    unsigned lanes = 0;
+    for (; lanes < 16 && s < options_.samples; ++lanes, s += step) {
+      const Sample2 sample = sequence[std::uint32_t(s)];
+      u[lanes] = sample.u, v[lanes] = sample.v;
+      packet.ray.id[lanes] = unsigned(s);
+    }
+    for (unsigned k = lanes; k < 16; ++k) u[k] = v[k] = 0;  // lanes past the end: traced as invalid
+    for (unsigned k = 0; k < 16; ++k) {
+      // Cosine-weighted: r = √u, φ = 2π v.
+      const float r = std::sqrt(u[k]), up = std::sqrt(std::max(0.0f, 1 - u[k]));
+      const auto [cos_phi, sin_phi] = unit_circle(v[k]);
+      const float x = r * cos_phi, y = r * sin_phi;
+      packet.ray.dir_x[k] = t.x * x + b.x * y + n.x * up;
+      packet.ray.dir_y[k] = t.y * x + b.y * y + n.y * up;
+      packet.ray.dir_z[k] = t.z * x + b.z * y + n.z * up;
+      packet.ray.org_x[k] = origin.x, packet.ray.org_y[k] = origin.y, packet.ray.org_z[k] = origin.z;
+      packet.ray.tnear[k] = 0, packet.ray.tfar[k] = far, packet.ray.time[k] = 0;
+      packet.ray.mask[k] = ~0u, packet.ray.flags[k] = 0;
+      packet.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+    }
+    if (lanes < 16) return count + lanes;
   }
   return count;
 }
