@@ -9,6 +9,8 @@
 # Kind ao_self (scripts/bench-ao-blender.sh): a scene's AO onto its own UVs, as `matbake bake-ao
 # --texture`: LOW.gltf is the scene, HIGH.gltf is ignored, every mesh object is baked, each material
 # into its own SIZE² image; OUT.exr is the first material's (EXTRUSION and MAX_RAY_DISTANCE unused).
+# The materials' normal maps are unplugged: Cycles' AO follows the shading normal, matbake's the
+# mesh's.
 import sys
 import time
 
@@ -64,6 +66,9 @@ if kind == "ao_self":
     images = [new_image(f"bake{i}") for i in range(len(materials))]
     for material, material_image in zip(materials, images):
         bake_into(material, material_image)
+        tree = material.node_tree
+        for link in [link for link in tree.links if link.to_socket.name == "Normal"]:
+            tree.links.remove(link)
     image = images[0]
 else:
     high = import_mesh(high_path)

@@ -45,7 +45,7 @@ matbake_bake() {
     "$matbake" --json bake "$work/${pair}_low.gltf" --from "$work/${pair}_high.gltf" -o "$work/$name/out.gltf" --maps "$map" \
       --size "$size" --front "$front" --back "$back" --absolute-cage --padding 0 --jobs "$threads" "$@" >"$work/$name.json"
     run=$(elapsed "$start")
-    bake=$(python3 -c 'import json, sys; r = json.load(open(sys.argv[1])); print("%.2f" % (r["setup_seconds"] + r["trace_seconds"]))' "$work/$name.json")
+    bake=$(python3 -c 'import json, sys; r = json.load(open(sys.argv[1])); print("%.3f" % (r["setup_seconds"] + r["trace_seconds"]))' "$work/$name.json")
     if [ -z "$seconds" ] || awk -v a="$bake" -v b="$seconds" 'BEGIN { exit !(a < b) }'; then seconds=$bake run_seconds=$run; fi
   done
   cp "$work/$name"/*_"$map".png "$work/$name.png"

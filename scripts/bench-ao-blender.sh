@@ -1,0 +1,102 @@
+#!/usr/bin/env bash
+# Texture AO of small scenes against Blender's AO bake (docs/bake-ao.md): each scene's occlusion
+# onto its own UVs, by `matbake bake-ao --texture` and by Cycles' AO bake (scripts/bench-bake-blender.py,
+# kind ao_self: every mesh, each material into its own image), binary AO within the same distance
+# (matbake's default, a quarter of the scene's radius), 2 threads each, at equal samples. Scenes:
+# ../shared/testdata's NormalTangentMirrorTest (5,240 triangles) and NormalTangentTest (7,774),
+# both one material, and SpecGlossVsMetalRough (9,028, four materials).
+# Time: matbake's bake (set-up, texels and rays, from --json; in brackets its whole run, reading
+# the scene and writing it with its PNGs) against Blender's bake call alone (its start, the import
+# and the image write left out); each the fastest of BENCH_AO_REPEATS runs (3). Error (one-material
+# scenes): against matbake at 4 positions × 4096 rays a texel, over the texels the UVs cover, 8 bits.
+# Markdown on stdout.
+# Usage: scripts/bench-ao-blender.sh   (about 12 minutes on 2 cores)
+# BENCH_AO_WORK=DIR keeps every image there.
+set -euo pipefail
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+testdata="$root/../shared/testdata/gltf"
+[ -d "$testdata" ] || { echo "bench-ao-blender: $testdata is absent (the project's shared folder)" >&2; exit 1; }
+bash "$root/scripts/apt-install.sh" "the AO bench needs Blender" blender:blender python3-numpy
+bash "$root/scripts/build.sh" "$root/build" >/dev/null
+matbake=$root/build/cli/matbake
+pairs_tool=$root/build/bench/bake_pairs
+work=${BENCH_AO_WORK:-}
+if [ -z "$work" ]; then
+  work=$(mktemp -d)
+  trap 'rm -rf "$work"' EXIT
+fi
+mkdir -p "$work"
+threads=2
+size=512
+repeats=${BENCH_AO_REPEATS:-3}
+
+now() { date +%s.%N; }
+elapsed() { echo "$1 $(now)" | awk '{printf "%.2f", $2 - $1}'; }
+json_field() { python3 -c 'import json, sys; print(json.load(open(sys.argv[1]))[sys.argv[2]])' "$1" "$2"; }
+
+# matbake_bake RUNS SCENE NAME FLAGS...: bakes SCENE's textures into $work/NAME/ RUNS times; of the
+# run whose bake was fastest, the bake's time in $seconds and the whole run's in $run_seconds.
+matbake_bake() {
+  local runs=$1 scene=$2 name=$3
+  shift 3
+  local start run bake
+  seconds=
+  for ((r = 0; r < runs; ++r)); do
+    rm -rf "${work:?}/$name" && mkdir -p "$work/$name"
+    start=$(now)
+    "$matbake" --json bake-ao "$scene" --texture "$size" --padding 0 --falloff none --existing-occlusion replace --jobs "$threads" \
+      -o "$work/$name/out.gltf" "$@" >"$work/$name.json"
+    run=$(elapsed "$start")
+    bake=$(python3 -c 'import json, sys; r = json.load(open(sys.argv[1]))
+print("%.3f" % (r["setup_seconds"] + r["texel_seconds"] + r["ray_seconds"]))' "$work/$name.json")
+    if [ -z "$seconds" ] || awk -v a="$bake" -v b="$seconds" 'BEGIN { exit !(a < b) }'; then seconds=$bake run_seconds=$run; fi
+  done
+}
+
+# blender_bake SCENE SAMPLES DISTANCE NAME: bakes $work/NAME.exr (the first material's) $repeats
+# times, the fastest bake call's time in $seconds.
+blender_bake() {
+  local scene=$1 samples=$2 distance=$3 name=$4
+  local log
+  log=$(timeout 3600 blender -b --factory-startup --python "$root/scripts/bench-bake-blender.py" -- \
+    "$scene" - "$work/$name.exr" ao_self "$size" "$samples" 0 0 "$distance" "$threads" "$repeats" 2>&1)
+  seconds=$(printf '%s\n' "$log" | sed -n 's/^seconds=//p')
+  [ -n "$seconds" ] || { printf '%s\n' "$log" | tail -20 >&2; echo "bench-ao-blender: Blender's bake failed" >&2; exit 1; }
+  seconds=$(printf '%.2f' "$seconds")
+}
+
+# error SCENE REFERENCE IMAGE: IMAGE's RMSE and largest error against REFERENCE, space-separated.
+error() {
+  "$pairs_tool" error scalar "$1" "$2" "$3" | sed -E 's/^[^ ]+ texels=[0-9]+ //; s/[a-z0-9_]+=//g'
+}
+ratio() { echo "$1 $2" | awk '{printf "%.1f×", $1 / ($2 > 0 ? $2 : 0.005)}'; }
+
+echo "matbake $("$matbake" --version | head -1 | awk '{print $NF}') against Blender's Cycles AO bake (CPU), $threads threads each, $(nproc) cores."
+echo
+echo "### Texture AO, binary, ${size}², against matbake at 4 positions × 4096 rays a texel"
+echo
+echo "| scene | triangles | rays a texel | matbake (s) | Blender (s) | faster | matbake error: RMSE, largest | Blender error |"
+echo "|---|---|---|---|---|---|---|---|"
+scenes=("NormalTangentMirrorTest 5240 $testdata/NormalTangentMirrorTest/glTF-Binary/NormalTangentMirrorTest.glb"
+  "NormalTangentTest 7774 $testdata/NormalTangentTest/glTF-Binary/NormalTangentTest.glb"
+  "SpecGlossVsMetalRough 9028 $testdata/SpecGlossVsMetalRough/glTF/SpecGlossVsMetalRough.gltf")
+for s in "${scenes[@]}"; do
+  read -r name triangles scene <<<"$s"
+  # The distance matbake derives from the scene's radius, given to both.
+  matbake_bake 1 "$scene" "${name}_distance" --samples 1
+  distance=$(json_field "$work/${name}_distance.json" max_distance)
+  materials=$(ls "$work/${name}_distance"/*_occlusion.png | wc -l)
+  [ "$materials" != 1 ] || matbake_bake 1 "$scene" "${name}_ref" --texel-samples 4 --samples 4096
+  for samples in 16 64 256; do
+    matbake_bake "$repeats" "$scene" "${name}_m$samples" --samples "$samples"
+    m_seconds=$seconds m_run=$run_seconds
+    blender_bake "$scene" "$samples" "$distance" "${name}_blender$samples"
+    m_error="—" b_error="—"
+    if [ "$materials" = 1 ]; then
+      reference=$(ls "$work/${name}_ref"/*_occlusion.png)
+      m_error=$(error "$scene" "$reference" "$(ls "$work/${name}_m$samples"/*_occlusion.png)" | sed 's/ /, /')
+      b_error=$(error "$scene" "$reference" "$work/${name}_blender$samples.exr" | sed 's/ /, /')
+    fi
+    echo "| $name | $triangles | $samples | $m_seconds ($m_run) | $seconds | $(ratio "$seconds" "$m_seconds") | $m_error | $b_error |"
+  done
+done
