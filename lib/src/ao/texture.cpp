@@ -34,7 +34,7 @@ double point_occlusion(const Tracer& tracer, const scene::Scene& scene, const te
   const auto& corners = inst.triangles[point.triangle];
   const texels::UvTriangle uv = texels::uv_triangle(inst, target.texcoord, point.triangle, texture.width, texture.height);
   const Mesh& mesh = tracer.mesh(point.instance);
-  const Vec3& face = mesh.face_normals[point.triangle];
+  const Vec3& face = tracer.face_normals(point.instance)[point.triangle];
   const float texel_size = texels::texel_size(double(glm::length(face)), uv);
   const int positions = texture.texel_samples;
   double sum = 0;

@@ -54,80 +54,22 @@ std::vector<float> mean_edge_lengths(const scene::Instance& inst) {
   return lengths;
 }
 
-namespace {
-
-Mesh prepare(const scene::Instance& inst, std::optional<scene::NormalWeighting> recompute) {
-  Mesh m;
-  m.normals = shading_normals(inst, recompute);
-  m.edge_length = mean_edge_lengths(inst);
-  for (const auto& t : inst.triangles) {
-    m.face_normals.push_back(glm::cross(inst.positions[t[1]] - inst.positions[t[0]], inst.positions[t[2]] - inst.positions[t[0]]));
-  }
-  return m;
-}
-
-// One-sided occlusion: a hit on the back of a face (its normal along the ray) is not a hit.
-void back_face_filter(const RTCFilterFunctionNArguments* args) {
-  const auto* faces = static_cast<const std::vector<Vec3>*>(args->geometryUserPtr);
-  for (unsigned i = 0; i < args->N; ++i) {
-    if (args->valid[i] != -1) continue;
-    const Vec3& n = (*faces)[RTCHitN_primID(args->hit, args->N, i)];
-    const Vec3 d(RTCRayN_dir_x(args->ray, args->N, i), RTCRayN_dir_y(args->ray, args->N, i),
-                 RTCRayN_dir_z(args->ray, args->N, i));
-    if (glm::dot(n, d) > 0) args->valid[i] = 0;
-  }
-}
-
-}  // namespace
-
-RTCGeometry triangle_geometry(RTCDevice device, const scene::Instance& inst) {
-  RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
-  // Embree reads vertex buffers in 16-byte loads: rtcSetNewGeometryBuffer pads for us.
-  auto* vertices = static_cast<float*>(
-      rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), inst.positions.size()));
-  for (std::size_t v = 0; v < inst.positions.size(); ++v) {
-    vertices[3 * v] = inst.positions[v].x, vertices[3 * v + 1] = inst.positions[v].y, vertices[3 * v + 2] = inst.positions[v].z;
-  }
-  auto* indices = static_cast<std::uint32_t*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                                       3 * sizeof(std::uint32_t), inst.triangles.size()));
-  for (std::size_t t = 0; t < inst.triangles.size(); ++t) {
-    for (std::size_t corner = 0; corner < 3; ++corner) indices[3 * t + corner] = inst.triangles[t][corner];
-  }
-  return g;
-}
-
-void reject_back_faces(RTCGeometry geometry, const std::vector<Vec3>& face_normals) {
-  rtcSetGeometryUserData(geometry, const_cast<std::vector<Vec3>*>(&face_normals));
-  rtcSetGeometryIntersectFilterFunction(geometry, back_face_filter);
-  rtcSetGeometryOccludedFilterFunction(geometry, back_face_filter);
-}
-
-Result<std::unique_ptr<Tracer>> Tracer::build(const scene::Scene& scene, const Options& options) {
+Result<std::unique_ptr<Tracer>> Tracer::build(const scene::Scene& scene, const Options& options,
+                                              std::shared_ptr<const Bvh> bvh) {
   std::unique_ptr<Tracer> tracer(new Tracer);
   tracer->options_ = options;
-  tracer->device_.reset(rtcNewDevice(nullptr));
-  if (!tracer->device_) return Error{"", "Embree could not start (rtcNewDevice failed)"};
-  RTCDevice device = tracer->device_.get();
-  tracer->scene_.reset(rtcNewScene(device));
-  RTCScene rtc = tracer->scene_.get();
-  if (options.watertight) rtcSetSceneFlags(rtc, RTC_SCENE_FLAG_ROBUST);
-  rtcSetSceneBuildQuality(rtc, RTC_BUILD_QUALITY_HIGH);
+  if (!bvh) {
+    auto built = Bvh::build(scene, options.watertight);
+    if (!built) return built.error();
+    bvh = std::move(*built);
+  }
+  tracer->bvh_ = std::move(bvh);
   // Normals and edge lengths per instance, in parallel (the serial part of a short bake otherwise).
-  // Sized once: the filter functions keep pointers into it.
   tracer->meshes_.resize(scene.instances.size());
   tbb::parallel_for(std::size_t{0}, scene.instances.size(), [&](std::size_t k) {
-    tracer->meshes_[k] = prepare(scene.instances[k], options.recompute_normals);
-  });
-  for (std::size_t k = 0; k < scene.instances.size(); ++k) {
     const scene::Instance& inst = scene.instances[k];
-    RTCGeometry g = triangle_geometry(device, inst);
-    if (!options.two_sided) reject_back_faces(g, tracer->meshes_[k].face_normals);
-    rtcCommitGeometry(g);
-    rtcAttachGeometry(rtc, g);
-    rtcReleaseGeometry(g);
-  }
-  rtcCommitScene(rtc);
-  if (rtcGetDeviceError(device) != RTC_ERROR_NONE) return Error{"", "Embree could not build the scene"};
+    tracer->meshes_[k] = Mesh{shading_normals(inst, options.recompute_normals), mean_edge_lengths(inst)};
+  });
   tracer->radius_ = scene.radius();
   tracer->d_max_ = options.absolute_distance > 0 ? options.absolute_distance : options.relative_distance * scene.radius();
   tracer->tau_ = options.tau / tracer->d_max_;
@@ -177,16 +119,15 @@ unsigned Tracer::aim(const Vec3& origin, const Vec3& n, std::uint64_t key, int f
 }
 
 void Tracer::trace(unsigned count, std::span<RTCRayHit16> rays, bool occlusion_only) const {
-  RTCIntersectContext context;
-  rtcInitIntersectContext(&context);
+  RayContext context(options_.two_sided);
   for (unsigned first = 0; first < count; first += 16) {
     alignas(64) int valid[16];
     for (unsigned k = 0; k < 16; ++k) valid[k] = first + k < count ? -1 : 0;
     RTCRayHit16& packet = rays[first / 16];
     if (occlusion_only) {
-      rtcOccluded16(valid, scene_.get(), &context, &packet.ray);
+      rtcOccluded16(valid, bvh_->scene(), &context.embree, &packet.ray);
     } else {
-      rtcIntersect16(valid, scene_.get(), &context, &packet);
+      rtcIntersect16(valid, bvh_->scene(), &context.embree, &packet);
     }
   }
 }

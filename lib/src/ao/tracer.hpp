@@ -7,21 +7,14 @@
 #include <span>
 #include <vector>
 
+#include "bvh.hpp"
 #include "matbake/ao.hpp"
 
 namespace matbake::ao {
 
 struct Mesh {
-  std::vector<scene::Vec3> normals;       // per vertex, unit
-  std::vector<float> edge_length;         // per vertex: mean length of its edges (the bias scale)
-  std::vector<scene::Vec3> face_normals;  // per triangle, not normalized (|n| = twice the area)
-};
-
-struct DeviceDeleter {
-  void operator()(RTCDevice d) const { rtcReleaseDevice(d); }
-};
-struct SceneDeleter {
-  void operator()(RTCScene s) const { rtcReleaseScene(s); }
+  std::vector<scene::Vec3> normals;  // per vertex, unit
+  std::vector<float> edge_length;    // per vertex: mean length of its edges (the bias scale)
 };
 
 // The instance's unit normals: the file's, area-weighted from the faces where it has none (or when
@@ -31,12 +24,6 @@ std::vector<scene::Vec3> shading_normals(const scene::Instance& inst, std::optio
 // Per vertex, the mean length of its edges (0 for a vertex no triangle uses).
 std::vector<float> mean_edge_lengths(const scene::Instance& inst);
 
-// A triangle geometry of the instance's world positions and triangles, not yet committed.
-RTCGeometry triangle_geometry(RTCDevice device, const scene::Instance& inst);
-// Hits on the back of a face (its normal, not normalized, along the ray) are not hits; the
-// normals must outlive the geometry.
-void reject_back_faces(RTCGeometry geometry, const std::vector<scene::Vec3>& face_normals);
-
 // Scratch for one point's rays, 16 to a packet: Embree traverses a packet's rays together, which
 // measured a fifth faster than a stream of single rays on closed meshes, where a point's rays share
 // the nodes around it and most cross the whole distance (docs/bake.md), and the same elsewhere.
@@ -45,10 +32,14 @@ inline std::size_t packets_for(int rays) { return std::size_t(rays + 15) / 16; }
 
 class Tracer {
  public:
-  // Every instance occludes, whatever options.targets says. Errors: Embree failing to start or build.
-  static Result<std::unique_ptr<Tracer>> build(const scene::Scene& scene, const Options& options);
+  // Every instance occludes, whatever options.targets says. `bvh`: the scene's, already built (a
+  // bake's high-poly, shared with its cage rays), or none to build one (robust unless
+  // options.watertight is false). Errors: Embree failing to start or build.
+  static Result<std::unique_ptr<Tracer>> build(const scene::Scene& scene, const Options& options,
+                                               std::shared_ptr<const Bvh> bvh = nullptr);
 
   const Mesh& mesh(std::size_t instance) const { return meshes_[instance]; }
+  const std::vector<scene::Vec3>& face_normals(std::size_t instance) const { return bvh_->face_normals(instance); }
   double max_distance() const { return d_max_; }
 
   // The ray-origin offset along the normal at p, for a surface whose local length scale is `scale`
@@ -78,8 +69,7 @@ class Tracer {
                std::span<RTCRayHit16> rays) const;
   // The first `count` rays traced, for their first hit or (`occlusion_only`) whether they have one.
   void trace(unsigned count, std::span<RTCRayHit16> rays, bool occlusion_only) const;
-  std::unique_ptr<RTCDeviceTy, DeviceDeleter> device_;
-  std::unique_ptr<RTCSceneTy, SceneDeleter> scene_;
+  std::shared_ptr<const Bvh> bvh_;
   std::vector<Mesh> meshes_;
   Options options_;
   float radius_ = 0;

@@ -484,27 +484,29 @@ std::string cage_mismatch(const scene::Scene& low, const scene::Scene& cage) {
 
 namespace {
 
-// The high-poly as the asked maps trace it: the cage rays' BVH, and the estimator's only where a map
-// needs it (occluder: ao and bent_normal, a second BVH; depths: thickness, every face from either side).
+// The high-poly as the asked maps trace it: one BVH for the cage rays, the estimator's occlusion
+// (ao and bent_normal) and its depths (thickness, every face from either side), each estimator only
+// where a map needs it; the estimator's own BVH only where its traversal is asked to be fast.
 struct Tracers {
   std::unique_ptr<HighPoly> high;
   std::unique_ptr<ao::Tracer> occluder, depths;
 };
 
 Result<Tracers> build_tracers(const scene::Scene& high, bool occluding, bool thickness, const ao::Options& occlusion) {
+  auto bvh = ao::Bvh::build(high, true);
+  if (!bvh) return bvh.error();
   Tracers out;
-  auto built = HighPoly::build(high);
-  if (!built) return built.error();
-  out.high = std::move(*built);
+  out.high = HighPoly::build(high, *bvh);
+  const auto estimator = [&](const ao::Options& options) { return ao::Tracer::build(high, options, options.watertight ? *bvh : nullptr); };
   if (occluding) {
-    auto made = ao::Tracer::build(high, occlusion);
+    auto made = estimator(occlusion);
     if (!made) return made.error();
     out.occluder = std::move(*made);
   }
   if (thickness) {
     ao::Options two_sided = occlusion;
     two_sided.two_sided = true;
-    auto made = ao::Tracer::build(high, two_sided);
+    auto made = estimator(two_sided);
     if (!made) return made.error();
     out.depths = std::move(*made);
   }

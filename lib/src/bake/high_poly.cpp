@@ -6,37 +6,15 @@
 
 namespace matbake::bake {
 
-Result<std::unique_ptr<HighPoly>> HighPoly::build(const scene::Scene& high) {
+std::unique_ptr<HighPoly> HighPoly::build(const scene::Scene& high, std::shared_ptr<const ao::Bvh> bvh) {
   std::unique_ptr<HighPoly> h(new HighPoly);
   h->scene_ = &high;
-  h->device_.reset(rtcNewDevice(nullptr));
-  if (!h->device_) return Error{"", "Embree could not start (rtcNewDevice failed)"};
-  RTCDevice device = h->device_.get();
-  h->rtc_.reset(rtcNewScene(device));
-  RTCScene rtc = h->rtc_.get();
-  rtcSetSceneFlags(rtc, RTC_SCENE_FLAG_ROBUST);  // no ray slips between two triangles sharing an edge
-  rtcSetSceneBuildQuality(rtc, RTC_BUILD_QUALITY_HIGH);
-  const std::size_t count = high.instances.size();
-  h->normals_.resize(count);
-  h->face_normals_.resize(count);  // sized once: the filter functions keep pointers into it
-  tbb::parallel_for(std::size_t{0}, count, [&](std::size_t k) {
+  h->bvh_ = std::move(bvh);
+  h->normals_.resize(high.instances.size());
+  tbb::parallel_for(std::size_t{0}, high.instances.size(), [&](std::size_t k) {
     const scene::Instance& inst = high.instances[k];
     if (!inst.normals.empty()) h->normals_[k] = ao::shading_normals(inst);  // none: glTF's flat normals
-    auto& faces = h->face_normals_[k];
-    faces.reserve(inst.triangles.size());
-    for (const auto& t : inst.triangles) {
-      faces.push_back(glm::cross(inst.positions[t[1]] - inst.positions[t[0]], inst.positions[t[2]] - inst.positions[t[0]]));
-    }
   });
-  for (std::size_t k = 0; k < count; ++k) {
-    RTCGeometry g = ao::triangle_geometry(device, high.instances[k]);
-    ao::reject_back_faces(g, h->face_normals_[k]);
-    rtcCommitGeometry(g);
-    rtcAttachGeometry(rtc, g);
-    rtcReleaseGeometry(g);
-  }
-  rtcCommitScene(rtc);
-  if (rtcGetDeviceError(device) != RTC_ERROR_NONE) return Error{"", "Embree could not build the high-poly scene"};
   return h;
 }
 
@@ -47,9 +25,8 @@ std::optional<Hit> HighPoly::first_hit(const glm::vec3& origin, const glm::vec3&
   rh.ray.tnear = 0, rh.ray.tfar = length, rh.ray.time = 0;
   rh.ray.mask = ~0u, rh.ray.id = 0, rh.ray.flags = 0;
   rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-  RTCIntersectContext context;
-  rtcInitIntersectContext(&context);
-  rtcIntersect1(rtc_.get(), &context, &rh);
+  ao::RayContext context(false);
+  rtcIntersect1(bvh_->scene(), &context.embree, &rh);
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return std::nullopt;
   Hit hit;
   hit.instance = rh.hit.geomID;  // geometries were attached in instance order, from 0
@@ -65,7 +42,7 @@ std::optional<Hit> HighPoly::first_hit(const glm::vec3& origin, const glm::vec3&
     if (!normals.empty()) n += hit.weights[int(k)] * normals[corners[k]];
   }
   // Opposite vertex normals that cancel: the face's own.
-  if (!(glm::length(n) > 0)) n = face_normals_[hit.instance][hit.triangle];
+  if (!(glm::length(n) > 0)) n = bvh_->face_normals(hit.instance)[hit.triangle];
   hit.normal = glm::normalize(n);
   return hit;
 }

@@ -26,8 +26,8 @@ struct Hit {
 
 class HighPoly {
  public:
-  // Errors: Embree failing to start or build.
-  static Result<std::unique_ptr<HighPoly>> build(const scene::Scene& high);
+  // `bvh`: the high-poly's, robust (a cage ray must not slip between two triangles).
+  static std::unique_ptr<HighPoly> build(const scene::Scene& high, std::shared_ptr<const ao::Bvh> bvh);
 
   // The first hit on the front of a face (its winding's normal against the ray) within `length`
   // of `origin` along the unit `direction`.
@@ -45,9 +45,8 @@ class HighPoly {
  private:
   HighPoly() = default;
   const scene::Scene* scene_ = nullptr;
-  std::unique_ptr<RTCDeviceTy, ao::DeviceDeleter> device_;
-  std::unique_ptr<RTCSceneTy, ao::SceneDeleter> rtc_;
-  std::vector<std::vector<glm::vec3>> normals_, face_normals_;  // per instance; no normals: flat
+  std::shared_ptr<const ao::Bvh> bvh_;
+  std::vector<std::vector<glm::vec3>> normals_;  // per instance; none: flat
 };
 
 }  // namespace matbake::bake
