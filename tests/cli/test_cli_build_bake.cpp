@@ -389,5 +389,29 @@ TEST(CliBuildBake, ALinkPlantedInTheBakesWorkFolderIsRefused) {
   }
 }
 
+// A map the bake writes beside the scene (here OUT/materials/s_wood_height.exr: scene output
+// materials/s.glb, material wood) named as another job's output (material s_wood's texture
+// "height" in EXR): the scene job fails naming the file before it exports anything, and the other
+// job's output is its own, in whichever order they ran.
+TEST(CliBuildBake, ABakedMapNamedAsAnotherJobsOutputFailsTheSceneJob) {
+  TempDir dir;
+  for (const char* f : {"showroom.gltf", "showroom.bin"}) fs::copy_file(kExamples / f, dir / f);
+  write_bytes(dir / "height.json", "{\"name\": \"height\", \"textures\": [{\"name\": \"height\", \"channels\": [{\"source\": \"roughness\"}]}]}");
+  write_bytes(dir / "m.toml", "output = \"out\"\n[materials.s_wood]\nsources = { base_color = 0.5, metallic = 0, roughness = 0.25 }\nsize = \"4x4\"\n"
+                              "layout = \"height.json\"\nformat = \"exr\"\nbits = \"float\"\nvalidate = { enabled = false }\n"
+                              "[scenes.s]\ninput = \"showroom.gltf\"\noutput = \"materials/s.glb\"\n"
+                              "bake = { from = \"showroom.gltf\", maps = \"height\", size = 16 }\n");
+  const RunResult r = matbake({"build", (dir / "m.toml").string()});
+  EXPECT_EQ(r.exit_code, 1) << r.out;
+  const fs::path clash = dir / "out/materials/s_wood_height.exr";
+  EXPECT_NE(r.err.find(clash.string() + ": "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("another output of this build"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "out/materials/s.glb"));
+  const auto texture = image::read_image(clash, color::Transfer::linear);
+  ASSERT_TRUE(texture) << texture.error().to_string();
+  EXPECT_EQ(texture->width, 4);
+  EXPECT_EQ(texture->pixels.front(), 0.25f);
+}
+
 }  // namespace
 }  // namespace matbake::test

@@ -133,6 +133,7 @@ Result<material::Maps> load_material(const MaterialSpec& m, DecodeCache& cache) 
 
 struct JobContext {
   const Manifest& manifest;
+  const Plan& plan;
   DecodeCache& cache;
   const std::vector<material_table::Material>* table;  // null when it could not be read
   const Error* table_error;
@@ -274,7 +275,10 @@ Result<std::vector<fs::path>> run_scene(const Job& job, const JobContext& ctx, c
     const fs::path& output = job.outputs.scene;
     if (Status st = ensure_folder(output.parent_path()); !st) return st.error();
     std::optional<BakedScene> baked;
+    std::vector<fs::path> map_targets;
+    std::optional<OutputGate> gate;  // what the bake moves and removes passes it
     if (s.bake) {
+      gate.emplace(output_gate(ctx.manifest, ctx.plan));
       report_stage(stage, Phase::ao, "baking from " + s.bake->from);
       auto made = bake_scene(job, s, state_folder, options.encoding);
       if (!made) return made.error();
@@ -284,6 +288,9 @@ Result<std::vector<fs::path>> run_scene(const Job& job, const JobContext& ctx, c
           if (!t.copy_of.empty() && g.material == t.copy_of) g.copies.push_back(t.name);
         }
       }
+      auto targets = baked_map_targets(job, *made, *gate);
+      if (!targets) return targets.error();
+      map_targets = std::move(*targets);
       baked = std::move(*made);
     }
     auto exported = exporter::export_scene(baked ? baked->gltf : s.input, output, options);
@@ -291,7 +298,7 @@ Result<std::vector<fs::path>> run_scene(const Job& job, const JobContext& ctx, c
     report.details = to_json(*exported);
     std::vector<fs::path> written(exported->written.begin(), exported->written.end());
     if (baked) {
-      auto maps = finish_bake(job, *baked);
+      auto maps = finish_bake(*baked, std::move(map_targets), *gate);
       if (!maps) return maps.error();
       written.insert(written.end(), maps->begin(), maps->end());
       report.details["bake"] = to_json(baked->report);
@@ -497,7 +504,7 @@ Result<Report> run(const Manifest& manifest, const Plan& plan, const RunOptions&
                                       : material_table::load_table(manifest.table);
   auto encode_cache_bytes = delivery::encode_cache_limit();
   if (!encode_cache_bytes) return encode_cache_bytes.error();
-  const JobContext ctx{manifest, cache, table ? &*table : nullptr, table ? nullptr : &table.error(), *encode_cache_bytes};
+  const JobContext ctx{manifest, plan, cache, table ? &*table : nullptr, table ? nullptr : &table.error(), *encode_cache_bytes};
 
   // Jobs that depend on none first, then the others (a scene after its materials' jobs), each
   // skipped when a job it depends on failed in this run.

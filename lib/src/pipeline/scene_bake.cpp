@@ -96,24 +96,37 @@ Status check_baked_materials(const SceneSpec& s, const BakedScene& baked, const 
   return success();
 }
 
-Result<std::vector<fs::path>> finish_bake(const Job& job, const BakedScene& baked) {
-  std::vector<NamedOutput> targets;
-  std::vector<fs::path> moved;
+Result<std::vector<fs::path>> baked_map_targets(const Job& job, const BakedScene& baked, const OutputGate& gate) {
+  std::vector<NamedOutput> named;
+  std::vector<fs::path> targets;
   for (const std::string& file : baked.report.beside) {
-    moved.push_back(job.outputs.scene.parent_path() / fs::path(file).filename());
-    targets.push_back({moved.back(), "baked map"});
+    const fs::path target = job.outputs.scene.parent_path() / fs::path(file).filename();
+    if (!gate.holds(target)) {
+      return Error{target.string(), "the baked map would be written outside the output folder (through a link); matbake writes only inside it"};
+    }
+    if (gate.is_protected(target)) {
+      return Error{target.string(), "the baked map is named as an input or another output of this build; matbake never "
+                                    "overwrites either (rename the scene's output or the glTF material)"};
+    }
+    targets.push_back(target);
+    named.push_back({target, "baked map"});
   }
-  if (Status s = check_outputs(targets, job.inputs); !s) return s.error();
-  for (std::size_t i = 0; i < moved.size(); ++i) {
+  if (Status s = check_outputs(named, {}); !s) return s.error();  // two maps of one name
+  return targets;
+}
+
+Result<std::vector<fs::path>> finish_bake(const BakedScene& baked, std::vector<fs::path> targets, const OutputGate& gate) {
+  for (std::size_t i = 0; i < targets.size() && i < baked.report.beside.size(); ++i) {
     std::error_code ec;
-    fs::rename(baked.report.beside[i], moved[i], ec);
-    if (ec) return Error{moved[i].string(), "cannot move the baked map here: " + ec.message()};
+    fs::rename(baked.report.beside[i], targets[i], ec);
+    if (ec) return Error{targets[i].string(), "cannot move the baked map here: " + ec.message()};
   }
   for (const std::string& file : baked.report.written) {
+    const bool moved = std::find(baked.report.beside.begin(), baked.report.beside.end(), file) != baked.report.beside.end();
     std::error_code ec;
-    if (std::find(baked.report.beside.begin(), baked.report.beside.end(), file) == baked.report.beside.end()) fs::remove(file, ec);
+    if (!moved && gate.holds(file) && !gate.is_protected(file)) fs::remove(file, ec);
   }
-  return moved;
+  return targets;
 }
 
 }  // namespace matbake::pipeline

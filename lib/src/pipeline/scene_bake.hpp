@@ -7,6 +7,7 @@
 
 #include "matbake/bake_file.hpp"
 #include "matbake/export.hpp"
+#include "matbake/output_gate.hpp"
 #include "matbake/pipeline.hpp"
 
 namespace matbake::pipeline {
@@ -34,8 +35,15 @@ Result<BakedScene> bake_scene(const Job& job, const SceneSpec& s, const std::fil
 // (base colour always, the occlusion and normal map when it has them), which is refused, naming both.
 Status check_baked_materials(const SceneSpec& s, const BakedScene& baked, const std::vector<exporter::MaterialMaps>& given);
 
-// After the export: the float maps moved beside the scene's output (never onto an input), the rest
-// of the bake removed. Returns the maps as moved.
-Result<std::vector<std::filesystem::path>> finish_bake(const Job& job, const BakedScene& baked);
+// Where the float maps go, beside the scene's output, checked by `gate` (the plan's: its inputs and
+// every job's outputs protected) before the export writes anything: only inside the output folder's
+// real path, never onto a file the build reads or another job writes (a map's name comes from the
+// glTF's material, which the plan cannot know).
+Result<std::vector<std::filesystem::path>> baked_map_targets(const Job& job, const BakedScene& baked, const OutputGate& gate);
+
+// After the export: the float maps moved to `targets` (baked_map_targets'), the rest of the bake's
+// work removed (only what the bake wrote, inside the output folder). Returns the maps as moved.
+Result<std::vector<std::filesystem::path>> finish_bake(const BakedScene& baked, std::vector<std::filesystem::path> targets,
+                                                       const OutputGate& gate);
 
 }  // namespace matbake::pipeline
