@@ -242,6 +242,25 @@ TEST(Inspect, AManifestsJobsAsTheStampsHaveThem) {
   }
 }
 
+// A scene that bakes: the plan exports the scene as it is, so the maps the bake adds are named as
+// not estimated (in JSON and as the text's last line), and nothing is written.
+TEST(Inspect, AScenesBakedMapsAreNamedAsNotEstimated) {
+  TempDir dir;
+  copy_example(dir.path(), false);
+  write_bytes(dir / "b.toml", "output = \"out\"\n[scenes.s]\ninput = \"showroom.gltf\"\n"
+                              "bake = { from = \"showroom.gltf\", maps = [\"normal\", \"ao\"], size = 64 }\n");
+  const json inspected = inspect_json(dir / "b.toml");
+  const json& delivery = inspected["inspected"]["jobs"][0]["delivery"];
+  EXPECT_EQ(delivery["not_estimated"], "the bake's maps (normal, ao, 64x64 a baked material): made when the scene is built, not in this estimate");
+  const RunResult text = matbake({"inspect", (dir / "b.toml").string()});
+  EXPECT_NE(text.out.find("\n  not estimated: the bake's maps (normal, ao, 64x64"), std::string::npos) << text.out;
+  EXPECT_FALSE(fs::exists(dir / "out"));
+  write_bytes(dir / "b.json", inspected.dump());
+  if (const auto problems = schema_problems({dir / "b.json"})) {
+    EXPECT_EQ(*problems, "");
+  }
+}
+
 // The scene job of a `build --json` or of `inspect --json` on a manifest.
 json scene_job(const json& jobs) {
   for (const json& job : jobs) {

@@ -1,6 +1,8 @@
 // `matbake inspect MANIFEST`: each job's state as a build would find it (its stamp, the failure
 // recorded beside it), what it reads and would write. Nothing is built or written.
+#include "matbake/bake.hpp"
 #include "matbake/inspect.hpp"
+#include "matbake/join.hpp"
 #include "matbake/pipeline.hpp"
 #include "matbake/report_json.hpp"
 
@@ -41,7 +43,16 @@ nlohmann::json planned_delivery(const pipeline::Manifest& manifest, const pipeli
     by_class[std::string(name_in(delivery::kTextureClassNames, t.texture_class))] += t.bytes;
     by_class["total"] += t.bytes;
   }
-  return {{"textures", textures}, {"estimated_bytes", by_class}};
+  nlohmann::json out = {{"textures", textures}, {"estimated_bytes", by_class}};
+  // The plan exports the scene as it is: the textures its bake adds exist only once it has traced.
+  if (const auto& bake = manifest.scenes[job.spec].bake; bake && !bake->request.bake.maps.empty()) {
+    std::vector<std::string> maps;
+    for (bake::Map m : bake->request.bake.maps) maps.emplace_back(name_in(bake::kMapNames, m));
+    const ao::TextureOptions& t = bake->request.texture;
+    out["not_estimated"] = "the bake's maps (" + join(maps, ", ") + ", " + std::to_string(t.width) + "x" + std::to_string(t.height) +
+                           " a baked material): made when the scene is built, not in this estimate";
+  }
+  return out;
 }
 
 }  // namespace

@@ -138,7 +138,8 @@ std::string delivery_text(const Json& job) {
   const Json& e = d["estimated_bytes"];
   return table(str(job["name"]) + ": textures as it would deliver them (estimated, docs/inspect.md)", textures) +
          "  estimated: colour " + bytes_text(e["colour"].get<std::uint64_t>()) + ", data " + bytes_text(e["data"].get<std::uint64_t>()) +
-         ", normal " + bytes_text(e["normal"].get<std::uint64_t>()) + ", total " + bytes_text(e["total"].get<std::uint64_t>()) + "\n";
+         ", normal " + bytes_text(e["normal"].get<std::uint64_t>()) + ", total " + bytes_text(e["total"].get<std::uint64_t>()) + "\n" +
+         (d.contains("not_estimated") ? "  not estimated: " + str(d["not_estimated"]) + "\n" : "");
 }
 
 std::string manifest_text(const Json& j) {
