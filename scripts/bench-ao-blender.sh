@@ -13,25 +13,12 @@
 # Usage: scripts/bench-ao-blender.sh   (about 12 minutes on 2 cores)
 # BENCH_AO_WORK=DIR keeps every image there.
 set -euo pipefail
-root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
-testdata="$root/../shared/testdata/gltf"
-[ -d "$testdata" ] || { echo "bench-ao-blender: $testdata is absent (the project's shared folder)" >&2; exit 1; }
-bash "$root/scripts/apt-install.sh" "the AO bench needs Blender" blender:blender python3-numpy
-bash "$root/scripts/build.sh" "$root/build" >/dev/null
-matbake=$root/build/cli/matbake
-pairs_tool=$root/build/bench/bake_pairs
-work=${BENCH_AO_WORK:-}
-if [ -z "$work" ]; then
-  work=$(mktemp -d)
-  trap 'rm -rf "$work"' EXIT
-fi
-mkdir -p "$work"
-threads=2
+bench=bench-ao-blender work_variable=BENCH_AO_WORK repeats_variable=BENCH_AO_REPEATS
+testdata="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)/../shared/testdata/gltf"
+[ -d "$testdata" ] || { echo "$bench: $testdata is absent (the project's shared folder)" >&2; exit 1; }
+source "$(dirname "${BASH_SOURCE[0]}")/bench-blender-setup.sh"
 size=512
-repeats=${BENCH_AO_REPEATS:-3}
 
-now() { date +%s.%N; }
-elapsed() { echo "$1 $(now)" | awk '{printf "%.2f", $2 - $1}'; }
 json_field() { python3 -c 'import json, sys; print(json.load(open(sys.argv[1]))[sys.argv[2]])' "$1" "$2"; }
 
 # matbake_bake RUNS SCENE NAME FLAGS...: bakes SCENE's textures into $work/NAME/ RUNS times; of the
@@ -49,27 +36,20 @@ matbake_bake() {
     run=$(elapsed "$start")
     bake=$(python3 -c 'import json, sys; r = json.load(open(sys.argv[1]))
 print("%.3f" % (r["setup_seconds"] + r["texel_seconds"] + r["ray_seconds"]))' "$work/$name.json")
-    if [ -z "$seconds" ] || awk -v a="$bake" -v b="$seconds" 'BEGIN { exit !(a < b) }'; then seconds=$bake run_seconds=$run; fi
+    keep_fastest "$bake" "$run"
   done
 }
 
 # blender_bake SCENE SAMPLES DISTANCE NAME: bakes $work/NAME.exr (the first material's) $repeats
 # times, the fastest bake call's time in $seconds.
 blender_bake() {
-  local scene=$1 samples=$2 distance=$3 name=$4
-  local log
-  log=$(timeout 3600 blender -b --factory-startup --python "$root/scripts/bench-bake-blender.py" -- \
-    "$scene" - "$work/$name.exr" ao_self "$size" "$samples" 0 0 "$distance" "$threads" "$repeats" 2>&1)
-  seconds=$(printf '%s\n' "$log" | sed -n 's/^seconds=//p')
-  [ -n "$seconds" ] || { printf '%s\n' "$log" | tail -20 >&2; echo "bench-ao-blender: Blender's bake failed" >&2; exit 1; }
-  seconds=$(printf '%.2f' "$seconds")
+  blender_run "$1" - "$work/$4.exr" ao_self "$size" "$2" 0 0 "$3" "$threads" "$repeats"
 }
 
 # error SCENE REFERENCE IMAGE: IMAGE's RMSE and largest error against REFERENCE, space-separated.
 error() {
   "$pairs_tool" error scalar "$1" "$2" "$3" | sed -E 's/^[^ ]+ texels=[0-9]+ //; s/[a-z0-9_]+=//g'
 }
-ratio() { echo "$1 $2" | awk '{printf "%.1f×", $1 / ($2 > 0 ? $2 : 0.005)}'; }
 
 echo "matbake $("$matbake" --version | head -1 | awk '{print $NF}') against Blender's Cycles AO bake (CPU), $threads threads each, $(nproc) cores."
 echo

@@ -11,25 +11,11 @@
 # BENCH_BAKE_WORK=DIR keeps the pairs and every image there; BENCH_BAKE_SECTIONS="normal ao" (the
 # default) names the tables to make (normal: the normal maps and their renders; ao: binary AO).
 set -euo pipefail
-root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
-bash "$root/scripts/apt-install.sh" "the bake bench needs Blender" blender:blender python3-numpy
-bash "$root/scripts/build.sh" "$root/build" >/dev/null
-matbake=$root/build/cli/matbake
-pairs_tool=$root/build/bench/bake_pairs
-work=${BENCH_BAKE_WORK:-}
-if [ -z "$work" ]; then
-  work=$(mktemp -d)
-  trap 'rm -rf "$work"' EXIT
-fi
-mkdir -p "$work"
+bench=bench-bake-blender work_variable=BENCH_BAKE_WORK repeats_variable=BENCH_BAKE_REPEATS
+source "$(dirname "${BASH_SOURCE[0]}")/bench-blender-setup.sh"
 "$pairs_tool" write "$work"
-threads=2
 ao_distance=0.5
-repeats=${BENCH_BAKE_REPEATS:-3}
 sections=" ${BENCH_BAKE_SECTIONS:-normal ao} "
-
-now() { date +%s.%N; }
-elapsed() { echo "$1 $(now)" | awk '{printf "%.2f", $2 - $1}'; }
 
 # matbake_bake RUNS PAIR FRONT BACK MAP SIZE NAME FLAGS...: bakes into $work/NAME/ RUNS times, leaves
 # the map's PNG at $work/NAME.png and, of the run whose bake was fastest, the whole run's time in
@@ -46,7 +32,7 @@ matbake_bake() {
       --size "$size" --front "$front" --back "$back" --absolute-cage --padding 0 --jobs "$threads" "$@" >"$work/$name.json"
     run=$(elapsed "$start")
     bake=$(python3 -c 'import json, sys; r = json.load(open(sys.argv[1])); print("%.3f" % (r["setup_seconds"] + r["trace_seconds"]))' "$work/$name.json")
-    if [ -z "$seconds" ] || awk -v a="$bake" -v b="$seconds" 'BEGIN { exit !(a < b) }'; then seconds=$bake run_seconds=$run; fi
+    keep_fastest "$bake" "$run"
   done
   cp "$work/$name"/*_"$map".png "$work/$name.png"
 }
@@ -55,20 +41,14 @@ matbake_bake() {
 # call's time in $seconds.
 blender_bake() {
   local pair=$1 front=$2 back=$3 map=$4 size=$5 samples=$6 name=$7
-  local log
-  log=$(timeout 3600 blender -b --factory-startup --python "$root/scripts/bench-bake-blender.py" -- \
-    "$work/${pair}_low.gltf" "$work/${pair}_high.gltf" "$work/$name.exr" "$map" "$size" "$samples" "$front" \
-    "$(echo "$front $back" | awk '{print $1 + $2}')" "$ao_distance" "$threads" "$repeats" 2>&1)
-  seconds=$(printf '%s\n' "$log" | sed -n 's/^seconds=//p')
-  [ -n "$seconds" ] || { printf '%s\n' "$log" | tail -20 >&2; echo "bench-bake-blender: Blender's bake failed" >&2; exit 1; }
-  seconds=$(printf '%.2f' "$seconds")
+  blender_run "$work/${pair}_low.gltf" "$work/${pair}_high.gltf" "$work/$name.exr" "$map" "$size" "$samples" "$front" \
+    "$(echo "$front $back" | awk '{print $1 + $2}')" "$ao_distance" "$threads" "$repeats"
 }
 
 # error KIND PAIR REFERENCE IMAGE: IMAGE's two error figures against REFERENCE, space-separated.
 error() {
   "$pairs_tool" error "$1" "$work/${2}_low.gltf" "$work/$3" "$work/$4" | sed -E 's/^[^ ]+ texels=[0-9]+ //; s/[a-z0-9_]+=//g'
 }
-ratio() { echo "$1 $2" | awk '{printf "%.1f×", $1 / ($2 > 0 ? $2 : 0.005)}'; }
 
 blender_version=$(blender -b --factory-startup --python-expr 'import bpy; print("version=" + bpy.app.version_string)' 2>/dev/null |
   sed -n 's/^version=//p')
