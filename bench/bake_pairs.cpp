@@ -6,11 +6,12 @@
 //     of sines, 20480 triangles, onto a smooth icosphere of 320) and rivets (a 12 × 12 grid of
 //     hemispheres of radius 0.03 on a plane onto a quad: detail a few texels wide, with creases,
 //     where a texel's footprint is not one normal);
-//   bake_pairs error normal|scalar LOW.gltf REFERENCE IMAGE...
+//   bake_pairs error normal|position|scalar LOW.gltf REFERENCE IMAGE...
 //     compares each IMAGE with REFERENCE over the texels whose centre a triangle of LOW's UV set 0
-//     covers (padding and empty texels left out), every value rounded to 8 bits first (as it is
-//     delivered): normal maps by the angle between decoded directions (mean and 99th percentile,
-//     degrees), scalar maps (the first channel) by RMSE and the largest difference;
+//     covers (padding and empty texels left out): normal maps by the angle between decoded
+//     directions (mean and 99th percentile, degrees) and scalar maps (the first channel) by RMSE and
+//     the largest difference, every value rounded to 8 bits first (as it is delivered); position
+//     maps (float files) by the distance between the positions (mean and 99th percentile);
 //   bake_pairs psnr REFERENCE.png RENDER.png
 //     the PSNR of a render against another over what either shows (the runtime tests' measure).
 #include <OpenImageIO/imageio.h>
@@ -21,6 +22,7 @@
 #include <cstdio>
 #include <exception>
 #include <filesystem>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -158,18 +160,22 @@ std::vector<bool> covered_texels(const fs::path& low, int width, int height) {
 
 struct Pixels {
   int width = 0, height = 0, channels = 0;
-  std::vector<float> values;  // rounded to 8 bits
+  std::vector<float> values;  // rounded to 8 bits unless read as floats
   const float* at(std::size_t texel) const { return &values[texel * std::size_t(channels)]; }
 };
 
-bool read_pixels(const std::string& path, Pixels& out) {
+// The image's samples as floats, or (`eight_bits`) clamped to [0, 1] and rounded to 8 bits, as a
+// PNG would hold them.
+bool read_pixels(const std::string& path, Pixels& out, bool eight_bits) {
   auto in = OIIO::ImageInput::open(path);
   if (!in) return false;
   const OIIO::ImageSpec& spec = in->spec();
   out.width = spec.width, out.height = spec.height, out.channels = spec.nchannels;
   out.values.resize(std::size_t(spec.width) * spec.height * spec.nchannels);
   if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, out.values.data())) return false;
-  for (float& v : out.values) v = std::round(std::clamp(v, 0.0f, 1.0f) * 255.0f) / 255.0f;
+  if (eight_bits) {
+    for (float& v : out.values) v = std::round(std::clamp(v, 0.0f, 1.0f) * 255.0f) / 255.0f;
+  }
   return true;
 }
 
@@ -177,39 +183,57 @@ glm::dvec3 decoded_normal(const float* rgb) {
   return glm::normalize(glm::dvec3(2.0 * rgb[0] - 1, 2.0 * rgb[1] - 1, 2.0 * rgb[2] - 1));
 }
 
-int compare(bool normal, const fs::path& low, const std::string& reference_path, const std::vector<std::string>& images) {
+// What `error` compares: normal maps by angle (°), positions by distance (scene units, as floats),
+// scalars by difference (8 bits).
+enum class ErrorKind { normal, position, scalar };
+
+double texel_error(ErrorKind kind, const float* image, const float* reference) {
+  switch (kind) {
+    case ErrorKind::normal: {
+      const double c = glm::dot(decoded_normal(image), decoded_normal(reference));
+      return std::acos(std::clamp(c, -1.0, 1.0)) * 180 / M_PI;
+    }
+    case ErrorKind::position:
+      return glm::distance(glm::dvec3(image[0], image[1], image[2]), glm::dvec3(reference[0], reference[1], reference[2]));
+    case ErrorKind::scalar:
+      break;
+  }
+  return double(image[0]) - double(reference[0]);
+}
+
+int compare(ErrorKind kind, const fs::path& low, const std::string& reference_path, const std::vector<std::string>& images) {
+  const bool eight_bits = kind != ErrorKind::position;
+  const int channels = kind == ErrorKind::scalar ? 1 : 3;
   Pixels reference;
-  if (!read_pixels(reference_path, reference)) {
+  if (!read_pixels(reference_path, reference, eight_bits) || reference.channels < channels) {
     std::fprintf(stderr, "bake_pairs: cannot read %s\n", reference_path.c_str());
     return 1;
   }
   const std::vector<bool> mask = covered_texels(low, reference.width, reference.height);
   for (const std::string& path : images) {
     Pixels image;
-    if (!read_pixels(path, image) || image.width != reference.width || image.height != reference.height ||
-        image.channels < (normal ? 3 : 1)) {
+    if (!read_pixels(path, image, eight_bits) || image.width != reference.width || image.height != reference.height ||
+        image.channels < channels) {
       std::fprintf(stderr, "bake_pairs: cannot read %s as a %d×%d image like the reference\n", path.c_str(), reference.width, reference.height);
       return 1;
     }
     std::vector<double> errors;
     for (std::size_t t = 0; t < mask.size(); ++t) {
-      if (!mask[t]) continue;
-      if (normal) {
-        const double c = glm::dot(decoded_normal(image.at(t)), decoded_normal(reference.at(t)));
-        errors.push_back(std::acos(std::clamp(c, -1.0, 1.0)) * 180 / M_PI);
-      } else {
-        errors.push_back(double(image.at(t)[0]) - double(reference.at(t)[0]));
-      }
+      if (mask[t]) errors.push_back(texel_error(kind, image.at(t), reference.at(t)));
     }
     double sum = 0, sum_sq = 0, largest = 0;
     for (const double e : errors) sum += e, sum_sq += e * e, largest = std::max(largest, std::abs(e));
     const double n = double(std::max<std::size_t>(errors.size(), 1));
-    if (normal) {
-      std::sort(errors.begin(), errors.end());
-      const double p99 = errors.empty() ? 0 : errors[std::size_t(0.99 * double(errors.size() - 1))];
+    if (kind == ErrorKind::scalar) {
+      std::printf("%s texels=%zu rmse=%.4f max=%.4f\n", path.c_str(), errors.size(), std::sqrt(sum_sq / n), largest);
+      continue;
+    }
+    std::sort(errors.begin(), errors.end());
+    const double p99 = errors.empty() ? 0 : errors[std::size_t(0.99 * double(errors.size() - 1))];
+    if (kind == ErrorKind::normal) {
       std::printf("%s texels=%zu mean_deg=%.3f p99_deg=%.3f\n", path.c_str(), errors.size(), sum / n, p99);
     } else {
-      std::printf("%s texels=%zu rmse=%.4f max=%.4f\n", path.c_str(), errors.size(), std::sqrt(sum_sq / n), largest);
+      std::printf("%s texels=%zu mean=%.2e p99=%.2e\n", path.c_str(), errors.size(), sum / n, p99);
     }
   }
   return 0;
@@ -227,8 +251,9 @@ int main(int argc, char** argv) {
     write_rivets(args[1]);
     return 0;
   }
-  if (args.size() >= 5 && args[0] == "error" && (args[1] == "normal" || args[1] == "scalar")) {
-    return compare(args[1] == "normal", args[2], args[3], {args.begin() + 4, args.end()});
+  if (args.size() >= 5 && args[0] == "error") {
+    const std::map<std::string, ErrorKind> kinds{{"normal", ErrorKind::normal}, {"position", ErrorKind::position}, {"scalar", ErrorKind::scalar}};
+    if (const auto kind = kinds.find(args[1]); kind != kinds.end()) return compare(kind->second, args[2], args[3], {args.begin() + 4, args.end()});
   }
   if (args.size() == 3 && args[0] == "psnr") {
     try {

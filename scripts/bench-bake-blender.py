@@ -1,11 +1,12 @@
 # Blender's "selected to active" bake of one pair, for scripts/bench-bake-blender.sh:
 #   blender -b --factory-startup --python scripts/bench-bake-blender.py -- \
-#     LOW.gltf HIGH.gltf OUT.exr normal|ao SIZE SAMPLES EXTRUSION MAX_RAY_DISTANCE AO_DISTANCE THREADS [REPEATS]
+#     LOW.gltf HIGH.gltf OUT.exr normal|ao|position SIZE SAMPLES EXTRUSION MAX_RAY_DISTANCE AO_DISTANCE THREADS [REPEATS]
 # Cycles on the CPU; the cage is the low-poly extruded by EXTRUSION along its normals, rays reach
 # MAX_RAY_DISTANCE inward (scene units). The low-poly is invisible to every ray (it is the surface
 # being replaced: it must not occlude the high-poly's AO). Bakes REPEATS times (default 1) and prints
 # one line `seconds=T`: the fastest bake call alone (not Blender's start, the imports or the image
-# write).
+# write). Kind position: the high-poly's position at each texel's hit, written in glTF's axes (Y up;
+# Blender's are Z up: its importer turns the coordinates, not the objects).
 # Kind ao_self (scripts/bench-ao-blender.sh): a scene's AO onto its own UVs, as `matbake bake-ao
 # --texture`: LOW.gltf is the scene, HIGH.gltf is ignored, every mesh object is baked, each material
 # into its own SIZE² image; OUT.exr is the first material's (EXTRUSION and MAX_RAY_DISTANCE unused).
@@ -107,8 +108,13 @@ bpy.context.view_layer.objects.active = baked[-1]
 seconds = float("inf")
 for _ in range(repeats):
     started = time.perf_counter()
-    bpy.ops.object.bake(type={"normal": "NORMAL", "ao": "AO", "ao_self": "AO"}[kind])
+    bpy.ops.object.bake(type={"normal": "NORMAL", "ao": "AO", "ao_self": "AO", "position": "POSITION"}[kind])
     seconds = min(seconds, time.perf_counter() - started)
+
+if kind == "position":  # Blender's (x, y, z) is glTF's (x, -z, y)
+    pixels = numpy.array(image.pixels[:], dtype=numpy.float32).reshape(-1, 4)
+    pixels[:, 1], pixels[:, 2] = pixels[:, 2].copy(), -pixels[:, 1]
+    image.pixels[:] = pixels.ravel()
 
 image.filepath_raw = out_path
 image.file_format = "OPEN_EXR"

@@ -1,24 +1,26 @@
 #!/usr/bin/env bash
-# The baker against Blender's (docs/bake.md): on three pairs with known geometry (bench/bake_pairs.cpp:
-# sphere, bump, sculpt), the tangent-space normal map and binary AO baked by `matbake bake` and by
-# Blender's Cycles "selected to active" (scripts/bench-bake-blender.py) with the same cage, the same
-# AO distance, 2 threads each, at equal samples; each compared with a high-sample reference
-# (bake_pairs error: the texels the low-poly's UVs cover, 8 bits). matbake's time is its whole run
-# (load, trace, PNG, glTF written); Blender's the bake call alone (not its start, imports or write).
+# The baker against Blender's (docs/bake.md): on four pairs with known geometry (bench/bake_pairs.cpp:
+# sphere, bump, sculpt, rivets), the tangent-space normal map, the position map and binary AO baked
+# by `matbake bake` and by Blender's Cycles "selected to active" (scripts/bench-bake-blender.py) with
+# the same cage, the same AO distance, 2 threads each, at equal samples; each compared with a
+# high-sample reference (bake_pairs error: the texels the low-poly's UVs cover, 8 bits but for
+# positions). matbake's time is its bake (set-up and trace, from --json; its whole run in brackets);
+# Blender's the bake call alone (not its start, imports or write).
 # Each time is the fastest of BENCH_BAKE_REPEATS runs (3; this VM's speed drifts by a third from one
 # minute to the next), the references' one run. Markdown on stdout.
 # Usage: scripts/bench-bake-blender.sh   (about 20 minutes on 2 cores)
-# BENCH_BAKE_WORK=DIR keeps the pairs and every image there; BENCH_BAKE_SECTIONS="normal ao" (the
-# default) names the tables to make (normal: the normal maps and their renders; ao: binary AO).
+# BENCH_BAKE_WORK=DIR keeps the pairs and every image there; BENCH_BAKE_SECTIONS="normal position ao"
+# (the default) names the tables to make (normal: the normal maps and their renders; position: the
+# high-poly's positions; ao: binary AO).
 set -euo pipefail
 bench=bench-bake-blender work_variable=BENCH_BAKE_WORK repeats_variable=BENCH_BAKE_REPEATS
 source "$(dirname "${BASH_SOURCE[0]}")/bench-blender-setup.sh"
 "$pairs_tool" write "$work"
 ao_distance=0.5
-sections=" ${BENCH_BAKE_SECTIONS:-normal ao} "
+sections=" ${BENCH_BAKE_SECTIONS:-normal position ao} "
 
 # matbake_bake RUNS PAIR FRONT BACK MAP SIZE NAME FLAGS...: bakes into $work/NAME/ RUNS times, leaves
-# the map's PNG at $work/NAME.png and, of the run whose bake was fastest, the whole run's time in
+# the map at $work/NAME.png (a float map beside the glTF: $work/NAME.exr) and, of the run whose bake was fastest, the whole run's time in
 # $run_seconds and the bake's (set-up and trace, from --json: what Blender's bake call spans) in $seconds.
 matbake_bake() {
   local runs=$1 pair=$2 front=$3 back=$4 map=$5 size=$6 name=$7
@@ -34,7 +36,10 @@ matbake_bake() {
     bake=$(python3 -c 'import json, sys; r = json.load(open(sys.argv[1])); print("%.3f" % (r["setup_seconds"] + r["trace_seconds"]))' "$work/$name.json")
     keep_fastest "$bake" "$run"
   done
-  cp "$work/$name"/*_"$map".png "$work/$name.png"
+  local made
+  for made in "$work/$name"/*_"$map".png "$work/$name"/*_"$map".exr; do
+    [ -f "$made" ] && cp "$made" "$work/$name.${made##*.}"
+  done
 }
 
 # blender_bake PAIR FRONT BACK MAP SIZE SAMPLES NAME: bakes $work/NAME.exr $repeats times, the fastest bake
@@ -112,6 +117,24 @@ if [[ "$sections" == *" normal "* ]]; then
     echo "(three.js in Chromium could not be installed here: no render comparison)"
     echo
   fi
+fi
+
+if [[ "$sections" == *" position "* ]]; then
+  echo "### Position map, 1024², against matbake at 64 positions a texel (floats, scene units; each pair about 2 across)"
+  echo
+  echo "| pair | rays a texel | matbake (s) | Blender (s) | faster | matbake error: mean, 99th pct | Blender error |"
+  echo "|---|---|---|---|---|---|---|"
+  for p in "${pairs[@]}"; do
+    read -r pair front back <<<"$p"
+    matbake_bake 1 "$pair" "$front" "$back" position 1024 "${pair}_position_ref" --texel-samples 64
+    matbake_bake "$repeats" "$pair" "$front" "$back" position 1024 "${pair}_position_m1" --texel-samples 1
+    m_seconds=$seconds m_run=$run_seconds
+    read -r m_mean m_p99 <<<"$(error position "$pair" "${pair}_position_ref.exr" "${pair}_position_m1.exr")"
+    blender_bake "$pair" "$front" "$back" position 1024 1 "${pair}_position_blender"
+    read -r b_mean b_p99 <<<"$(error position "$pair" "${pair}_position_ref.exr" "${pair}_position_blender.exr")"
+    echo "| $pair | 1 | $m_seconds ($m_run) | $seconds | $(ratio "$seconds" "$m_seconds") | $m_mean, $m_p99 | $b_mean, $b_p99 |"
+  done
+  echo
 fi
 
 [[ "$sections" == *" ao "* ]] || exit 0
