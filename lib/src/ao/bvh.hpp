@@ -1,8 +1,8 @@
 #pragma once
 // A scene's triangles in one Embree BVH, shared by everything that traces that scene: a bake's cage
-// rays, its occlusion rays and its thickness rays use one build, not three (on a 20k-triangle
-// high-poly a build took a third of a 16-ray bake). Whether the back of a face is a hit is each
-// trace's choice (RayContext), not the BVH's.
+// rays, its occlusion rays and its thickness rays use one build, not three (a second build was a
+// sixth of a 16-ray AO bake on a 20k-triangle high-poly). Whether the back of a face is a hit is
+// each trace's choice (RayContext), not the BVH's.
 #include <embree3/rtcore.h>
 
 #include <memory>
