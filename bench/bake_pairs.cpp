@@ -1,17 +1,20 @@
 // The bake bench's pairs and its error measure (scripts/bench-bake-blender.sh):
 //   bake_pairs write DIR
-//     writes three high/low pairs with known geometry: sphere (an icosphere of 5120 smooth triangles
+//     writes four high/low pairs with known geometry (each high-poly also as NAME_painted.gltf, with
+//     vertex colours): sphere (an icosphere of 5120 smooth triangles
 //     onto a flat-shaded one of 320, each low triangle its own UV island), bump (a hemisphere of
 //     radius 0.5 on a 128 × 128 grid onto a quad), sculpt (a unit sphere displaced by a product
 //     of sines, 20480 triangles, onto a smooth icosphere of 320) and rivets (a 12 × 12 grid of
 //     hemispheres of radius 0.03 on a plane onto a quad: detail a few texels wide, with creases,
 //     where a texel's footprint is not one normal);
-//   bake_pairs error normal|position|scalar LOW.gltf REFERENCE IMAGE...
+//   bake_pairs error normal|position|colour|scalar LOW.gltf REFERENCE IMAGE...
 //     compares each IMAGE with REFERENCE over the texels whose centre a triangle of LOW's UV set 0
 //     covers (padding and empty texels left out): normal maps by the angle between decoded
-//     directions (mean and 99th percentile, degrees) and scalar maps (the first channel) by RMSE and
-//     the largest difference, every value rounded to 8 bits first (as it is delivered); position
-//     maps (float files) by the distance between the positions (mean and 99th percentile);
+//     directions (mean and 99th percentile, degrees), scalar maps (the first channel) by RMSE and
+//     the largest difference, colours (RGB) by the RMS of the channels' differences (RMSE and the
+//     largest), every value rounded to 8 bits first (as it is delivered; a float file's colours
+//     encoded to sRGB); position maps (float files) by the distance between the positions (mean and
+//     99th percentile);
 //   bake_pairs psnr REFERENCE.png RENDER.png
 //     the PSNR of a render against another over what either shows (the runtime tests' measure).
 #include <OpenImageIO/imageio.h>
@@ -26,6 +29,7 @@
 #include <string>
 #include <vector>
 
+#include "matbake/color.hpp"
 #include "matbake/scene.hpp"
 #include "tests/support/gltf_builder.hpp"
 #include "tests/support/render_psnr.hpp"
@@ -38,9 +42,22 @@ namespace {
 
 using Triangles = std::vector<std::array<std::uint32_t, 3>>;
 
+// A pair's high-poly as NAME_high.gltf, and as NAME_painted.gltf with vertex colours (linear RGB in
+// [0.1, 0.9], smooth bands a few across the pair) for the colour transfer; the renders compare the
+// grey one with the grey low-poly.
+void write_high(const fs::path& dir, const std::string& name, const std::vector<glm::dvec3>& positions,
+                const std::vector<glm::dvec3>& normals, const Triangles& triangles) {
+  test::write_grey_mesh(dir / (name + "_high.gltf"), positions, normals, {}, triangles);
+  std::vector<glm::dvec3> colors;
+  for (const glm::dvec3& p : positions) {
+    colors.push_back(0.5 + 0.4 * glm::dvec3(std::sin(5 * p.x + 1), std::sin(7 * p.y + 2), std::sin(9 * p.z + 3)));
+  }
+  test::write_grey_mesh(dir / (name + "_painted.gltf"), positions, normals, {}, triangles, colors);
+}
+
 void write_sphere(const fs::path& dir) {
   const test::Icosphere fine = test::icosphere(4);
-  test::write_grey_mesh(dir / "sphere_high.gltf", fine.vertices, fine.vertices, {}, fine.triangles);
+  write_high(dir, "sphere", fine.vertices, fine.vertices, fine.triangles);
   const test::AtlasMesh low = test::icosphere_atlas(2, true);
   test::write_grey_mesh(dir / "sphere_low.gltf", low.positions, low.normals, low.texcoords, low.triangles);
 }
@@ -75,7 +92,7 @@ void write_bump(const fs::path& dir) {
       triangles.push_back({a, d, c});
     }
   }
-  test::write_grey_mesh(dir / "bump_high.gltf", positions, normals, {}, triangles);
+  write_high(dir, "bump", positions, normals, triangles);
   write_quad(dir / "bump_low.gltf");
 }
 
@@ -90,7 +107,7 @@ void write_sculpt(const fs::path& dir) {
     for (const std::uint32_t v : t) normals[v] += area;
   }
   for (glm::dvec3& n : normals) n = glm::normalize(n);
-  test::write_grey_mesh(dir / "sculpt_high.gltf", sphere.vertices, normals, {}, sphere.triangles);
+  write_high(dir, "sculpt", sphere.vertices, normals, sphere.triangles);
   const test::AtlasMesh low = test::icosphere_atlas(2, false);
   test::write_grey_mesh(dir / "sculpt_low.gltf", low.positions, low.normals, low.texcoords, low.triangles);
 }
@@ -128,7 +145,7 @@ void write_rivets(const fs::path& dir) {
       }
     }
   }
-  test::write_grey_mesh(dir / "rivets_high.gltf", positions, normals, {}, triangles);
+  write_high(dir, "rivets", positions, normals, triangles);
   write_quad(dir / "rivets_low.gltf");
 }
 
@@ -164,17 +181,23 @@ struct Pixels {
   const float* at(std::size_t texel) const { return &values[texel * std::size_t(channels)]; }
 };
 
-// The image's samples as floats, or (`eight_bits`) clamped to [0, 1] and rounded to 8 bits, as a
-// PNG would hold them.
-bool read_pixels(const std::string& path, Pixels& out, bool eight_bits) {
+// How `error` reads an image's samples: as floats; clamped to [0, 1] and rounded to 8 bits, as a
+// PNG would hold them; or as sRGB colour in 8 bits (a float file's linear values encoded first, an
+// 8-bit file's codes as they are).
+enum class Reading { floats, eight_bits, srgb_eight_bits };
+
+bool read_pixels(const std::string& path, Pixels& out, Reading reading) {
   auto in = OIIO::ImageInput::open(path);
   if (!in) return false;
   const OIIO::ImageSpec& spec = in->spec();
   out.width = spec.width, out.height = spec.height, out.channels = spec.nchannels;
   out.values.resize(std::size_t(spec.width) * spec.height * spec.nchannels);
   if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, out.values.data())) return false;
-  if (eight_bits) {
-    for (float& v : out.values) v = std::round(std::clamp(v, 0.0f, 1.0f) * 255.0f) / 255.0f;
+  if (reading == Reading::floats) return true;
+  const bool encode = reading == Reading::srgb_eight_bits && spec.format.is_floating_point();
+  for (float& v : out.values) {
+    const float stored = encode ? float(color::encoded_from_linear(color::Transfer::srgb, std::clamp(double(v), 0.0, 1.0))) : v;
+    v = std::round(std::clamp(stored, 0.0f, 1.0f) * 255.0f) / 255.0f;
   }
   return true;
 }
@@ -184,8 +207,8 @@ glm::dvec3 decoded_normal(const float* rgb) {
 }
 
 // What `error` compares: normal maps by angle (°), positions by distance (scene units, as floats),
-// scalars by difference (8 bits).
-enum class ErrorKind { normal, position, scalar };
+// colours by the RMS of their channels' differences (sRGB, 8 bits), scalars by difference (8 bits).
+enum class ErrorKind { normal, position, colour, scalar };
 
 double texel_error(ErrorKind kind, const float* image, const float* reference) {
   switch (kind) {
@@ -195,6 +218,8 @@ double texel_error(ErrorKind kind, const float* image, const float* reference) {
     }
     case ErrorKind::position:
       return glm::distance(glm::dvec3(image[0], image[1], image[2]), glm::dvec3(reference[0], reference[1], reference[2]));
+    case ErrorKind::colour:
+      return glm::distance(glm::dvec3(image[0], image[1], image[2]), glm::dvec3(reference[0], reference[1], reference[2])) / std::sqrt(3.0);
     case ErrorKind::scalar:
       break;
   }
@@ -202,17 +227,19 @@ double texel_error(ErrorKind kind, const float* image, const float* reference) {
 }
 
 int compare(ErrorKind kind, const fs::path& low, const std::string& reference_path, const std::vector<std::string>& images) {
-  const bool eight_bits = kind != ErrorKind::position;
+  const Reading reading = kind == ErrorKind::position ? Reading::floats
+                          : kind == ErrorKind::colour ? Reading::srgb_eight_bits
+                                                      : Reading::eight_bits;
   const int channels = kind == ErrorKind::scalar ? 1 : 3;
   Pixels reference;
-  if (!read_pixels(reference_path, reference, eight_bits) || reference.channels < channels) {
+  if (!read_pixels(reference_path, reference, reading) || reference.channels < channels) {
     std::fprintf(stderr, "bake_pairs: cannot read %s\n", reference_path.c_str());
     return 1;
   }
   const std::vector<bool> mask = covered_texels(low, reference.width, reference.height);
   for (const std::string& path : images) {
     Pixels image;
-    if (!read_pixels(path, image, eight_bits) || image.width != reference.width || image.height != reference.height ||
+    if (!read_pixels(path, image, reading) || image.width != reference.width || image.height != reference.height ||
         image.channels < channels) {
       std::fprintf(stderr, "bake_pairs: cannot read %s as a %d×%d image like the reference\n", path.c_str(), reference.width, reference.height);
       return 1;
@@ -224,7 +251,7 @@ int compare(ErrorKind kind, const fs::path& low, const std::string& reference_pa
     double sum = 0, sum_sq = 0, largest = 0;
     for (const double e : errors) sum += e, sum_sq += e * e, largest = std::max(largest, std::abs(e));
     const double n = double(std::max<std::size_t>(errors.size(), 1));
-    if (kind == ErrorKind::scalar) {
+    if (kind == ErrorKind::scalar || kind == ErrorKind::colour) {
       std::printf("%s texels=%zu rmse=%.4f max=%.4f\n", path.c_str(), errors.size(), std::sqrt(sum_sq / n), largest);
       continue;
     }
@@ -252,7 +279,8 @@ int main(int argc, char** argv) {
     return 0;
   }
   if (args.size() >= 5 && args[0] == "error") {
-    const std::map<std::string, ErrorKind> kinds{{"normal", ErrorKind::normal}, {"position", ErrorKind::position}, {"scalar", ErrorKind::scalar}};
+    const std::map<std::string, ErrorKind> kinds{
+        {"normal", ErrorKind::normal}, {"position", ErrorKind::position}, {"colour", ErrorKind::colour}, {"scalar", ErrorKind::scalar}};
     if (const auto kind = kinds.find(args[1]); kind != kinds.end()) return compare(kind->second, args[2], args[3], {args.begin() + 4, args.end()});
   }
   if (args.size() == 3 && args[0] == "psnr") {

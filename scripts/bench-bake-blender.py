@@ -1,12 +1,14 @@
 # Blender's "selected to active" bake of one pair, for scripts/bench-bake-blender.sh:
 #   blender -b --factory-startup --python scripts/bench-bake-blender.py -- \
-#     LOW.gltf HIGH.gltf OUT.exr normal|ao|position SIZE SAMPLES EXTRUSION MAX_RAY_DISTANCE AO_DISTANCE THREADS [REPEATS]
+#     LOW.gltf HIGH.gltf OUT.exr normal|ao|position|transfer SIZE SAMPLES EXTRUSION MAX_RAY_DISTANCE AO_DISTANCE THREADS [REPEATS]
 # Cycles on the CPU; the cage is the low-poly extruded by EXTRUSION along its normals, rays reach
 # MAX_RAY_DISTANCE inward (scene units). The low-poly is invisible to every ray (it is the surface
 # being replaced: it must not occlude the high-poly's AO). Bakes REPEATS times (default 1) and prints
 # one line `seconds=T`: the fastest bake call alone (not Blender's start, the imports or the image
 # write). Kind position: the high-poly's position at each texel's hit, written in glTF's axes (Y up;
-# Blender's are Z up: its importer turns the coordinates, not the objects).
+# Blender's are Z up: its importer turns the coordinates, not the objects). Kind transfer: the
+# high-poly's base colour (Cycles' diffuse colour pass alone; its importer multiplies COLOR_0 in),
+# linear.
 # Kind ao_self (scripts/bench-ao-blender.sh): a scene's AO onto its own UVs, as `matbake bake-ao
 # --texture`: LOW.gltf is the scene, HIGH.gltf is ignored, every mesh object is baked, each material
 # into its own SIZE² image; OUT.exr is the first material's (EXTRUSION and MAX_RAY_DISTANCE unused).
@@ -100,6 +102,8 @@ bake.max_ray_distance = max_ray
 bake.margin = 0
 bake.normal_space = "TANGENT"
 bake.normal_r, bake.normal_g, bake.normal_b = "POS_X", "POS_Y", "POS_Z"
+bake.use_pass_direct = bake.use_pass_indirect = False  # the diffuse pass's colour alone (transfer)
+bake.use_pass_color = True
 
 bpy.ops.object.select_all(action="DESELECT")
 for o in baked:
@@ -108,7 +112,7 @@ bpy.context.view_layer.objects.active = baked[-1]
 seconds = float("inf")
 for _ in range(repeats):
     started = time.perf_counter()
-    bpy.ops.object.bake(type={"normal": "NORMAL", "ao": "AO", "ao_self": "AO", "position": "POSITION"}[kind])
+    bpy.ops.object.bake(type={"normal": "NORMAL", "ao": "AO", "ao_self": "AO", "position": "POSITION", "transfer": "DIFFUSE"}[kind])
     seconds = min(seconds, time.perf_counter() - started)
 
 if kind == "position":  # Blender's (x, y, z) is glTF's (x, -z, y)

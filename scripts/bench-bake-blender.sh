@@ -1,23 +1,23 @@
 #!/usr/bin/env bash
 # The baker against Blender's (docs/bake.md): on four pairs with known geometry (bench/bake_pairs.cpp:
-# sphere, bump, sculpt, rivets), the tangent-space normal map, the position map and binary AO baked
-# by `matbake bake` and by Blender's Cycles "selected to active" (scripts/bench-bake-blender.py) with
-# the same cage, the same AO distance, 2 threads each, at equal samples; each compared with a
-# high-sample reference (bake_pairs error: the texels the low-poly's UVs cover, 8 bits but for
-# positions). matbake's time is its bake (set-up and trace, from --json; its whole run in brackets);
+# sphere, bump, sculpt, rivets), the tangent-space normal map, the position map, the colour transfer
+# and binary AO baked by `matbake bake` and by Blender's Cycles "selected to active"
+# (scripts/bench-bake-blender.py) with the same cage, the same AO distance, 2 threads each, at equal
+# samples; each compared with a high-sample reference (bake_pairs error: the texels the low-poly's
+# UVs cover, 8 bits but for positions). matbake's time is its bake (set-up and trace, from --json; its whole run in brackets);
 # Blender's the bake call alone (not its start, imports or write).
 # Each time is the fastest of BENCH_BAKE_REPEATS runs (3; this VM's speed drifts by a third from one
 # minute to the next), the references' one run. Markdown on stdout.
-# Usage: scripts/bench-bake-blender.sh   (about 20 minutes on 2 cores)
-# BENCH_BAKE_WORK=DIR keeps the pairs and every image there; BENCH_BAKE_SECTIONS="normal position ao"
-# (the default) names the tables to make (normal: the normal maps and their renders; position: the
-# high-poly's positions; ao: binary AO).
+# Usage: scripts/bench-bake-blender.sh   (about 25 minutes on 2 cores)
+# BENCH_BAKE_WORK=DIR keeps the pairs and every image there; BENCH_BAKE_SECTIONS="normal position
+# transfer ao" (the default) names the tables to make (normal: the normal maps and their renders;
+# position: the high-poly's positions; transfer: its vertex colours; ao: binary AO).
 set -euo pipefail
 bench=bench-bake-blender work_variable=BENCH_BAKE_WORK repeats_variable=BENCH_BAKE_REPEATS
 source "$(dirname "${BASH_SOURCE[0]}")/bench-blender-setup.sh"
 "$pairs_tool" write "$work"
 ao_distance=0.5
-sections=" ${BENCH_BAKE_SECTIONS:-normal position ao} "
+sections=" ${BENCH_BAKE_SECTIONS:-normal position transfer ao} "
 
 # matbake_bake RUNS PAIR FRONT BACK MAP SIZE NAME FLAGS...: bakes into $work/NAME/ RUNS times, leaves
 # the map at $work/NAME.png (a float map beside the glTF: $work/NAME.exr) and, of the run whose bake was fastest, the whole run's time in
@@ -30,7 +30,7 @@ matbake_bake() {
   for ((r = 0; r < runs; ++r)); do
     rm -rf "${work:?}/$name" && mkdir -p "$work/$name"
     start=$(now)
-    "$matbake" --json bake "$work/${pair}_low.gltf" --from "$work/${pair}_high.gltf" -o "$work/$name/out.gltf" --maps "$map" \
+    "$matbake" --json bake "$work/${pair}_low.gltf" --from "$work/${pair}_$high.gltf" -o "$work/$name/out.gltf" --maps "$map" \
       --size "$size" --front "$front" --back "$back" --absolute-cage --padding 0 --jobs "$threads" "$@" >"$work/$name.json"
     run=$(elapsed "$start")
     bake=$(python3 -c 'import json, sys; r = json.load(open(sys.argv[1])); print("%.3f" % (r["setup_seconds"] + r["trace_seconds"]))' "$work/$name.json")
@@ -38,7 +38,7 @@ matbake_bake() {
   done
   local made
   for made in "$work/$name"/*_"$map".png "$work/$name"/*_"$map".exr; do
-    [ -f "$made" ] && cp "$made" "$work/$name.${made##*.}"
+    if [ -f "$made" ]; then cp "$made" "$work/$name.${made##*.}"; fi
   done
 }
 
@@ -46,7 +46,7 @@ matbake_bake() {
 # call's time in $seconds.
 blender_bake() {
   local pair=$1 front=$2 back=$3 map=$4 size=$5 samples=$6 name=$7
-  blender_run "$work/${pair}_low.gltf" "$work/${pair}_high.gltf" "$work/$name.exr" "$map" "$size" "$samples" "$front" \
+  blender_run "$work/${pair}_low.gltf" "$work/${pair}_$high.gltf" "$work/$name.exr" "$map" "$size" "$samples" "$front" \
     "$(echo "$front $back" | awk '{print $1 + $2}')" "$ao_distance" "$threads" "$repeats"
 }
 
@@ -61,6 +61,7 @@ echo "matbake $("$matbake" --version | head -1 | awk '{print $NF}') against Blen
 echo "Time: matbake's bake (set-up and trace; in brackets its whole run: reading, tangents, PNG and glTF"
 echo "written) and Blender's bake call (its start, imports and image write left out)."
 echo
+high=high  # the high-poly the bakes read: PAIR_high.gltf, or PAIR_painted.gltf (vertex colours) for transfer
 # pair, cage front and back (scene units).
 pairs=("sphere 0.3 0.3" "bump 0.6 0.05" "sculpt 0.15 0.15" "rivets 0.05 0.02")
 
@@ -134,6 +135,26 @@ if [[ "$sections" == *" position "* ]]; then
     read -r b_mean b_p99 <<<"$(error position "$pair" "${pair}_position_ref.exr" "${pair}_position_blender.exr")"
     echo "| $pair | 1 | $m_seconds ($m_run) | $seconds | $(ratio "$seconds" "$m_seconds") | $m_mean, $m_p99 | $b_mean, $b_p99 |"
   done
+  echo
+fi
+
+if [[ "$sections" == *" transfer "* ]]; then
+  echo "### Colour transfer (the high-poly's vertex colours), 1024², against matbake at 64 positions a texel (sRGB, 8 bits)"
+  echo
+  echo "| pair | rays a texel | matbake (s) | Blender (s) | faster | matbake error: RMSE, largest | Blender error |"
+  echo "|---|---|---|---|---|---|---|"
+  high=painted
+  for p in "${pairs[@]}"; do
+    read -r pair front back <<<"$p"
+    matbake_bake 1 "$pair" "$front" "$back" transfer 1024 "${pair}_transfer_ref" --texel-samples 64
+    matbake_bake "$repeats" "$pair" "$front" "$back" transfer 1024 "${pair}_transfer_m1" --texel-samples 1
+    m_seconds=$seconds m_run=$run_seconds
+    read -r m_rmse m_largest <<<"$(error colour "$pair" "${pair}_transfer_ref.png" "${pair}_transfer_m1.png")"
+    blender_bake "$pair" "$front" "$back" transfer 1024 1 "${pair}_transfer_blender"
+    read -r b_rmse b_largest <<<"$(error colour "$pair" "${pair}_transfer_ref.png" "${pair}_transfer_blender.exr")"
+    echo "| $pair | 1 | $m_seconds ($m_run) | $seconds | $(ratio "$seconds" "$m_seconds") | $m_rmse, $m_largest | $b_rmse, $b_largest |"
+  done
+  high=high
   echo
 fi
 

@@ -79,17 +79,19 @@ void GltfBuilder::write(const std::filesystem::path& path, const std::vector<int
 
 void write_grey_mesh(const std::filesystem::path& path, const std::vector<glm::dvec3>& positions,
                      const std::vector<glm::dvec3>& normals, const std::vector<glm::vec2>& texcoords,
-                     const std::vector<std::array<std::uint32_t, 3>>& triangles) {
+                     const std::vector<std::array<std::uint32_t, 3>>& triangles, const std::vector<glm::dvec3>& colors) {
   GltfBuilder b;
-  std::vector<float> p, n, uv;
+  std::vector<float> p, n, uv, rgb;
   std::vector<std::uint32_t> indices;
   for (const auto& v : positions) p.insert(p.end(), {float(v.x), float(v.y), float(v.z)});
   for (const auto& v : normals) n.insert(n.end(), {float(v.x), float(v.y), float(v.z)});
   for (const auto& v : texcoords) uv.insert(uv.end(), {v.x, v.y});
+  for (const auto& c : colors) rgb.insert(rgb.end(), {float(c.r), float(c.g), float(c.b)});
   for (const auto& t : triangles) indices.insert(indices.end(), t.begin(), t.end());
   const int mesh = b.add_mesh(b.add_vec3(p), b.add_indices(indices), 4, n.empty() ? -1 : b.add_vec3(n));
   auto& primitive = b.doc["meshes"][std::size_t(mesh)]["primitives"][0];
   if (!uv.empty()) primitive["attributes"]["TEXCOORD_0"] = b.add_floats(uv, "VEC2", 2);
+  if (!rgb.empty()) primitive["attributes"]["COLOR_0"] = b.add_floats(rgb, "VEC3", 3);
   primitive["material"] = 0;
   b.doc["materials"] = {{{"name", "grey"},
                          {"pbrMetallicRoughness", {{"baseColorFactor", {0.2, 0.2, 0.2, 1}}, {"metallicFactor", 0}, {"roughnessFactor", 0.6}}}}};

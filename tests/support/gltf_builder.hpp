@@ -34,9 +34,10 @@ struct GltfBuilder {
 std::string base64(const std::vector<unsigned char>& bytes);
 
 // One mesh of one primitive with a dark grey rough dielectric material (a render of it is not clipped
-// to white): positions, normals (none when empty), UVs as TEXCOORD_0 (none when empty).
+// to white): positions, normals (none when empty), UVs as TEXCOORD_0 and linear RGB vertex colours
+// as COLOR_0 (each none when empty).
 void write_grey_mesh(const std::filesystem::path& path, const std::vector<glm::dvec3>& positions,
                      const std::vector<glm::dvec3>& normals, const std::vector<glm::vec2>& texcoords,
-                     const std::vector<std::array<std::uint32_t, 3>>& triangles);
+                     const std::vector<std::array<std::uint32_t, 3>>& triangles, const std::vector<glm::dvec3>& colors = {});
 
 }  // namespace matbake::test
