@@ -120,42 +120,35 @@ if [[ "$sections" == *" normal "* ]]; then
   fi
 fi
 
-if [[ "$sections" == *" position "* ]]; then
-  echo "### Position map, 1024², against matbake at 64 positions a texel (floats, scene units; each pair about 2 across)"
+# one_ray_table MAP ERROR_KIND EXT ERRORS TITLE: a table of MAP at 1024², one ray a texel, by both
+# bakers against matbake at 64 positions (its file $work/NAME.EXT), ERRORS naming bake_pairs'
+# ERROR_KIND figures.
+one_ray_table() {
+  local map=$1 kind=$2 ext=$3 errors=$4 title=$5
+  echo "### $title, 1024², against matbake at 64 positions a texel"
   echo
-  echo "| pair | rays a texel | matbake (s) | Blender (s) | faster | matbake error: mean, 99th pct | Blender error |"
+  echo "| pair | rays a texel | matbake (s) | Blender (s) | faster | matbake error: $errors | Blender error |"
   echo "|---|---|---|---|---|---|---|"
   for p in "${pairs[@]}"; do
     read -r pair front back <<<"$p"
-    matbake_bake 1 "$pair" "$front" "$back" position 1024 "${pair}_position_ref" --texel-samples 64
-    matbake_bake "$repeats" "$pair" "$front" "$back" position 1024 "${pair}_position_m1" --texel-samples 1
+    matbake_bake 1 "$pair" "$front" "$back" "$map" 1024 "${pair}_${map}_ref" --texel-samples 64
+    matbake_bake "$repeats" "$pair" "$front" "$back" "$map" 1024 "${pair}_${map}_m1" --texel-samples 1
     m_seconds=$seconds m_run=$run_seconds
-    read -r m_mean m_p99 <<<"$(error position "$pair" "${pair}_position_ref.exr" "${pair}_position_m1.exr")"
-    blender_bake "$pair" "$front" "$back" position 1024 1 "${pair}_position_blender"
-    read -r b_mean b_p99 <<<"$(error position "$pair" "${pair}_position_ref.exr" "${pair}_position_blender.exr")"
-    echo "| $pair | 1 | $m_seconds ($m_run) | $seconds | $(ratio "$seconds" "$m_seconds") | $m_mean, $m_p99 | $b_mean, $b_p99 |"
+    read -r m_first m_second <<<"$(error "$kind" "$pair" "${pair}_${map}_ref.$ext" "${pair}_${map}_m1.$ext")"
+    blender_bake "$pair" "$front" "$back" "$map" 1024 1 "${pair}_${map}_blender"
+    read -r b_first b_second <<<"$(error "$kind" "$pair" "${pair}_${map}_ref.$ext" "${pair}_${map}_blender.exr")"
+    echo "| $pair | 1 | $m_seconds ($m_run) | $seconds | $(ratio "$seconds" "$m_seconds") | $m_first, $m_second | $b_first, $b_second |"
   done
   echo
-fi
+}
 
+if [[ "$sections" == *" position "* ]]; then
+  one_ray_table position position exr "mean, 99th pct" "Position map (floats, scene units; each pair about 2 across)"
+fi
 if [[ "$sections" == *" transfer "* ]]; then
-  echo "### Colour transfer (the high-poly's vertex colours), 1024², against matbake at 64 positions a texel (sRGB, 8 bits)"
-  echo
-  echo "| pair | rays a texel | matbake (s) | Blender (s) | faster | matbake error: RMSE, largest | Blender error |"
-  echo "|---|---|---|---|---|---|---|"
   high=painted
-  for p in "${pairs[@]}"; do
-    read -r pair front back <<<"$p"
-    matbake_bake 1 "$pair" "$front" "$back" transfer 1024 "${pair}_transfer_ref" --texel-samples 64
-    matbake_bake "$repeats" "$pair" "$front" "$back" transfer 1024 "${pair}_transfer_m1" --texel-samples 1
-    m_seconds=$seconds m_run=$run_seconds
-    read -r m_rmse m_largest <<<"$(error colour "$pair" "${pair}_transfer_ref.png" "${pair}_transfer_m1.png")"
-    blender_bake "$pair" "$front" "$back" transfer 1024 1 "${pair}_transfer_blender"
-    read -r b_rmse b_largest <<<"$(error colour "$pair" "${pair}_transfer_ref.png" "${pair}_transfer_blender.exr")"
-    echo "| $pair | 1 | $m_seconds ($m_run) | $seconds | $(ratio "$seconds" "$m_seconds") | $m_rmse, $m_largest | $b_rmse, $b_largest |"
-  done
+  one_ray_table transfer colour png "RMSE, largest" "Colour transfer (the high-poly's vertex colours; sRGB, 8 bits)"
   high=high
-  echo
 fi
 
 [[ "$sections" == *" ao "* ]] || exit 0
