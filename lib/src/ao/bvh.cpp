@@ -42,7 +42,6 @@ RTCGeometry triangle_geometry(RTCDevice device, const scene::Instance& inst) {
 
 Result<std::shared_ptr<const Bvh>> Bvh::build(const scene::Scene& scene, bool robust) {
   std::shared_ptr<Bvh> bvh(new Bvh);
-  bvh->robust_ = robust;
   bvh->device_.reset(rtcNewDevice(nullptr));
   if (!bvh->device_) return Error{"", "Embree could not start (rtcNewDevice failed)"};
   RTCDevice device = bvh->device_.get();

@@ -28,7 +28,6 @@ class Bvh {
   static Result<std::shared_ptr<const Bvh>> build(const scene::Scene& scene, bool robust);
 
   RTCScene scene() const { return scene_.get(); }
-  bool robust() const { return robust_; }
   // Instance k's face normals, not normalized (|n| = twice the area): they decide a face's back.
   const std::vector<scene::Vec3>& face_normals(std::size_t instance) const { return face_normals_[instance]; }
 
@@ -37,7 +36,6 @@ class Bvh {
   std::unique_ptr<RTCDeviceTy, DeviceDeleter> device_;
   std::unique_ptr<RTCSceneTy, SceneDeleter> scene_;
   std::vector<std::vector<scene::Vec3>> face_normals_;  // sized once: the filter keeps pointers into it
-  bool robust_ = true;
 };
 
 // The context every trace of a Bvh passes Embree, which hands it to the BVH's filter: a hit on the
