@@ -570,6 +570,33 @@ TEST(Bake, PerVertexAoAndThicknessAreTheTexelsClosedForms) {
   EXPECT_EQ(walled->vertices.misses + slab->vertices.misses, 0u);
 }
 
+// Nothing outside a convex mesh occludes it: AO from its surface is 1 at every texel and vertex,
+// exactly. The high-poly is a sphere of 5120 triangles, the low-poly its 80-triangle icosphere turned
+// so that no cage ray lands on the high-poly's edges. Radial normals lean from the faces, so some of
+// a hit's rays leave below the plane of the face they start on and would meet that face again
+// (Cycles skips the face a ray leaves; so must the bake: without it a texel read 63/64).
+TEST(Bake, AoOnAConvexHighPolyIsOneAtEveryTexelAndVertex) {
+  const test::Icosphere fine = test::icosphere(4);
+  const scene::Scene high = scene_of({placed(fine.vertices, fine.vertices, fine.triangles, glm::dmat4(1))});
+  const scene::Scene low = scene_of({icosphere_low(false, glm::rotate(glm::dmat4(1), 0.7, glm::normalize(dvec3(1, 2, 3))))});
+  Options options;
+  options.maps = {Map::ao};
+  options.vertex_maps = {Map::ao};
+  options.front = 0.3, options.back = 0.3, options.absolute_distances = true;
+  ao::Options occlusion;
+  occlusion.samples = 64, occlusion.falloff = ao::Falloff::none, occlusion.absolute_distance = 0.5;
+  auto baked = bake(low, high, {ao::TextureTarget{{0}, 0}}, {.width = kCells * 16, .height = kCells * 16, .padding = 0}, options,
+                    occlusion);
+  ASSERT_TRUE(baked) << baked.error().message;
+  const TextureBake& t = baked->textures.at(0);
+  ASSERT_GT(t.texels, 0u);
+  EXPECT_EQ(t.misses, 0u);
+  std::size_t below_one = 0;
+  for (float ao : map_of(t, Map::ao).values) below_one += ao != 1.0f;
+  EXPECT_EQ(below_one, 0u) << "of " << t.texels << " texels";
+  for (float ao : baked->vertices.values[0][0]) EXPECT_EQ(ao, 1.0f);
+}
+
 // A vertex whose ray misses: the plane's quad (vertices 0 (−1, −1), 1 (1, −1), 2 (1, 1), 3 (−1, 1);
 // triangles 0 1 2 and 0 2 3) over a high-poly only where x < 0.5, the plane z = −0.1 − 0.05 y.
 // Vertices 0 and 3 hit it at heights −0.05 and −0.15; 1 and 2 miss and take the mean of their hit

@@ -68,7 +68,7 @@ Result<Bake> bake(const scene::Scene& scene, const Options& options) {
       const Vec3 n = mesh.normals[v];
       const Vec3 p = scene.instances[k].positions[v];
       const Vec3 origin = p + n * rays_from.origin_offset(p, mesh.edge_length[v]);
-      const double sum = rays_from.sum_over_rays(origin, n, sample_key(options.seed, k, v), 0, 1, rays, cast);
+      const double sum = rays_from.sum_over_rays({origin, n, {}}, sample_key(options.seed, k, v), 0, 1, rays, cast);
       result.values[k][v] = float(sum / options.samples);
     }
   });

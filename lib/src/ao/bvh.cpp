@@ -8,13 +8,20 @@ namespace {
 
 using scene::Vec3;
 
-// Called for every hit Embree finds: rejects those on a face's back unless the trace is two-sided.
-void back_face_filter(const RTCFilterFunctionNArguments* args) {
-  if (reinterpret_cast<const RayContext*>(args->context)->two_sided) return;
+// Called for every hit Embree finds: rejects those on the face the rays leave, and those on a face's
+// back unless the trace is two-sided.
+void face_filter(const RTCFilterFunctionNArguments* args) {
+  const auto* context = reinterpret_cast<const RayContext*>(args->context);
   const auto* faces = static_cast<const std::vector<Vec3>*>(args->geometryUserPtr);
   for (unsigned i = 0; i < args->N; ++i) {
     if (args->valid[i] != -1) continue;
-    const Vec3& n = (*faces)[RTCHitN_primID(args->hit, args->N, i)];
+    const unsigned triangle = RTCHitN_primID(args->hit, args->N, i);
+    if (triangle == context->leaving.triangle && RTCHitN_geomID(args->hit, args->N, i) == context->leaving.instance) {
+      args->valid[i] = 0;
+      continue;
+    }
+    if (context->two_sided) continue;
+    const Vec3& n = (*faces)[triangle];
     const Vec3 d(RTCRayN_dir_x(args->ray, args->N, i), RTCRayN_dir_y(args->ray, args->N, i),
                  RTCRayN_dir_z(args->ray, args->N, i));
     if (glm::dot(n, d) > 0) args->valid[i] = 0;
@@ -61,8 +68,8 @@ Result<std::shared_ptr<const Bvh>> Bvh::build(const scene::Scene& scene, bool ro
   for (std::size_t k = 0; k < scene.instances.size(); ++k) {
     RTCGeometry g = triangle_geometry(device, scene.instances[k]);
     rtcSetGeometryUserData(g, &bvh->face_normals_[k]);
-    rtcSetGeometryIntersectFilterFunction(g, back_face_filter);
-    rtcSetGeometryOccludedFilterFunction(g, back_face_filter);
+    rtcSetGeometryIntersectFilterFunction(g, face_filter);
+    rtcSetGeometryOccludedFilterFunction(g, face_filter);
     rtcCommitGeometry(g);
     rtcAttachGeometry(rtc, g);
     rtcReleaseGeometry(g);

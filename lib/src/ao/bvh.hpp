@@ -38,12 +38,23 @@ class Bvh {
   std::vector<std::vector<scene::Vec3>> face_normals_;  // sized once: the filter keeps pointers into it
 };
 
+// A triangle of a Bvh: instance (Embree's geometry) and triangle index; none by default.
+struct Face {
+  unsigned instance = RTC_INVALID_GEOMETRY_ID, triangle = RTC_INVALID_GEOMETRY_ID;
+};
+
 // The context every trace of a Bvh passes Embree, which hands it to the BVH's filter: a hit on the
-// back of a face (its normal along the ray) is no hit unless `two_sided`.
+// back of a face (its normal along the ray) is no hit unless `two_sided`, and the face the rays
+// leave is never one. Rays from a point of a face go around its shading normal, whose hemisphere
+// near an edge of a curved mesh reaches below the face's plane: such a ray would meet the face it
+// leaves (Cycles skips that face too).
 struct RayContext {
   RTCIntersectContext embree;  // first, so that Embree's pointer to it is a pointer to this
   bool two_sided = false;
-  explicit RayContext(bool two_sided_traces) : two_sided(two_sided_traces) { rtcInitIntersectContext(&embree); }
+  Face leaving;
+  RayContext(bool two_sided_traces, Face leaving_face) : two_sided(two_sided_traces), leaving(leaving_face) {
+    rtcInitIntersectContext(&embree);
+  }
 };
 
 }  // namespace matbake::ao

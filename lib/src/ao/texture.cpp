@@ -52,7 +52,8 @@ double point_occlusion(const Tracer& tracer, const scene::Scene& scene, const te
     if (!(glm::length(n) > 0)) n = face;  // opposite vertex normals cancel: the face's own
     n = glm::length(n) > 0 ? glm::normalize(n) : Vec3(0, 0, 1);
     const Vec3 origin = p + n * tracer.origin_offset(p, texel_size);
-    sum += tracer.sum_over_rays(origin, n, key, j, positions, rays, cast);
+    const Face leaving{unsigned(point.instance), unsigned(point.triangle)};
+    sum += tracer.sum_over_rays({origin, n, leaving}, key, j, positions, rays, cast);
   }
   return sum / samples;
 }

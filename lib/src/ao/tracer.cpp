@@ -118,8 +118,8 @@ unsigned Tracer::aim(const Vec3& origin, const Vec3& n, std::uint64_t key, int f
   return count;
 }
 
-void Tracer::trace(unsigned count, std::span<RTCRayHit16> rays, bool occlusion_only) const {
-  RayContext context(options_.two_sided);
+void Tracer::trace(unsigned count, std::span<RTCRayHit16> rays, bool occlusion_only, Face leaving) const {
+  RayContext context(options_.two_sided, leaving);
   for (unsigned first = 0; first < count; first += 16) {
     alignas(64) int valid[16];
     for (unsigned k = 0; k < 16; ++k) valid[k] = first + k < count ? -1 : 0;
@@ -138,10 +138,11 @@ Vec3 direction(const RTCRay16& rays, unsigned k) { return Vec3(rays.dir_x[k], ra
 
 }  // namespace
 
-double Tracer::sum_of_depths(const Vec3& origin, const Vec3& n, std::uint64_t key, int first, int step,
-                             std::span<RTCRayHit16> rays, std::uint64_t& cast) const {
-  const unsigned count = aim(origin, n, key, first, step, rays);
-  trace(count, rays, false);
+double Tracer::sum_of_depths(const RayStart& from, std::uint64_t key, int first, int step, std::span<RTCRayHit16> rays,
+                             std::uint64_t& cast) const {
+  const Vec3& n = from.normal;
+  const unsigned count = aim(from.origin, n, key, first, step, rays);
+  trace(count, rays, false, from.leaving);
   double sum = 0;
   for (unsigned i = 0; i < count; ++i) {
     const RTCRay16& packet = rays[i / 16].ray;  // a miss keeps tfar = d_max
@@ -151,11 +152,11 @@ double Tracer::sum_of_depths(const Vec3& origin, const Vec3& n, std::uint64_t ke
   return sum;
 }
 
-double Tracer::sum_over_rays(const Vec3& origin, const Vec3& n, std::uint64_t key, int first, int step,
-                             std::span<RTCRayHit16> rays, std::uint64_t& cast, Vec3* bent) const {
-  const unsigned count = aim(origin, n, key, first, step, rays);
+double Tracer::sum_over_rays(const RayStart& from, std::uint64_t key, int first, int step, std::span<RTCRayHit16> rays,
+                             std::uint64_t& cast, Vec3* bent) const {
+  const unsigned count = aim(from.origin, from.normal, key, first, step, rays);
   const bool binary = options_.falloff == Falloff::none;
-  trace(count, rays, binary);
+  trace(count, rays, binary, from.leaving);
   double sum = 0;
   for (unsigned i = 0; i < count; ++i) {
     const RTCRayHit16& packet = rays[i / 16];

@@ -30,6 +30,13 @@ std::vector<float> mean_edge_lengths(const scene::Instance& inst);
 using RayPackets = std::vector<RTCRayHit16>;
 inline std::size_t packets_for(int rays) { return std::size_t(rays + 15) / 16; }
 
+// Where a point's rays start: at `origin`, around the unit `normal`, leaving the face `leaving` (never
+// a hit; none for a vertex, which no single face holds).
+struct RayStart {
+  scene::Vec3 origin, normal;
+  Face leaving;
+};
+
 class Tracer {
  public:
   // Every instance occludes, whatever options.targets says. `bvh`: the scene's, already built (a
@@ -50,16 +57,16 @@ class Tracer {
   float origin_offset(const scene::Vec3& p, float scale) const;
 
   // Σ μ over rays first, first + step, ... (below options.samples) of the sequence keyed by `key`,
-  // cast from `origin` around the unit normal `n`; `rays` is scratch for at least those rays.
+  // cast from `from`; `rays` is scratch for at least those rays.
   // Returns the sum and adds the ray count to `cast`; with `bent`, adds Σ μ · direction to it (the
   // bent normal's estimator: the mean open direction, cosine-weighted).
-  double sum_over_rays(const scene::Vec3& origin, const scene::Vec3& n, std::uint64_t key, int first, int step,
-                       std::span<RTCRayHit16> rays, std::uint64_t& cast, scene::Vec3* bent = nullptr) const;
+  double sum_over_rays(const RayStart& from, std::uint64_t key, int first, int step, std::span<RTCRayHit16> rays,
+                       std::uint64_t& cast, scene::Vec3* bent = nullptr) const;
 
-  // Over the same rays: Σ of the depth each reaches along n, its distance to the first surface
-  // (d_max where it finds none) times the cosine to n (for thickness, cast into a surface).
-  double sum_of_depths(const scene::Vec3& origin, const scene::Vec3& n, std::uint64_t key, int first, int step,
-                       std::span<RTCRayHit16> rays, std::uint64_t& cast) const;
+  // Over the same rays: Σ of the depth each reaches along the normal, its distance to the first
+  // surface (d_max where it finds none) times the cosine to the normal (for thickness, cast into a surface).
+  double sum_of_depths(const RayStart& from, std::uint64_t key, int first, int step, std::span<RTCRayHit16> rays,
+                       std::uint64_t& cast) const;
 
  private:
   Tracer() = default;
@@ -68,7 +75,7 @@ class Tracer {
   unsigned aim(const scene::Vec3& origin, const scene::Vec3& n, std::uint64_t key, int first, int step,
                std::span<RTCRayHit16> rays) const;
   // The first `count` rays traced, for their first hit or (`occlusion_only`) whether they have one.
-  void trace(unsigned count, std::span<RTCRayHit16> rays, bool occlusion_only) const;
+  void trace(unsigned count, std::span<RTCRayHit16> rays, bool occlusion_only, Face leaving) const;
   std::shared_ptr<const Bvh> bvh_;
   std::vector<Mesh> meshes_;
   Options options_;

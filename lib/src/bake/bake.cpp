@@ -137,17 +137,20 @@ void trace_from_hit(const Rays& c, const Hit& hit, const LowPoint& low, float sc
                     TexelSum& sum) {
   thread_local ao::RayPackets rays;  // scratch: a texel's worth of rays, reused
   rays.resize(ao::packets_for(c.occlusion_samples / positions + 1));
+  const ao::Face leaving{hit.instance, hit.triangle};
   if (c.occlusion) {
     const glm::vec3 origin = hit.position + hit.normal * c.occlusion->origin_offset(hit.position, scale);
     glm::vec3 bent(0);
-    sum.occlusion += c.occlusion->sum_over_rays(origin, hit.normal, key, j, positions, rays, sum.occlusion_rays, c.bent ? &bent : nullptr);
+    sum.occlusion += c.occlusion->sum_over_rays({origin, hit.normal, leaving}, key, j, positions, rays, sum.occlusion_rays,
+                                                c.bent ? &bent : nullptr);
     if (c.bent) sum.bent += tangent_space(low.basis, glm::dvec3(bent)) * double(glm::length(bent));
   }
   if (c.thickness) {
     // The origin's offset below the surface is depth too: added back for every ray.
     const float offset = c.thickness->origin_offset(hit.position, scale);
     std::uint64_t inward = 0;
-    sum.thickness += c.thickness->sum_of_depths(hit.position - hit.normal * offset, -hit.normal, key, j, positions, rays, inward) +
+    sum.thickness += c.thickness->sum_of_depths({hit.position - hit.normal * offset, -hit.normal, leaving}, key, j, positions,
+                                                rays, inward) +
                      double(inward) * double(offset);
     sum.thickness_rays += inward;
   }

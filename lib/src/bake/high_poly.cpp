@@ -25,7 +25,7 @@ std::optional<Hit> HighPoly::first_hit(const glm::vec3& origin, const glm::vec3&
   rh.ray.tnear = 0, rh.ray.tfar = length, rh.ray.time = 0;
   rh.ray.mask = ~0u, rh.ray.id = 0, rh.ray.flags = 0;
   rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-  ao::RayContext context(false);
+  ao::RayContext context(false, {});
   rtcIntersect1(bvh_->scene(), &context.embree, &rh);
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return std::nullopt;
   Hit hit;
