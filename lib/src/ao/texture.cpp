@@ -37,6 +37,7 @@ double point_occlusion(const Tracer& tracer, const scene::Scene& scene, const te
   const Vec3& face = tracer.face_normals(point.instance)[point.triangle];
   const float texel_size = texels::texel_size(double(glm::length(face)), uv);
   const int positions = texture.texel_samples;
+  const Face leaving{unsigned(point.instance), unsigned(point.triangle)};
   double sum = 0;
   for (int j = 0; j < positions; ++j) {
     glm::dvec2 at(point.x, point.y);
@@ -52,7 +53,6 @@ double point_occlusion(const Tracer& tracer, const scene::Scene& scene, const te
     if (!(glm::length(n) > 0)) n = face;  // opposite vertex normals cancel: the face's own
     n = glm::length(n) > 0 ? glm::normalize(n) : Vec3(0, 0, 1);
     const Vec3 origin = p + n * tracer.origin_offset(p, texel_size);
-    const Face leaving{unsigned(point.instance), unsigned(point.triangle)};
     sum += tracer.sum_over_rays({origin, n, leaving}, key, j, positions, rays, cast);
   }
   return sum / samples;
