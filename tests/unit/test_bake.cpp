@@ -622,3 +622,116 @@ TEST(Bake, AVertexWhoseRayMissesTakesTheMeanOfItsHitNeighbours) {
 
 }  // namespace
 }  // namespace matbake::bake
+
+namespace matbake::bake {
+namespace {
+
+// Matching by name: Substance's examples of its rule (a name up to the first suffix, the whole name
+// without one, case-sensitive).
+TEST(BakeParts, ANamesKeyIsItUpToItsFirstSuffix) {
+  EXPECT_EQ(part_key("body_high", "_high"), "body");
+  EXPECT_EQ(part_key("body_high_top", "_high"), "body");
+  EXPECT_EQ(part_key("body_high_1", "_high"), "body");
+  EXPECT_EQ(part_key("Leg_high_high_top", "_high"), "Leg");
+  EXPECT_EQ(part_key("body_top_high", "_high"), "body_top");
+  EXPECT_EQ(part_key("body-high", "_high"), "body-high");
+  EXPECT_EQ(part_key("Leg_low_top", "_low"), "Leg");
+  EXPECT_EQ(part_key("", "_low"), "");
+  scene::Scene low, high;
+  for (const char* name : {"body_low", "Head_low", "Leg_low_top", "Head_low"}) low.instances.push_back({.name = name});
+  for (const char* name : {"Leg_high", "body_high", "head_high", "body_high_2"}) high.instances.push_back({.name = name});
+  const PartMatch parts = match_parts(low, high);
+  EXPECT_EQ(parts.high, (std::vector<std::uint32_t>{0, 1, 2, 1}));
+  ASSERT_EQ(parts.low.size(), 4u);
+  EXPECT_EQ(parts.low[0], 1u);  // body
+  EXPECT_EQ(parts.low[2], 0u);  // Leg
+  EXPECT_EQ(parts.low[1], parts.low[3]);
+  EXPECT_TRUE(std::find(parts.high.begin(), parts.high.end(), parts.low[1]) == parts.high.end());  // Head meets nothing
+  EXPECT_EQ(parts.unmatched, std::vector<std::string>{"Head_low"});
+}
+
+// A square quad z = `z` over [x0, x1] × [−2, 2], facing +z (or −z), named.
+scene::Instance quad(double z, double x0, double x1, bool up, const char* name) {
+  scene::Instance q = placed({{x0, -2, z}, {x1, -2, z}, {x1, 2, z}, {x0, 2, z}}, {}, up ? std::vector<std::array<std::uint32_t, 3>>{{0, 1, 2}, {0, 2, 3}}
+                                                                                     : std::vector<std::array<std::uint32_t, 3>>{{0, 2, 1}, {0, 3, 2}},
+                             glm::dmat4(1));
+  q.name = name;
+  return q;
+}
+
+// Two high-poly parts over the bump test's plane (named a_low): its own, a_high, 0.02 below it, and
+// b_high 0.02 above it where x < 0 (facing up, within the cage's front). Every ray meets b_high
+// first where it can; matched by name, a_low's rays meet only a_high: height −0.02 at every texel
+// and vertex. Tolerance: float32 at magnitude 1.
+TEST(BakeParts, MatchedByNameALowPartsRaysMeetOnlyItsHighPart) {
+  BumpPair pair = bump_pair(1, 0.5);
+  pair.low.instances[0].name = "a_low";
+  const scene::Scene high = scene_of({quad(-0.02, -3, 3, true, "a_high"), quad(0.02, -3, 0, true, "b_high")});
+  Options options;
+  options.maps = {Map::height};
+  options.vertex_maps = {Map::height};
+  options.front = 0.05, options.back = 0.05, options.absolute_distances = true;
+  const ao::TextureOptions texture{.width = 16, .height = 16, .padding = 0, .texel_samples = 1};
+  for (Match match : {Match::always, Match::by_name}) {
+    options.match = match;
+    auto baked = bake(pair.low, high, {ao::TextureTarget{{0}, 0}}, texture, options);
+    ASSERT_TRUE(baked) << baked.error().message;
+    EXPECT_TRUE(baked->unmatched.empty());
+    const TextureBake& t = baked->textures.at(0);
+    EXPECT_EQ(t.misses, 0u);
+    for (int j = 0; j < 16; ++j) {
+      for (int i = 0; i < 16; ++i) {
+        const bool under_b = i < 8 && match == Match::always;
+        ASSERT_NEAR(map_of(t, Map::height).values[std::size_t(j * 16 + i)], under_b ? 0.02 : -0.02, 1e-6) << i << "," << j;
+      }
+    }
+    const std::vector<float>& vertex = baked->vertices.values[0][0];  // vertices 0 and 3 at x = −1
+    for (std::size_t v = 0; v < 4; ++v) EXPECT_NEAR(vertex[v], (v == 0 || v == 3) && match == Match::always ? 0.02 : -0.02, 1e-6) << v;
+  }
+  // A low part no high part matches: every ray misses, and the bake names it.
+  pair.low.instances[0].name = "c_low";
+  options.match = Match::by_name;
+  auto unmatched = bake(pair.low, high, {ao::TextureTarget{{0}, 0}}, texture, options);
+  ASSERT_TRUE(unmatched) << unmatched.error().message;
+  EXPECT_EQ(unmatched->unmatched, std::vector<std::string>{"c_low"});
+  EXPECT_EQ(unmatched->textures.at(0).missed_texels, unmatched->textures.at(0).texels);
+  EXPECT_EQ(unmatched->vertices.misses, 4u);
+}
+
+// AO under a ceiling of another part: a_high (the plane, 0.02 below a_low) under b_high, a quad 0.1
+// above it facing down, 10⁴ wide. Matched, with the matched occluders, a_high alone is open: AO
+// exactly 1. With every part occluding, the rays are those of the bake without matching, texel for
+// texel; for the infinite ceiling at h = 0.1 over binary rays reaching d = 0.2, the cosine-weighted
+// chance of missing it is (h/d)² = 1/4 (a ray meets it within d where cos θ ≥ h/d). Tolerance: 64
+// rays a texel averaged over 256 texels, a standard error of about 0.004; 0.02 is five of them.
+TEST(BakeParts, MatchedOccludersLeaveOutTheOtherPartsAndAllKeepsThem) {
+  BumpPair pair = bump_pair(1, 0.5);
+  pair.low.instances[0].name = "a_low";
+  const scene::Scene high = scene_of({quad(-0.02, -3, 3, true, "a_high"), quad(0.08, -1e4, 1e4, false, "b_high")});
+  Options options;
+  options.maps = {Map::ao};
+  options.front = 0.05, options.back = 0.05, options.absolute_distances = true;
+  ao::Options occlusion;
+  occlusion.samples = 64, occlusion.falloff = ao::Falloff::none, occlusion.absolute_distance = 0.2;
+  const ao::TextureOptions texture{.width = 16, .height = 16, .padding = 0, .texel_samples = 1};
+  const auto ao_of = [&](Match match, Occluders occluders) {
+    options.match = match, options.occluders = occluders;
+    auto baked = bake(pair.low, high, {ao::TextureTarget{{0}, 0}}, texture, options, occlusion);
+    EXPECT_TRUE(baked);
+    EXPECT_EQ(baked->textures.at(0).misses, 0u);
+    return map_of(baked->textures.at(0), Map::ao).values;
+  };
+  const std::vector<float> always = ao_of(Match::always, Occluders::matched);
+  const std::vector<float> matched = ao_of(Match::by_name, Occluders::matched);
+  const std::vector<float> all = ao_of(Match::by_name, Occluders::all);
+  EXPECT_EQ(all, always);
+  double mean = 0;
+  for (std::size_t texel = 0; texel < matched.size(); ++texel) {
+    EXPECT_EQ(matched[texel], 1.0f) << texel;
+    mean += always[texel] / double(always.size());
+  }
+  EXPECT_NEAR(mean, 0.25, 0.02);
+}
+
+}  // namespace
+}  // namespace matbake::bake

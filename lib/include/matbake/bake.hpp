@@ -21,6 +21,8 @@
 #include <cstdint>
 #include <functional>
 #include <optional>
+#include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -79,6 +81,19 @@ inline constexpr NameTable<Green, 2> kGreenNames{{{Green::opengl, "opengl"}, {Gr
 enum class IdSource { material, primitive };
 inline constexpr NameTable<IdSource, 2> kIdSourceNames{{{IdSource::material, "material"}, {IdSource::primitive, "primitive"}}};
 
+// Which high-poly parts a low-poly part's rays meet (Substance's "Match", Marmoset's bake groups):
+// every one, or those of the same name: a part's name (its node's, else its mesh's) up to its
+// first "_low" (low-poly) or "_high" (high-poly), the whole name where it has none, compared
+// case-sensitively: body_low and body_low_2 meet body_high and body_high_top, not Body_high nor
+// body_top_high. Parts close together then bake as if exploded apart.
+enum class Match { always, by_name };
+inline constexpr NameTable<Match, 2> kMatchNames{{{Match::always, "always"}, {Match::by_name, "by_name"}}};
+
+// With Match::by_name, what a hit's AO, bent-normal and thickness rays meet: its own part's
+// surfaces (as an exploded bake) or every part's (the contact shadows of the parts beside it).
+enum class Occluders { matched, all };
+inline constexpr NameTable<Occluders, 2> kOccluderNames{{{Occluders::matched, "matched"}, {Occluders::all, "all"}}};
+
 struct Options {
   std::vector<Map> maps = {Map::normal};
   // Per low-poly vertex (per_vertex maps): one ray from the cage along the vertex's normal, the
@@ -91,6 +106,8 @@ struct Options {
   Green green = Green::opengl;
   IdSource id_by = IdSource::material;
   std::uint64_t seed = 0;  // of the anti-aliasing positions
+  Match match = Match::always;
+  Occluders occluders = Occluders::matched;  // with Match::by_name
 };
 
 Status check(const Options& options);
@@ -118,6 +135,18 @@ struct MapImage {
   int channels = 0;
   std::vector<float> values;  // width × height × channels, row-major
 };
+
+// A part's name up to the first `suffix` ("_low" or "_high"), or the whole name without one.
+std::string_view part_key(std::string_view name, std::string_view suffix);
+
+// The parts Match::by_name pairs: a number per low and per high instance, equal where they meet (a
+// low part no high part matches has a number no high instance has); `unmatched` names those low
+// parts, each once, in order.
+struct PartMatch {
+  std::vector<std::uint32_t> low, high;
+  std::vector<std::string> unmatched;
+};
+PartMatch match_parts(const scene::Scene& low, const scene::Scene& high);
 
 struct TextureBake {
   int width = 0, height = 0;
@@ -147,6 +176,7 @@ struct VertexBake {
 struct Bake {
   std::vector<TextureBake> textures;  // one per target
   VertexBake vertices;                // with Options::vertex_maps
+  std::vector<std::string> unmatched;  // with Match::by_name: low parts no high part matches (all rays miss)
   double front = 0, back = 0;         // the cage distances used, scene units
   double setup_seconds = 0, trace_seconds = 0;
 };

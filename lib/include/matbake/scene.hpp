@@ -25,6 +25,7 @@ using Vec3 = glm::vec3;
 // One primitive placed by one node (a mesh instanced by two nodes gives two).
 struct Instance {
   int node = -1, mesh = -1, primitive = -1;
+  std::string name;                               // the placing node's, else its mesh's; may be empty
   int material = -1;                              // the primitive's material; -1: none
   glm::dmat4 world{1.0};                          // node to world
   std::vector<Vec3> positions;                    // world space, one per vertex of the primitive

@@ -8,15 +8,17 @@ namespace {
 
 using scene::Vec3;
 
-// Called for every hit Embree finds: rejects those on the face the rays leave, and those on a face's
-// back unless the trace is two-sided.
+// Called for every hit Embree finds: rejects those on the face the rays leave, on an instance
+// outside the trace's parts, and on a face's back unless the trace is two-sided.
 void face_filter(const RTCFilterFunctionNArguments* args) {
   const auto* context = reinterpret_cast<const RayContext*>(args->context);
   const auto* faces = static_cast<const std::vector<Vec3>*>(args->geometryUserPtr);
   for (unsigned i = 0; i < args->N; ++i) {
     if (args->valid[i] != -1) continue;
     const unsigned triangle = RTCHitN_primID(args->hit, args->N, i);
-    if (triangle == context->leaving.triangle && RTCHitN_geomID(args->hit, args->N, i) == context->leaving.instance) {
+    const unsigned instance = RTCHitN_geomID(args->hit, args->N, i);
+    if ((triangle == context->leaving.triangle && instance == context->leaving.instance) ||
+        (context->parts.of && (*context->parts.of)[instance] != context->parts.part)) {
       args->valid[i] = 0;
       continue;
     }

@@ -43,16 +43,25 @@ struct Face {
   unsigned instance = RTC_INVALID_GEOMETRY_ID, triangle = RTC_INVALID_GEOMETRY_ID;
 };
 
+// Which instances of a Bvh a trace may hit: every one (no `of`), or those whose part number
+// (`of`, one per instance) is `part` (a bake's parts matched by name).
+struct Parts {
+  const std::vector<std::uint32_t>* of = nullptr;
+  std::uint32_t part = 0;
+};
+
 // The context every trace of a Bvh passes Embree, which hands it to the BVH's filter: a hit on the
-// back of a face (its normal along the ray) is no hit unless `two_sided`, and the face the rays
-// leave is never one. Rays from a point of a face go around its shading normal, whose hemisphere
-// near an edge of a curved mesh reaches below the face's plane: such a ray would meet the face it
-// leaves (Cycles skips that face too).
+// back of a face (its normal along the ray) is no hit unless `two_sided`, the face the rays leave is
+// never one, nor is a face of an instance outside `parts`. Rays from a point of a face go around its
+// shading normal, whose hemisphere near an edge of a curved mesh reaches below the face's plane:
+// such a ray would meet the face it leaves (Cycles skips that face too).
 struct RayContext {
   RTCIntersectContext embree;  // first, so that Embree's pointer to it is a pointer to this
   bool two_sided = false;
   Face leaving;
-  RayContext(bool two_sided_traces, Face leaving_face) : two_sided(two_sided_traces), leaving(leaving_face) {
+  Parts parts;
+  RayContext(bool two_sided_traces, Face leaving_face, Parts seen = {})
+      : two_sided(two_sided_traces), leaving(leaving_face), parts(seen) {
     rtcInitIntersectContext(&embree);
   }
 };

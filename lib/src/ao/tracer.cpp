@@ -118,8 +118,8 @@ unsigned Tracer::aim(const Vec3& origin, const Vec3& n, std::uint64_t key, int f
   return count;
 }
 
-void Tracer::trace(unsigned count, std::span<RTCRayHit16> rays, bool occlusion_only, Face leaving) const {
-  RayContext context(options_.two_sided, leaving);
+void Tracer::trace(unsigned count, std::span<RTCRayHit16> rays, bool occlusion_only, const RayStart& from) const {
+  RayContext context(options_.two_sided, from.leaving, from.parts);
   for (unsigned first = 0; first < count; first += 16) {
     alignas(64) int valid[16];
     for (unsigned k = 0; k < 16; ++k) valid[k] = first + k < count ? -1 : 0;
@@ -142,7 +142,7 @@ double Tracer::sum_of_depths(const RayStart& from, std::uint64_t key, int first,
                              std::uint64_t& cast) const {
   const Vec3& n = from.normal;
   const unsigned count = aim(from.origin, n, key, first, step, rays);
-  trace(count, rays, false, from.leaving);
+  trace(count, rays, false, from);
   double sum = 0;
   for (unsigned i = 0; i < count; ++i) {
     const RTCRay16& packet = rays[i / 16].ray;  // a miss keeps tfar = d_max
@@ -156,7 +156,7 @@ double Tracer::sum_over_rays(const RayStart& from, std::uint64_t key, int first,
                              std::uint64_t& cast, Vec3* bent) const {
   const unsigned count = aim(from.origin, from.normal, key, first, step, rays);
   const bool binary = options_.falloff == Falloff::none;
-  trace(count, rays, binary, from.leaving);
+  trace(count, rays, binary, from);
   double sum = 0;
   for (unsigned i = 0; i < count; ++i) {
     const RTCRayHit16& packet = rays[i / 16];

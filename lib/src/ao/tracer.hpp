@@ -31,10 +31,11 @@ using RayPackets = std::vector<RTCRayHit16>;
 inline std::size_t packets_for(int rays) { return std::size_t(rays + 15) / 16; }
 
 // Where a point's rays start: at `origin`, around the unit `normal`, leaving the face `leaving` (never
-// a hit; none for a vertex, which no single face holds).
+// a hit; none for a vertex, which no single face holds), meeting only the instances of `parts`.
 struct RayStart {
   scene::Vec3 origin, normal;
   Face leaving;
+  Parts parts;
 };
 
 class Tracer {
@@ -75,7 +76,7 @@ class Tracer {
   unsigned aim(const scene::Vec3& origin, const scene::Vec3& n, std::uint64_t key, int first, int step,
                std::span<RTCRayHit16> rays) const;
   // The first `count` rays traced, for their first hit or (`occlusion_only`) whether they have one.
-  void trace(unsigned count, std::span<RTCRayHit16> rays, bool occlusion_only, Face leaving) const;
+  void trace(unsigned count, std::span<RTCRayHit16> rays, bool occlusion_only, const RayStart& from) const;
   std::shared_ptr<const Bvh> bvh_;
   std::vector<Mesh> meshes_;
   Options options_;

@@ -97,7 +97,14 @@ struct Rays {
   std::uint64_t occlusion_seed;
   const std::vector<BaseColor>* base_colors;  // for transfer (null: not asked)
   const std::vector<int>* primitive_numbers;  // per high instance, for an id map by primitive (null: by material)
+  const PartMatch* parts;                     // Match::by_name's parts (null: every ray meets every part)
+  bool occluders_matched;                     // with parts: a hit's AO and thickness rays meet its part only
 };
+
+// The high-poly parts low instance `instance`'s cage rays meet.
+ao::Parts cage_parts(const Rays& c, std::size_t instance) {
+  return c.parts ? ao::Parts{&c.parts->high, c.parts->low[instance]} : ao::Parts{};
+}
 
 // One texture target's trace.
 struct TraceContext {
@@ -138,10 +145,11 @@ void trace_from_hit(const Rays& c, const Hit& hit, const LowPoint& low, float sc
   thread_local ao::RayPackets rays;  // scratch: a texel's worth of rays, reused
   rays.resize(ao::packets_for(c.occlusion_samples / positions + 1));
   const ao::Face leaving{hit.instance, hit.triangle};
+  const ao::Parts parts = c.parts && c.occluders_matched ? ao::Parts{&c.parts->high, c.parts->high[hit.instance]} : ao::Parts{};
   if (c.occlusion) {
     const glm::vec3 origin = hit.position + hit.normal * c.occlusion->origin_offset(hit.position, scale);
     glm::vec3 bent(0);
-    sum.occlusion += c.occlusion->sum_over_rays({origin, hit.normal, leaving}, key, j, positions, rays, sum.occlusion_rays,
+    sum.occlusion += c.occlusion->sum_over_rays({origin, hit.normal, leaving, parts}, key, j, positions, rays, sum.occlusion_rays,
                                                 c.bent ? &bent : nullptr);
     if (c.bent) sum.bent += tangent_space(low.basis, glm::dvec3(bent)) * double(glm::length(bent));
   }
@@ -149,7 +157,7 @@ void trace_from_hit(const Rays& c, const Hit& hit, const LowPoint& low, float sc
     // The origin's offset below the surface is depth too: added back for every ray.
     const float offset = c.thickness->origin_offset(hit.position, scale);
     std::uint64_t inward = 0;
-    sum.thickness += c.thickness->sum_of_depths({hit.position - hit.normal * offset, -hit.normal, leaving}, key, j, positions,
+    sum.thickness += c.thickness->sum_of_depths({hit.position - hit.normal * offset, -hit.normal, leaving, parts}, key, j, positions,
                                                 rays, inward) +
                      double(inward) * double(offset);
     sum.thickness_rays += inward;
@@ -164,22 +172,22 @@ struct CageHit {
 
 // The cage ray at a low-poly point: from `from_cage` (the cage mesh's point with the same weights)
 // towards it, else (no cage mesh, or it touches the low-poly there) from the extrusion's `front`
-// outside along its normal; either reaching `back` beyond it.
-std::optional<CageHit> cast(const Rays& c, const LowPoint& low, const std::optional<glm::dvec3>& from_cage) {
+// outside along its normal; either reaching `back` beyond it, meeting the high-poly's `parts`.
+std::optional<CageHit> cast(const Rays& c, const LowPoint& low, const std::optional<glm::dvec3>& from_cage, ao::Parts parts) {
   const float front = c.front;
   if (from_cage) {
     const glm::dvec3 to_low = glm::dvec3(low.position) - *from_cage;
     const double distance = glm::length(to_low);
     // Below float32's resolution at the point the direction is noise: the cage touches the low-poly.
     if (distance > 1e-6 * (1 + glm::length(glm::dvec3(low.position)))) {
-      auto hit = c.high.first_hit(glm::vec3(*from_cage), glm::vec3(to_low / distance), float(distance) + c.back);
+      auto hit = c.high.first_hit(glm::vec3(*from_cage), glm::vec3(to_low / distance), float(distance) + c.back, parts);
       if (!hit) return std::nullopt;
       return CageHit{*hit, distance - double(hit->distance)};
     }
   }
   const glm::vec3 n(low.basis[2]);
   if (!(glm::length(n) > 0)) return std::nullopt;
-  auto hit = c.high.first_hit(low.position + front * n, -n, front + c.back);
+  auto hit = c.high.first_hit(low.position + front * n, -n, front + c.back, parts);
   if (!hit) return std::nullopt;
   return CageHit{*hit, double(front) - double(hit->distance)};
 }
@@ -228,11 +236,11 @@ void trace_point(const TraceContext& t, const ao::texels::SurfacePoint& point, s
     glm::dvec3 w = ao::texels::nearest_weights(uv, at);
     LowPoint low = low_point(inst, t.frames[point.instance], point.triangle, w);
     ++sum.rays;
-    auto cage_hit = cast(c, low, cage_point(c, point.instance, point.triangle, w));
+    auto cage_hit = cast(c, low, cage_point(c, point.instance, point.triangle, w), cage_parts(c, point.instance));
     if (!cage_hit && on_edge(w)) {
       w = inside(w);
       low = low_point(inst, t.frames[point.instance], point.triangle, w);
-      cage_hit = cast(c, low, cage_point(c, point.instance, point.triangle, w));
+      cage_hit = cast(c, low, cage_point(c, point.instance, point.triangle, w), cage_parts(c, point.instance));
     }
     if (!cage_hit) continue;
     add_hit(c, *cage_hit, low, sum);
@@ -362,7 +370,7 @@ std::optional<CageHit> cast_at_vertex(const Rays& c, std::size_t instance, std::
   low = {inst.positions[vertex], glm::dmat3(glm::dvec3(0), glm::dvec3(0), glm::dvec3(normals[vertex]))};  // no tangents read
   const std::optional<glm::dvec3> from_cage =
       c.cage ? std::optional(glm::dvec3(c.cage->instances[instance].positions[vertex])) : std::nullopt;
-  if (auto hit = cast(c, low, from_cage)) return hit;
+  if (auto hit = cast(c, low, from_cage, cage_parts(c, instance))) return hit;
   for (std::uint32_t t : triangles) {
     const auto& corners = inst.triangles[t];
     glm::dvec3 w(0);
@@ -371,7 +379,7 @@ std::optional<CageHit> cast_at_vertex(const Rays& c, std::size_t instance, std::
     glm::dvec3 p(0), n(0);
     for (int k = 0; k < 3; ++k) p += w[k] * glm::dvec3(inst.positions[corners[std::size_t(k)]]), n += w[k] * glm::dvec3(normals[corners[std::size_t(k)]]);
     low = {glm::vec3(p), glm::dmat3(glm::dvec3(0), glm::dvec3(0), glm::length(n) > 0 ? glm::normalize(n) : n)};
-    if (auto hit = cast(c, low, cage_point(c, instance, t, w))) return hit;
+    if (auto hit = cast(c, low, cage_point(c, instance, t, w), cage_parts(c, instance))) return hit;
   }
   return std::nullopt;
 }
@@ -642,6 +650,9 @@ Result<Bake> bake(const scene::Scene& low, const scene::Scene& high, const std::
   result.setup_seconds = seconds_since(start);
 
   const std::vector<int> primitives = primitive_numbers(high);
+  const std::optional<PartMatch> parts = options.match == Match::by_name ? std::optional(match_parts(low, high)) : std::nullopt;
+  if (parts) result.unmatched = parts->unmatched;
+  const bool occluders_matched = options.occluders == Occluders::matched;
   const auto trace_start = Clock::now();
   // Each pass's rays read only the tracers and inputs its maps need.
   const Rays texel_rays{low,
@@ -656,7 +667,9 @@ Result<Bake> bake(const scene::Scene& low, const scene::Scene& high, const std::
                         occlusion.samples,
                         occlusion.seed,
                         asked(Map::transfer) ? &base_colors : nullptr,
-                        options.id_by == IdSource::primitive ? &primitives : nullptr};
+                        options.id_by == IdSource::primitive ? &primitives : nullptr,
+                        parts ? &*parts : nullptr,
+                        occluders_matched};
   for (std::size_t index = 0; index < targets.size() && !options.maps.empty(); ++index) {
     auto traced = trace_target(TraceContext{texel_rays, *frames, targets[index], texture, index}, options);
     if (!traced) return traced.error();
@@ -675,7 +688,9 @@ Result<Bake> bake(const scene::Scene& low, const scene::Scene& high, const std::
                            occlusion.samples,
                            occlusion.seed,
                            nullptr,
-                           nullptr};
+                           nullptr,
+                           parts ? &*parts : nullptr,
+                           occluders_matched};
     result.vertices = bake_vertices(vertex_rays, options.vertex_maps);
   }
   result.trace_seconds = seconds_since(trace_start);

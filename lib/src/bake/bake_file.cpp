@@ -423,6 +423,12 @@ Result<FileReport> bake_file(const fs::path& low_path, const FileOptions& option
     }
     report.notes = low->notes;
     report.notes.insert(report.notes.end(), targets->notes.begin(), targets->notes.end());
+    if (!baked->unmatched.empty()) {
+      std::vector<std::string> names;
+      for (const std::string& name : baked->unmatched) names.push_back("'" + escape_control(name) + "'");
+      report.notes.push_back("no high-poly part matches these low-poly parts by name, so each of their rays misses: " +
+                             join(names, ", "));
+    }
     report.front = baked->front, report.back = baked->back;
     report.setup_seconds = baked->setup_seconds, report.trace_seconds = baked->trace_seconds;
     const bool normal = std::find(options.request.bake.maps.begin(), options.request.bake.maps.end(), Map::normal) !=

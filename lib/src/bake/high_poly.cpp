@@ -18,14 +18,14 @@ std::unique_ptr<HighPoly> HighPoly::build(const scene::Scene& high, std::shared_
   return h;
 }
 
-std::optional<Hit> HighPoly::first_hit(const glm::vec3& origin, const glm::vec3& direction, float length) const {
+std::optional<Hit> HighPoly::first_hit(const glm::vec3& origin, const glm::vec3& direction, float length, ao::Parts parts) const {
   RTCRayHit rh;
   rh.ray.org_x = origin.x, rh.ray.org_y = origin.y, rh.ray.org_z = origin.z;
   rh.ray.dir_x = direction.x, rh.ray.dir_y = direction.y, rh.ray.dir_z = direction.z;
   rh.ray.tnear = 0, rh.ray.tfar = length, rh.ray.time = 0;
   rh.ray.mask = ~0u, rh.ray.id = 0, rh.ray.flags = 0;
   rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-  ao::RayContext context(false, {});
+  ao::RayContext context(false, {}, parts);
   rtcIntersect1(bvh_->scene(), &context.embree, &rh);
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return std::nullopt;
   Hit hit;

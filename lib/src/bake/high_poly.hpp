@@ -29,9 +29,9 @@ class HighPoly {
   // `bvh`: the high-poly's, robust (a cage ray must not slip between two triangles).
   static std::unique_ptr<HighPoly> build(const scene::Scene& high, std::shared_ptr<const ao::Bvh> bvh);
 
-  // The first hit on the front of a face (its winding's normal against the ray) within `length`
-  // of `origin` along the unit `direction`.
-  std::optional<Hit> first_hit(const glm::vec3& origin, const glm::vec3& direction, float length) const;
+  // The first hit on the front of a face (its winding's normal against the ray) of an instance in
+  // `parts`, within `length` of `origin` along the unit `direction`.
+  std::optional<Hit> first_hit(const glm::vec3& origin, const glm::vec3& direction, float length, ao::Parts parts = {}) const;
 
   // The mean curvature (κ₁ + κ₂)/2 at a hit, from the high-poly's normals: half the trace of the
   // shape operator of its triangle, the derivative of the linearly interpolated vertex normals

@@ -111,6 +111,17 @@ params::Group<Request> make_group() {
                                    .help = "What the id map colours: the hit's material or its glTF primitive",
                                    .example = "primitive"},
                               [](auto& r) -> auto& { return r.bake.id_by; }, kIdSourceNames),
+      params::choice<Request>(Spec{.name = "match",
+                                   .help = "Which high-poly parts a low-poly part's rays meet: always (every one) or "
+                                           "by_name (NAME_low... meets NAME_high...: parts close together bake as if "
+                                           "exploded)",
+                                   .example = "by_name"},
+                              [](auto& r) -> auto& { return r.bake.match; }, kMatchNames),
+      params::choice<Request>(Spec{.name = "occluders",
+                                   .help = "With match by_name, what a hit's AO, bent-normal and thickness rays meet: "
+                                           "its own part (matched) or every part (all: contact shadows)",
+                                   .example = "all"},
+                              [](auto& r) -> auto& { return r.bake.occluders; }, kOccluderNames),
       size(),
       params::integer<Request>(Spec{.name = "padding",
                                     .help = "Texels around the UV islands that take the nearest island texel's value "

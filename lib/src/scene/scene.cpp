@@ -274,6 +274,7 @@ Result<Scene> scene_from_document(const gltf::Document& doc, const SceneContent&
           }
           auto inst = place_primitive(read, primitives[p], n, m, int(p), world, content);
           if (!inst) return inst.error();
+          inst->name = gltf::name_in(node, gltf::name_in(meshes[std::size_t(m)], ""));
           scene.instances.push_back(std::move(*inst));
         }
       }
