@@ -381,6 +381,54 @@ TEST(CliBake, PerInstanceGivesEachPlacementItsOwnMapsAndVertexValues) {
   }
 }
 
+// Matching parts by name from the files' node names: the low-poly's quad (node "plate_low") under
+// two high-poly parts within its cage, its own 0.02 below it ("plate_high") and another's 0.02
+// above it ("bolt_high"). Every ray meets the bolt first; with --match by_name, only the plate.
+// Renamed so that no high part matches, every texel misses and the notes name the part.
+TEST(CliBake, MatchByNameKeepsAPartsRaysOnItsOwnHighPolyPart) {
+  TempDir dir;
+  const auto write_low = [&](const std::string& name) {
+    GltfBuilder b;
+    const int quad = b.add_mesh(b.add_vec3({-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0}), b.add_indices({0, 1, 2, 0, 2, 3}), 4,
+                                b.add_vec3({0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1}));
+    auto& primitive = b.doc["meshes"][0]["primitives"][0];
+    primitive["attributes"]["TEXCOORD_0"] = b.add_floats({0, 1, 1, 1, 1, 0, 0, 0}, "VEC2", 2);
+    primitive["material"] = 0;
+    b.doc["materials"] = {{{"name", "plate"}}};
+    b.write(dir / "low.gltf", {b.add_node({{"mesh", quad}, {"name", name}})});
+  };
+  {
+    GltfBuilder b;
+    const int below = b.add_mesh(b.add_vec3({-2, -2, -0.02f, 2, -2, -0.02f, 2, 2, -0.02f, -2, 2, -0.02f}), b.add_indices({0, 1, 2, 0, 2, 3}));
+    const int above = b.add_mesh(b.add_vec3({-2, -2, 0.02f, 2, -2, 0.02f, 2, 2, 0.02f, -2, 2, 0.02f}), b.add_indices({0, 1, 2, 0, 2, 3}));
+    b.write(dir / "high.gltf", {b.add_node({{"mesh", below}, {"name", "plate_high"}}), b.add_node({{"mesh", above}, {"name", "bolt_high"}})});
+  }
+  const fs::path out = dir / "out.gltf";
+  const auto bake_with = [&](std::vector<std::string> extra) {
+    std::vector<std::string> args = {"--json", "bake", (dir / "low.gltf").string(), "--from", (dir / "high.gltf").string(),
+                                     "--maps", "height", "--front", "0.1", "--back", "0.1", "--absolute-cage", "--size", "8",
+                                     "-o", out.string()};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return matbake(args);
+  };
+  write_low("plate_low");
+  for (const bool by_name : {false, true}) {
+    const auto r = bake_with(by_name ? std::vector<std::string>{"--match", "by_name"} : std::vector<std::string>{});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const auto report = nlohmann::json::parse(r.out);
+    auto height = image::read_image(report["textures"][0]["files"][0].get<std::string>(), color::Transfer::linear);
+    ASSERT_TRUE(height);
+    for (float v : height->pixels) ASSERT_NEAR(v, by_name ? -0.02 : 0.02, 1e-6) << by_name;
+  }
+  write_low("washer_low");
+  const auto r = bake_with({"--match", "by_name"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto report = nlohmann::json::parse(r.out);
+  EXPECT_EQ(report["textures"][0]["missed_texels"], report["textures"][0]["texels"]);
+  EXPECT_NE(report["notes"].dump().find("no high-poly part matches these low-poly parts by name, so each of their rays misses: 'washer_low'"),
+            std::string::npos) << report["notes"].dump();
+}
+
 TEST(CliBake, BadRequestsAreOneErrorLineAndWriteNothing) {
   TempDir dir;
   const fs::path scene = kExamples / "showroom.gltf";
@@ -395,6 +443,9 @@ TEST(CliBake, BadRequestsAreOneErrorLineAndWriteNothing) {
   expect_one_error_line(r, "", "--maps: 'normal,shiny': maps among " + names_in(bake::kMapNames) + ", comma-separated");
   r = bake_args({"--maps", "normal,normal"});
   expect_one_error_line(r, "", "--maps: 'normal,normal': each map once");
+  r = bake_args({"--match", "sometimes"});
+  EXPECT_EQ(r.exit_code, 2);
+  expect_one_error_line(r, "", "--match: 'sometimes': use always or by_name");
   r = bake_args({"--front", "0", "--back", "0"});
   EXPECT_EQ(r.exit_code, 2);
   expect_one_error_line(r, "", "the cage distances must be finite, 0 or more, and not both 0");

@@ -92,3 +92,26 @@ TEST(MapCache, AnIndexChangedAnywhereIsUsedWholeOrNotAtAll) {
 
 }  // namespace
 }  // namespace matbake::bake
+
+namespace matbake::bake {
+namespace {
+
+// A kept map is keyed by the parameters it reads: the part matching by every map, the occluders only
+// by those whose rays from the hit they decide (ao, bent_normal, thickness), and only when matching.
+TEST(MapCache, MatchKeysEveryMapAndOccludersOnlyTheHitsRaysWhenMatching) {
+  const auto key = [](Map map, Match match, Occluders occluders) {
+    Request request;
+    request.bake.match = match, request.bake.occluders = occluders;
+    return map_key("inputs", map, request, "targets");
+  };
+  for (Map map : {Map::normal, Map::height, Map::ao, Map::bent_normal, Map::thickness, Map::id}) {
+    const bool secondary = map == Map::ao || map == Map::bent_normal || map == Map::thickness;
+    SCOPED_TRACE(std::string(name_in(kMapNames, map)));
+    EXPECT_NE(key(map, Match::always, Occluders::matched), key(map, Match::by_name, Occluders::matched));
+    EXPECT_EQ(key(map, Match::always, Occluders::matched), key(map, Match::always, Occluders::all));
+    EXPECT_EQ(key(map, Match::by_name, Occluders::matched) != key(map, Match::by_name, Occluders::all), secondary);
+  }
+}
+
+}  // namespace
+}  // namespace matbake::bake
