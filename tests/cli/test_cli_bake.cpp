@@ -331,19 +331,27 @@ TEST(CliBake, VertexMapsAreAttributesThatSplitVerticesCarryAndColoursMultiply) {
 // material copy, TANGENT on both, and its own maps: every texel of A's height map and every
 // _HEIGHT of A's vertices 0.02, B's 0.05. Without it, one texture and one set of vertices hold
 // the placements' mean, 0.035. Tolerance: float32 at magnitude 10.
+// The quad z = 0 over [−1, 1]² (normals +z, u along x, v against y) with material `material`, placed
+// by each of `nodes` (a node's name, transform, ...), written to `path`.
+void write_quad_low(const fs::path& path, const std::string& material, const std::vector<nlohmann::json>& nodes) {
+  GltfBuilder b;
+  const int quad = b.add_mesh(b.add_vec3({-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0}), b.add_indices({0, 1, 2, 0, 2, 3}), 4,
+                              b.add_vec3({0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1}));
+  auto& primitive = b.doc["meshes"][0]["primitives"][0];
+  primitive["attributes"]["TEXCOORD_0"] = b.add_floats({0, 1, 1, 1, 1, 0, 0, 0}, "VEC2", 2);
+  primitive["material"] = 0;
+  b.doc["materials"] = {{{"name", material}}};
+  std::vector<int> placed;
+  for (nlohmann::json node : nodes) {
+    node["mesh"] = quad;
+    placed.push_back(b.add_node(node));
+  }
+  b.write(path, placed);
+}
+
 TEST(CliBake, PerInstanceGivesEachPlacementItsOwnMapsAndVertexValues) {
   TempDir dir;
-  {
-    GltfBuilder b;
-    const int quad = b.add_mesh(b.add_vec3({-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0}), b.add_indices({0, 1, 2, 0, 2, 3}), 4,
-                                b.add_vec3({0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1}));
-    auto& primitive = b.doc["meshes"][0]["primitives"][0];
-    primitive["attributes"]["TEXCOORD_0"] = b.add_floats({0, 1, 1, 1, 1, 0, 0, 0}, "VEC2", 2);
-    primitive["material"] = 0;
-    b.doc["materials"] = {{{"name", "quad"}}};
-    b.write(dir / "low.gltf", {b.add_node({{"mesh", quad}, {"name", "A"}}),
-                               b.add_node({{"mesh", quad}, {"name", "B"}, {"translation", {10, 0, 0}}})});
-  }
+  write_quad_low(dir / "low.gltf", "quad", {{{"name", "A"}}, {{"name", "B"}, {"translation", {10, 0, 0}}}});
   {
     GltfBuilder b;
     const int a = b.add_mesh(b.add_vec3({-2, -2, 0.02f, 2, -2, 0.02f, 2, 2, 0.02f, -2, 2, 0.02f}), b.add_indices({0, 1, 2, 0, 2, 3}));
@@ -387,16 +395,7 @@ TEST(CliBake, PerInstanceGivesEachPlacementItsOwnMapsAndVertexValues) {
 // Renamed so that no high part matches, every texel misses and the notes name the part.
 TEST(CliBake, MatchByNameKeepsAPartsRaysOnItsOwnHighPolyPart) {
   TempDir dir;
-  const auto write_low = [&](const std::string& name) {
-    GltfBuilder b;
-    const int quad = b.add_mesh(b.add_vec3({-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0}), b.add_indices({0, 1, 2, 0, 2, 3}), 4,
-                                b.add_vec3({0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1}));
-    auto& primitive = b.doc["meshes"][0]["primitives"][0];
-    primitive["attributes"]["TEXCOORD_0"] = b.add_floats({0, 1, 1, 1, 1, 0, 0, 0}, "VEC2", 2);
-    primitive["material"] = 0;
-    b.doc["materials"] = {{{"name", "plate"}}};
-    b.write(dir / "low.gltf", {b.add_node({{"mesh", quad}, {"name", name}})});
-  };
+  const auto write_low = [&](const std::string& name) { write_quad_low(dir / "low.gltf", "plate", {{{"name", name}}}); };
   {
     GltfBuilder b;
     const int below = b.add_mesh(b.add_vec3({-2, -2, -0.02f, 2, -2, -0.02f, 2, 2, -0.02f, -2, 2, -0.02f}), b.add_indices({0, 1, 2, 0, 2, 3}));
