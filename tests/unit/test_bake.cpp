@@ -735,3 +735,67 @@ TEST(BakeParts, MatchedOccludersLeaveOutTheOtherPartsAndAllKeepsThem) {
 
 }  // namespace
 }  // namespace matbake::bake
+
+namespace matbake::bake {
+namespace {
+
+// The box [−s, s]³ with split normals, as a hard-edged low-poly is stored: 24 vertices, each face
+// its own four with the face's normal.
+scene::Instance hard_box(double s) {
+  std::vector<dvec3> positions, normals;
+  std::vector<std::array<std::uint32_t, 3>> triangles;
+  for (int axis = 0; axis < 3; ++axis) {
+    for (const double sign : {1.0, -1.0}) {
+      dvec3 n(0), u(0), v(0);
+      n[axis] = sign, u[(axis + 1) % 3] = 1, v[(axis + 2) % 3] = sign;  // u × v = n: counter-clockwise seen from outside
+      const auto first = std::uint32_t(positions.size());
+      for (const auto& [a, b] : {std::pair{-1, -1}, {1, -1}, {1, 1}, {-1, 1}}) {
+        positions.push_back(s * (n + double(a) * u + double(b) * v));
+        normals.push_back(n);
+      }
+      triangles.push_back({first, first + 1, first + 2});
+      triangles.push_back({first, first + 2, first + 3});
+    }
+  }
+  return placed(positions, normals, triangles, glm::dmat4(1));
+}
+
+// A hard-edged box (split normals) under the same box 1.1 times larger, per vertex. Extruded along
+// its own normal, the three vertices at a corner c cast three rays (from c + f·n, along −n) that
+// meet the large box's three faces at height 0.1 each, at three points. With averaged normals they
+// are one ray, from c + f·c/|c| along the diagonal, meeting the large box's corner 1.1·c: height
+// |1.1·c − c| = 0.1·√3, position 1.1·c, the same for all three. Where the low-poly has no split
+// normals (the bump test's plane), the averaged cage's rays are the extrusion's (their origins and
+// the height's arithmetic differ by rounding). Tolerance: float32 at magnitude 1.
+TEST(Bake, AveragedNormalsCastOneRayWhereAHardEdgesSplitVerticesMeet) {
+  const scene::Scene low = scene_of({hard_box(1.0)});
+  const scene::Scene high = scene_of({hard_box(1.1)});
+  Options options;
+  options.maps = {};
+  options.vertex_maps = {Map::height};
+  options.front = 0.3, options.back = 0.3, options.absolute_distances = true;
+  for (const bool averaged : {false, true}) {
+    options.average_normals = averaged;
+    auto baked = bake(low, high, {}, {}, options);
+    ASSERT_TRUE(baked) << baked.error().message;
+    EXPECT_EQ(baked->vertices.misses, 0u);
+    EXPECT_NEAR(baked->front, 0.3, 1e-6);
+    for (float h : baked->vertices.values[0][0]) EXPECT_NEAR(h, averaged ? 0.1 * std::sqrt(3.0) : 0.1, 1e-6) << averaged;
+  }
+  BumpPair pair = bump_pair(8, 0.5);
+  options.maps = {Map::normal, Map::height};
+  const ao::TextureOptions texture{.width = 16, .height = 16, .texel_samples = 4};
+  options.average_normals = false;
+  auto extruded = bake(pair.low, pair.high, {ao::TextureTarget{{0}, 0}}, texture, options);
+  options.average_normals = true;
+  auto averaged = bake(pair.low, pair.high, {ao::TextureTarget{{0}, 0}}, texture, options);
+  ASSERT_TRUE(extruded && averaged);
+  for (std::size_t m = 0; m < 2; ++m) {
+    const std::vector<float>&a = extruded->textures[0].maps[m].values, &b = averaged->textures[0].maps[m].values;
+    ASSERT_EQ(a.size(), b.size());
+    for (std::size_t i = 0; i < a.size(); ++i) ASSERT_NEAR(a[i], b[i], 1e-6) << m << " " << i;
+  }
+}
+
+}  // namespace
+}  // namespace matbake::bake

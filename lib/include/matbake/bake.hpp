@@ -108,6 +108,12 @@ struct Options {
   std::uint64_t seed = 0;  // of the anti-aliasing positions
   Match match = Match::always;
   Occluders occluders = Occluders::matched;  // with Match::by_name
+  // Without a cage mesh: the cage is the low-poly pushed out by `front` along normals averaged where
+  // its split vertices meet (averaged_normal_cage), rays heading from it for the low-poly's point,
+  // as Substance's "average normals" and Blender's extrusion of a welded mesh. Along a hard edge the
+  // two sides' rays then sweep the high-poly between them with neither gap nor overlap; where the
+  // low-poly has no split normals the rays are the extrusion's.
+  bool average_normals = false;
 };
 
 Status check(const Options& options);
@@ -120,6 +126,10 @@ std::pair<double, double> cage_distances(const scene::Scene& low, const Options&
 // Why `cage` cannot be the cage of `low` (empty when it can): it must place the low-poly's
 // primitives in the same order with the same vertex count and triangles (its positions moved).
 std::string cage_mismatch(const scene::Scene& low, const scene::Scene& cage);
+
+// The cage of Options::average_normals: per low instance, its positions (and nothing else) each
+// moved `front` along the mean of the distinct normals of the vertices at that position.
+scene::Scene averaged_normal_cage(const scene::Scene& low, double front);
 
 // A high-poly material's base colour as a runtime shades it: factor × texture × COLOR_0 (linear).
 struct BaseColor {

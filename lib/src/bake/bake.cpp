@@ -645,6 +645,11 @@ Result<Bake> bake(const scene::Scene& low, const scene::Scene& high, const std::
   if (!frames) return frames.error();
   auto tracers = build_tracers(high, occluding, thickness, occlusion);
   if (!tracers) return tracers.error();
+  std::optional<scene::Scene> averaged;
+  if (options.average_normals && !cage) {
+    averaged = averaged_normal_cage(low, cage_distances(low, options).first);
+    cage = &*averaged;
+  }
   Bake result;
   std::tie(result.front, result.back) = cage_distances(low, options, cage);
   result.setup_seconds = seconds_since(start);
