@@ -2,8 +2,9 @@
 // Baking a high-poly surface onto a low-poly one's UVs, as Substance's, Marmoset's and Blender's
 // "selected to active" bakers do. For each texel of the low-poly (the texels of ao::TextureTarget:
 // covered and touched, several positions over the footprint for anti-aliasing), one ray from the
-// cage toward the low-poly: it starts `front` outside the surface along the low-poly's interpolated
-// normal and ends `back` inside it; its first hit on the front of a high-poly face is the texel's
+// cage toward the low-poly: it starts on the cage (the low-poly pushed `front` out along its
+// normals averaged where split vertices meet, Options::average_normals; or a cage mesh) and ends
+// `back` beyond the low-poly's point; its first hit on the front of a high-poly face is the texel's
 // sample, and every map is computed from it. A ray that finds nothing is a miss: counted, and the
 // texel takes its nearest hit neighbour's value.
 //
@@ -113,7 +114,7 @@ struct Options {
   // as Substance's "average normals" and Blender's extrusion of a welded mesh. Along a hard edge the
   // two sides' rays then sweep the high-poly between them with neither gap nor overlap; where the
   // low-poly has no split normals the rays are the extrusion's.
-  bool average_normals = false;
+  bool average_normals = true;
 };
 
 Status check(const Options& options);

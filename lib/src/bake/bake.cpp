@@ -52,11 +52,18 @@ LowPoint low_point(const scene::Instance& inst, const std::vector<CornerFrame>& 
   return {glm::vec3(p), glm::dmat3(unit(t), unit(b), unit(n))};
 }
 
-// A point on an edge (a texel centre past a triangle, clamped to it) moved a hair inside: a ray at
-// an open edge of the high-poly where it meets the low-poly's (a bake of a mesh onto itself or its
-// simplification keeps the borders) misses it as often as it hits it, and is cast again from there.
+// A point on an edge moved a hair inside. A position past the triangle, clamped onto its edge (a
+// seam texel, an anti-aliasing position beyond it), moves before its ray: on a hard edge that the
+// high-poly shares (a bake onto itself) the ray would meet the face beside it as often as its own.
+// Any point on an edge whose ray misses is cast again from there: at an open edge of the high-poly
+// where it meets the low-poly's (a bake onto itself or a simplification keeping the borders) the
+// ray misses as often as it hits.
 constexpr double kLeast = 1e-5;  // of the triangle's size: float32 resolves 1e-7 of the positions
 bool on_edge(const glm::dvec3& w) { return std::min({w.x, w.y, w.z}) < kLeast; }
+// Whether `at` lies outside `uv`, whose nearest point has the weights `w` (beyond float64's rounding).
+bool outside(const ao::texels::UvTriangle& uv, const glm::dvec2& at, const glm::dvec3& w) {
+  return glm::length(w.x * uv.a + w.y * uv.b + w.z * uv.c - at) > 1e-9;
+}
 glm::dvec3 inside(glm::dvec3 w) {
   w = glm::max(w, glm::dvec3(kLeast));
   return w / (w.x + w.y + w.z);
@@ -227,6 +234,9 @@ void trace_point(const TraceContext& t, const ao::texels::SurfacePoint& point, s
         double(glm::length(glm::cross(inst.positions[tri[1]] - inst.positions[tri[0]], inst.positions[tri[2]] - inst.positions[tri[0]]))), uv);
   }
   const std::uint64_t occlusion_key = ao::sample_key(c.occlusion_seed, t.target_index, point.texel);
+  // A seam texel: its centre (integer coordinates) outside the triangle, its point the nearest on it.
+  const glm::dvec2 centre(double(point.texel % std::uint32_t(t.texture.width)), double(point.texel / std::uint32_t(t.texture.width)));
+  const bool touched = outside(uv, centre, ao::texels::nearest_weights(uv, centre));
   for (int j = 0; j < positions; ++j) {
     glm::dvec2 at(point.x, point.y);
     if (positions > 1) {
@@ -234,6 +244,7 @@ void trace_point(const TraceContext& t, const ao::texels::SurfacePoint& point, s
       at += glm::dvec2(offset.u - 0.5, offset.v - 0.5);
     }
     glm::dvec3 w = ao::texels::nearest_weights(uv, at);
+    if (on_edge(w) && (touched || outside(uv, at, w))) w = inside(w);
     LowPoint low = low_point(inst, t.frames[point.instance], point.triangle, w);
     ++sum.rays;
     auto cage_hit = cast(c, low, cage_point(c, point.instance, point.triangle, w), cage_parts(c, point.instance));
@@ -645,13 +656,13 @@ Result<Bake> bake(const scene::Scene& low, const scene::Scene& high, const std::
   if (!frames) return frames.error();
   auto tracers = build_tracers(high, occluding, thickness, occlusion);
   if (!tracers) return tracers.error();
+  Bake result;
+  std::tie(result.front, result.back) = cage_distances(low, options, cage);  // an averaged cage's: front
   std::optional<scene::Scene> averaged;
   if (options.average_normals && !cage) {
-    averaged = averaged_normal_cage(low, cage_distances(low, options).first);
+    averaged = averaged_normal_cage(low, result.front);
     cage = &*averaged;
   }
-  Bake result;
-  std::tie(result.front, result.back) = cage_distances(low, options, cage);
   result.setup_seconds = seconds_since(start);
 
   const std::vector<int> primitives = primitive_numbers(high);

@@ -105,8 +105,9 @@ params::Group<Request> make_group() {
                             [](auto& r) -> auto& { return r.bake.absolute_distances; }),
       params::flag<Request>(Spec{.name = "average_normals",
                                  .help = "Without a cage mesh, rays start front out along normals averaged where split "
-                                         "vertices meet (hard edges: no gap or doubled detail along them)",
-                                 .example = "true"},
+                                         "vertices meet (hard edges: no gap or doubled detail along them); off: along "
+                                         "each face's own interpolated normal",
+                                 .example = "false"},
                             [](auto& r) -> auto& { return r.bake.average_normals; }),
       params::choice<Request>(Spec{.name = "green",
                                    .help = "The normal map's green: opengl (glTF's: up the texture) or directx",
