@@ -30,8 +30,10 @@ matbake_bake() {
   for ((r = 0; r < runs; ++r)); do
     rm -rf "${work:?}/$name" && mkdir -p "$work/$name"
     start=$(now)
+    # --no-average-normals: Blender extrudes a flat-shaded low-poly (the sphere pair's icosphere, its
+    # vertices split per face) along each face's normal; so does matbake with it: the same rays.
     "$matbake" --json bake "$work/${pair}_low.gltf" --from "$work/${pair}_$high.gltf" -o "$work/$name/out.gltf" --maps "$map" \
-      --size "$size" --front "$front" --back "$back" --absolute-cage --padding 0 --jobs "$threads" "$@" >"$work/$name.json"
+      --size "$size" --front "$front" --back "$back" --absolute-cage --no-average-normals --padding 0 --jobs "$threads" "$@" >"$work/$name.json"
     run=$(elapsed "$start")
     bake=$(python3 -c 'import json, sys; r = json.load(open(sys.argv[1])); print("%.3f" % (r["setup_seconds"] + r["trace_seconds"]))' "$work/$name.json")
     keep_fastest "$bake" "$run"
