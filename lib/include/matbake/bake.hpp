@@ -172,7 +172,8 @@ struct TextureBake {
 };
 
 // Options::vertex_maps at each vertex of each low-poly instance: the cage ray from the vertex (its
-// cage vertex, or `front` out along its normal: the file's, else area-weighted) to `back` inside,
+// cage vertex, the cage mesh's or the averaged cage's, or else `front` out along its normal: the
+// file's, else area-weighted) to `back` inside,
 // the map's value at the hit as a texel with one position computes it (ao and thickness: the
 // estimator's samples from the hit, keyed by instance and vertex). A vertex whose ray misses takes
 // the mean of its hit neighbours (sharing a triangle), repeatedly outwards; where none is reached,
