@@ -14,7 +14,7 @@ set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 testdata=$root/../shared/testdata
 build=$root/build-fuzz
-targets=(image gltf glb manifest layout materials ktx2 state cache scripts)
+targets=(image gltf glb manifest layout materials ktx2 state cache scripts json)
 
 if [ $# -lt 2 ]; then
   echo "usage: scripts/fuzz.sh TARGET|--smoke SECONDS [libFuzzer flags...]  (targets: ${targets[*]})" >&2
@@ -79,6 +79,9 @@ run() {  # target, seconds, extra flags
     # The caches' files (tests/fuzz/regressions/cache: an entry's header, a kept-map index).
     cache) seeds=$(seed cache -path '*regressions/cache*') ;;
     scripts) seeds=$(seed scripts -name '*.txt' -path '*regressions*') ;;
+    # The bounded JSON reader (tests/fuzz/regressions/json: nestings past its limit and within it,
+    # brackets in strings and escapes).
+    json) seeds=$(seed json -path '*regressions/json*') ;;
     *) echo "scripts/fuzz.sh: unknown target '$target' (${targets[*]})" >&2; exit 2 ;;
   esac
   mkdir -p "$build/corpus/$target" "$build/artifacts/$target"

@@ -9,6 +9,7 @@
 #include "matbake/bake_params.hpp"
 #include "matbake/read_file.hpp"
 #include "matbake/version.hpp"
+#include "../io/bounded_json.hpp"
 
 namespace matbake::bake {
 namespace fs = std::filesystem;
@@ -42,7 +43,8 @@ nlohmann::json read_index(const fs::path& folder) {
   const std::uintmax_t size = fs::file_size(index_file(folder), ec);
   std::string text;
   if (ec || size > kIndexLimit || !read_whole_file(index_file(folder), text)) return nlohmann::json::object();
-  nlohmann::json index = nlohmann::json::parse(text, nullptr, false);
+  std::string problem;  // too deep or not JSON: as none (the maps are traced again)
+  nlohmann::json index = parse_bounded_json<nlohmann::json>(text, kIndexLimit, problem);
   // Compared as JSON: value("form", 0) throws on a form of another type (found by fuzz_cache).
   if (!index.is_object() || !index.contains("form") || index["form"] != kForm) return nlohmann::json::object();
   return index;

@@ -8,6 +8,7 @@
 #include <iterator>
 
 #include "decode.hpp"
+#include "../io/bounded_json.hpp"
 #include "json_text.hpp"
 #include "load_model.hpp"
 #include "references.hpp"
@@ -59,7 +60,21 @@ struct Glb {
   Json json;
   std::vector<unsigned char> bin;
 };
-Result<Glb> read_glb(const fs::path& path) {
+// A glTF's JSON text, from a .gltf file or a GLB's chunk: within the size and depth limits
+// (io/bounded_json.hpp) and an object.
+constexpr std::size_t kJsonLimit = std::size_t(512) << 20;  // far past any scene's: the bytes live in buffers
+
+Result<Json> parse_gltf_json(const fs::path& path, std::string_view text) {
+  std::string problem;
+  Json json = parse_bounded_json<Json>(text, kJsonLimit, problem);
+  if (!problem.empty() && json_limit_problem(text, kJsonLimit).empty()) problem = "not a valid glTF: the JSON is malformed";
+  if (problem.empty() && !json.is_object()) problem = "not a valid glTF: the JSON is not an object";
+  if (!problem.empty()) return Error{path.string(), problem};
+  return json;
+}
+
+// With `with_bin` false, the JSON chunk alone is read (what the plan and the bake's input hashing need).
+Result<Glb> read_glb(const fs::path& path, bool with_bin = true) {
   const auto bad = [&](const std::string& what) { return Error{path.string(), "not a valid glTF: " + what}; };
   std::ifstream in(path, std::ios::binary | std::ios::ate);
   if (!in) return Error{path.string(), "cannot be read"};
@@ -70,13 +85,15 @@ Result<Glb> read_glb(const fs::path& path) {
   if (header.compare(0, 4, "glTF") != 0 || u32_at(header, 4) != 2) return bad("not a GLB 2 file");
   const std::uint64_t json_length = u32_at(header, 12);
   if (header.compare(16, 4, "JSON") != 0 || 20 + json_length > size) return bad("the GLB's JSON chunk is truncated");
+  if (json_length > kJsonLimit) return Error{path.string(), json_size_problem(json_length, kJsonLimit)};
   std::string text(json_length, '\0');
   if (!in.read(text.data(), std::streamsize(json_length))) return bad("the GLB's JSON chunk is truncated");
   Glb glb;
-  glb.json = Json::parse(text, nullptr, false);
-  if (glb.json.is_discarded() || !glb.json.is_object()) return bad("the JSON is malformed");
+  auto json = parse_gltf_json(path, text);
+  if (!json) return json.error();
+  glb.json = std::move(*json);
   const std::uint64_t bin_at = 20 + (json_length + 3) / 4 * 4;
-  if (bin_at + 8 <= size) {
+  if (with_bin && bin_at + 8 <= size) {
     std::string chunk(8, '\0');
     in.seekg(std::streamoff(bin_at));
     if (!in.read(chunk.data(), 8)) return bad("the GLB's BIN chunk is truncated");
@@ -326,26 +343,28 @@ Result<AccessorBytes> accessor_bytes(const Document& doc, std::size_t index) {
   return out;
 }
 
+// A .gltf's text, refused by its size before it is read.
+Result<std::string> gltf_text(const fs::path& path) {
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec)) return Error{path.string(), "cannot read the glTF (missing or not a file)"};
+  if (std::string problem = json_size_problem(fs::file_size(path, ec), kJsonLimit); !problem.empty()) return Error{path.string(), problem};
+  std::string bytes;
+  if (!read_whole_file(path, bytes)) return Error{path.string(), "cannot be read"};
+  return bytes;
+}
+
 Result<Json> read_json(const fs::path& path) {
   return guarded(path.string(), [&]() -> Result<Json> {
     std::error_code ec;
     if (!fs::is_regular_file(path, ec)) return Error{path.string(), "cannot read the glTF (missing or not a file)"};
-    return json_of(path, read_bytes(path));
-  });
-}
-
-Result<Json> json_of(const fs::path& path, const std::string& bytes) {
-  return guarded(path.string(), [&]() -> Result<Json> {
-    std::string_view text = bytes;
     if (path.extension() == ".glb") {
-      if (bytes.size() < 20) return Error{path.string(), "not a GLB: shorter than its header"};
-      const std::size_t json_length = u32_at(bytes, 12);
-      if (20 + json_length > bytes.size()) return Error{path.string(), "GLB JSON chunk is truncated"};
-      text = text.substr(20, json_length);
+      auto glb = read_glb(path, false);
+      if (!glb) return glb.error();
+      return std::move(glb->json);
     }
-    Json json = Json::parse(text, nullptr, false);
-    if (json.is_discarded() || !json.is_object()) return Error{path.string(), "not a valid glTF: the JSON is malformed"};
-    return json;
+    auto text = gltf_text(path);
+    if (!text) return text.error();
+    return parse_gltf_json(path, *text);
   });
 }
 
@@ -380,16 +399,20 @@ Result<Document> read_document(const fs::path& path) {
       doc.json = std::move(glb->json);
       glb_bin = std::move(glb->bin);
     } else {
-      std::string bytes;
-      if (!read_whole_file(path, bytes)) return Error{path.string(), "cannot be read"};
-      auto json = json_of(path, bytes);
+      auto text = gltf_text(path);
+      if (!text) return text.error();
+      auto json = parse_gltf_json(path, *text);
       if (!json) return json.error();
       doc.json = std::move(*json);
     }
     if (Status s = check_types(doc.file, doc.json); !s) return s.error();
     if (Status s = check_references(doc.file, doc.json); !s) return s.error();
     tinygltf::Model model;  // tinygltf reads the buffers: data: URIs, files beside the glTF, sizes
-    if (Status loaded = load_model_json(path, for_tinygltf(doc.json, path.extension() == ".glb", glb_bin).dump(), glb_bin, model);
+    std::vector<std::string> buffer_uris;
+    for (const Json& buffer : array_in(doc.json, "buffers")) {
+      if (buffer.contains("uri") && buffer["uri"].is_string()) buffer_uris.push_back(buffer["uri"].get<std::string>());
+    }
+    if (Status loaded = load_model_json(path, for_tinygltf(doc.json, path.extension() == ".glb", glb_bin).dump(), glb_bin, buffer_uris, model);
         !loaded) {
       return loaded.error();
     }
@@ -444,7 +467,8 @@ Result<std::vector<fs::path>> write_document(const Document& doc, const fs::path
 
     // Every file the document came from, none of which may be written.
     // (The one output rule: by real path and inode, so a link to an input is one too.)
-    const std::vector<fs::path> inputs = source_files(doc.file, doc.json, doc.new_files);
+    std::vector<fs::path> inputs = source_files(doc.file, doc.json, doc.new_files);
+    inputs.insert(inputs.end(), doc.other_inputs.begin(), doc.other_inputs.end());
     const NamedOutput files_out[] = {{output, "glTF output"}, {glb ? fs::path() : bin_path, "its buffer"}};
     if (Status s = check_outputs(files_out, inputs); !s) return s.error();
 
@@ -501,6 +525,9 @@ Result<std::vector<fs::path>> write_document(const Document& doc, const fs::path
           const fs::path target = output.parent_path() / decode_uri(uri);
           const NamedOutput image_file{target, "image '" + uri + "'"};
           if (Status s = check_outputs(std::span(&image_file, 1), inputs); !s) return s.error();
+          if (!is_really_inside(out_folder, target)) {
+            return Error{target.string(), "leaves the output's folder (a link on the way); matbake writes only inside it", true};
+          }
           files.emplace_back(target, std::move(*bytes));
           continue;
         }

@@ -37,6 +37,9 @@ struct Document {
   int added_buffer = -1;          // the buffer add_view appends to, once there is one
   // Files made here, by relative URI (images): written beside a .gltf, embedded in a .glb.
   std::map<std::string, std::string> new_files;
+  // The files the command read besides this document (a bake's high-poly and cage, and what they
+  // reference): write_document writes none of them, as none of the document's own.
+  std::vector<std::filesystem::path> other_inputs;
   DecodedGeometry decoded;
 };
 
@@ -89,8 +92,9 @@ int add_float_accessor(Document& doc, const std::vector<float>& values, std::siz
 // Writes `doc` as `output`: .gltf (JSON, with every buffer merged into one `<stem>.bin` beside it
 // and images referenced by URI copied beside it when the folder differs) or .glb (one BIN chunk
 // holding every buffer and every image). Each file goes through a temporary file and a rename, the
-// .gltf or .glb last. Refuses to write over any file the document was read from. Returns the files
-// written, the .gltf or .glb last.
+// .gltf or .glb last. Refuses, before writing anything, to write over any file the document was read
+// from or `other_inputs`, and an image whose real path leaves the output's folder (a link on the
+// way). Returns the files written, the .gltf or .glb last.
 Result<std::vector<std::filesystem::path>> write_document(const Document& doc, const std::filesystem::path& output);
 
 // The encoded bytes of image `index`: a file beside the document, a data: URI, a buffer view, or
@@ -132,10 +136,9 @@ inline std::size_t size_in(const Json& object, const char* key, std::size_t fall
   return integer_in<std::size_t>(object, key, fallback, SIZE_MAX);
 }
 
-// The JSON of a .gltf or .glb alone (no buffers read, nothing checked but the container).
+// The JSON of a .gltf or .glb alone (a GLB's JSON chunk read alone; no buffers read, nothing
+// checked but the container and the size and depth limits of io/bounded_json.hpp).
 Result<Json> read_json(const std::filesystem::path& path);
-// The same from the file's bytes (`path` says which container, and names it in errors).
-Result<Json> json_of(const std::filesystem::path& path, const std::string& bytes);
 
 // The files a document is read from: `file` itself, then its buffers' and images' URIs that are
 // neither data: URIs nor in `made` (absolute, normalized; whether they exist is not checked).

@@ -1,11 +1,13 @@
 #include "load_model.hpp"
 
+#include "document.hpp"
 #include "matbake/read_file.hpp"
 
 #include <algorithm>
 #include <fstream>
 #include <iterator>
 #include <limits>
+#include <set>
 
 namespace matbake::gltf {
 namespace fs = std::filesystem;
@@ -15,6 +17,7 @@ struct ConfinedFolder {
   fs::path base;         // absolute
   std::string refused;   // the first URI refused, with the reason
   std::vector<unsigned char>* glb_bin = nullptr;  // served for kGlbBinUri
+  std::set<fs::path> buffer_files;  // what is read whole; any other file (an image) only checked
 };
 
 bool is_glb_bin(const std::string& path, const ConfinedFolder* folder) {
@@ -77,6 +80,10 @@ bool read_file(std::vector<unsigned char>* out, std::string* err, const std::str
     if (err) *err += "cannot read " + path + "\n";
     return false;
   }
+  if (!static_cast<ConfinedFolder*>(user)->buffer_files.contains(fs::path(path).lexically_normal())) {
+    out->assign(1, 0);  // an image: its pixels are never decoded here, so its bytes are not read
+    return true;
+  }
   if (!read_whole_file(path, *out)) {
     if (err) *err += "cannot read " + path + "\n";
     return false;
@@ -110,9 +117,13 @@ bool is_inside(const fs::path& base, const fs::path& path) {
 }
 
 Status load_model_json(const fs::path& path, const std::string& json_text, std::vector<unsigned char>& glb_bin,
-                       tinygltf::Model& model) {
+                       const std::vector<std::string>& buffer_uris, tinygltf::Model& model) {
   const std::string file = path.string();
-  ConfinedFolder folder{fs::absolute(path).parent_path(), {}, &glb_bin};
+  ConfinedFolder folder{fs::absolute(path).parent_path(), {}, &glb_bin, {}};
+  for (const std::string& uri : buffer_uris) {  // as written and percent-decoded: tinygltf asks for one of them
+    folder.buffer_files.insert((folder.base / uri).lexically_normal());
+    folder.buffer_files.insert((folder.base / decode_uri(uri)).lexically_normal());
+  }
   tinygltf::TinyGLTF loader;
   loader.SetFsCallbacks({file_exists, expand_path, read_file, refuse_write, &folder});
   loader.SetImageLoader(skip_image_decoding, nullptr);

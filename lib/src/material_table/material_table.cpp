@@ -2,6 +2,7 @@
 #include "matbake/read_file.hpp"
 #include "matbake/material_table.hpp"
 #include "matbake/near_names.hpp"
+#include "../io/bounded_toml.hpp"
 
 #include <toml++/toml.h>
 
@@ -55,6 +56,10 @@ std::string_view f0_class_name(F0Class c) {
 Result<std::vector<Material>> parse_table(std::string_view toml_text, const std::string& origin) {
   return guarded(origin, [&]() -> Result<std::vector<Material>> {
     toml::table doc;
+    const TomlDepth depth = toml_key_depth(toml_text);
+    if (std::string problem = toml_depth_problem(depth); !problem.empty()) {
+      return Error{origin, problem + " (line " + std::to_string(depth.line) + ")"};
+    }
     try {
       doc = toml::parse(toml_text, origin);
     } catch (const toml::parse_error& e) {

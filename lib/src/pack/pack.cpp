@@ -13,6 +13,7 @@
 #include "builtin_layouts.hpp"
 #include "matbake/near_names.hpp"
 #include "matbake/read_file.hpp"
+#include "../io/bounded_json.hpp"
 
 namespace matbake::pack {
 namespace fs = std::filesystem;
@@ -203,9 +204,12 @@ std::vector<std::string> builtin_layout_names() {
   return names;
 }
 
+constexpr std::size_t kLayoutLimit = 1u << 20;  // a layout names a few textures and channels
+
 Result<Layout> parse_layout(std::string_view json_text, const std::string& origin) {
   return guarded(origin, [&]() -> Result<Layout> {
     nlohmann::json j;
+    if (std::string problem = json_limit_problem(json_text, kLayoutLimit); !problem.empty()) return Error{origin, problem};
     try {
       j = nlohmann::json::parse(json_text);
     } catch (const nlohmann::json::parse_error& e) {

@@ -76,7 +76,7 @@ MadeLog read_made_log(const StampRoots& roots, std::string& problem) {
   problem = read.problem;
   MadeLog log;
   if (read.absent || !problem.empty()) return log;
-  problem = parse_log(nlohmann::json::parse(read.text, nullptr, false), log);
+  problem = parse_log(read.json, log);
   if (!problem.empty()) log = {};
   return log;
 }

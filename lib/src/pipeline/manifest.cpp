@@ -19,6 +19,7 @@
 #include "matbake/validate_params.hpp"
 #include "matbake/read_file.hpp"
 #include "matbake/pipeline.hpp"
+#include "../io/bounded_toml.hpp"
 #include "../params/toml_value.hpp"
 
 namespace matbake::pipeline {
@@ -585,6 +586,8 @@ Result<Manifest> parse_manifest(std::string_view toml_text, const fs::path& file
     m.folder = m.file.parent_path();
     const Reader r{file.string()};
     toml::table doc;
+    const TomlDepth depth = toml_key_depth(toml_text);
+    if (std::string problem = toml_depth_problem(depth); !problem.empty()) return Error{file.string() + ":" + std::to_string(depth.line), problem};
     try {
       doc = toml::parse(toml_text, file.string());
     } catch (const toml::parse_error& e) {

@@ -384,9 +384,9 @@ Status check_scene_materials(const Manifest& manifest, const Plan& plan, const S
   for (const Job& job : plan.jobs) {
     if (job.kind != JobKind::scene) continue;
     const StateText read = read_state_file(roots.state_folder / (job_file_stem(job.name) + ".json"), kStampLimit);
-    const nlohmann::json stamp = nlohmann::json::parse(read.text, nullptr, false);
+    const nlohmann::json& stamp = read.json;
     if (!read.problem.empty() || !stamp.is_object() || !stamp.contains("options") || !stamp["options"].is_string()) continue;
-    const nlohmann::json options = nlohmann::json::parse(stamp["options"].get<std::string>(), nullptr, false);
+    const nlohmann::json options = options_json(stamp["options"].get<std::string>());
     if (!options.is_object() || !options.contains("materials") || !options["materials"].is_object()) continue;
     for (const auto& [gltf_name, material] : options["materials"].items()) {
       if (job.materials.count(gltf_name)) continue;

@@ -11,6 +11,7 @@
 
 #include "matbake/atomic_file.hpp"
 #include "matbake/output_gate.hpp"
+#include "../io/bounded_json.hpp"
 #include "matbake/version.hpp"
 
 namespace matbake::pipeline {
@@ -120,6 +121,12 @@ std::string check_recorded(nlohmann::json& f, const fs::path& p, const char* mis
 
 }  // namespace
 
+nlohmann::json options_json(const std::string& text) {
+  std::string problem;
+  nlohmann::json options = parse_bounded_json<nlohmann::json>(text, kStampLimit, problem);
+  return problem.empty() ? options : nlohmann::json();
+}
+
 std::string job_file_stem(const std::string& job_name) {
   std::string stem = job_name;
   if (const std::size_t colon = stem.find(':'); colon != std::string::npos) stem[colon] = '-';
@@ -175,6 +182,7 @@ StateText read_state_file(const fs::path& file, std::size_t limit) {
       done += std::size_t(n);
     }
     out.text.resize(done);
+    if (out.problem.empty()) out.json = parse_bounded_json<nlohmann::json>(out.text, limit, out.problem);
   }
   ::close(fd);
   return out;
@@ -217,18 +225,17 @@ bool changed_since(const fs::path& file, const FileIdentity& read) {
 std::string out_of_date_reason(const Job& job, const StampRoots& roots, bool refresh, std::map<fs::path, std::string>* recorded_outputs,
                                nlohmann::json* changed) {
   const fs::path file = stamp_path(job.name, roots);
-  const StateText read = read_state_file(file, kStampLimit);
+  StateText read = read_state_file(file, kStampLimit);
   if (read.absent) return "no earlier build";
-  nlohmann::json stamp = nlohmann::json::parse(read.text, nullptr, false);
+  nlohmann::json stamp = std::move(read.json);
   std::string problem = read.problem;
-  if (problem.empty()) problem = stamp.is_discarded() ? "is not JSON" : stamp_problem(stamp);
+  if (problem.empty()) problem = stamp_problem(stamp);
   if (!problem.empty()) return std::string(kBadStamp) + file.string() + " " + (read.problem.empty() ? "is not one matbake wrote: " : "") + problem;
   if (stamp.value("form", 1) != kStampForm) return "its stamp is from an older matbake (recorded anew)";
   if (stamp["matbake"] != version) return "matbake's version changed";
   if (stamp["options"] != job.options) {
     nlohmann::json changes = nlohmann::json::array();
-    option_changes(nlohmann::json::parse(stamp["options"].get<std::string>(), nullptr, false),
-                   nlohmann::json::parse(job.options, nullptr, false), "", changes);
+    option_changes(options_json(stamp["options"].get<std::string>()), options_json(job.options), "", changes);
     if (changed) *changed = changes;
     return options_reason(changes);
   }
@@ -280,7 +287,7 @@ Status write_stamp(const Job& job, const std::vector<StampedFile>& read, const s
 std::optional<JobSummary> recorded_summary(const std::string& job_name, const StampRoots& roots) {
   const StateText read = read_state_file(stamp_path(job_name, roots), kStampLimit);
   if (!read.problem.empty() || read.absent) return std::nullopt;
-  const nlohmann::json stamp = nlohmann::json::parse(read.text, nullptr, false);
+  const nlohmann::json& stamp = read.json;
   if (!stamp.is_object() || !stamp.contains("summary") || !stamp["summary"].is_object()) return std::nullopt;
   const nlohmann::json& s = stamp["summary"];
   if (!s.contains("seconds") || !s["seconds"].is_number() || !s.contains("details") || !s.contains("warnings") ||
@@ -320,7 +327,7 @@ void remove_failure(const std::string& job_name, const StampRoots& roots) {
 std::optional<std::string> recorded_failure(const std::string& job_name, const StampRoots& roots) {
   const StateText read = read_state_file(failure_path(job_name, roots), kStampLimit);
   if (!read.problem.empty() || read.absent) return std::nullopt;  // a bad record is as none: "not built"
-  const nlohmann::json record = nlohmann::json::parse(read.text, nullptr, false);
+  const nlohmann::json& record = read.json;
   if (!record.is_object() || !record.contains("error") || !record["error"].is_string()) return std::nullopt;
   return record["error"].get<std::string>();
 }

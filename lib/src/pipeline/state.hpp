@@ -47,14 +47,19 @@ std::optional<FileIdentity> identify(const std::filesystem::path& file);
 // Whether the file is no longer what `read` says (the size or time differ and so do the bytes).
 bool changed_since(const std::filesystem::path& file, const FileIdentity& read);
 
-// matbake's state files (stamps, made.json, failure records) are read as hostile input: a link, a
-// file that is not regular or one over `limit` bytes is refused before it is read.
+// matbake's state files (stamps, made.json, failure records, owner files) are read as hostile
+// input: a link, a file that is not regular or one over `limit` bytes is refused before it is read,
+// and its JSON is parsed only within kJsonDepthLimit (io/bounded_json.hpp).
 struct StateText {
   std::string text;     // the bytes, when read
-  std::string problem;  // why it was refused or could not be read (empty: read, or absent)
+  nlohmann::json json;  // what they hold, when read and valid JSON within the limits
+  std::string problem;  // why it was refused, could not be read or parsed (empty: read, or absent)
   bool absent = false;  // no such file: not a problem
 };
 StateText read_state_file(const std::filesystem::path& file, std::size_t limit);
+// A job's options as a stamp holds them (JSON in a text), read as outside input: null when not
+// JSON within the limits.
+nlohmann::json options_json(const std::string& text);
 inline constexpr std::size_t kStampLimit = 16u << 20;    // a scene with thousands of images: ~1 MB
 inline constexpr std::size_t kMadeLogLimit = 64u << 20;  // 100,000 files: ~10 MB
 

@@ -16,6 +16,7 @@
 
 #include "matbake/shading_catalog.hpp"
 #include "matbake/workflow_maps.hpp"
+#include "../io/bounded_json.hpp"
 
 namespace matbake::preview {
 namespace {
@@ -163,11 +164,14 @@ Status check(const Material& m) {
   return success();
 }
 
+constexpr std::size_t kMaterialFileLimit = 16u << 20;  // a list of colours and numbers
+
 Result<std::vector<Material>> load_materials(const std::filesystem::path& path) {
   return guarded(path.string(), [&]() -> Result<std::vector<Material>> {
     std::string text;
     if (!read_whole_file(path, text)) return Error{path.string(), "cannot open (missing, unreadable or not a file)"};
     std::vector<Material> materials;
+    if (std::string problem = json_limit_problem(text, kMaterialFileLimit); !problem.empty()) return Error{path.string(), problem};
     try {
       const nlohmann::json doc = nlohmann::json::parse(text);
       if (!doc.is_array()) return Error{path.string(), "expected a JSON array of materials"};
