@@ -391,6 +391,7 @@ Result<FileReport> bake_file(const fs::path& low_path, const FileOptions& option
     }
     auto doc = gltf::read_document(low_path);
     if (!doc) return doc.error();
+    doc->other_inputs = inputs;  // the high-poly's and the cage's files: never written either
     const gltf::Reachable as_read = reach_before_bake(doc->json);
     auto low = scene::scene_from_document(*doc, {.texcoords = true, .object_space = true});
     if (!low) return low.error();
@@ -401,6 +402,9 @@ Result<FileReport> bake_file(const fs::path& low_path, const FileOptions& option
     // Each target's material: with per_instance, a placement's own copy (and its mesh's).
     const std::vector<int> into = gltf::split_placements(*doc, *low, targets->materials, targets->nodes);
     std::vector<NamedOutput> outputs = {{options.output, "glTF output"}};
+    if (options.output.extension() == ".gltf") {
+      outputs.push_back({options.output.parent_path() / (options.output.stem().string() + ".bin"), "its buffer"});
+    }
     const Json& materials = doc->json["materials"];
     for (int m : into) {
       for (Map map : options.request.bake.maps) {

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <functional>
 #include <map>
+#include <set>
 
 #include "../gltf/document.hpp"
 #include "matbake/atomic_file.hpp"
@@ -48,6 +49,14 @@ std::string href(const fs::path& file, const fs::path& page_folder) {
   return out;
 }
 
+// A recorded summary is outside input (anyone may edit a stamp): a member of a value that is no
+// object, or of another JSON type than the page shows, reads as absent.
+json member(const json& j, const char* key) { return j.is_object() && j.contains(key) ? j[key] : json(); }
+std::string text_in(const json& j, const char* key) {
+  const json m = member(j, key);
+  return m.is_string() ? m.get<std::string>() : std::string();
+}
+
 std::string file_safe(const std::string& name) {
   std::string out;
   for (const char c : name) out += std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' ? c : '_';
@@ -78,15 +87,15 @@ std::string per_level(const json& texture) {
     line += "</div>";
     return line;
   };
-  const json& errors = texture.value("level_error", json::array());
+  const json& errors = member(texture, "level_error");
   const auto field = [](const char* key, const char* format) {
-    return [=](const json& level) { return level.is_object() ? number(level.value(key, json()), format) : std::string("-"); };
+    return [=](const json& level) { return level.is_object() ? number(member(level, key), format) : std::string("-"); };
   };
   std::string out = row("PSNR (dB)", errors, field("psnr", "%.1f"));
-  if (texture.value("class", "") == "normal") {
+  if (text_in(texture, "class") == "normal") {
     out += row("angle mean (°)", errors, field("mean_angle", "%.2f")) + row("angle max (°)", errors, field("max_angle", "%.1f"));
   }
-  const json& coverage = texture.value("coverage", json::array());
+  const json& coverage = member(texture, "coverage");
   out += row("coverage made (source first)", coverage, [](const json& c) { return number(c, "%.3f"); });
   if (texture.contains("alpha_cutoff")) out += row("coverage decoded", errors, field("coverage", "%.3f"));
   return out;
@@ -136,14 +145,14 @@ std::string jobs_table(const std::vector<JobView>& views) {
 
 std::string conversion_table(const json& conversion) {
   if (!conversion.is_object() || !conversion.contains("errors") || !conversion["errors"].is_object()) return "";
-  std::string out = "<p>" + html(conversion.value("direction", "")) + ", mapping " + html(conversion.value("mapping", "")) +
+  std::string out = "<p>" + html(text_in(conversion, "direction")) + ", mapping " + html(text_in(conversion, "mapping")) +
                     "</p><table><tr><th>error</th><th>mean</th><th>max</th><th>Khronos converter mean</th></tr>";
-  const json& khronos = conversion.value("khronos_converter_errors", json::object());
+  const json& khronos = member(conversion, "khronos_converter_errors");
   for (const auto& [name, e] : conversion["errors"].items()) {
     if (!e.is_object()) continue;
     const json k = khronos.is_object() && khronos.contains(name) && khronos[name].is_object() ? khronos[name] : json::object();
-    out += "<tr><td>" + html(name) + "</td><td>" + number(e.value("mean", json())) + "</td><td>" + number(e.value("max", json())) +
-           "</td><td>" + number(k.value("mean", json())) + "</td></tr>";
+    out += "<tr><td>" + html(name) + "</td><td>" + number(member(e, "mean")) + "</td><td>" + number(member(e, "max")) +
+           "</td><td>" + number(member(k, "mean")) + "</td></tr>";
   }
   return out + "</table>";
 }
@@ -161,28 +170,39 @@ std::string material_section(const JobView& v, const fs::path& page_folder) {
     out += figure(href(v.job->outputs.heatmap, page_folder), "validation heatmap");
   }
   out += "</div>";
-  const json& validation = v.details.value("validation", json::object());
+  const json& validation = member(v.details, "validation");
   if (validation.is_object() && validation.contains("checked")) {
-    const json& fraction = validation.value("violation_fraction", json());
-    out += "<p>validation: " + number(validation.value("violations", json()), "%.0f") + " of " +
-           number(validation.value("checked", json()), "%.0f") + " texels flagged (" +
+    const json& fraction = member(validation, "violation_fraction");
+    out += "<p>validation: " + number(member(validation, "violations"), "%.0f") + " of " +
+           number(member(validation, "checked"), "%.0f") + " texels flagged (" +
            number(fraction.is_number() ? json(100 * fraction.get<double>()) : json(), "%.3g") + "%), " +
-           (validation.value("passed", false) ? "passed" : "over the limit") + "</p>";
+           (member(validation, "passed") == true ? "passed" : "over the limit") + "</p>";
   }
-  out += conversion_table(v.details.value("conversion", json()));
+  out += conversion_table(member(v.details, "conversion"));
   for (const std::string& w : v.warnings) out += "<p class=\"warning\">" + html(w) + "</p>";
   if (!v.error.empty()) out += "<p class=\"error\">" + html(v.error) + "</p>";
   return out + "</section>";
 }
 
-// The scene's PNG, JPEG and WebP images copied beside the page (report/SCENE/NAME.EXT), by image
-// name; a browser cannot show KTX2. Best effort: a scene that cannot be read shows none.
-std::map<std::string, std::string> copy_scene_images(const Job& job, const fs::path& page_folder, std::vector<std::string>& problems) {
-  std::map<std::string, std::string> shown;  // image name → href
+// `base`, else base-2, base-3, ...: the first name `used` does not hold yet (now held). Names that
+// file_safe makes one (`a/b` and `a_b`) stay two files.
+std::string unique_name(const std::string& base, std::set<std::string>& used) {
+  std::string name = base;
+  for (int n = 2; !used.insert(name).second; ++n) name = base + "-" + std::to_string(n);
+  return name;
+}
+
+// The scene's PNG, JPEG and WebP images copied beside the page (report/SCENE/NAME.EXT, each name
+// its own file), in image order with their names; a browser cannot show KTX2. Every copy passes the
+// build's output gate: inside the output folder's real path (no link on the way), never an input
+// or a job's output. Best effort otherwise: a scene that cannot be read shows none.
+std::vector<std::pair<std::string, std::string>> copy_scene_images(const Job& job, const fs::path& folder, const OutputGate& gate,
+                                                                   const fs::path& page_folder, std::vector<std::string>& problems) {
+  std::vector<std::pair<std::string, std::string>> shown;  // image name, href
   if (job.outputs.scene.empty() || !fs::exists(job.outputs.scene)) return shown;
   auto doc = gltf::read_document(job.outputs.scene);
   if (!doc) return shown;
-  const fs::path folder = page_folder / "report" / file_safe(job.name);
+  std::set<std::string> used;
   const gltf::Json& images = gltf::array_in(doc->json, "images");
   for (std::size_t i = 0; i < images.size(); ++i) {
     const std::string mime = images[i].value("mimeType", "");
@@ -197,32 +217,37 @@ std::map<std::string, std::string> copy_scene_images(const Job& job, const fs::p
     auto bytes = gltf::image_bytes(*doc, i);
     if (!bytes) continue;
     const std::string name = gltf::name_in(images[i], "image_" + std::to_string(i));
-    const fs::path file = folder / (file_safe(name) + ext);
-    if (Status s = write_file_atomically(file, *bytes); !s) {
+    const fs::path file = folder / (unique_name(file_safe(name), used) + ext);
+    Status s = gate.holds(file) ? gate.check_side_output(file, "the report page's copy of an image")
+                                : Status(Error{file.string(), "leaves the output folder (a link on the way); the report page writes only inside it"});
+    if (s) s = write_file_atomically(file, *bytes);
+    if (!s) {
       problems.push_back(s.error().to_string());
       continue;
     }
-    shown[name] = href(file, page_folder);
+    shown.emplace_back(name, href(file, page_folder));
   }
   return shown;
 }
 
-std::string scene_section(const JobView& v, const fs::path& page_folder, std::vector<std::string>& problems) {
+std::string scene_section(const JobView& v, const fs::path& folder, const OutputGate& gate, const fs::path& page_folder,
+                          std::vector<std::string>& problems) {
   const std::string name = v.job->name.substr(v.job->name.find(':') + 1);
   std::string out = "<section id=\"" + html(v.job->name) + "\"><h3>" + html(name) + "</h3><p>" +
                     html(v.job->outputs.scene.filename().string()) + ", " + number(v.seconds, "%.2f") + " s";
   if (v.details.contains("ao_rays")) out += ", " + number(v.details["ao_rays"], "%.0f") + " AO rays";
   out += "</p>";
-  const std::map<std::string, std::string> images = copy_scene_images(*v.job, page_folder, problems);
-  const json& ao = v.details.value("ao_textures", json::array());
+  const auto images = copy_scene_images(*v.job, folder, gate, page_folder, problems);
+  const json& ao = member(v.details, "ao_textures");
   if (ao.is_array() && !ao.empty()) {
     out += "<h4>AO textures</h4><div class=\"figures\">";
     for (const json& t : ao) {
       if (!t.is_object()) continue;
-      const std::string file = t.value("file", "");
+      const std::string file = text_in(t, "file");
       const std::string image = file.substr(0, file.rfind('.'));
-      const std::string caption = t.value("name", "") + ": mean " + number(t.value("mean_ao", json()), "%.3f");
-      if (const auto found = images.find(image); found != images.end()) {
+      const std::string caption = text_in(t, "name") + ": mean " + number(member(t, "mean_ao"), "%.3f");
+      const auto found = std::find_if(images.begin(), images.end(), [&](const auto& shown) { return shown.first == image; });
+      if (found != images.end()) {
         out += figure(found->second, caption);
       } else {
         out += "<figure><figcaption>" + html(caption) + " (in the scene; not shown)</figcaption></figure>";
@@ -230,21 +255,21 @@ std::string scene_section(const JobView& v, const fs::path& page_folder, std::ve
     }
     out += "</div>";
   }
-  const json& textures = v.details.value("textures", json::array());
+  const json& textures = member(v.details, "textures");
   if (textures.is_array() && !textures.empty()) {
     out += "<h4>Textures</h4><table><tr><th>texture</th><th>class</th><th>source</th><th>delivered</th><th>needed side</th>"
            "<th>codec</th><th>levels</th><th>bytes</th><th>time (s)</th><th>per level, level 0 first</th><th>note</th></tr>";
     for (const json& t : textures) {
       if (!t.is_object()) continue;
       const auto size = [&](const char* key) {
-        const json& s = t.value(key, json());
+        const json& s = member(t, key);
         return s.is_array() && s.size() == 2 ? number(s[0], "%.0f") + "×" + number(s[1], "%.0f") : std::string("-");
       };
-      out += "<tr><td>" + number(t.value("texture", json()), "%.0f") + "</td><td>" + html(t.value("class", "")) + "</td><td>" +
-             size("source_size") + "</td><td>" + size("size") + "</td><td>" + number(t.value("needed_side", json()), "%.0f") +
-             "</td><td>" + html(t.value("codec", "")) + "</td><td>" + number(t.value("levels", json()), "%.0f") + "</td><td>" +
-             number(t.value("bytes", json()), "%.0f") + "</td><td>" + number(t.value("seconds", json()), "%.2f") + "</td><td>" +
-             per_level(t) + "</td><td>" + html(t.value("note", "")) + "</td></tr>";
+      out += "<tr><td>" + number(member(t, "texture"), "%.0f") + "</td><td>" + html(text_in(t, "class")) + "</td><td>" +
+             size("source_size") + "</td><td>" + size("size") + "</td><td>" + number(member(t, "needed_side"), "%.0f") +
+             "</td><td>" + html(text_in(t, "codec")) + "</td><td>" + number(member(t, "levels"), "%.0f") + "</td><td>" +
+             number(member(t, "bytes"), "%.0f") + "</td><td>" + number(member(t, "seconds"), "%.2f") + "</td><td>" +
+             per_level(t) + "</td><td>" + html(text_in(t, "note")) + "</td></tr>";
     }
     out += "</table>";
   }
@@ -288,12 +313,15 @@ Status write_report_page(const Manifest& manifest, const Plan& plan, const Repor
   for (const auto& [outcome, n] : counts) body += html(outcome) + " " + std::to_string(n) + " ";
   body += "</p>" + jobs_table(views);
   std::vector<std::string> problems;
+  const OutputGate gate = output_gate(manifest, plan);
+  std::set<std::string> scene_folders;
   std::string materials = "<h2 id=\"materials\">Materials</h2>", scenes = "<h2 id=\"scenes\">Scenes</h2>";
   for (const JobView& v : views) {
     if (v.job->kind == JobKind::material) {
       materials += material_section(v, folder);
     } else {
-      scenes += scene_section(v, folder, problems);
+      const fs::path images = folder / "report" / unique_name(file_safe(v.job->name), scene_folders);
+      scenes += scene_section(v, images, gate, folder, problems);
     }
   }
   for (const std::string& w : plan.warnings) body += "<p class=\"warning\">" + html(w) + "</p>";
