@@ -218,6 +218,7 @@ struct TextureReport {
   std::vector<double> coverage;              // with alpha_cutoff: the source's, then each level's (8-bit, before encoding)
   std::string note;                          // why it was kept, when it was
   bool reused = false;                       // KTX2: read from the encode cache, not encoded
+  bool cache_rejected = false;               // an encode-cache entry under its key failed its content hash: made again
   std::vector<LevelError> level_error;       // KTX2: each level's, level 0 first
   double seconds = 0;                        // decoding and making it (0 when kept or made by another)
 };

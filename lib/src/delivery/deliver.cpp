@@ -188,6 +188,7 @@ struct Work {
   std::vector<LevelError> level_error;
   double seconds = 0;   // decoding and making it
   bool reused = false;  // from the encode cache
+  bool cache_rejected = false;  // an entry under its key failed its content hash: made again
   Status status = success();
 };
 
@@ -219,14 +220,15 @@ Status make(Work& w, image::Image source, const Options& options, const gltf::Im
     const std::string key =
         kept.on() ? made_file_key(source, w.size, request, cache.webp() ? "webp" : "png", cache.png_level(), "matbake " + std::string(matbake::version))
               : std::string();
-    made = through_cache(kept, key, w.size, [&] { return resized_file(w, source, request, cache); }, w.reused);
+    made = through_cache(kept, key, w.size, [&] { return resized_file(w, source, request, cache); }, w.reused,
+                         &w.cache_rejected);
   } else {
     EncodeRequest encode{.texture_class = w.use.texture_class, .options = options.of(w.use.texture_class), .sampling = w.sampling,
                          .mipmaps = options.mipmaps, .alpha = has_alpha(source),
                          .scratch = output.parent_path() / (w.name + ".ktx2"), .threads = threads,
                          .measure_levels = options.measure_levels};
     made = encode_with_cache(kept, *encoder, std::move(source), w.size, request, encode,
-                             "matbake " + std::string(matbake::version) + " / basisu " + encoder->version, w.reused);
+                             "matbake " + std::string(matbake::version) + " / basisu " + encoder->version, w.reused, &w.cache_rejected);
   }
   if (!made) return made.error();
   w.file = std::move(made->file);
@@ -464,7 +466,7 @@ Result<std::vector<TextureReport>> deliver_textures(gltf::Document& doc, gltf::I
                          .source = w.source_size, .delivered = w.size, .needed = w.needed,
                          .materials = materials_of(w.use), .levels = made.levels,
                          .alpha_cutoff = w.use.alpha_cutoff, .coverage = made.coverage, .note = w.shared_note,
-                         .reused = made.reused, .level_error = made.level_error, .seconds = w.seconds};
+                         .reused = made.reused, .cache_rejected = made.cache_rejected, .level_error = made.level_error, .seconds = w.seconds};
     if (options.keep_alpha_coverage && options.mipmaps && w.use.alpha_cutoff && w.codec == Codec::etc1s) {
       report.note += std::string(report.note.empty() ? "" : "; ") +
                      "ETC1S levels are basisu's own: keep_alpha_coverage does not act on them (UASTC does)";

@@ -14,6 +14,7 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <span>
 
 #include "matbake/atomic_file.hpp"
 #include "matbake/image.hpp"
@@ -27,11 +28,12 @@ namespace {
 // Every version's entries begin with the prefix (so that eviction removes an older version's too);
 // only this version's are read.
 constexpr std::string_view kEntryPrefix = "matbake encoded texture ";
-constexpr std::string_view kMagic = "matbake encoded texture 2\n";
+constexpr std::string_view kMagic = "matbake encoded texture 3\n";
 constexpr std::string_view kSuffix = ".ktx2e";
 constexpr std::size_t kKeyDigits = 32;
 constexpr std::uint32_t kMostLevels = 32;
 constexpr std::size_t kLevelErrorValues = 4;  // a LevelError's
+constexpr std::size_t kHashBytes = sizeof(XXH128_canonical_t);  // an entry's content hash
 
 using Descriptor = UniqueFd;
 
@@ -44,7 +46,7 @@ bool is_entry_name(const std::string& name) {
 // encoder, or a PNG or WebP file of 8-bit RGBA stored uncompressed (4 bytes a texel, a filter byte a
 // row, chunks), plus the header.
 std::uint64_t entry_limit(Size base) {
-  return 5 * std::uint64_t(base.width) * std::uint64_t(base.height) + (1u << 20) + kMagic.size() + 12 + 8 * (kMostLevels + 1) +
+  return 5 * std::uint64_t(base.width) * std::uint64_t(base.height) + (1u << 20) + kMagic.size() + kHashBytes + 12 + 8 * (kMostLevels + 1) +
          8 * kLevelErrorValues * kMostLevels;
 }
 
@@ -58,10 +60,25 @@ void hash_text(XXH3_state_t* state, const std::string& text) {
   XXH3_128bits_update(state, text.data(), text.size());
 }
 
-// An entry's bytes: the magic, the level count, the coverage count, the level error count, the
-// coverage values, each level error's four values, the KTX2 file.
+// An entry's content hash: XXH3-128 of its key and every byte after the hash. An entry is used only
+// when it holds: one swapped for another texture's (a valid entry under another key), or with any
+// byte changed, was delivered as the texture while its size and levels were right.
+XXH128_canonical_t entry_hash(const std::string& key, std::span<const std::string_view> parts) {
+  XXH3_state_t* state = XXH3_createState();
+  XXH3_128bits_reset(state);
+  XXH3_128bits_update(state, key.data(), key.size());
+  for (const std::string_view part : parts) XXH3_128bits_update(state, part.data(), part.size());
+  XXH128_canonical_t canonical;
+  XXH128_canonicalFromHash(&canonical, XXH3_128bits_digest(state));
+  XXH3_freeState(state);
+  return canonical;
+}
+
+// An entry's bytes: the magic, the content hash, the level count, the coverage count, the level
+// error count, the coverage values, each level error's four values, the KTX2 file. Here the part
+// after the hash up to the file.
 std::string header_of(const Encoded& e) {
-  std::string h(kMagic);
+  std::string h;
   const std::uint32_t counts[3] = {std::uint32_t(e.levels), std::uint32_t(e.coverage.size()), std::uint32_t(e.level_error.size())};
   h.append(reinterpret_cast<const char*>(counts), sizeof counts);
   std::vector<double> values = e.coverage;
@@ -70,17 +87,25 @@ std::string header_of(const Encoded& e) {
   return h;
 }
 
-std::optional<Encoded> parse_entry(const std::vector<unsigned char>& bytes, Size base, const std::string& name) {
+// The entry in `bytes` when it is one of `key`: its content hash holds, and it is a file of the asked
+// size. `rejected` says when an entry of this version was there and failed either.
+std::optional<Encoded> parse_entry(const std::vector<unsigned char>& bytes, Size base, const std::string& name, const std::string& key,
+                                   bool& rejected) {
   std::uint32_t counts[3];
-  if (bytes.size() < kMagic.size() + sizeof counts || std::memcmp(bytes.data(), kMagic.data(), kMagic.size()) != 0) return std::nullopt;
-  std::memcpy(counts, bytes.data() + kMagic.size(), sizeof counts);
+  constexpr std::size_t kAt = kMagic.size() + kHashBytes;  // where the hashed part begins
+  if (bytes.size() < kAt + sizeof counts || std::memcmp(bytes.data(), kMagic.data(), kMagic.size()) != 0) return std::nullopt;
+  rejected = true;
+  const std::string_view hashed(reinterpret_cast<const char*>(bytes.data()) + kAt, bytes.size() - kAt);
+  const XXH128_canonical_t hash = entry_hash(key, std::span(&hashed, 1));
+  if (std::memcmp(&hash, bytes.data() + kMagic.size(), kHashBytes) != 0) return std::nullopt;
+  std::memcpy(counts, bytes.data() + kAt, sizeof counts);
   if (counts[0] == 0 || counts[0] > kMostLevels || counts[1] > kMostLevels + 1 || counts[2] > counts[0]) return std::nullopt;
   const std::size_t value_count = counts[1] + kLevelErrorValues * counts[2];
-  const std::size_t file_at = kMagic.size() + sizeof counts + value_count * sizeof(double);
+  const std::size_t file_at = kAt + sizeof counts + value_count * sizeof(double);
   if (bytes.size() <= file_at) return std::nullopt;
   std::vector<double> values(value_count);
   if (value_count > 0) {  // memcpy to an empty vector's null data() is undefined, even of 0 bytes
-    std::memcpy(values.data(), bytes.data() + kMagic.size() + sizeof counts, value_count * sizeof(double));
+    std::memcpy(values.data(), bytes.data() + kAt + sizeof counts, value_count * sizeof(double));
   }
   if (!std::all_of(values.begin(), values.end(), [](double v) { return std::isfinite(v) && v >= 0; })) return std::nullopt;
   Encoded e;
@@ -95,17 +120,19 @@ std::optional<Encoded> parse_entry(const std::vector<unsigned char>& bytes, Size
     if (!read || read->width != unsigned(base.width) || read->height != unsigned(base.height) || read->levels.size() != counts[0]) {
       return std::nullopt;
     }
+    rejected = false;
     return e;
   }
   // A PNG or WebP file: one level of the asked size whose pixels decode.
   auto layout = image::check_image_bytes(e.file, name);
   if (!layout || counts[0] != 1 || layout->width != base.width || layout->height != base.height) return std::nullopt;
+  rejected = false;
   return e;
 }
 
 // The entry of `key`, when there is a well-formed one; marked as used now (its modification time,
 // which eviction orders by).
-std::optional<Encoded> read_entry(const fs::path& folder, const std::string& key, Size base) {
+std::optional<Encoded> read_entry(const fs::path& folder, const std::string& key, Size base, bool& rejected) {
   const Descriptor dir(::open(folder.c_str(), O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC));
   if (dir.fd < 0) return std::nullopt;
   const std::string name = key + std::string(kSuffix);
@@ -121,7 +148,7 @@ std::optional<Encoded> read_entry(const fs::path& folder, const std::string& key
     if (n <= 0) return std::nullopt;
     got += std::size_t(n);
   }
-  auto entry = parse_entry(bytes, base, (folder / name).string());
+  auto entry = parse_entry(bytes, base, (folder / name).string(), key, rejected);
   if (entry) ::futimens(file.fd, nullptr);
   return entry;
 }
@@ -138,7 +165,9 @@ void keep_entry(const EncodeCache& cache, const std::string& key, const Encoded&
   fs::create_directory(cache.folder, ec);
   if (!fs::is_directory(fs::symlink_status(cache.folder, ec))) return;  // a link or a file: no cache
   const std::string header = header_of(e);
-  const std::string_view parts[2] = {header, std::string_view(reinterpret_cast<const char*>(e.file.data()), e.file.size())};
+  const std::string_view hashed[2] = {header, std::string_view(reinterpret_cast<const char*>(e.file.data()), e.file.size())};
+  const XXH128_canonical_t hash = entry_hash(key, hashed);
+  const std::string_view parts[4] = {kMagic, std::string_view(reinterpret_cast<const char*>(&hash), kHashBytes), hashed[0], hashed[1]};
   if (!write_file_atomically(cache.folder / (key + std::string(kSuffix)), parts)) return;  // a full disk: encoded, not kept
   evict_encoded(cache.folder, cache.limit_bytes);
 }
@@ -247,20 +276,22 @@ std::string made_file_key(const image::Image& source, Size base, const MipReques
 }
 
 Result<Encoded> through_cache(const EncodeCache& cache, const std::string& key, Size base, const std::function<Result<Encoded>()>& encode,
-                              bool& reused) {
+                              bool& reused, bool* rejected) {
   reused = false;
   if (!cache.on()) return encode();
-  if (auto hit = read_entry(cache.folder, key, base)) {
+  bool bad = false;
+  if (auto hit = read_entry(cache.folder, key, base, bad)) {
     reused = true;
     return std::move(*hit);
   }
+  if (rejected != nullptr) *rejected = bad;
   std::optional<Result<Encoded>> made;
   tbb::collaborative_call_once(in_flight(key)->once, [&] {
     made = encode();
     if (*made) keep_entry(cache, key, **made);
   });
   if (made) return std::move(*made);
-  if (auto hit = read_entry(cache.folder, key, base)) {  // another task of this process encoded it
+  if (auto hit = read_entry(cache.folder, key, base, bad)) {  // another task of this process encoded it
     reused = true;
     return std::move(*hit);
   }
@@ -269,9 +300,11 @@ Result<Encoded> through_cache(const EncodeCache& cache, const std::string& key, 
 }
 
 Result<Encoded> encode_with_cache(const EncodeCache& cache, const Encoder& encoder, image::Image source, Size base,
-                                  const MipRequest& mips, const EncodeRequest& request, const std::string& writer, bool& reused) {
+                                  const MipRequest& mips, const EncodeRequest& request, const std::string& writer, bool& reused,
+                                  bool* rejected) {
   const std::string key = cache.on() ? encode_key(source, base, mips, request, writer) : std::string();
-  return through_cache(cache, key, base, [&] { return encode_texture(encoder, std::move(source), base, mips, request, writer); }, reused);
+  return through_cache(cache, key, base, [&] { return encode_texture(encoder, std::move(source), base, mips, request, writer); }, reused,
+                       rejected);
 }
 
 }  // namespace matbake::delivery

@@ -5,7 +5,8 @@
 // texture encode it once. A build keeps them in its output folder's
 // state (OUT/.matbake/encode-cache/), one file per encode named by its key; least recently used
 // entries are removed past a size limit. Entries are outside input: read through O_NOFOLLOW, size-
-// limited and parsed as a file of the asked size, or ignored (encoded again).
+// limited, checked against their content hash and parsed as a file of the asked size, or ignored
+// (encoded again).
 #include <cstdint>
 #include <filesystem>
 #include <functional>
@@ -43,13 +44,16 @@ std::string made_file_key(const image::Image& source, Size base, const MipReques
 
 // `encode` through the cache under `key`: an entry found (a KTX2 file of level 0 at `base`, or a
 // PNG or WebP file of that size) is used and marked recently used, else encode() runs and its result
-// is kept. `reused` says which. Within a process one key is encoded once: a second caller waits for
+// is kept. `reused` says which; `rejected` (when given) whether an entry under the key failed its
+// content hash or shape (another texture's entry, changed bytes): it is made again and overwritten,
+// never delivered. Within a process one key is encoded once: a second caller waits for
 // the first (its thread working on other tasks meanwhile) and reads its entry.
 Result<Encoded> through_cache(const EncodeCache& cache, const std::string& key, Size base, const std::function<Result<Encoded>()>& encode,
-                              bool& reused);
+                              bool& reused, bool* rejected = nullptr);
 
 // encode_texture through the cache, under encode_key.
 Result<Encoded> encode_with_cache(const EncodeCache& cache, const Encoder& encoder, image::Image source, Size base,
-                                  const MipRequest& mips, const EncodeRequest& request, const std::string& writer, bool& reused);
+                                  const MipRequest& mips, const EncodeRequest& request, const std::string& writer, bool& reused,
+                                  bool* rejected = nullptr);
 
 }  // namespace matbake::delivery

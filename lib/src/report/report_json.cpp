@@ -96,6 +96,7 @@ nlohmann::json to_json(const delivery::TextureReport& t) {
                       {"source_bytes", t.source_bytes},
                       {"bytes", t.bytes}};
   if (!t.uri.empty()) j["reused"] = t.reused, j["seconds"] = t.seconds;  // a file made (KTX2, or a resized PNG or WebP)
+  if (t.cache_rejected) j["cache_rejected"] = true;
   if (!t.level_error.empty()) {
     nlohmann::json& levels = j["level_error"] = nlohmann::json::array();
     for (const delivery::LevelError& l : t.level_error) {
