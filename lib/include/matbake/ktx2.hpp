@@ -35,7 +35,8 @@ struct Descriptor {
 };
 
 struct Level {
-  std::vector<unsigned char> bytes;  // as stored (supercompressed when the file is)
+  std::vector<unsigned char> bytes;  // as stored (supercompressed when the file is); none from read_header
+  std::uint64_t byte_length = 0;     // as the level index says
   std::uint64_t uncompressed_length = 0;
 };
 
@@ -53,6 +54,14 @@ struct Texture {
 
 // A 2D KTX2 file read: header, level index, DFD, key/value pairs, global data. Errors name `name`.
 Result<Texture> read(std::span<const unsigned char> bytes, const std::string& name);
+
+// How many leading bytes of a KTX2 file read_header needs (header, level index, DFD, key/value
+// data, global data), from its first kHeaderBytes; 0 when they are not a KTX2 header.
+inline constexpr std::size_t kHeaderBytes = 80;
+std::uint64_t header_extent(std::span<const unsigned char> first);
+// As read, from the file's first header_extent bytes and its size, without its levels' bytes (each
+// level's place checked against `file_size`): what inspect needs, whatever the file's size.
+Result<Texture> read_header(std::span<const unsigned char> head, std::uint64_t file_size, const std::string& name);
 
 // The DFD of a UASTC texture: one 128-bit sample of `channel`, sRGB or linear transfer with its
 // primaries_for; bytesPlane0 16 unless zstd-supercompressed (then 0, as the specification asks).

@@ -13,7 +13,6 @@ namespace matbake::ktx2 {
 namespace {
 
 constexpr unsigned char kIdentifier[12] = {0xAB, 'K', 'T', 'X', ' ', '2', '0', 0xBB, '\r', '\n', 0x1A, '\n'};
-constexpr std::size_t kHeaderBytes = 80;
 constexpr std::size_t kLevelIndexEntryBytes = 24;
 constexpr std::size_t kUastcBlockBytes = 16;
 constexpr std::size_t kMaxLevels = 15;  // 16384 × 16384 down to 1 × 1
@@ -71,7 +70,10 @@ Result<std::vector<std::pair<std::string, std::string>>> key_values_of(std::span
 
 }  // namespace
 
-Result<Texture> read(std::span<const unsigned char> bytes, const std::string& name) {
+namespace {
+
+// A KTX2 file from `bytes`, its first bytes (all of it when `with_levels`), of `file_size` bytes.
+Result<Texture> read_file(std::span<const unsigned char> bytes, std::uint64_t file_size, bool with_levels, const std::string& name) {
   if (bytes.size() < kHeaderBytes || std::memcmp(bytes.data(), kIdentifier, sizeof kIdentifier) != 0) {
     return Error{name, "not a KTX2 file (no KTX 20 identifier)"};
   }
@@ -104,13 +106,30 @@ Result<Texture> read(std::span<const unsigned char> bytes, const std::string& na
   for (std::size_t l = 0; l < level_count; ++l) {
     const std::size_t entry = kHeaderBytes + l * kLevelIndexEntryBytes;
     const std::uint64_t offset = u64_at(bytes, entry), length = u64_at(bytes, entry + 8);
-    if (!within(offset, length, bytes.size())) return Error{name, "KTX2 level " + std::to_string(l) + " lies past the end of the file"};
+    if (!within(offset, length, file_size)) return Error{name, "KTX2 level " + std::to_string(l) + " lies past the end of the file"};
     Level level;
-    level.bytes.assign(bytes.begin() + std::ptrdiff_t(offset), bytes.begin() + std::ptrdiff_t(offset + length));
+    if (with_levels) level.bytes.assign(bytes.begin() + std::ptrdiff_t(offset), bytes.begin() + std::ptrdiff_t(offset + length));
+    level.byte_length = length;
     level.uncompressed_length = u64_at(bytes, entry + 16);
     t.levels.push_back(std::move(level));
   }
   return t;
+}
+
+}  // namespace
+
+Result<Texture> read(std::span<const unsigned char> bytes, const std::string& name) { return read_file(bytes, bytes.size(), true, name); }
+
+std::uint64_t header_extent(std::span<const unsigned char> first) {
+  if (first.size() < kHeaderBytes || std::memcmp(first.data(), kIdentifier, sizeof kIdentifier) != 0) return 0;
+  const std::uint64_t levels = std::max<std::uint32_t>(1, u32_at(first, 40));
+  return std::max({kHeaderBytes + std::min<std::uint64_t>(levels, kMaxLevels + 1) * kLevelIndexEntryBytes,
+                   std::uint64_t(u32_at(first, 48)) + u32_at(first, 52), std::uint64_t(u32_at(first, 56)) + u32_at(first, 60),
+                   u64_at(first, 64) + std::min<std::uint64_t>(u64_at(first, 72), UINT64_MAX - u64_at(first, 64))});
+}
+
+Result<Texture> read_header(std::span<const unsigned char> head, std::uint64_t file_size, const std::string& name) {
+  return read_file(head, file_size, false, name);
 }
 
 Result<std::vector<unsigned char>> level_data(const Texture& texture, std::size_t level, const std::string& name) {

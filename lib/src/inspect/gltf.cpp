@@ -1,9 +1,12 @@
 // `matbake inspect` of a .gltf or .glb: read as export reads it (every index checked, compressed
 // geometry decoded), images measured from their headers, nothing else decoded.
+#include <fcntl.h>
+
 #include <map>
 #include <set>
 
 #include "../gltf/document.hpp"
+#include "../io/unique_fd.hpp"
 #include "image_facts.hpp"
 #include "matbake/delivery.hpp"
 #include "matbake/image.hpp"
@@ -152,6 +155,25 @@ Instances walk_scene(const Json& json, const Json& scene, const std::vector<std:
   return out;
 }
 
+// Image `index` of `doc` as image_facts reads it: a file beside the glTF by its leading bytes alone
+// (memory and time independent of its size), an embedded one whole.
+Result<ImageHead> image_head(const gltf::Document& doc, std::size_t index) {
+  const Json& image = doc.json["images"][index];
+  const std::string uri = image.contains("uri") && image["uri"].is_string() ? image["uri"].get<std::string>() : "";
+  if (!uri.empty() && uri.rfind("data:", 0) != 0) return read_head(doc.folder / gltf::decode_uri(uri));
+  auto bytes = gltf::image_bytes(doc, index);
+  if (!bytes) return bytes.error();
+  return ImageHead{{bytes->begin(), bytes->end()}, bytes->size()};
+}
+
+// What tells two images' bytes apart: a file's hash read in blocks, an embedded image's of its bytes.
+std::string image_hash(const gltf::Document& doc, std::size_t index, const ImageHead& head) {
+  if (head.bytes.size() == head.size) return hash_bytes(head.bytes);
+  const std::string uri = doc.json["images"][index]["uri"].get<std::string>();
+  const UniqueFd file(::open((doc.folder / gltf::decode_uri(uri)).c_str(), O_RDONLY | O_CLOEXEC));
+  return file.fd < 0 ? std::string() : hash_file_descriptor(file.fd);
+}
+
 }  // namespace
 
 Result<nlohmann::json> inspect_gltf(const fs::path& path) {
@@ -227,13 +249,12 @@ Result<nlohmann::json> inspect_gltf(const fs::path& path) {
   out["images"] = nlohmann::json::array();
   for (std::size_t i = 0; i < gltf::array_in(json, "images").size(); ++i) {
     const Json& image = json["images"][i];
-    auto bytes = gltf::image_bytes(doc, i);
-    if (!bytes) return bytes.error();
-    const auto span = std::span(reinterpret_cast<const unsigned char*>(bytes->data()), bytes->size());
-    auto measured = image_facts(span, doc.file + ": image " + std::to_string(i));
+    auto head = image_head(doc, i);
+    if (!head) return head.error();
+    auto measured = image_facts(head->bytes, head->size, doc.file + ": image " + std::to_string(i));
     if (!measured) return measured.error();
     facts.push_back(*measured);
-    const std::string hash = hash_bytes(span);
+    const std::string hash = image_hash(doc, i, *head);
     const auto [first, fresh] = first_with_hash.try_emplace(hash, i);
     nlohmann::json entry = facts_json(*measured);
     entry["index"] = i;

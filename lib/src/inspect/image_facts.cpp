@@ -1,5 +1,8 @@
 #include "image_facts.hpp"
 
+#include <algorithm>
+#include <fstream>
+
 #include <cstring>
 #include <set>
 
@@ -38,13 +41,45 @@ std::string ktx2_codec(const ktx2::Texture& texture) {
   return "vk-format-" + std::to_string(texture.vk_format);
 }
 
-Result<ImageFacts> image_facts(std::span<const unsigned char> bytes, const std::string& name) {
+namespace {
+constexpr std::uint64_t kHeadBytes = 4u << 20, kMostKtx2HeaderBytes = 16u << 20;
+
+bool read_at_start(std::ifstream& in, std::vector<unsigned char>& bytes) {
+  in.clear();
+  in.seekg(0);
+  return bool(in.read(reinterpret_cast<char*>(bytes.data()), std::streamsize(bytes.size())));
+}
+}  // namespace
+
+Result<ImageHead> read_head(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary | std::ios::ate);
+  if (!in) return Error{file.string(), "cannot be read"};
+  ImageHead head;
+  head.size = std::uint64_t(in.tellg());
+  head.bytes.resize(std::min(head.size, kHeadBytes));
+  if (!read_at_start(in, head.bytes)) return Error{file.string(), "cannot be read"};
+  const std::uint64_t extent = ktx2::header_extent(head.bytes);
+  if (extent > head.bytes.size() && extent <= std::min(head.size, kMostKtx2HeaderBytes)) {
+    head.bytes.resize(extent);
+    if (!read_at_start(in, head.bytes)) return Error{file.string(), "cannot be read"};
+  }
+  return head;
+}
+
+Result<ktx2::Texture> ktx2_header(std::span<const unsigned char> head, std::uint64_t size, const std::string& name) {
+  const std::uint64_t extent = ktx2::header_extent(head);
+  if (extent > size) return Error{name, "KTX2 index points past the end of the file"};
+  if (extent > head.size()) return Error{name, "KTX2 header data of " + std::to_string(extent) + " bytes, more than inspect reads"};
+  return ktx2::read_header(head, size, name);
+}
+
+Result<ImageFacts> image_facts(std::span<const unsigned char> head, std::uint64_t size, const std::string& name) {
   ImageFacts facts;
-  facts.bytes = bytes.size();
-  facts.format = format_of(bytes);
+  facts.bytes = size;
+  facts.format = format_of(head);
   if (facts.format.empty()) return Error{name, "not a PNG, JPEG, WebP or KTX2 image"};
   if (facts.format == "ktx2") {
-    auto texture = ktx2::read(bytes, name);
+    auto texture = ktx2_header(head, size, name);
     if (!texture) return texture.error();
     facts.width = texture->width, facts.height = texture->height;
     facts.levels = std::uint32_t(texture->levels.size());
@@ -52,7 +87,7 @@ Result<ImageFacts> image_facts(std::span<const unsigned char> bytes, const std::
     facts.supercompression = supercompression_name(texture->supercompression);
     return facts;
   }
-  auto layout = image::probe_image_bytes(bytes, name);
+  auto layout = image::probe_image_bytes(head, name);
   if (!layout) return layout.error();
   facts.width = std::uint32_t(layout->width), facts.height = std::uint32_t(layout->height);
   facts.codec = facts.format;

@@ -3,6 +3,8 @@
 #include <nlohmann/json.hpp>
 
 #include <cstdint>
+#include <filesystem>
+#include <vector>
 #include <span>
 #include <string>
 
@@ -20,7 +22,19 @@ struct ImageFacts {
   std::uint64_t bytes = 0;
 };
 
-Result<ImageFacts> image_facts(std::span<const unsigned char> bytes, const std::string& name);
+// An image file's leading bytes and its size: what inspect reads of a file, so that its memory and
+// time do not grow with the file (a KTX2 file's header part, up to 16 MiB; 4 MiB of others, room
+// for a JPEG's metadata before its frame header).
+struct ImageHead {
+  std::vector<unsigned char> bytes;
+  std::uint64_t size = 0;  // the whole file's
+};
+Result<ImageHead> read_head(const std::filesystem::path& file);
+
+// The facts of an image from its leading bytes `head` (all of it, or a read_head) and its size.
+Result<ImageFacts> image_facts(std::span<const unsigned char> head, std::uint64_t size, const std::string& name);
+// A KTX2 file's header, index and descriptors (no level's bytes) from its leading bytes.
+Result<ktx2::Texture> ktx2_header(std::span<const unsigned char> head, std::uint64_t size, const std::string& name);
 // Its fields, with GPU memory by formula (gpu_bytes): a KTX2 with its stored levels, other formats
 // with the full chain a runtime makes.
 nlohmann::json facts_json(const ImageFacts& facts);

@@ -39,9 +39,10 @@ GpuBytes gpu_bytes(std::uint32_t width, std::uint32_t height, std::uint32_t leve
 }
 
 Result<nlohmann::json> inspect_ktx2(const fs::path& path) {
-  std::vector<unsigned char> bytes;
-  if (!read_whole_file(path, bytes)) return Error{path.string(), "cannot be read"};
-  auto texture = ktx2::read(bytes, path.string());
+  auto head = read_head(path);
+  if (!head) return head.error();
+  const std::uint64_t file_size = head->size;
+  auto texture = ktx2_header(head->bytes, file_size, path.string());
   if (!texture) return texture.error();
   const ktx2::Descriptor& d = texture->descriptor;
   nlohmann::json levels = nlohmann::json::array();
@@ -49,7 +50,7 @@ Result<nlohmann::json> inspect_ktx2(const fs::path& path) {
     levels.push_back({{"level", i},
                       {"width", std::max(1u, texture->width >> i)},
                       {"height", std::max(1u, texture->height >> i)},
-                      {"bytes", texture->levels[i].bytes.size()},
+                      {"bytes", texture->levels[i].byte_length},
                       {"uncompressed_bytes", texture->levels[i].uncompressed_length}});
   }
   nlohmann::json key_values = nlohmann::json::object();
@@ -58,7 +59,7 @@ Result<nlohmann::json> inspect_ktx2(const fs::path& path) {
   return nlohmann::json{
       {"kind", "ktx2"},
       {"file", path.string()},
-      {"bytes", bytes.size()},
+      {"bytes", file_size},
       {"header",
        {{"vk_format", texture->vk_format},
         {"type_size", texture->type_size},
