@@ -36,6 +36,11 @@ Status write_file_atomically(const std::filesystem::path& target, std::string_vi
 // The parts one after the other (a large file written without assembling it in memory first).
 Status write_file_atomically(const std::filesystem::path& target, std::span<const std::string_view> parts);
 
+// Removes `path` whatever it is: a file, a link (removed, never followed), a folder with all it
+// holds. For what a program matbake ran left in a temporary folder under a name matbake gave it (an
+// encoder that made a folder where its output file should be kept the folder for good).
+void remove_program_output(const std::filesystem::path& path);
+
 // Removes every temporary file an AtomicFile of this process holds now, and keeps new ones from
 // being made (create() fails from then on): for a SIGINT/SIGTERM handler that is about to _exit,
 // so that an interrupted run leaves its finished outputs and no temporary files. Call it from a

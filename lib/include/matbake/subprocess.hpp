@@ -3,9 +3,12 @@
 // build, outlive it, nor flood it (docs/reliability.md).
 //
 // The child runs in its own process group with the signals matbake blocks unblocked and their
-// default actions restored, stdin from /dev/null, and PR_SET_PDEATHSIG so that it dies with the
-// thread that started it even when matbake is killed with SIGKILL. Its stdout and stderr go to a
-// pipe of which only the last `output_limit` bytes are kept. At `time_limit` its group is killed.
+// default actions restored, stdin from /dev/null. The group's leader is a small supervisor (a fork
+// of matbake) that starts the program and kills the whole group, itself included, when matbake's
+// end of a pipe closes: matbake exited or was killed with SIGKILL, so no descendant of the program
+// (a wrapper's basisu) outlives it, unless it left the group itself (setsid). Its stdout and stderr
+// go to a pipe of which only the last `output_limit` bytes are kept. At `time_limit` its group is
+// killed.
 // An interrupt of matbake (SIGINT, SIGTERM, SIGHUP) kills every running group
 // (kill_subprocesses_for_exit, from the interrupt thread).
 #include <chrono>

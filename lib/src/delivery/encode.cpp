@@ -72,7 +72,7 @@ struct Piece {
 struct EncoderOutputs {
   std::vector<fs::path> paths;
   ~EncoderOutputs() {
-    for (const fs::path& p : paths) ::unlink(p.c_str());
+    for (const fs::path& p : paths) remove_program_output(p);
   }
 };
 

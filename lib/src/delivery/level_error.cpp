@@ -22,7 +22,7 @@ struct UnpackedFiles {
   ~UnpackedFiles() {
     std::error_code ec;
     for (const fs::directory_entry& e : fs::directory_iterator(folder, ec)) {
-      if (e.path().filename().string().starts_with(prefix)) ::unlink(e.path().c_str());
+      if (e.path().filename().string().starts_with(prefix)) remove_program_output(e.path());
     }
   }
 };

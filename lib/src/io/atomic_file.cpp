@@ -1,5 +1,6 @@
 #include "matbake/atomic_file.hpp"
 
+#include <dirent.h>
 #include <fcntl.h>
 #include <signal.h>
 #include <sys/file.h>
@@ -18,6 +19,7 @@
 #include <random>
 #include <set>
 #include <string>
+#include <vector>
 
 namespace fs = std::filesystem;
 
@@ -85,9 +87,31 @@ bool owner_gone(int folder_fd, const std::string& name) {
   return std::chrono::system_clock::now() - changed > kLeftoverAge;
 }
 
+// Removes `name` in the folder `dir` (a descriptor, or AT_FDCWD) whatever it is: a file or a link is
+// unlinked (never followed), a folder emptied the same way first, down to kMostDepth folders. A
+// temporary folder may hold what a program it ran left there (an encoder that made a folder where
+// its output file should be).
+constexpr int kMostDepth = 64;
+void remove_entry(int dir, const char* name, int depth) {
+  if (::unlinkat(dir, name, 0) == 0 || errno != EISDIR || depth > kMostDepth) return;
+  const int fd = ::openat(dir, name, O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC);
+  if (fd < 0) return;
+  DIR* folder = ::fdopendir(fd);
+  if (folder == nullptr) {
+    ::close(fd);
+    return;
+  }
+  std::vector<std::string> names;
+  while (const dirent* e = ::readdir(folder)) {
+    if (std::strcmp(e->d_name, ".") != 0 && std::strcmp(e->d_name, "..") != 0) names.emplace_back(e->d_name);
+  }
+  for (const std::string& n : names) remove_entry(::dirfd(folder), n.c_str(), depth + 1);
+  ::closedir(folder);
+  ::unlinkat(dir, name, AT_REMOVEDIR);
+}
+
 // Removes the leftover temporary folders in `folder` whose owners are provably gone (a run killed
-// with SIGKILL leaves one): their files, then the folder. Nothing is followed (a link is removed as
-// a link); a folder inside one is left.
+// with SIGKILL leaves one), whatever they hold. Nothing is followed (a link is removed as a link).
 void sweep_leftovers(const fs::path& folder) {
   std::error_code ec;
   for (const auto& entry : fs::directory_iterator(folder, ec)) {
@@ -95,11 +119,7 @@ void sweep_leftovers(const fs::path& folder) {
     if (name.rfind(kPrefix, 0) != 0 || name == folder_name()) continue;
     const int fd = ::open(entry.path().c_str(), O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC);
     if (fd < 0) continue;
-    if (owner_gone(fd, name)) {
-      std::error_code inner;
-      for (const auto& file : fs::directory_iterator(entry.path(), inner)) ::unlinkat(fd, file.path().filename().c_str(), 0);
-      ::rmdir(entry.path().c_str());
-    }
+    if (owner_gone(fd, name)) remove_entry(AT_FDCWD, entry.path().c_str(), 0);
     ::close(fd);
   }
 }
@@ -121,7 +141,7 @@ void remove_temporary_folder(const fs::path& folder) {
   for (int pass = 0; pass < 100; ++pass) {
     if (::rmdir(folder.c_str()) == 0 || errno == ENOENT) return;
     std::error_code ec;
-    for (const auto& entry : fs::directory_iterator(folder, ec)) ::unlink(entry.path().c_str());
+    for (const auto& entry : fs::directory_iterator(folder, ec)) remove_entry(AT_FDCWD, entry.path().c_str(), 0);
   }
 }
 
@@ -141,6 +161,8 @@ Status make_temporary_folder(TemporaryFiles& files, const fs::path& temp_folder,
 }
 
 }  // namespace
+
+void remove_program_output(const fs::path& path) { remove_entry(AT_FDCWD, path.c_str(), 0); }
 
 void remove_temporary_files_for_exit() {
   TemporaryFiles& files = temporary_files();

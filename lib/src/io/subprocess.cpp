@@ -31,23 +31,58 @@ Running& running() {
   return r;
 }
 
-// In the child, between fork and exec: async-signal-safe calls only.
-[[noreturn]] void exec_child(const char* program, char* const* argv, int output_fd, pid_t parent, const char* directory) {
+// The child matbake forks: the leader of the program's process group, which starts the program
+// and waits for it. When matbake's end of the `life` pipe closes (matbake exited, or was killed with
+// SIGKILL, which no handler sees), it kills the whole group, itself included: a wrapper that starts
+// basisu without exec has its basisu killed too, which PR_SET_PDEATHSIG on the program alone cannot
+// do (it is not inherited). It ends as the program did. Between fork and exit: async-signal-safe
+// calls only.
+[[noreturn]] void supervise(const char* program, char* const* argv, int output_fd, int life_fd, pid_t parent, const char* directory) {
   ::setpgid(0, 0);
-  ::prctl(PR_SET_PDEATHSIG, SIGKILL);
-  if (::getppid() != parent) ::_exit(127);  // the parent died before prctl took effect
+  if (::getppid() != parent) ::_exit(127);  // matbake died before the pipe was watched
   for (int s : {SIGINT, SIGTERM, SIGHUP, SIGPIPE, SIGQUIT}) ::signal(s, SIG_DFL);
-  sigset_t none;
-  sigemptyset(&none);
-  ::sigprocmask(SIG_SETMASK, &none, nullptr);
+  // Moved past 0-3 first: either may be one of them in a process that closed its standard streams.
+  const int out = ::fcntl(output_fd, F_DUPFD, 10), alive = ::fcntl(life_fd, F_DUPFD, 10);
   const int null = ::open("/dev/null", O_RDONLY);
-  if (null < 0 || ::dup2(null, 0) < 0 || ::dup2(output_fd, 1) < 0 || ::dup2(output_fd, 2) < 0) ::_exit(127);
-  // Nothing else of matbake's (a copy of its stderr kept for messages, a lock): a program that
-  // outlived matbake would keep a pipe reading matbake's stderr waiting.
-  ::close_range(3, ~0u, 0);
-  if (directory != nullptr && ::chdir(directory) != 0) ::_exit(127);
-  ::execve(program, argv, environ);
-  ::_exit(127);
+  if (out < 0 || alive < 0 || null < 0 || ::dup2(null, 0) < 0 || ::dup2(out, 1) < 0 || ::dup2(out, 2) < 0 || ::dup2(alive, 3) < 0) {
+    ::_exit(127);
+  }
+  // Nothing else of matbake's (a copy of its stderr kept for messages, a lock, another run's life
+  // pipe): a program that outlived matbake would keep a pipe reading matbake's stderr waiting.
+  ::close_range(4, ~0u, 0);
+  // SIGCHLD blocked but while waiting in ppoll: the program's end wakes the wait, with no race.
+  struct sigaction wake {};
+  wake.sa_handler = [](int) {};
+  ::sigaction(SIGCHLD, &wake, nullptr);
+  sigset_t none, child;
+  sigemptyset(&none);
+  sigemptyset(&child);
+  sigaddset(&child, SIGCHLD);
+  ::sigprocmask(SIG_SETMASK, &child, nullptr);
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    ::close(3);
+    ::signal(SIGCHLD, SIG_DFL);
+    ::sigprocmask(SIG_SETMASK, &none, nullptr);
+    ::prctl(PR_SET_PDEATHSIG, SIGKILL);
+    if (directory != nullptr && ::chdir(directory) != 0) ::_exit(127);
+    ::execve(program, argv, environ);
+    ::_exit(127);
+  }
+  if (pid < 0) ::_exit(127);
+  for (;;) {
+    int status = 0;
+    if (::waitpid(pid, &status, WNOHANG) == pid) {
+      if (WIFSIGNALED(status)) {  // ended by a signal: so does the supervisor, for matbake's report
+        ::signal(WTERMSIG(status), SIG_DFL);
+        ::sigprocmask(SIG_SETMASK, &none, nullptr);
+        ::kill(::getpid(), WTERMSIG(status));
+      }
+      ::_exit(WIFEXITED(status) ? WEXITSTATUS(status) : 127);
+    }
+    pollfd life{3, POLLIN, 0};
+    if (::ppoll(&life, 1, nullptr, &none) > 0 && life.revents != 0) ::kill(0, SIGKILL);  // matbake is gone
+  }
 }
 
 // Appends `bytes` to `tail`, keeping its last `limit` bytes.
@@ -148,9 +183,15 @@ SubprocessResult run_supervised(const SubprocessRequest& request) {
   std::vector<char*> argv;
   for (std::string& a : argv_text) argv.push_back(a.data());
   argv.push_back(nullptr);
-  int pipe_fds[2];
+  int pipe_fds[2], life[2];  // the program's output; matbake's life (its end closes when matbake goes)
   if (::pipe2(pipe_fds, O_CLOEXEC) != 0) {
     result.start_error = std::strerror(errno);
+    return result;
+  }
+  if (::pipe2(life, O_CLOEXEC) != 0) {
+    result.start_error = std::strerror(errno);
+    ::close(pipe_fds[0]);
+    ::close(pipe_fds[1]);
     return result;
   }
   const pid_t parent = ::getpid();
@@ -161,8 +202,8 @@ SubprocessResult run_supervised(const SubprocessRequest& request) {
     std::lock_guard lock(running().mutex);
     if (!running().closed) pid = ::fork();
     if (pid == 0) {
-      exec_child(argv_text[0].c_str(), argv.data(), pipe_fds[1], parent,
-                 request.working_directory.empty() ? nullptr : request.working_directory.c_str());
+      supervise(argv_text[0].c_str(), argv.data(), pipe_fds[1], life[0], parent,
+                request.working_directory.empty() ? nullptr : request.working_directory.c_str());
     }
     if (pid > 0) {
       ::setpgid(pid, pid);
@@ -171,8 +212,10 @@ SubprocessResult run_supervised(const SubprocessRequest& request) {
   }
   const int fork_errno = errno;
   ::close(pipe_fds[1]);
+  ::close(life[0]);
   if (pid < 0) {
     ::close(pipe_fds[0]);
+    ::close(life[1]);
     result.start_error = running().closed ? "interrupted" : std::strerror(fork_errno);
     return result;
   }
@@ -183,6 +226,7 @@ SubprocessResult run_supervised(const SubprocessRequest& request) {
   // (the leader, a zombie until reaped, keeps the group's id from being reused).
   ::kill(-pid, SIGKILL);
   result.status = wait_for(pid);
+  ::close(life[1]);
   {
     std::lock_guard lock(running().mutex);
     running().groups.erase(pid);
