@@ -31,12 +31,12 @@ std::size_t after_string(std::string_view text, std::size_t at) {
 TomlDepth toml_key_depth(std::string_view text) {
   TomlDepth deepest;
   std::size_t header = 0, dots = 0, line = 1;
-  bool line_is_header = false, line_started = false;
+  bool line_is_header = false, line_started = false, in_value = false;
   const auto end_line = [&] {
     const std::size_t depth = line_is_header ? dots + 1 : (line_started ? header + dots + 1 : 0);
     if (line_is_header) header = dots + 1;
     if (depth > deepest.depth) deepest = {depth, line};
-    dots = 0, line_is_header = false, line_started = false;
+    dots = 0, line_is_header = false, line_started = false, in_value = false;
   };
   for (std::size_t i = 0; i < text.size(); ++i) {
     const char c = text[i];
@@ -50,10 +50,12 @@ TomlDepth toml_key_depth(std::string_view text) {
       for (std::size_t j = i; j < next; ++j) line += text[j] == '\n' ? 1 : 0;
       i = next - 1;
       line_started = true;
-    } else if (c == '.' && !(i > 0 && digit_at(text, i - 1) && digit_at(text, i + 1))) {
-      ++dots;
+    } else if (c == '.') {
+      // A key's parts may be digits (`[0.0.0]`); after `=`, a dot between digits is a number's.
+      if (!in_value || !(i > 0 && digit_at(text, i - 1) && digit_at(text, i + 1))) ++dots;
     } else if (!std::isspace(static_cast<unsigned char>(c))) {
       if (!line_started && c == '[') line_is_header = true;
+      if (c == '=' && !line_is_header) in_value = true;
       line_started = true;
     }
   }

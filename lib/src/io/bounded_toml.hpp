@@ -16,8 +16,8 @@ struct TomlDepth {
   std::size_t line = 0;   // where (1-based), 0 in an empty text
 };
 
-// Counted by one linear pass: the dots of every key outside strings and comments (a dot between
-// two digits is a number's), a header's parts carried to the keys below it.
+// Counted by one linear pass: the dots of every key outside strings and comments (after `=`, a dot
+// between two digits is a number's), a header's parts carried to the keys below it.
 TomlDepth toml_key_depth(std::string_view text);
 
 // Why a text of depth `d` may not be parsed (its keys nest past kTomlDepthLimit; d.line says
