@@ -8,10 +8,11 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <ctime>
 #include <cerrno>
 #include <cstring>
 #include <mutex>
-#include <set>
+#include <map>
 
 #include "matbake/result.hpp"
 
@@ -20,10 +21,11 @@ extern char** environ;
 namespace matbake {
 namespace {
 
-// The process groups running now, for the interrupt handler.
+// The process groups running now (their supervisor's pid), each with matbake's end of its life
+// pipe, for the interrupt handler.
 struct Running {
   std::mutex mutex;
-  std::set<pid_t> groups;
+  std::map<pid_t, int> groups;
   bool closed = false;
 };
 Running& running() {
@@ -31,15 +33,63 @@ Running& running() {
   return r;
 }
 
-// The child matbake forks: the leader of the program's process group, which starts the program
-// and waits for it. When matbake's end of the `life` pipe closes (matbake exited, or was killed with
-// SIGKILL, which no handler sees), it kills the whole group, itself included: a wrapper that starts
-// basisu without exec has its basisu killed too, which PR_SET_PDEATHSIG on the program alone cannot
-// do (it is not inherited). It ends as the program did. Between fork and exit: async-signal-safe
-// calls only.
+// `pid`'s children (of its main thread) appended to `found` (at most `most`), from /proc.
+void add_children(pid_t pid, pid_t* found, std::size_t& n, std::size_t most) {
+  char path[64] = "/proc/", digits[16];
+  std::size_t d = 0, at = 6;
+  for (unsigned long v = static_cast<unsigned long>(pid); d == 0 || v > 0; v /= 10) digits[d++] = char('0' + v % 10);
+  for (std::size_t k = 0; k < 2; ++k) {  // /proc/PID/task/PID/children
+    for (std::size_t j = d; j > 0; --j) path[at++] = digits[j - 1];
+    const char* part = k == 0 ? "/task/" : "/children";
+    while (*part != 0) path[at++] = *part++;
+  }
+  path[at] = 0;
+  const int fd = ::open(path, O_RDONLY | O_CLOEXEC);
+  if (fd < 0) return;
+  char text[4096];
+  const ssize_t got = ::read(fd, text, sizeof text);
+  ::close(fd);
+  long value = -1;
+  for (ssize_t i = 0; i <= got; ++i) {
+    if (i < got && text[i] >= '0' && text[i] <= '9') {
+      value = (value < 0 ? 0 : value * 10) + (text[i] - '0');
+    } else if (value > 0) {
+      if (n < most) found[n++] = pid_t(value);
+      value = -1;
+    }
+  }
+}
+
+// Kills every descendant of the supervisor, whatever process group or session it moved to (a
+// wrapper under `set -m`, setsid): the supervisor is a child subreaper, so orphans come back to it
+// and stay in its tree. Walked breadth-first from /proc until none is left (at most 1,024 a pass,
+// 100 passes), each reaped.
+void kill_descendants() {
+  for (int pass = 0; pass < 100; ++pass) {
+    pid_t found[1024];
+    std::size_t n = 0;
+    add_children(::getpid(), found, n, 1024);
+    for (std::size_t k = 0; k < n; ++k) add_children(found[k], found, n, 1024);
+    if (n == 0) return;
+    for (std::size_t k = 0; k < n; ++k) ::kill(found[k], SIGKILL);
+    while (::waitpid(-1, nullptr, WNOHANG) > 0) {
+    }
+    const timespec pause{0, 2000000};  // 2 ms: the killed become zombies, reaped by the next pass
+    ::nanosleep(&pause, nullptr);
+  }
+}
+
+// The child matbake forks: the leader of the program's process group, a child subreaper, which
+// starts the program and waits for it. When matbake's end of the `life` pipe closes (matbake exited,
+// was killed with SIGKILL, which no handler sees, or closed it at the time limit), it kills every
+// descendant and its group, itself included: a wrapper that starts basisu without exec has its
+// basisu killed too, which PR_SET_PDEATHSIG on the program alone cannot do (it is not inherited).
+// When the program ends, what it left running is killed and the supervisor ends as the program did.
+// Between fork and exit: async-signal-safe calls only.
 [[noreturn]] void supervise(const char* program, char* const* argv, int output_fd, int life_fd, pid_t parent, const char* directory) {
   ::setpgid(0, 0);
   if (::getppid() != parent) ::_exit(127);  // matbake died before the pipe was watched
+  ::prctl(PR_SET_CHILD_SUBREAPER, 1);
   for (int s : {SIGINT, SIGTERM, SIGHUP, SIGPIPE, SIGQUIT}) ::signal(s, SIG_DFL);
   // Moved past 0-3 first: either may be one of them in a process that closed its standard streams.
   const int out = ::fcntl(output_fd, F_DUPFD, 10), alive = ::fcntl(life_fd, F_DUPFD, 10);
@@ -73,6 +123,7 @@ Running& running() {
   for (;;) {
     int status = 0;
     if (::waitpid(pid, &status, WNOHANG) == pid) {
+      kill_descendants();  // what it left running (a process holding the output pipe open)
       if (WIFSIGNALED(status)) {  // ended by a signal: so does the supervisor, for matbake's report
         ::signal(WTERMSIG(status), SIG_DFL);
         ::sigprocmask(SIG_SETMASK, &none, nullptr);
@@ -81,7 +132,10 @@ Running& running() {
       ::_exit(WIFEXITED(status) ? WEXITSTATUS(status) : 127);
     }
     pollfd life{3, POLLIN, 0};
-    if (::ppoll(&life, 1, nullptr, &none) > 0 && life.revents != 0) ::kill(0, SIGKILL);  // matbake is gone
+    if (::ppoll(&life, 1, nullptr, &none) > 0 && life.revents != 0) {  // matbake is gone, or asks it to end
+      kill_descendants();
+      ::kill(0, SIGKILL);
+    }
   }
 }
 
@@ -207,7 +261,7 @@ SubprocessResult run_supervised(const SubprocessRequest& request) {
     }
     if (pid > 0) {
       ::setpgid(pid, pid);
-      running().groups.insert(pid);
+      running().groups[pid] = life[1];
     }
   }
   const int fork_errno = errno;
@@ -222,15 +276,17 @@ SubprocessResult run_supervised(const SubprocessRequest& request) {
   const auto deadline = std::chrono::steady_clock::now() + request.time_limit;
   result.timed_out = !read_until_ended(pipe_fds[0], pid, deadline, result.output_tail, request.output_limit);
   ::close(pipe_fds[0]);
-  // The whole group goes: at the time limit, and after a normal exit any child it left behind
-  // (the leader, a zombie until reaped, keeps the group's id from being reused).
-  ::kill(-pid, SIGKILL);
-  result.status = wait_for(pid);
-  ::close(life[1]);
+  // Everything goes: after a normal end the supervisor has killed what the program left; at the
+  // time limit its life pipe closes and it kills the program's tree. The group is killed after a
+  // grace second in any case (the leader, a zombie until reaped, keeps the group's id from being reused).
   {
     std::lock_guard lock(running().mutex);
     running().groups.erase(pid);
+    ::close(life[1]);
   }
+  (void)ended_by(pid, std::chrono::steady_clock::now() + std::chrono::seconds(1));
+  ::kill(-pid, SIGKILL);
+  result.status = wait_for(pid);
   if (result.output_tail.size() > request.output_limit) {
     result.output_tail.erase(0, result.output_tail.size() - request.output_limit);
   }
@@ -242,7 +298,12 @@ void kill_subprocesses_for_exit() {
   Running& r = running();
   r.mutex.lock();  // held until the process exits: no program starts after this
   r.closed = true;
-  for (pid_t group : r.groups) ::kill(-group, SIGKILL);
+  for (const auto& [group, life] : r.groups) ::close(life);  // each supervisor kills its program's tree
+  const auto grace = std::chrono::steady_clock::now() + std::chrono::milliseconds(500);
+  for (const auto& [group, life] : r.groups) {
+    (void)ended_by(group, grace);
+    ::kill(-group, SIGKILL);
+  }
 }
 
 }  // namespace matbake
