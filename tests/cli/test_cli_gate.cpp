@@ -162,7 +162,7 @@ TEST(Gate, StateFilesAreReadAsHostileInput) {
   write_bytes(stamp, whole.substr(0, whole.size() / 2));
   const RunResult truncated = lib.build();
   EXPECT_EQ(truncated.exit_code, 0) << truncated.err;
-  EXPECT_NE(truncated.err.find(stamp.string() + " is not one matbake wrote: is not JSON"), std::string::npos) << truncated.err;
+  EXPECT_NE(truncated.err.find(stamp.string() + " is not valid JSON"), std::string::npos) << truncated.err;
   write_bytes(lib.dir / "u/stamp.json", read_bytes(stamp));
   fs::remove(stamp);
   fs::create_symlink(lib.dir / "u/stamp.json", stamp);

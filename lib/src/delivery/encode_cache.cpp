@@ -284,9 +284,9 @@ Result<Encoded> through_cache(const EncodeCache& cache, const std::string& key, 
     reused = true;
     return std::move(*hit);
   }
-  if (rejected != nullptr) *rejected = bad;
   std::optional<Result<Encoded>> made;
   tbb::collaborative_call_once(in_flight(key)->once, [&] {
+    if (rejected != nullptr) *rejected = bad;  // this call makes it again (another reads what it made)
     made = encode();
     if (*made) keep_entry(cache, key, **made);
   });

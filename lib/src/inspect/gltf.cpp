@@ -171,7 +171,7 @@ std::string image_hash(const gltf::Document& doc, std::size_t index, const Image
   if (head.bytes.size() == head.size) return hash_bytes(head.bytes);
   const std::string uri = doc.json["images"][index]["uri"].get<std::string>();
   const UniqueFd file(::open((doc.folder / gltf::decode_uri(uri)).c_str(), O_RDONLY | O_CLOEXEC));
-  return file.fd < 0 ? std::string() : hash_file_descriptor(file.fd);
+  return file.fd < 0 ? "unreadable " + uri : hash_file_descriptor(file.fd);
 }
 
 }  // namespace
@@ -247,14 +247,23 @@ Result<nlohmann::json> inspect_gltf(const fs::path& path) {
     }
   }
   out["images"] = nlohmann::json::array();
+  std::map<std::uint64_t, std::size_t> images_of_size;  // only images of one size can be duplicates: the others are not hashed
+  std::vector<ImageHead> heads;
   for (std::size_t i = 0; i < gltf::array_in(json, "images").size(); ++i) {
-    const Json& image = json["images"][i];
     auto head = image_head(doc, i);
+    if (!head) return head.error();
+    ++images_of_size[head->size];
+    if (head->bytes.size() < head->size) head->bytes = {};  // a file's first bytes: read again below
+    heads.push_back(std::move(*head));
+  }
+  for (std::size_t i = 0; i < heads.size(); ++i) {
+    const Json& image = json["images"][i];
+    auto head = heads[i].bytes.empty() ? image_head(doc, i) : Result<ImageHead>(std::move(heads[i]));
     if (!head) return head.error();
     auto measured = image_facts(head->bytes, head->size, doc.file + ": image " + std::to_string(i));
     if (!measured) return measured.error();
     facts.push_back(*measured);
-    const std::string hash = image_hash(doc, i, *head);
+    const std::string hash = images_of_size[head->size] > 1 ? image_hash(doc, i, *head) : "size " + std::to_string(head->size);
     const auto [first, fresh] = first_with_hash.try_emplace(hash, i);
     nlohmann::json entry = facts_json(*measured);
     entry["index"] = i;

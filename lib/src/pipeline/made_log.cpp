@@ -44,7 +44,6 @@ MadeLog::Files files_in(const nlohmann::json& j, std::string& problem) {
 
 // The log in `j`, or why it is not one matbake wrote.
 std::string parse_log(const nlohmann::json& j, MadeLog& log) {
-  if (j.is_discarded()) return "is not JSON";
   if (!j.is_object() || !j.contains("form") || j["form"] != kLogForm) return "is not a log of this matbake (form " + std::to_string(kLogForm) + ")";
   if (!j.contains("jobs") || !j["jobs"].is_object() || !j.contains("stale")) return "has no jobs or stale files";
   std::string problem;

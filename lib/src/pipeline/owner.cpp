@@ -80,7 +80,7 @@ Status check_shared_claims(const Manifest& manifest, const Plan& plan, const nlo
     const nlohmann::json& j = read.json;
     if (!read.problem.empty() || !j.is_object() || !j.contains("manifest") || !j["manifest"].is_string() ||
         !j.contains("outputs") || !j["outputs"].is_array() || j["manifest"] == plan.owner ||
-        !fs::exists(resolved_path(j["manifest"].get<std::string>(), manifest.output), ec)) {
+        !fs::is_regular_file(resolved_path(j["manifest"].get<std::string>(), manifest.output), ec)) {
       continue;  // absent, not one matbake wrote, or of a manifest that is gone: nothing claimed
     }
     for (const nlohmann::json& file : j["outputs"]) {
