@@ -39,8 +39,9 @@ std::map<fs::path, std::string> contents(const fs::path& folder) {
   return out;
 }
 
-// The quad z = 0 over [−1, 1]² with UVs, material `material`, written to `path` (its buffer a data: URI).
-void write_quad(const fs::path& path, const std::string& material, float z = 0) {
+// The quad z = 0 over [−1, 1]² with UVs, material `material` (its base colour the image file
+// `image` when one is named), written to `path` (its buffer a data: URI).
+void write_quad(const fs::path& path, const std::string& material, float z = 0, const std::string& image = "") {
   GltfBuilder b;
   const int quad = b.add_mesh(b.add_vec3({-1, -1, z, 1, -1, z, 1, 1, z, -1, 1, z}), b.add_indices({0, 1, 2, 0, 2, 3}), 4,
                               b.add_vec3({0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1}));
@@ -48,6 +49,11 @@ void write_quad(const fs::path& path, const std::string& material, float z = 0) 
   primitive["attributes"]["TEXCOORD_0"] = b.add_floats({0, 1, 1, 1, 1, 0, 0, 0}, "VEC2", 2);
   primitive["material"] = 0;
   b.doc["materials"] = {{{"name", material}}};
+  if (!image.empty()) {
+    b.doc["images"] = {{{"uri", image}}};
+    b.doc["textures"] = {{{"source", 0}}};
+    b.doc["materials"][0]["pbrMetallicRoughness"] = {{"baseColorTexture", {{"index", 0}}}};
+  }
   b.write(path, {b.add_node({{"mesh", quad}})});
 }
 
@@ -208,11 +214,7 @@ TEST(Contained, ABakeNeverWritesOverTheHighPolysOrTheCagesFiles) {
   fs::remove(dir / "art/baked.bin");
   fs::remove(dir / "art/cage.gltf");
   write_raw(dir / "art/baked_plate_normal.png", 2, 2, 3, "uint8", std::vector<double>(12, 7));
-  nlohmann::json high = nlohmann::json::parse(read_bytes(dir / "art/high.gltf"));
-  high["images"] = {{{"uri", "baked_plate_normal.png"}}};
-  high["textures"] = {{{"source", 0}}};
-  high["materials"][0]["pbrMetallicRoughness"] = {{"baseColorTexture", {{"index", 0}}}};
-  write_bytes(dir / "art/high.gltf", high.dump());
+  write_quad(dir / "art/high.gltf", "plate", 0.02f, "baked_plate_normal.png");
   before = contents(dir.path());
   r = run_bake({"--from", (dir / "art/high.gltf").string()});
   EXPECT_EQ(r.exit_code, 2) << r.err;
@@ -399,12 +401,7 @@ TEST(Contained, InspectReadsHeadersAloneWhateverTheFilesSize) {
   fs::resize_file(dir / "huge.ktx2", kHuge);
   write_raw(dir / "huge.png", 4, 4, 3, "uint8", std::vector<double>(48, 9));
   fs::resize_file(dir / "huge.png", kHuge);
-  write_quad(dir / "quad.gltf", "plate");
-  nlohmann::json quad = nlohmann::json::parse(read_bytes(dir / "quad.gltf"));
-  quad["images"] = {{{"uri", "huge.png"}}};
-  quad["textures"] = {{{"source", 0}}};
-  quad["materials"][0]["pbrMetallicRoughness"] = {{"baseColorTexture", {{"index", 0}}}};
-  write_bytes(dir / "quad.gltf", quad.dump());
+  write_quad(dir / "quad.gltf", "plate", 0, "huge.png");
   for (const char* name : {"huge.ktx2", "quad.gltf"}) {
     const RunResult r = run_measured(matbake_exe(), {"--json", "inspect", (dir / name).string()}, matbake_environment());
     ASSERT_EQ(r.exit_code, 0) << name << ": " << r.err;
@@ -421,13 +418,8 @@ TEST(Contained, InspectReadsHeadersAloneWhateverTheFilesSize) {
 // should be: the run fails and leaves no temporary folder in the output folder (one stayed for good).
 TEST(Contained, NoEncoderDescendantOutlivesMatbakeAndNoTemporaryFolderStays) {
   TempDir dir;
-  write_quad(dir / "quad.gltf", "plate");
+  write_quad(dir / "quad.gltf", "plate", 0, "c.png");
   write_raw(dir / "c.png", 4, 4, 3, "uint8", std::vector<double>(48, 90));
-  nlohmann::json quad = nlohmann::json::parse(read_bytes(dir / "quad.gltf"));
-  quad["images"] = {{{"uri", "c.png"}}};
-  quad["textures"] = {{{"source", 0}}};
-  quad["materials"][0]["pbrMetallicRoughness"] = {{"baseColorTexture", {{"index", 0}}}};
-  write_bytes(dir / "quad.gltf", quad.dump());
   const fs::path wrapper = dir / "basisu";
   write_bytes(wrapper, "#!/bin/bash\n"
                        "if [ \"$1\" = -version ]; then echo 'Basis Universal GPU Texture Compressor v1.16.4'; exit 0; fi\n"
