@@ -388,8 +388,9 @@ TEST(Contained, AnEncodeCacheEntryIsUsedOnlyWhenItsContentIsItsKeys) {
 
 // inspect of a 512 MB KTX2 file and of a glTF whose image is a 512 MB PNG: headers only, memory
 // independent of the file's size (it read the whole file: 525 MB). The files are sparse; each is
-// inspected small first, and growing it to 512 MB may cost at most 16 MB more (under 64 MB in all
-// in the release build; the sanitizers' own memory is more than that).
+// inspected small first, and growing it to 512 MB may cost at most 16 MB more (under 64 MB in all)
+// in the release build. Under the sanitizers the 4 MiB head of an image and its copies stay in
+// ASan's quarantine after they are freed (+25 to +32 MB measured): 64 MB more there, far from 512.
 TEST(Contained, InspectReadsHeadersAloneWhateverTheFilesSize) {
   TempDir dir;
   constexpr std::uintmax_t kHuge = std::uintmax_t(512) << 20;
@@ -411,10 +412,13 @@ TEST(Contained, InspectReadsHeadersAloneWhateverTheFilesSize) {
   for (const char* name : {"huge.ktx2", "quad.gltf"}) {
     const RunResult r = inspect(name);
     ASSERT_EQ(r.exit_code, 0) << name << ": " << r.err;
-    EXPECT_LT(r.peak_mb, (std::string(name) == "huge.ktx2" ? small_ktx2 : small_gltf) + 16) << name;
-#ifndef MATBAKE_SANITIZED
+#ifdef MATBAKE_SANITIZED
+    constexpr double kMoreMb = 64;
+#else
+    constexpr double kMoreMb = 16;
     EXPECT_LT(r.peak_mb, 64) << name;
 #endif
+    EXPECT_LT(r.peak_mb, (std::string(name) == "huge.ktx2" ? small_ktx2 : small_gltf) + kMoreMb) << name;
     const nlohmann::json report = nlohmann::json::parse(r.out)["inspected"];
     const nlohmann::json& facts = std::string(name) == "huge.ktx2" ? report : report["images"][0];
     EXPECT_EQ(facts["bytes"], kHuge) << name;
