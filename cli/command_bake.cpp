@@ -35,6 +35,7 @@ int run_bake(const BakeSettings& s, const GlobalOptions& global) {
   if (Status st = finish_tree(bake::request_tree(), options, s.given); !st) return report_error(st.error());
   auto report = bake::bake_file(s.low, options);
   if (!report) return report_error(report.error());
+  for (const std::string& w : report->warnings) std::cerr << "matbake: warning: " << escape_control(w) << "\n";
   if (global.json) {
     nlohmann::json out = {{"command", "bake"}, {"low", s.low}, {"high", s.high}, {"output", s.output}};
     if (!s.cage.empty()) out["cage"] = s.cage;

@@ -132,7 +132,7 @@ int run_slurm_plan(const PlanSettings& s, const GlobalOptions& global, pipeline:
   } else if (!global.quiet && !s.dry_run) {
     std::printf("%s: %s\n", (target.folder / "submit.sh").c_str(), pipeline::submission_counts(submission).c_str());
   }
-  for (const std::string& w : plan.warnings) std::cerr << "matbake: warning: " << w << "\n";
+  for (const std::string& w : plan.warnings) std::cerr << "matbake: warning: " << escape_control(w) << "\n";
   return kOk;
 }
 
@@ -209,7 +209,7 @@ int run_plan(const PlanSettings& s, const GlobalOptions& global) {
   } else if (!global.quiet) {
     std::printf("%s: %zu edges\n", s.output.c_str(), plan->jobs.size());
   }
-  for (const std::string& w : plan->warnings) std::cerr << "matbake: warning: " << w << "\n";
+  for (const std::string& w : plan->warnings) std::cerr << "matbake: warning: " << escape_control(w) << "\n";
   return kOk;
 }
 
@@ -229,7 +229,7 @@ int run_build(const BuildSettings& s, const GlobalOptions& global) {
     if (Status st = pipeline::check_report_page(manifest, *plan, page); !st) return report_error(st.error(), key_mention);
   }
   if (!global.quiet) {
-    for (const std::string& w : plan->warnings) std::cerr << "matbake: warning: " << w << "\n";
+    for (const std::string& w : plan->warnings) std::cerr << "matbake: warning: " << escape_control(w) << "\n";
   }
 
   // Progress: a bar on a terminal; elsewhere (build logs) a line per job started and finished, and
@@ -295,10 +295,10 @@ int run_build(const BuildSettings& s, const GlobalOptions& global) {
   }
   if (!global.json && !global.quiet) {
     for (const pipeline::JobReport& r : report->jobs) {
-      for (const std::string& w : r.warnings) std::cerr << "matbake: warning: " << r.job->name << ": " << w << "\n";
+      for (const std::string& w : r.warnings) std::cerr << "matbake: warning: " << escape_control(r.job->name + ": " + w) << "\n";
     }
     print_stale(report->stale, s.dry_run);
-    for (const std::string& w : report->warnings) std::cerr << "matbake: warning: " << w << "\n";
+    for (const std::string& w : report->warnings) std::cerr << "matbake: warning: " << escape_control(w) << "\n";
     const std::size_t built = report->count(pipeline::Outcome::built), current = report->count(pipeline::Outcome::up_to_date),
                       pending = report->count(pipeline::Outcome::out_of_date), skipped = report->count(pipeline::Outcome::skipped);
     if (built + failed + pending + skipped == 0) {

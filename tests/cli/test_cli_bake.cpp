@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include <fstream>
+#include <functional>
 #include <set>
 
 #include "lib/src/bake/frames.hpp"
@@ -80,8 +81,10 @@ TEST(CliBake, EveryKhronosModelOntoItsSimplificationIsValidatorCleanWithMikkTSpa
     const auto r = matbake({"--json", "bake", low.string(), "--from", high.string(), "-o", out.string(), "--size", "64",
                             "--texel-samples", "1", "--maps", "normal,ao,transfer", "--ao-samples", "4",
                             "--vertex-maps", "ao,curvature"});
-    if (r.exit_code != 0) {  // a model without a material over UVs has nothing to bake onto: said so
-      EXPECT_NE(r.err.find("no material of the low-poly can take baked maps"), std::string::npos) << name << ": " << r.err;
+    if (r.exit_code != 0) {  // a model without a material, or without UVs, has nothing to bake onto: said so
+      EXPECT_TRUE(r.err.find("no primitive of the low-poly has a material") != std::string::npos ||
+                  r.err.find("no material of the low-poly can take baked maps") != std::string::npos)
+          << name << ": " << r.err;
       continue;
     }
     ++baked;
@@ -190,6 +193,87 @@ void write_icosphere_pair(const fs::path& folder, int fine, int coarse) {
   write_grey_mesh(folder / "high.gltf", high.vertices, high.vertices, {}, high.triangles);
   const AtlasMesh low = icosphere_atlas(coarse, true);
   write_grey_mesh(folder / "low.gltf", low.positions, low.normals, low.texcoords, low.triangles);
+}
+
+// `folder`/`from` rewritten as `to` by `edit` (its JSON; the buffers stay beside it).
+void edit_gltf(const fs::path& folder, const std::string& from, const std::string& to,
+               const std::function<void(nlohmann::json&)>& edit) {
+  nlohmann::json j = nlohmann::json::parse(std::ifstream(folder / from));
+  edit(j);
+  std::ofstream(folder / to) << j.dump();
+}
+
+// The scene's nodes under one root node of `root`'s transform (a high-poly in other units, moved).
+std::function<void(nlohmann::json&)> under_root(const nlohmann::json& root) {
+  return [root](nlohmann::json& j) {
+    nlohmann::json node = root;
+    node["children"] = j["scenes"][0]["nodes"];
+    j["nodes"].push_back(node);
+    j["scenes"][0]["nodes"] = {j["nodes"].size() - 1};
+  };
+}
+
+// A bake that cannot be right fails with one line naming the material, the share and the likely
+// cause, and writes nothing: the high-poly in centimetres (×100), the high-poly moved away. Below
+// max_misses, misses are a warning (stderr and --json) naming the cage reach that would meet them.
+// A low-poly without a material, without UVs, and the two files swapped are three different errors.
+TEST(CliBake, AUnitsOrPlacementMistakeFailsNamingTheCauseAndMissesBelowTheLimitWarn) {
+  TempDir dir;
+  write_icosphere_pair(dir.path(), 3, 1);
+  edit_gltf(dir.path(), "high.gltf", "high_cm.gltf", under_root({{"scale", {100, 100, 100}}}));
+  edit_gltf(dir.path(), "high.gltf", "high_moved.gltf", under_root({{"translation", {30, 0, 0}}}));
+  const std::string low = (dir / "low.gltf").string(), out = (dir / "out.glb").string();
+  const auto bake_from = [&](const std::string& high, std::vector<std::string> extra = {}) {
+    std::vector<std::string> args{"bake", low, "--from", (dir / high).string(), "-o", out, "--size", "32"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return matbake(args);
+  };
+  auto r = bake_from("high_cm.gltf");
+  EXPECT_EQ(r.exit_code, 1);
+  expect_one_error_line(r, low, "material 0 '");
+  EXPECT_NE(r.err.find("100% of the rays"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("more than max_misses 0.5 allows: the high-poly's bounding box is 100× the low-poly's: the two are "
+                       "likely in different units"), std::string::npos) << r.err;
+  r = bake_from("high_moved.gltf");
+  EXPECT_EQ(r.exit_code, 1);
+  expect_one_error_line(r, low, "material 0 '");
+  EXPECT_NE(r.err.find("the two meshes' bounding boxes barely overlap"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+
+  // A cage 0.001 out over flat faces inside the sphere: the rays at the faces' middles start
+  // beneath it and miss. Allowed, they are one warning line naming the reach that would meet them.
+  r = matbake({"--json", "bake", low, "--from", (dir / "high.gltf").string(), "-o", (dir / "allowed.glb").string(), "--size",
+               "32", "--front", "0.001", "--back", "0.001", "--absolute-cage", "--max-misses", "1"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto report = nlohmann::json::parse(r.out);
+  const std::size_t misses = report["textures"][0]["misses"], rays = report["textures"][0]["rays"];
+  EXPECT_GT(misses, rays / 10);
+  ASSERT_EQ(report["warnings"].size(), 1u) << report["warnings"];
+  const std::string warning = report["warnings"][0];
+  EXPECT_NE(warning.find("missed the high-poly"), std::string::npos) << warning;
+  EXPECT_NE(warning.find("the cage is too small: front 0.0"), std::string::npos) << warning;
+  EXPECT_EQ(r.err, "matbake: warning: " + warning + "\n");
+  // The same misses over the default limit: the error, and no file.
+  r = bake_from("high.gltf", {"--front", "0.001", "--back", "0.001", "--absolute-cage", "--max-misses", "0.05"});
+  EXPECT_EQ(r.exit_code, 1);
+  expect_one_error_line(r, low, "material 0 '");
+  EXPECT_NE(r.err.find("the cage is too small"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+
+  // Swapped: the "low-poly" (the sphere, without UVs) is the denser of the two.
+  r = matbake({"bake", (dir / "high.gltf").string(), "--from", low, "-o", out});
+  EXPECT_EQ(r.exit_code, 1);
+  expect_one_error_line(r, (dir / "high.gltf").string(), "the low-poly's materials lack their UV sets, and it has 1280 triangles, "
+                                                         "more than the high-poly's 80: are the two swapped?");
+  edit_gltf(dir.path(), "low.gltf", "no_uv.gltf", [](nlohmann::json& j) { j["meshes"][0]["primitives"][0]["attributes"].erase("TEXCOORD_0"); });
+  r = matbake({"bake", (dir / "no_uv.gltf").string(), "--from", (dir / "high.gltf").string(), "-o", out});
+  EXPECT_EQ(r.exit_code, 1);
+  expect_one_error_line(r, (dir / "no_uv.gltf").string(), "no material of the low-poly can take baked maps: each needs its UV set");
+  edit_gltf(dir.path(), "low.gltf", "no_material.gltf", [](nlohmann::json& j) { j["meshes"][0]["primitives"][0].erase("material"); });
+  r = matbake({"bake", (dir / "no_material.gltf").string(), "--from", (dir / "high.gltf").string(), "-o", out});
+  EXPECT_EQ(r.exit_code, 1);
+  expect_one_error_line(r, (dir / "no_material.gltf").string(), "no primitive of the low-poly has a material");
+  EXPECT_FALSE(fs::exists(out));
 }
 
 // A bake removes what it leaves unused, as gltf-transform's prune would, and nothing else: the
@@ -419,8 +503,16 @@ TEST(CliBake, MatchByNameKeepsAPartsRaysOnItsOwnHighPolyPart) {
     ASSERT_TRUE(height);
     for (float v : height->pixels) ASSERT_NEAR(v, by_name ? -0.02 : 0.02, 1e-6) << by_name;
   }
+  // Every ray a miss: the bake fails naming the part (not a flat map with exit 0); allowed, the
+  // notes name it and every texel is filled.
   write_low("washer_low");
-  const auto r = bake_with({"--match", "by_name"});
+  fs::remove(out);
+  auto r = bake_with({"--match", "by_name"});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("material 0 'plate': 100% of the rays (256 of 256) missed the high-poly, more than max_misses 0.5 "
+                       "allows: no high-poly part matches the low-poly parts 'washer_low' by name"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+  r = bake_with({"--match", "by_name", "--max-misses", "1"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto report = nlohmann::json::parse(r.out);
   EXPECT_EQ(report["textures"][0]["missed_texels"], report["textures"][0]["texels"]);

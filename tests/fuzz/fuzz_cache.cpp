@@ -48,6 +48,6 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const auto kept = bake::load_map(folder(), bake::Map::height, "k", 1, 4, 4);
   if (kept && (kept->images.size() != 1 || kept->images[0].values.size() != 16)) std::abort();
   const auto counts = bake::load_trace(folder(), "k", 1);
-  if (counts && counts->size() != 1) std::abort();
+  if (counts && counts->textures.size() != 1) std::abort();
   return 0;
 }

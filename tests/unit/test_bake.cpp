@@ -760,7 +760,7 @@ namespace {
 
 // The box [−s, s]³ with split normals, as a hard-edged low-poly is stored: 24 vertices, each face
 // its own four with the face's normal.
-scene::Instance hard_box(double s) {
+scene::Instance hard_box(double s, const glm::dmat4& world = glm::dmat4(1)) {
   std::vector<dvec3> positions, normals;
   std::vector<std::array<std::uint32_t, 3>> triangles;
   for (int axis = 0; axis < 3; ++axis) {
@@ -776,7 +776,7 @@ scene::Instance hard_box(double s) {
       triangles.push_back({first, first + 2, first + 3});
     }
   }
-  return placed(positions, normals, triangles, glm::dmat4(1));
+  return placed(positions, normals, triangles, world);
 }
 
 // A hard-edged box (split normals) under the same box 1.1 times larger, per vertex. Extruded along
@@ -814,6 +814,114 @@ TEST(Bake, AveragedNormalsCastOneRayWhereAHardEdgesSplitVerticesMeet) {
     ASSERT_EQ(a.size(), b.size());
     for (std::size_t i = 0; i < a.size(); ++i) ASSERT_NEAR(a[i], b[i], 1e-6) << m << " " << i;
   }
+}
+
+// The bump of radius 0.5 with the cage's front 0.2 (scene units): a texel's ray starts beneath the
+// bump wherever its surface is higher than 0.2, and finds nothing. Those texels, and no others,
+// miss (one position a texel: its centre); the probe's reach for them is the bump's height there,
+// whose 95th percentile is the front that would have met 95% of them (float64 reference over the
+// same texel centres; float32 distances of magnitude 3).
+TEST(BakeMisses, ACageBelowABumpMissesWhereTheBumpRisesAboveItAndSaysHowFarToReach) {
+  const BumpPair pair = bump_pair(40, 0.5);
+  Options options;
+  options.maps = {Map::height};
+  options.front = 0.2, options.back = 0.25, options.absolute_distances = true;
+  const ao::TextureOptions texture{.width = 64, .height = 64, .padding = 2, .texel_samples = 1};
+  auto baked = bake(pair.low, pair.high, {ao::TextureTarget{{0}, 0}}, texture, options);
+  ASSERT_TRUE(baked) << baked.error().message;
+  const TextureBake& t = baked->textures.at(0);
+  std::vector<double> above;
+  for (int j = 0; j < 64; ++j) {
+    for (int i = 0; i < 64; ++i) {
+      const double z = bump_surface(pair, 2 * (i + 0.5) / 64 - 1, 1 - 2 * (j + 0.5) / 64).z;
+      ASSERT_GT(std::abs(z - 0.2), 1e-4) << "a texel on the boundary would make the count a coin toss";
+      if (z > 0.2) above.push_back(z);
+    }
+  }
+  ASSERT_GT(above.size(), 100u);
+  EXPECT_EQ(t.samples, 64u * 64u);
+  EXPECT_EQ(t.misses, above.size());
+  EXPECT_EQ(t.missed_texels, above.size());
+  EXPECT_EQ(t.from_inside, 0u);  // an open sheet: the rays beneath it meet nothing at all
+  std::sort(above.begin(), above.end());
+  EXPECT_NEAR(t.reach_front, above[std::min(above.size() - 1, above.size() * 95 / 100)], 1e-5);
+  EXPECT_EQ(t.reach_back, 0);
+  const std::string cause = miss_cause(baked->boxes, t, options, 2 * std::sqrt(2.0));
+  EXPECT_EQ(cause.rfind("the cage is too small: front 0.", 0), 0u) << cause;
+  EXPECT_NE(cause.find("(scene units)"), std::string::npos) << cause;
+}
+
+// A closed box floating over a sheet (x, y in [-0.25, 0.25], z in [0.05, 0.3]), the sheet 0.05 below
+// the low-poly plane, the cage's front 0.1: the rays of the texels under the box start inside it,
+// leave through its bottom (a face's back) and read the sheet: counted, every one of them (16 × 16
+// texel centres lie under the box at 64², none on its edges), and no other. Every texel's height is
+// the sheet's.
+TEST(BakeMisses, RaysThatStartInsideAClosedPartAreCounted) {
+  BumpPair pair = bump_pair(1, 0.5);  // the plane; its high-poly replaced
+  const glm::dmat4 knob = glm::scale(glm::translate(glm::dmat4(1), dvec3(0, 0, 0.175)), dvec3(0.25, 0.25, 0.125));
+  const scene::Scene high = scene_of({quad(-0.05, -3, 3, true, "sheet"), hard_box(1, knob)});
+  Options options;
+  options.maps = {Map::height};
+  options.front = 0.1, options.back = 0.1, options.absolute_distances = true;
+  const ao::TextureOptions texture{.width = 64, .height = 64, .padding = 2, .texel_samples = 1};
+  auto baked = bake(pair.low, high, {ao::TextureTarget{{0}, 0}}, texture, options);
+  ASSERT_TRUE(baked) << baked.error().message;
+  const TextureBake& t = baked->textures.at(0);
+  EXPECT_EQ(t.from_inside, 16u * 16u);
+  EXPECT_EQ(t.misses, 0u);
+  for (float h : map_of(t, Map::height).values) ASSERT_NEAR(h, -0.05, 1e-6);
+}
+
+// The plane's two halves, each a quad over its own high-poly (x < 0: a sheet 0.05 below; x > 0: one
+// 0.05 above). Half A's UVs fill the 0–1 tile; half B's are A's moved one whole tile right (the way
+// an artist keeps a mirrored half out of the bake). The 0–1 tile holds A's height alone (−0.05 at
+// every texel; wrapped in, B would average it to 0), B's two triangles are counted as outside, and
+// no texel is overlapped. With B's UVs moved back into the tile, every texel holds the mean of the
+// two (0) and is counted as overlapped.
+TEST(BakeTiles, AShellMovedOutByWholeTilesIsNotBakedIntoTheTile) {
+  const auto half = [](int mesh, double x0, double x1, double u0) {
+    scene::Instance q = placed({{x0, -1, 0}, {x1, -1, 0}, {x1, 1, 0}, {x0, 1, 0}}, {{0, 0, 1}, {0, 0, 1}, {0, 0, 1}, {0, 0, 1}},
+                               {{0, 1, 2}, {0, 2, 3}}, glm::dmat4(1));
+    q.texcoords.push_back({{u0, 1}, {u0 + 1, 1}, {u0 + 1, 0}, {u0, 0}});
+    q.mesh = mesh;  // two meshes: one mesh placed twice would be one surface
+    return q;
+  };
+  const scene::Scene high = scene_of({quad(-0.05, -3, 0, true, "a"), quad(0.05, 0, 3, true, "b")});
+  Options options;
+  options.maps = {Map::height};
+  options.front = 0.1, options.back = 0.1, options.absolute_distances = true;
+  const ao::TextureOptions texture{.width = 32, .height = 32, .padding = 2, .texel_samples = 1};
+  for (const double shift : {1.0, 0.0}) {
+    const scene::Scene low = scene_of({half(0, -1, 0, 0), half(1, 0, 1, shift)});
+    auto baked = bake(low, high, {ao::TextureTarget{{0, 1}, 0}}, texture, options);
+    ASSERT_TRUE(baked) << baked.error().message;
+    const TextureBake& t = baked->textures.at(0);
+    EXPECT_EQ(t.outside_tile, shift == 1 ? 2u : 0u);
+    EXPECT_EQ(t.overlapped, shift == 1 ? 0u : 32u * 32u);
+    for (float h : map_of(t, Map::height).values) ASSERT_NEAR(h, shift == 1 ? -0.05 : 0.0, 1e-6) << shift;
+  }
+}
+
+// What the two meshes' boxes say: a high-poly 100× the low-poly (centimetres against metres), one
+// moved away, and one in place over a small cage.
+TEST(BakeMisses, TheCauseNamedIsUnitsPlacementOrTheCage) {
+  const scene::Scene low = scene_of({hard_box(1)});
+  const scene::Scene in_cm = scene_of({hard_box(100)});
+  const scene::Scene moved = scene_of({hard_box(1, glm::translate(glm::dmat4(1), dvec3(30, 0, 0)))});
+  const scene::Scene in_place = scene_of({hard_box(1.2)});
+  const Boxes units = compare_boxes(low, in_cm), placement = compare_boxes(low, moved), cage = compare_boxes(low, in_place);
+  EXPECT_NEAR(units.high_diagonal / units.low_diagonal, 100, 1e-4);
+  EXPECT_NEAR(placement.overlap, 0, 1e-9);
+  EXPECT_NEAR(cage.overlap, 1, 1e-9);
+  TextureBake t;
+  t.reach_front = 0.2 * 2 * std::sqrt(3.0);  // a fifth of the low-poly's diagonal
+  Options options;  // fractions of the diagonal
+  const double diagonal = units.low_diagonal;
+  EXPECT_NE(miss_cause(units, t, options, diagonal).find("100× the low-poly's"), std::string::npos) << miss_cause(units, t, options, diagonal);
+  EXPECT_NE(miss_cause(placement, t, options, diagonal).find("barely overlap (0%"), std::string::npos);
+  EXPECT_EQ(miss_cause(cage, t, options, diagonal),
+            "the cage is too small: front 0.2 (of the diagonal) would reach 95% of the missed rays that have the high-poly along them");
+  EXPECT_EQ(miss_cause(cage, TextureBake{}, options, diagonal).rfind("no high-poly surface lies along the missed rays", 0), 0u);
 }
 
 }  // namespace

@@ -18,15 +18,19 @@ using nlohmann::json;
 
 constexpr int kSide = 2;
 
-std::vector<TextureBake> two_targets() {
-  std::vector<TextureBake> baked(2);
+Bake two_targets() {
+  Bake out;
+  out.boxes = {2.5, 250, 0.75};
+  std::vector<TextureBake>& baked = out.textures;
+  baked.resize(2);
   for (std::size_t t = 0; t < baked.size(); ++t) {
     baked[t].width = baked[t].height = kSide;
     baked[t].texels = 3 + t, baked[t].missed_texels = t, baked[t].padded = 1;
-    baked[t].height_min = -0.25, baked[t].height_max = 0.5 + double(t);
+    baked[t].samples = 12 + t, baked[t].misses = 2 * t, baked[t].from_inside = 5, baked[t].outside_tile = 6;
+    baked[t].height_min = -0.25, baked[t].height_max = 0.5 + double(t), baked[t].reach_front = 0.125;
     baked[t].maps.push_back({Map::height, 1, {0.f, 0.125f, float(t), -1.f}});
   }
-  return baked;
+  return out;
 }
 
 // Every place in `j` (objects' members and arrays' items, `j` itself too) as a JSON pointer.
@@ -41,8 +45,9 @@ void places(const json& j, const json::json_pointer& at, std::vector<json::json_
 
 TEST(MapCache, KeptMapsReadBackExactly) {
   const test::TempDir dir;
-  const std::vector<TextureBake> baked = two_targets();
-  ASSERT_TRUE(store_maps(dir.path(), baked, "trace-key", {{Map::height, "height-key"}}));
+  const Bake bake = two_targets();
+  const std::vector<TextureBake>& baked = bake.textures;
+  ASSERT_TRUE(store_maps(dir.path(), bake, "trace-key", {{Map::height, "height-key"}}));
   const auto kept = load_map(dir.path(), Map::height, "height-key", 2, kSide, kSide);
   ASSERT_TRUE(kept);
   ASSERT_EQ(kept->images.size(), 2u);
@@ -52,16 +57,27 @@ TEST(MapCache, KeptMapsReadBackExactly) {
   EXPECT_FALSE(load_map(dir.path(), Map::normal, "height-key", 2, kSide, kSide));
   const auto counts = load_trace(dir.path(), "trace-key", 2);
   ASSERT_TRUE(counts);
-  EXPECT_EQ((*counts)[1].texels, 4u);
-  EXPECT_EQ((*counts)[1].missed_texels, 1u);
-  EXPECT_EQ((*counts)[1].height_max, 1.5);
+  ASSERT_EQ(counts->textures.size(), 2u);
+  const TextureBake& second = counts->textures[1];
+  EXPECT_EQ(second.texels, 4u);
+  EXPECT_EQ(second.missed_texels, 1u);
+  EXPECT_EQ(second.height_max, 1.5);
+  // The rays and misses of the trace kept: a build that reuses it reports them, not zeros.
+  EXPECT_EQ(second.samples, 13u);
+  EXPECT_EQ(second.misses, 2u);
+  EXPECT_EQ(second.from_inside, 5u);
+  EXPECT_EQ(second.outside_tile, 6u);
+  EXPECT_EQ(second.reach_front, 0.125);
+  EXPECT_EQ(counts->boxes.high_diagonal, 250);
+  EXPECT_EQ(counts->boxes.overlap, 0.75);
   EXPECT_FALSE(load_trace(dir.path(), "trace-key", 1));
 }
 
 TEST(MapCache, AnIndexChangedAnywhereIsUsedWholeOrNotAtAll) {
   const test::TempDir dir;
-  const std::vector<TextureBake> baked = two_targets();
-  ASSERT_TRUE(store_maps(dir.path(), baked, "trace-key", {{Map::height, "height-key"}}));
+  const Bake bake = two_targets();
+  const std::vector<TextureBake>& baked = bake.textures;
+  ASSERT_TRUE(store_maps(dir.path(), bake, "trace-key", {{Map::height, "height-key"}}));
   const json index = json::parse(test::read_bytes(dir / "maps.json"));
   std::vector<json::json_pointer> at;
   places(index, json::json_pointer(), at);
@@ -80,9 +96,9 @@ TEST(MapCache, AnIndexChangedAnywhereIsUsedWholeOrNotAtAll) {
         }
         const auto counts = load_trace(dir.path(), "trace-key", 2);
         if (counts) {
-          EXPECT_EQ(counts->size(), 2u);
+          EXPECT_EQ(counts->textures.size(), 2u);
         }
-        EXPECT_TRUE(store_maps(dir.path(), baked, "trace-key", {{Map::height, "height-key"}}));
+        EXPECT_TRUE(store_maps(dir.path(), bake, "trace-key", {{Map::height, "height-key"}}));
       } catch (const std::exception& e) {
         ADD_FAILURE() << "threw: " << e.what();
       }

@@ -108,6 +108,7 @@ struct TextureTarget {
   std::vector<std::size_t> instances;  // indices into scene.instances
   int texcoord = 0;                    // TEXCOORD_n; an instance without it is skipped and counted
   Wrap wrap_s = Wrap::repeat, wrap_t = Wrap::repeat;  // how the texture will be sampled past [0, 1]
+  bool tile_only = false;  // the 0–1 tile alone: what lies outside it is not wrapped in (a high-to-low bake)
   std::string name = "";  // what errors call this texture ("material 2 'wood'"); empty: "texture N"
 };
 

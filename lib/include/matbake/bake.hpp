@@ -8,6 +8,8 @@
 // sample, and every map is computed from it. A ray that finds nothing is a miss: counted, and the
 // texel takes its nearest hit neighbour's value.
 //
+// Only UVs in the 0–1 tile are baked (a shell moved out by whole tiles is not wrapped back in).
+//
 // The tangent-space normal map is made for the basis a runtime shades with, so that it gives back
 // the high-poly's normal: per vertex the low-poly's TANGENT (MikkTSpace where the file has none, in
 // glTF's sign convention) and NORMAL, carried to world space; B = normalize(w · cross(N, T)) per
@@ -169,6 +171,13 @@ struct TextureBake {
   std::size_t missed_texels = 0;        // texels all of whose rays missed: filled from neighbours
   std::size_t padded = 0;
   double height_min = 0, height_max = 0;  // over the hits
+  std::size_t from_inside = 0;   // rays whose first surface was a high-poly face's back (a start inside a closed part)
+  std::size_t overlapped = 0;    // texels whose centre several triangles cover (overlapping islands): their mean
+  std::size_t outside_tile = 0;  // triangles whose UVs lie wholly outside the 0–1 tile: not baked
+  // The cage reach, scene units, that would have met 95% of the missed rays a probe along the
+  // low-poly's normal (the low-poly's diagonal either way) found the high-poly for: outside (front)
+  // and inside (back); 0 where none.
+  double reach_front = 0, reach_back = 0;
 };
 
 // Options::vertex_maps at each vertex of each low-poly instance: the cage ray from the vertex (its
@@ -185,7 +194,20 @@ struct VertexBake {
   std::size_t occlusion_rays = 0;
 };
 
+// The two meshes' bounding boxes, which tell a units or placement mistake from a small cage.
+struct Boxes {
+  double low_diagonal = 0, high_diagonal = 0;
+  double overlap = 1;  // the least, over the axes, share of the low-poly's extent the high-poly's covers
+};
+Boxes compare_boxes(const scene::Scene& low, const scene::Scene& high);
+
+// The likely cause of a texture's misses, a clause: the boxes' sizes differ by a power of ten
+// (units), they barely overlap (placement or the wrong file), or else the cage, with the front and
+// back that would have reached (in `options`'s terms: fractions of `diagonal`, or scene units).
+std::string miss_cause(const Boxes& boxes, const TextureBake& texture, const Options& options, double diagonal);
+
 struct Bake {
+  Boxes boxes;
   std::vector<TextureBake> textures;  // one per target
   VertexBake vertices;                // with Options::vertex_maps
   std::vector<std::string> unmatched;  // with Match::by_name: low parts no high part matches (all rays miss)

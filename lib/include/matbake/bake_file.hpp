@@ -21,6 +21,10 @@ struct Request {
   // A mesh placed by several nodes: its texels and vertices hold the mean of the placements (false),
   // or each placement gets its own copy of the mesh and material and its own maps (true).
   bool per_instance = false;
+  // The share of a material's rays (or of the vertices' rays) that may miss the high-poly before the
+  // bake fails: a units or placement mistake misses nearly all; a sound bake a few percent, and the
+  // roughest pair the tests bake (a Khronos model onto its 10% simplification) 28%.
+  double max_misses = 0.5;
 };
 
 struct FileOptions {
@@ -42,6 +46,7 @@ struct TextureReport {
   int width = 0, height = 0, texcoord = 0;
   std::size_t texels = 0, samples = 0, misses = 0, missed_texels = 0, padded = 0, occlusion_rays = 0;
   double height_min = 0, height_max = 0;
+  std::size_t from_inside = 0, overlapped = 0, outside_tile = 0;  // bake.hpp's TextureBake
   std::vector<std::string> files;  // per map, in the order asked: the image's URI or the file written
   std::string existing;            // what happened to the material's own normalTexture and occlusionTexture
                                    // ("", "normal replaced", "occlusion replaced", both)
@@ -60,13 +65,15 @@ struct FileReport {
   double front = 0, back = 0;          // the cage, scene units
   double seconds = 0, setup_seconds = 0, trace_seconds = 0;
   std::vector<std::string> notes;
+  std::vector<std::string> warnings;   // misses and rays that started inside a part, per material, with the likely cause
   std::vector<std::string> written;    // files
   std::vector<std::string> beside;     // those of them the glTF does not reference: the float maps
   std::vector<std::string> reused;     // maps read back from FileOptions::keep, not traced
 };
 
 // Errors: either file unreadable (named), an output onto an input, no low-poly material with the
-// UV set, options out of range.
+// UV set, options out of range, a material's (or the vertices') share of missed rays above
+// Request::max_misses (naming the likely cause).
 Result<FileReport> bake_file(const std::filesystem::path& low, const FileOptions& options);
 
 }  // namespace matbake::bake

@@ -3,13 +3,16 @@
 #include <glm/geometric.hpp>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
+
 namespace matbake::ao {
 namespace {
 
 using scene::Vec3;
 
 // Called for every hit Embree finds: rejects those on the face the rays leave, on an instance
-// outside the trace's parts, and on a face's back unless the trace is two-sided.
+// outside the trace's parts, and on a face's back unless the trace is two-sided (noting the
+// nearest such back where asked).
 void face_filter(const RTCFilterFunctionNArguments* args) {
   const auto* context = reinterpret_cast<const RayContext*>(args->context);
   const auto* faces = static_cast<const std::vector<Vec3>*>(args->geometryUserPtr);
@@ -26,7 +29,10 @@ void face_filter(const RTCFilterFunctionNArguments* args) {
     const Vec3& n = (*faces)[triangle];
     const Vec3 d(RTCRayN_dir_x(args->ray, args->N, i), RTCRayN_dir_y(args->ray, args->N, i),
                  RTCRayN_dir_z(args->ray, args->N, i));
-    if (glm::dot(n, d) > 0) args->valid[i] = 0;
+    if (glm::dot(n, d) <= 0) continue;
+    args->valid[i] = 0;
+    // Embree holds the candidate's distance in the ray's tfar while it asks.
+    if (context->nearest_back) *context->nearest_back = std::min(*context->nearest_back, RTCRayN_tfar(args->ray, args->N, i));
   }
 }
 

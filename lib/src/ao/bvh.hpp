@@ -60,6 +60,9 @@ struct RayContext {
   bool two_sided = false;
   Face leaving;
   Parts parts;
+  // When set (rtcIntersect1 only), the distance of the nearest back face the trace passed: a ray
+  // whose first surface is a face's back started inside a closed part.
+  float* nearest_back = nullptr;
   RayContext(bool two_sided_traces, Face leaving_face, Parts seen = {})
       : two_sided(two_sided_traces), leaving(leaving_face), parts(seen) {
     rtcInitIntersectContext(&embree);

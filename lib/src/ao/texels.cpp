@@ -265,8 +265,12 @@ Tiling tile(const scene::Scene& scene, const TextureTarget& target, int width, i
         continue;
       }
       const Box box = bounds(uv);
-      const CellRect cells{std::ceil(box.x0 - kReach), std::floor(box.x1 + kReach), std::ceil(box.y0 - kReach),
-                           std::floor(box.y1 + kReach)};
+      CellRect cells{std::ceil(box.x0 - kReach), std::floor(box.x1 + kReach), std::ceil(box.y0 - kReach),
+                     std::floor(box.y1 + kReach)};
+      if (target.tile_only) {
+        cells = {std::max(cells.i0, 0.0), std::min(cells.i1, width - 1.0), std::max(cells.j0, 0.0), std::min(cells.j1, height - 1.0)};
+        if (cells.i0 > cells.i1 || cells.j0 > cells.j1) continue;  // wholly outside the tile
+      }
       if ((cells.i1 - cells.i0 + 1) * (cells.j1 - cells.j0 + 1) > max_cells ||
           std::max({std::abs(box.x0), std::abs(box.x1), std::abs(box.y0), std::abs(box.y1)}) > kFarthest) {
         ++out.too_large;

@@ -86,6 +86,10 @@ struct TexelSum {
   double height = 0, curvature = 0, occlusion = 0, thickness = 0;
   std::uint64_t occlusion_rays = 0, thickness_rays = 0;
   int hits = 0, rays = 0;
+  int from_inside = 0;  // rays whose first surface was a face's back
+  // Of the rays that missed: how far out (front) or in (back) the high-poly lies along them, where
+  // it does (the cage's reach that would have met it).
+  std::vector<float> wanted_front, wanted_back;
   int id = -1;  // the first hit's material or primitive number (Options::id_by)
 };
 
@@ -106,6 +110,7 @@ struct Rays {
   const std::vector<int>* primitive_numbers;  // per high instance, for an id map by primitive (null: by material)
   const PartMatch* parts;                     // Match::by_name's parts (null: every ray meets every part)
   bool occluders_matched;                     // with parts: a hit's AO and thickness rays meet its part only
+  float probe;                                // how far a missed ray's probe looks either way (0: no probe)
 };
 
 // The high-poly parts low instance `instance`'s cage rays meet.
@@ -180,23 +185,39 @@ struct CageHit {
 // The cage ray at a low-poly point: from `from_cage` (the cage mesh's point with the same weights)
 // towards it, else (no cage mesh, or it touches the low-poly there) from the extrusion's `front`
 // outside along its normal; either reaching `back` beyond it, meeting the high-poly's `parts`.
-std::optional<CageHit> cast(const Rays& c, const LowPoint& low, const std::optional<glm::dvec3>& from_cage, ao::Parts parts) {
+// `from_inside`, when given, is set to whether the ray's first surface was a face's back.
+std::optional<CageHit> cast(const Rays& c, const LowPoint& low, const std::optional<glm::dvec3>& from_cage, ao::Parts parts,
+                            bool* from_inside = nullptr) {
   const float front = c.front;
+  if (from_inside) *from_inside = false;
   if (from_cage) {
     const glm::dvec3 to_low = glm::dvec3(low.position) - *from_cage;
     const double distance = glm::length(to_low);
     // Below float32's resolution at the point the direction is noise: the cage touches the low-poly.
     if (distance > 1e-6 * (1 + glm::length(glm::dvec3(low.position)))) {
-      auto hit = c.high.first_hit(glm::vec3(*from_cage), glm::vec3(to_low / distance), float(distance) + c.back, parts);
+      auto hit = c.high.first_hit(glm::vec3(*from_cage), glm::vec3(to_low / distance), float(distance) + c.back, parts, from_inside);
       if (!hit) return std::nullopt;
       return CageHit{*hit, distance - double(hit->distance)};
     }
   }
   const glm::vec3 n(low.basis[2]);
   if (!(glm::length(n) > 0)) return std::nullopt;
-  auto hit = c.high.first_hit(low.position + front * n, -n, front + c.back, parts);
+  auto hit = c.high.first_hit(low.position + front * n, -n, front + c.back, parts, from_inside);
   if (!hit) return std::nullopt;
   return CageHit{*hit, double(front) - double(hit->distance)};
+}
+
+// A missed ray's probe: from c.probe outside the low-poly point along its normal to c.probe inside,
+// the high-poly's first front face gives the cage reach that would have met it (front where it lies
+// outside, back where inside), noted in `sum`.
+void probe_miss(const Rays& c, const LowPoint& low, ao::Parts parts, TexelSum& sum) {
+  const glm::vec3 n(low.basis[2]);
+  if (!(c.probe > 0) || !(glm::length(n) > 0)) return;
+  const auto hit = c.high.first_hit(low.position + c.probe * n, -n, 2 * c.probe, parts);
+  if (!hit) return;
+  const float height = c.probe - hit->distance;  // positive outside
+  if (height > c.front) sum.wanted_front.push_back(height);
+  if (-height > c.back) sum.wanted_back.push_back(-height);
 }
 
 // The cage mesh's point of low instance `instance`'s triangle at weights `w` (none without a cage).
@@ -247,13 +268,18 @@ void trace_point(const TraceContext& t, const ao::texels::SurfacePoint& point, s
     if (on_edge(w) && (touched || outside(uv, at, w))) w = inside(w);
     LowPoint low = low_point(inst, t.frames[point.instance], point.triangle, w);
     ++sum.rays;
-    auto cage_hit = cast(c, low, cage_point(c, point.instance, point.triangle, w), cage_parts(c, point.instance));
+    bool from_inside = false;
+    auto cage_hit = cast(c, low, cage_point(c, point.instance, point.triangle, w), cage_parts(c, point.instance), &from_inside);
     if (!cage_hit && on_edge(w)) {
       w = inside(w);
       low = low_point(inst, t.frames[point.instance], point.triangle, w);
-      cage_hit = cast(c, low, cage_point(c, point.instance, point.triangle, w), cage_parts(c, point.instance));
+      cage_hit = cast(c, low, cage_point(c, point.instance, point.triangle, w), cage_parts(c, point.instance), &from_inside);
     }
-    if (!cage_hit) continue;
+    sum.from_inside += from_inside;
+    if (!cage_hit) {
+      probe_miss(c, low, cage_parts(c, point.instance), sum);
+      continue;
+    }
     add_hit(c, *cage_hit, low, sum);
     if (c.occlusion || c.thickness) trace_from_hit(c, cage_hit->hit, low, texel_size, j, positions, occlusion_key, sum);
   }
@@ -553,14 +579,38 @@ Result<std::vector<std::vector<CornerFrame>>> target_frames(const scene::Scene& 
 
 // The counts of one tile's texels for the report (summed over tiles, in any order).
 struct TileTally {
-  std::size_t texels = 0, samples = 0, occlusion_rays = 0, misses = 0, missed_texels = 0;
+  std::size_t texels = 0, samples = 0, occlusion_rays = 0, misses = 0, missed_texels = 0, from_inside = 0, overlapped = 0;
   double height_min = std::numeric_limits<double>::infinity(), height_max = -std::numeric_limits<double>::infinity();
+  std::vector<float> wanted_front, wanted_back;  // TexelSum's, of every texel
   void add(const TileTally& o) {
     texels += o.texels, samples += o.samples, occlusion_rays += o.occlusion_rays, misses += o.misses;
-    missed_texels += o.missed_texels;
+    missed_texels += o.missed_texels, from_inside += o.from_inside, overlapped += o.overlapped;
     height_min = std::min(height_min, o.height_min), height_max = std::max(height_max, o.height_max);
+    wanted_front.insert(wanted_front.end(), o.wanted_front.begin(), o.wanted_front.end());
+    wanted_back.insert(wanted_back.end(), o.wanted_back.begin(), o.wanted_back.end());
   }
 };
+
+// The reach that would have met 95% of the missed rays the probes placed (0: none placed).
+double reach_for(std::vector<float>& wanted) {
+  if (wanted.empty()) return 0;
+  const auto at = wanted.begin() + std::ptrdiff_t(std::min(wanted.size() - 1, wanted.size() * 95 / 100));
+  std::nth_element(wanted.begin(), at, wanted.end());
+  return double(*at);
+}
+
+// Whether a texel's points lie on several triangles of the low-poly's meshes (overlapping islands);
+// one triangle placed by several nodes is one.
+bool overlapping(const scene::Scene& low, const ao::texels::SurfacePoint* first, const ao::texels::SurfacePoint* last) {
+  const auto triangle = [&](const ao::texels::SurfacePoint& p) {
+    const scene::Instance& inst = low.instances[p.instance];
+    return std::tuple(inst.mesh, inst.primitive, p.triangle);
+  };
+  for (const auto* p = first + 1; p < last; ++p) {
+    if (triangle(*p) != triangle(*first)) return true;
+  }
+  return false;
+}
 
 // One tile's texels traced into `out`'s maps: each texel's points into one sum; marks `traced` and
 // out.hit (bytes: tiles write their own texels in parallel).
@@ -575,10 +625,14 @@ void trace_tile(const TraceContext& context, const Options& options, const ao::t
       trace_point(context, points[last], key, sum);
     }
     ++tally.texels;
+    tally.overlapped += overlapping(context.rays.low, points.data() + first, points.data() + last);
     traced[texel] = 1;
     tally.samples += std::size_t(sum.rays);
     tally.occlusion_rays += sum.occlusion_rays + sum.thickness_rays;
     tally.misses += std::size_t(sum.rays - sum.hits);
+    tally.from_inside += std::size_t(sum.from_inside);
+    tally.wanted_front.insert(tally.wanted_front.end(), sum.wanted_front.begin(), sum.wanted_front.end());
+    tally.wanted_back.insert(tally.wanted_back.end(), sum.wanted_back.begin(), sum.wanted_back.end());
     if (sum.hits == 0) {
       ++tally.missed_texels;
       continue;
@@ -588,6 +642,22 @@ void trace_tile(const TraceContext& context, const Options& options, const ao::t
     const double height = sum.height / sum.hits;
     tally.height_min = std::min(tally.height_min, height), tally.height_max = std::max(tally.height_max, height);
   }
+}
+
+// The target's triangles whose UVs lie wholly outside the 0–1 tile (none of their texels baked).
+std::size_t triangles_outside_tile(const scene::Scene& low, const ao::TextureTarget& target) {
+  std::size_t outside = 0;
+  for (std::size_t k : target.instances) {
+    const scene::Instance& inst = low.instances[k];
+    if (std::size_t(target.texcoord) >= inst.texcoords.size()) continue;
+    const auto& uv = inst.texcoords[std::size_t(target.texcoord)];
+    for (const auto& corners : inst.triangles) {
+      glm::vec2 lo(uv[corners[0]]), hi = lo;
+      for (std::uint32_t v : corners) lo = glm::min(lo, uv[v]), hi = glm::max(hi, uv[v]);
+      outside += hi.x <= 0 || hi.y <= 0 || lo.x >= 1 || lo.y >= 1;
+    }
+  }
+  return outside;
 }
 
 // Options::maps over one texture target: its texels traced tile by tile as each tile's coverage is
@@ -620,6 +690,9 @@ Result<TextureBake> trace_target(const TraceContext& context, const Options& opt
   for (const TileTally& t : tallies) total.add(t);
   out.texels = total.texels, out.samples = total.samples, out.occlusion_rays = total.occlusion_rays;
   out.misses = total.misses, out.missed_texels = total.missed_texels;
+  out.from_inside = total.from_inside, out.overlapped = total.overlapped;
+  out.outside_tile = triangles_outside_tile(context.rays.low, context.target);
+  out.reach_front = reach_for(total.wanted_front), out.reach_back = reach_for(total.wanted_back);
   if (total.height_min <= total.height_max) out.height_min = total.height_min, out.height_max = total.height_max;
   const std::vector<bool> hit(out.hit.begin(), out.hit.end()), was_traced(traced.begin(), traced.end());
   // Only where a texel missed every ray: the nearest-hit transform is over the whole texture.
@@ -657,6 +730,7 @@ Result<Bake> bake(const scene::Scene& low, const scene::Scene& high, const std::
   auto tracers = build_tracers(high, occluding, thickness, occlusion);
   if (!tracers) return tracers.error();
   Bake result;
+  result.boxes = compare_boxes(low, high);
   std::tie(result.front, result.back) = cage_distances(low, options, cage);  // an averaged cage's: front
   std::optional<scene::Scene> averaged;
   if (options.average_normals && !cage) {
@@ -685,9 +759,14 @@ Result<Bake> bake(const scene::Scene& low, const scene::Scene& high, const std::
                         asked(Map::transfer) ? &base_colors : nullptr,
                         options.id_by == IdSource::primitive ? &primitives : nullptr,
                         parts ? &*parts : nullptr,
-                        occluders_matched};
+                        occluders_matched,
+                        2 * low.radius()};
   for (std::size_t index = 0; index < targets.size() && !options.maps.empty(); ++index) {
-    auto traced = trace_target(TraceContext{texel_rays, *frames, targets[index], texture, index}, options);
+    // The 0–1 tile alone, as Substance, Marmoset and Blender bake: a shell moved out by whole tiles
+    // (a mirrored half kept out of the bake) is not wrapped back into it.
+    ao::TextureTarget in_tile = targets[index];
+    in_tile.tile_only = true;
+    auto traced = trace_target(TraceContext{texel_rays, *frames, in_tile, texture, index}, options);
     if (!traced) return traced.error();
     result.textures.push_back(std::move(*traced));
   }
@@ -706,7 +785,8 @@ Result<Bake> bake(const scene::Scene& low, const scene::Scene& high, const std::
                            nullptr,
                            nullptr,
                            parts ? &*parts : nullptr,
-                           occluders_matched};
+                           occluders_matched,
+                           0};
     result.vertices = bake_vertices(vertex_rays, options.vertex_maps);
   }
   result.trace_seconds = seconds_since(trace_start);

@@ -2,6 +2,7 @@
 // material, written into the document (normalTexture, TANGENT) and beside it (float maps).
 #include <cctype>
 #include <chrono>
+#include <cstdio>
 #include <map>
 #include <set>
 #include <tuple>
@@ -38,9 +39,29 @@ int normal_texcoord(const Json& material) {
   return gltf::integer_in<int>(material["normalTexture"], "texCoord", 0, 0);
 }
 
+std::size_t triangle_count(const scene::Scene& scene) {
+  std::size_t n = 0;
+  for (const scene::Instance& inst : scene.instances) n += inst.triangles.size();
+  return n;
+}
+
+// Why no material of the low-poly can take maps: none has a material, the two files look swapped
+// (the "low-poly" denser than the high-poly: a sculpt seldom has UVs), or none has its UV set.
+std::string no_target_reason(const scene::Scene& low, bool no_material, const fs::path& high) {
+  if (no_material) return "no primitive of the low-poly has a material, and baked maps go into one: give its primitives a material";
+  const std::size_t low_triangles = triangle_count(low);
+  if (auto dense = scene::load_scene(high); dense && low_triangles > triangle_count(*dense)) {
+    return "the low-poly's materials lack their UV sets, and it has " + std::to_string(low_triangles) +
+           " triangles, more than the high-poly's " + std::to_string(triangle_count(*dense)) +
+           ": are the two swapped? (matbake bake LOW --from HIGH)";
+  }
+  return "no material of the low-poly can take baked maps: each needs its UV set (TEXCOORD_n of its normalTexture, else "
+         "TEXCOORD_0) on all its primitives; unwrap the low-poly";
+}
+
 // One target per material the low-poly's instances use (per placing node too with `per_instance`),
-// when every one of them has its UV set.
-Result<Targets> material_targets(const gltf::Document& doc, const scene::Scene& low, bool per_instance) {
+// when every one of them has its UV set; `high` is read only to say why there is none.
+Result<Targets> material_targets(const gltf::Document& doc, const scene::Scene& low, bool per_instance, const fs::path& high) {
   const Json& materials = gltf::array_in(doc.json, "materials");
   std::map<std::pair<int, int>, std::vector<std::size_t>> by_material;  // (material, node or -1) → instances
   Targets out;
@@ -83,7 +104,7 @@ Result<Targets> material_targets(const gltf::Document& doc, const scene::Scene& 
     out.nodes.push_back(node);
     out.targets.push_back(std::move(target));
   }
-  if (out.targets.empty()) return Error{doc.file, "no material of the low-poly can take baked maps (each needs its UV set on all its primitives)"};
+  if (out.targets.empty()) return Error{doc.file, no_target_reason(low, by_material.empty(), high)};
   return out;
 }
 
@@ -181,6 +202,7 @@ Result<TextureReport> write_maps(gltf::Document& doc, const gltf::ImageCache& ca
   report.width = baked.width, report.height = baked.height, report.texcoord = targets.targets[t].texcoord;
   report.texels = baked.texels, report.samples = baked.samples, report.misses = baked.misses;
   report.missed_texels = baked.missed_texels, report.padded = baked.padded;
+  report.from_inside = baked.from_inside, report.overlapped = baked.overlapped, report.outside_tile = baked.outside_tile;
   report.height_min = baked.height_min, report.height_max = baked.height_max;
   report.occlusion_rays = baked.occlusion_rays;
   const std::string file_name = gltf::material_file_name(material, m);
@@ -311,7 +333,7 @@ Result<Bake> bake_or_reuse(const scene::Scene& low, const Targets& targets, cons
                                     targets.targets.size(), texture.width, texture.height);
     if (!kept[i]) to_trace.push_back(maps[i]);
   }
-  std::optional<std::vector<TextureBake>> counts;
+  std::optional<Bake> counts;
   if (to_trace.empty() && !maps.empty()) {
     counts = load_trace(options.keep, trace_key, targets.targets.size());
     if (!counts) to_trace = maps, kept.assign(maps.size(), std::nullopt);  // kept maps without their trace's counts
@@ -324,12 +346,12 @@ Result<Bake> bake_or_reuse(const scene::Scene& low, const Targets& targets, cons
     if (keeping && !to_trace.empty()) {
       std::vector<std::pair<Map, std::string>> keys;
       for (Map m : to_trace) keys.emplace_back(m, map_key(inputs, m, options.request, targets_text));
-      if (Status s = store_maps(options.keep, traced->textures, trace_key, keys); !s) return s.error();
+      if (Status s = store_maps(options.keep, *traced, trace_key, keys); !s) return s.error();
     }
-    if (counts) traced->textures = std::move(*counts);  // every texture map kept: only the vertices traced
+    if (counts) traced->textures = std::move(counts->textures), traced->boxes = counts->boxes;  // only the vertices traced
     out = std::move(*traced);
   } else {
-    out.textures = std::move(*counts);
+    out.textures = std::move(counts->textures), out.boxes = counts->boxes;
     std::optional<scene::Scene> cage;  // as the kept maps were traced (the same content: in their key)
     if (!options.cage.empty()) {
       auto loaded = scene::load_scene(options.cage);
@@ -356,6 +378,56 @@ Result<Bake> bake_or_reuse(const scene::Scene& low, const Targets& targets, cons
     if (kept[i]) reused.emplace_back(matbake::name_in(kMapNames, maps[i]));
   }
   return out;
+}
+
+// 'a', 'b': names from a file, quoted and escaped (appended: GCC 12 -O3 misreads `"'" + std::string`).
+std::string quoted(const std::vector<std::string>& names) {
+  std::string text;
+  for (const std::string& name : names) {
+    if (!text.empty()) text += ", ";
+    text += '\'';
+    text += escape_control(name);
+    text += '\'';
+  }
+  return text;
+}
+
+std::string percent(std::size_t part, std::size_t whole) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.3g%%", 100.0 * double(part) / double(whole));
+  return text;
+}
+
+// The misses judged, per texture and for the vertices: a share above max_misses is the error naming
+// the likely cause; below it, any miss is a warning, as is a ray that started inside a part.
+Status judge_misses(const Bake& baked, const Targets& targets, const FileOptions& options, double diagonal, FileReport& report) {
+  const double limit = options.request.max_misses;
+  // Of all misses when parts matched by name lack partners.
+  const std::string cause = baked.unmatched.empty() ? "" : "no high-poly part matches the low-poly parts " + quoted(baked.unmatched) + " by name";
+  const auto judge = [&](const std::string& what, std::size_t misses, std::size_t rays, const TextureBake* texture) -> Status {
+    if (misses == 0 || rays == 0) return success();
+    const std::string why = !cause.empty() ? cause : miss_cause(baked.boxes, texture ? *texture : TextureBake{}, options.request.bake, diagonal);
+    const std::string share = percent(misses, rays) + " of the rays (" + std::to_string(misses) + " of " + std::to_string(rays) + ")";
+    if (double(misses) > limit * double(rays)) {
+      char limit_text[32];
+      std::snprintf(limit_text, sizeof limit_text, "%g", limit);
+      return Error{"", what + ": " + share + " missed the high-poly, more than max_misses " + limit_text + " allows: " + why};
+    }
+    report.warnings.push_back(what + ": " + share + " missed the high-poly (their texels take their neighbours' values): " + why);
+    return success();
+  };
+  for (std::size_t t = 0; t < baked.textures.size() && t < targets.targets.size(); ++t) {
+    const TextureBake& texture = baked.textures[t];
+    const std::string& what = targets.targets[t].name;
+    if (Status s = judge(what, texture.misses, texture.samples, &texture); !s) return s;
+    if (texture.from_inside) {
+      report.warnings.push_back(what + ": " + percent(texture.from_inside, texture.samples) + " of the rays (" +
+                                std::to_string(texture.from_inside) + ") started inside a closed high-poly part (their first "
+                                "surface was a face's back) and read the surface beyond it: widen the cage (front) past "
+                                "that part, or match parts by name");
+    }
+  }
+  return judge("the vertices", baked.vertices.misses, baked.vertices.vertices, nullptr);
 }
 
 // What of a document a bake may remove once it has written its maps: what the scene reached as
@@ -396,7 +468,7 @@ Result<FileReport> bake_file(const fs::path& low_path, const FileOptions& option
     auto low = scene::scene_from_document(*doc, {.texcoords = true, .object_space = true});
     if (!low) return low.error();
     // Vertex maps alone need no UVs: no texture targets.
-    auto targets = options.request.bake.maps.empty() ? Result<Targets>(Targets{}) : material_targets(*doc, *low, options.request.per_instance);
+    auto targets = options.request.bake.maps.empty() ? Result<Targets>(Targets{}) : material_targets(*doc, *low, options.request.per_instance, options.high);
     if (!targets) return targets.error();
 
     // Each target's material: with per_instance, a placement's own copy (and its mesh's).
@@ -428,15 +500,28 @@ Result<FileReport> bake_file(const fs::path& low_path, const FileOptions& option
     report.notes = low->notes;
     report.notes.insert(report.notes.end(), targets->notes.begin(), targets->notes.end());
     if (!baked->unmatched.empty()) {
-      std::vector<std::string> names;
-      for (const std::string& name : baked->unmatched) names.push_back("'" + escape_control(name) + "'");
       report.notes.push_back("no high-poly part matches these low-poly parts by name, so each of their rays misses: " +
-                             join(names, ", "));
+                             quoted(baked->unmatched));
+    }
+    if (Status s = judge_misses(*baked, *targets, options, 2.0 * double(low->radius()), report); !s) {
+      return Error{doc->file, s.error().message};
+    }
+    for (std::size_t t = 0; t < baked->textures.size() && t < targets->targets.size(); ++t) {
+      const TextureBake& b = baked->textures[t];
+      const std::string& what = targets->targets[t].name;
+      if (b.outside_tile) {
+        report.notes.push_back(what + ": " + std::to_string(b.outside_tile) + " triangles have UVs wholly outside the 0–1 "
+                               "tile (a shell moved out by whole tiles): not baked");
+      }
+      if (b.overlapped) {
+        report.notes.push_back(what + ": " + std::to_string(b.overlapped) + " texels are covered by several triangles "
+                               "(overlapping UV islands, or a mesh placed several times): each holds their mean");
+      }
     }
     report.front = baked->front, report.back = baked->back;
     report.setup_seconds = baked->setup_seconds, report.trace_seconds = baked->trace_seconds;
-    const bool normal = std::find(options.request.bake.maps.begin(), options.request.bake.maps.end(), Map::normal) !=
-                        options.request.bake.maps.end();
+    // The maps stored in the low-poly's tangent basis: a runtime needs the basis they were baked in.
+    const bool tangent_basis = std::ranges::any_of(options.request.bake.maps, [](Map m) { return m == Map::normal || m == Map::bent_normal; });
     gltf::ImageCache cache(*doc, options.encoding, gltf::MadeFormat::png);
     for (std::size_t t = 0; t < targets->targets.size(); ++t) {
       auto written = write_maps(*doc, cache, options, *targets, t, into[t], baked->textures[t]);
@@ -456,7 +541,7 @@ Result<FileReport> bake_file(const fs::path& low_path, const FileOptions& option
     if (!options.request.bake.vertex_maps.empty()) {
       write_vertex_maps(*doc, *low, baked->vertices, options.request.vertex_ao_into, options.request.per_instance, report);
     }
-    if (normal) {
+    if (tangent_basis) {
       if (Status s = write_tangents(*doc, *low, *targets, report); !s) return s.error();
     }
     if (const auto removed = gltf::prune_unreachable(*doc, nullptr, &as_read); !removed.empty()) {

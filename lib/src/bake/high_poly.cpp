@@ -4,6 +4,8 @@
 #include <glm/mat2x2.hpp>
 #include <tbb/parallel_for.h>
 
+#include <limits>
+
 namespace matbake::bake {
 
 std::unique_ptr<HighPoly> HighPoly::build(const scene::Scene& high, std::shared_ptr<const ao::Bvh> bvh) {
@@ -18,7 +20,8 @@ std::unique_ptr<HighPoly> HighPoly::build(const scene::Scene& high, std::shared_
   return h;
 }
 
-std::optional<Hit> HighPoly::first_hit(const glm::vec3& origin, const glm::vec3& direction, float length, ao::Parts parts) const {
+std::optional<Hit> HighPoly::first_hit(const glm::vec3& origin, const glm::vec3& direction, float length, ao::Parts parts,
+                                       bool* from_inside) const {
   RTCRayHit rh;
   rh.ray.org_x = origin.x, rh.ray.org_y = origin.y, rh.ray.org_z = origin.z;
   rh.ray.dir_x = direction.x, rh.ray.dir_y = direction.y, rh.ray.dir_z = direction.z;
@@ -26,8 +29,12 @@ std::optional<Hit> HighPoly::first_hit(const glm::vec3& origin, const glm::vec3&
   rh.ray.mask = ~0u, rh.ray.id = 0, rh.ray.flags = 0;
   rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
   ao::RayContext context(false, {}, parts);
+  float nearest_back = std::numeric_limits<float>::infinity();
+  if (from_inside) context.nearest_back = &nearest_back;
   rtcIntersect1(bvh_->scene(), &context.embree, &rh);
-  if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return std::nullopt;
+  const bool missed = rh.hit.geomID == RTC_INVALID_GEOMETRY_ID;
+  if (from_inside) *from_inside = nearest_back < (missed ? std::numeric_limits<float>::infinity() : rh.ray.tfar);
+  if (missed) return std::nullopt;
   Hit hit;
   hit.instance = rh.hit.geomID;  // geometries were attached in instance order, from 0
   hit.triangle = rh.hit.primID;

@@ -30,8 +30,11 @@ class HighPoly {
   static std::unique_ptr<HighPoly> build(const scene::Scene& high, std::shared_ptr<const ao::Bvh> bvh);
 
   // The first hit on the front of a face (its winding's normal against the ray) of an instance in
-  // `parts`, within `length` of `origin` along the unit `direction`.
-  std::optional<Hit> first_hit(const glm::vec3& origin, const glm::vec3& direction, float length, ao::Parts parts = {}) const;
+  // `parts`, within `length` of `origin` along the unit `direction`. `from_inside`, when given, is
+  // set to whether the ray met the back of a face (of those parts) before that hit or without one:
+  // it started inside a closed part.
+  std::optional<Hit> first_hit(const glm::vec3& origin, const glm::vec3& direction, float length, ao::Parts parts = {},
+                               bool* from_inside = nullptr) const;
 
   // The mean curvature (κ₁ + κ₂)/2 at a hit, from the high-poly's normals: half the trace of the
   // shape operator of its triangle, the derivative of the linearly interpolated vertex normals

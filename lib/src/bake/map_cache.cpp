@@ -15,7 +15,7 @@ namespace matbake::bake {
 namespace fs = std::filesystem;
 namespace {
 
-constexpr int kForm = 1;
+constexpr int kForm = 2;  // 2: the trace's rays, misses, starts inside and probes' reach
 constexpr std::uintmax_t kIndexLimit = 1u << 20;  // a few hundred bytes a target and map
 
 std::string hex128(XXH128_hash_t hash) {
@@ -59,7 +59,8 @@ bool text_at(const nlohmann::json& j, const char* key, const std::string& expect
 nlohmann::json map_parameters(std::optional<Map> map, const Request& request) {
   nlohmann::json p = params::to_json(request_params(), request);
   // Another map asked or dropped changes none of the others; the vertex maps are never kept.
-  for (const char* unread : {"maps", "vertex_maps", "vertex_ao_into", "vertex_existing_colors"}) p.erase(unread);
+  // max_misses judges a trace, it does not change one.
+  for (const char* unread : {"maps", "vertex_maps", "vertex_ao_into", "vertex_existing_colors", "max_misses"}) p.erase(unread);
   const bool tangent = map == Map::normal || map == Map::bent_normal;
   if (!tangent) p.erase("green");
   if (map != Map::id) p.erase("id_by");
@@ -110,25 +111,36 @@ std::optional<KeptMap> load_map(const fs::path& folder, Map map, const std::stri
   return kept;
 }
 
-std::optional<std::vector<TextureBake>> load_trace(const fs::path& folder, const std::string& key, std::size_t targets) {
+std::optional<Bake> load_trace(const fs::path& folder, const std::string& key, std::size_t targets) {
   const nlohmann::json trace = read_index(folder).value("trace", nlohmann::json());
   if (!text_at(trace, "key", key) || !trace.contains("targets") || !trace["targets"].is_array() || trace["targets"].size() != targets) {
     return std::nullopt;
   }
-  std::vector<TextureBake> out;
+  // A field of another type reads as 0 (the maps, checked by hash, are what matters).
+  const auto count = [](const nlohmann::json& j, const char* k) {
+    return j.is_object() && j.value(k, nlohmann::json()).is_number_unsigned() ? j[k].get<std::size_t>() : 0;
+  };
+  const auto number = [](const nlohmann::json& j, const char* k) {
+    return j.is_object() && j.value(k, nlohmann::json()).is_number() ? j[k].get<double>() : 0.0;
+  };
+  Bake out;
+  const nlohmann::json boxes = trace.value("boxes", nlohmann::json());
+  out.boxes = {number(boxes, "low_diagonal"), number(boxes, "high_diagonal"), number(boxes, "overlap")};
   for (const nlohmann::json& t : trace["targets"]) {
     if (!t.is_object()) return std::nullopt;
-    TextureBake& b = out.emplace_back();
-    const auto count = [&](const char* k) { return t.value(k, nlohmann::json()).is_number_unsigned() ? t[k].get<std::size_t>() : 0; };
-    const auto number = [&](const char* k) { return t.value(k, nlohmann::json()).is_number() ? t[k].get<double>() : 0.0; };
-    b.texels = count("texels"), b.missed_texels = count("missed_texels"), b.padded = count("padded");
-    b.height_min = number("height_min"), b.height_max = number("height_max");
+    TextureBake& b = out.textures.emplace_back();
+    b.texels = count(t, "texels"), b.missed_texels = count(t, "missed_texels"), b.padded = count(t, "padded");
+    b.samples = count(t, "rays"), b.misses = count(t, "misses"), b.occlusion_rays = count(t, "occlusion_rays");
+    b.from_inside = count(t, "from_inside"), b.overlapped = count(t, "overlapped"), b.outside_tile = count(t, "outside_tile");
+    b.height_min = number(t, "height_min"), b.height_max = number(t, "height_max");
+    b.reach_front = number(t, "reach_front"), b.reach_back = number(t, "reach_back");
   }
   return out;
 }
 
-Status store_maps(const fs::path& folder, const std::vector<TextureBake>& baked, const std::string& trace_key,
+Status store_maps(const fs::path& folder, const Bake& bake, const std::string& trace_key,
                   const std::vector<std::pair<Map, std::string>>& keys) {
+  const std::vector<TextureBake>& baked = bake.textures;
   std::error_code ec;
   fs::create_directories(folder, ec);
   if (ec) return Error{folder.string(), "cannot make the folder of kept maps: " + ec.message()};
@@ -142,9 +154,13 @@ Status store_maps(const fs::path& folder, const std::vector<TextureBake>& baked,
   nlohmann::json stats = nlohmann::json::array();
   for (const TextureBake& t : baked) {
     stats.push_back({{"texels", t.texels}, {"missed_texels", t.missed_texels}, {"padded", t.padded},
-                     {"height_min", t.height_min}, {"height_max", t.height_max}});
+                     {"height_min", t.height_min}, {"height_max", t.height_max}, {"rays", t.samples}, {"misses", t.misses},
+                     {"occlusion_rays", t.occlusion_rays}, {"from_inside", t.from_inside}, {"overlapped", t.overlapped},
+                     {"outside_tile", t.outside_tile}, {"reach_front", t.reach_front}, {"reach_back", t.reach_back}});
   }
-  index["trace"] = {{"key", trace_key}, {"targets", stats}};
+  const nlohmann::json boxes = {{"low_diagonal", bake.boxes.low_diagonal}, {"high_diagonal", bake.boxes.high_diagonal},
+                                {"overlap", bake.boxes.overlap}};
+  index["trace"] = {{"key", trace_key}, {"targets", stats}, {"boxes", boxes}};
   if (Status s = write_file_atomically(index_file(folder), index.dump()); !s) return s;
   for (const auto& [map, key] : keys) {
     nlohmann::json files = nlohmann::json::array();

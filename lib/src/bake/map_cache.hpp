@@ -40,14 +40,13 @@ struct KeptMap {
 std::optional<KeptMap> load_map(const std::filesystem::path& folder, Map map, const std::string& key,
                                 std::size_t targets, int width, int height);
 
-// The counts of the trace kept under `key` (texels, missed and padded, height range), one per target,
-// without maps; nothing when absent or not as recorded.
-std::optional<std::vector<TextureBake>> load_trace(const std::filesystem::path& folder, const std::string& key,
-                                                   std::size_t targets);
+// The trace kept under `key`: its boxes and per target its counts (texels, rays, misses, starts
+// inside, ...), without maps; nothing when absent or not as recorded.
+std::optional<Bake> load_trace(const std::filesystem::path& folder, const std::string& key, std::size_t targets);
 
-// Keeps each of `baked`'s maps named in `keys` (their targets' images) under its key, and the
-// trace's counts under `trace_key`; the index is written before (without those maps) and after.
-Status store_maps(const std::filesystem::path& folder, const std::vector<TextureBake>& baked, const std::string& trace_key,
+// Keeps each of `bake`'s maps named in `keys` (their targets' images) under its key, and the
+// trace's counts and boxes under `trace_key`; the index is written before (without those maps) and after.
+Status store_maps(const std::filesystem::path& folder, const Bake& bake, const std::string& trace_key,
                   const std::vector<std::pair<Map, std::string>>& keys);
 
 // The files store_maps writes for `maps` over `targets` targets (for the output check).

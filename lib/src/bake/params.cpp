@@ -143,6 +143,12 @@ params::Group<Request> make_group() {
                                          "and its own maps (default: averaged)",
                                  .example = "true"},
                             [](auto& r) -> auto& { return r.per_instance; }),
+      params::number<Request>(Spec{.name = "max_misses",
+                                   .help = "The share of a material's rays that may miss the high-poly before the bake "
+                                           "fails, naming the likely cause (units, placement, the cage); below it, "
+                                           "misses are a warning",
+                                   .min = 0, .max = 1, .example = "0.05"},
+                              [](auto& r) -> auto& { return r.max_misses; }),
       params::integer<Request>(Spec{.name = "seed", .help = "Scrambling seed of the texel positions",
                                     .min = 0, .max = 9007199254740992.0, .example = "3"},
                                [](auto& r) -> auto& { return r.bake.seed; }),

@@ -283,6 +283,7 @@ Result<std::vector<fs::path>> run_scene(const Job& job, const JobContext& ctx, c
       auto made = bake_scene(job, s, state_folder, options.encoding);
       if (!made) return made.error();
       if (Status st = check_baked_materials(s, *made, options.materials); !st) return st.error();
+      for (const std::string& w : made->report.warnings) report.warnings.push_back("scenes." + s.name + ".bake: " + w);
       for (const bake::TextureReport& t : made->report.textures) {  // a placement's copy takes its original's
         for (exporter::MaterialMaps& g : options.materials) {
           if (!t.copy_of.empty() && g.material == t.copy_of) g.copies.push_back(t.name);

@@ -166,12 +166,13 @@ nlohmann::json to_json(const bake::FileReport& r) {
                         {"texcoord", t.texcoord}, {"texels", t.texels}, {"rays", t.samples}, {"misses", t.misses},
                         {"missed_texels", t.missed_texels}, {"padded", t.padded}, {"height_min", t.height_min},
                         {"height_max", t.height_max}, {"files", t.files}, {"existing", t.existing},
-                        {"occlusion_rays", t.occlusion_rays}});
+                        {"occlusion_rays", t.occlusion_rays}, {"from_inside", t.from_inside}, {"overlapped", t.overlapped},
+                        {"outside_tile", t.outside_tile}});
     if (t.copy_of_material >= 0) textures.back()["copy_of"] = t.copy_of, textures.back()["copy_of_material"] = t.copy_of_material;
   }
   return {{"front", r.front}, {"back", r.back}, {"textures", textures}, {"tangent_primitives", r.tangent_primitives},
           {"split_vertices", r.split_vertices}, {"seconds", r.seconds}, {"setup_seconds", r.setup_seconds},
-          {"trace_seconds", r.trace_seconds}, {"notes", r.notes}, {"written", r.written}, {"reused", r.reused},
+          {"trace_seconds", r.trace_seconds}, {"notes", r.notes}, {"warnings", r.warnings}, {"written", r.written}, {"reused", r.reused},
           {"vertices", {{"vertices", r.vertices.vertices}, {"misses", r.vertices.misses},
                         {"occlusion_rays", r.vertices.occlusion_rays}, {"attributes", r.vertices.attributes}}}};
 }

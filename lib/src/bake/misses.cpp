@@ -1,0 +1,62 @@
+// Why a bake's rays missed, from what the two meshes and the probes tell: what its error and
+// warnings name as the likely cause.
+#include <glm/geometric.hpp>
+
+#include <cmath>
+#include <cstdio>
+
+#include "matbake/bake.hpp"
+
+namespace matbake::bake {
+
+Boxes compare_boxes(const scene::Scene& low, const scene::Scene& high) {
+  Boxes out;
+  const glm::dvec3 a0(low.bounds_min), a1(low.bounds_max), b0(high.bounds_min), b1(high.bounds_max);
+  out.low_diagonal = glm::length(a1 - a0), out.high_diagonal = glm::length(b1 - b0);
+  // A flat low-poly has no extent along its normal: an axis counts at least 1% of the diagonal.
+  const double least = 0.01 * std::max(out.low_diagonal, out.high_diagonal);
+  for (int k = 0; k < 3; ++k) {
+    const double pad = std::max(0.0, least - (a1[k] - a0[k])) / 2;
+    const double lo = a0[k] - pad, hi = a1[k] + pad;
+    const double shared = std::max(0.0, std::min(hi, b1[k] + pad) - std::max(lo, b0[k] - pad));
+    out.overlap = std::min(out.overlap, hi > lo ? shared / (hi - lo) : 1.0);
+  }
+  return out;
+}
+
+namespace {
+
+std::string number(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.3g", v);
+  return text;
+}
+
+}  // namespace
+
+std::string miss_cause(const Boxes& boxes, const TextureBake& texture, const Options& options, double diagonal) {
+  if (boxes.low_diagonal > 0 && boxes.high_diagonal > 0) {
+    const double ratio = boxes.high_diagonal / boxes.low_diagonal;
+    if (ratio >= 5 || ratio <= 0.2) {
+      const double power = std::pow(10.0, std::round(std::log10(ratio)));
+      return "the high-poly's bounding box is " + number(ratio) + "× the low-poly's: the two are likely in different units (a "
+             "factor of " + number(power) + ": centimetres against metres?)";
+    }
+  }
+  if (boxes.overlap < 0.5) {
+    return "the two meshes' bounding boxes barely overlap (" + number(100 * boxes.overlap) +
+           "% of the low-poly's extent along one axis): one is misplaced, or it is the wrong file";
+  }
+  if (texture.reach_front > 0 || texture.reach_back > 0) {
+    const double unit = options.absolute_distances || !(diagonal > 0) ? 1.0 : diagonal;
+    std::string wider;
+    if (texture.reach_front > 0) wider = "front " + number(texture.reach_front / unit);
+    if (texture.reach_back > 0) wider += std::string(wider.empty() ? "" : " and ") + "back " + number(texture.reach_back / unit);
+    return "the cage is too small: " + wider + (options.absolute_distances ? " (scene units)" : " (of the diagonal)") +
+           " would reach 95% of the missed rays that have the high-poly along them";
+  }
+  return "no high-poly surface lies along the missed rays within the low-poly's size: holes in the high-poly, or parts "
+         "of the low-poly it does not have";
+}
+
+}  // namespace matbake::bake
