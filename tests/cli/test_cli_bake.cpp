@@ -232,7 +232,7 @@ TEST(CliBake, AUnitsOrPlacementMistakeFailsNamingTheCauseAndMissesBelowTheLimitW
   EXPECT_EQ(r.exit_code, 1);
   expect_one_error_line(r, low, "material 0 '");
   EXPECT_NE(r.err.find("100% of the rays"), std::string::npos) << r.err;
-  EXPECT_NE(r.err.find("more than max_misses 0.5 allows: the high-poly's bounding box is 100× the low-poly's: the two are "
+  EXPECT_NE(r.err.find("more than --max-misses 0.5 allows: the high-poly's bounding box is 100× the low-poly's: the two are "
                        "likely in different units"), std::string::npos) << r.err;
   r = bake_from("high_moved.gltf");
   EXPECT_EQ(r.exit_code, 1);
@@ -274,6 +274,54 @@ TEST(CliBake, AUnitsOrPlacementMistakeFailsNamingTheCauseAndMissesBelowTheLimitW
   EXPECT_EQ(r.exit_code, 1);
   expect_one_error_line(r, (dir / "no_material.gltf").string(), "no primitive of the low-poly has a material");
   EXPECT_FALSE(fs::exists(out));
+}
+
+// A plane over a tilted plane (z = 0.1x + 0.05y − 0.02 beneath the low-poly's [-1, 1]², every texel
+// centre one ray): the normal is the tilted plane's everywhere and the height its z. At 16 bits the
+// normal map's codes are within one 16-bit step of n = normalize(−0.1, −0.05, 1) (8 bits is 128×
+// coarser); the height as a 16-bit PNG, decoded through its reported range, within one step of
+// it; the mask all hits. green directx into the glTF is one error line; beside it (bent_normal), allowed.
+TEST(CliBake, SixteenBitNormalsAndPngMapsHoldTheTiltedPlaneWithinOneStep) {
+  TempDir dir;
+  const std::vector<std::array<std::uint32_t, 3>> quad = {{0, 1, 2}, {0, 2, 3}};
+  write_grey_mesh(dir / "low.gltf", {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}}, std::vector<glm::dvec3>(4, {0, 0, 1}),
+                  {{0, 1}, {1, 1}, {1, 0}, {0, 0}}, quad);
+  const auto plane = [](double x, double y) { return 0.1 * x + 0.05 * y - 0.02; };
+  const glm::dvec3 n = glm::normalize(glm::dvec3(-0.1, -0.05, 1));
+  std::vector<glm::dvec3> corners;
+  for (const auto& [x, y] : {std::pair{-2.0, -2.0}, {2.0, -2.0}, {2.0, 2.0}, {-2.0, 2.0}}) corners.emplace_back(x, y, plane(x, y));
+  write_grey_mesh(dir / "high.gltf", corners, std::vector<glm::dvec3>(4, n), {}, quad);
+  const auto bake_with = [&](std::vector<std::string> extra) {
+    std::vector<std::string> args{"--json", "bake", (dir / "low.gltf").string(), "--from", (dir / "high.gltf").string(),
+                                  "-o", (dir / "out.gltf").string(), "--size", "32", "--texel-samples", "1", "--front", "0.5",
+                                  "--back", "0.5", "--absolute-cage"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return matbake(args);
+  };
+  const auto r = bake_with({"--maps", "normal,height,mask", "--bits", "16", "--map-format", "png"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto t = nlohmann::json::parse(r.out)["textures"][0];
+  const auto normal = image::read_image(dir / t["files"][0].get<std::string>(), color::Transfer::linear);
+  const auto height = image::read_image(t["files"][1].get<std::string>(), color::Transfer::linear);
+  const auto mask = image::read_image(t["files"][2].get<std::string>(), color::Transfer::linear);
+  ASSERT_TRUE(normal && height && mask);
+  ASSERT_EQ(normal->width * normal->height, 32 * 32);
+  const double lo = t["ranges"][1][0], hi = t["ranges"][1][1], step = 1.0 / 65535;
+  EXPECT_EQ(lo, -hi);
+  for (int j = 0; j < 32; ++j) {
+    for (int i = 0; i < 32; ++i) {
+      const std::size_t texel = std::size_t(j * 32 + i);
+      const double x = 2 * (i + 0.5) / 32 - 1, y = 1 - 2 * (j + 0.5) / 32;
+      for (int k = 0; k < 3; ++k) ASSERT_NEAR(normal->pixels[3 * texel + std::size_t(k)] * 2.0 - 1, n[k], 2 * step) << i << "," << j;
+      ASSERT_NEAR(lo + height->pixels[texel] * (hi - lo), plane(x, y), (hi - lo) * step) << i << "," << j;
+      for (int k = 0; k < 3; ++k) ASSERT_EQ(mask->pixels[3 * texel + std::size_t(k)], k == 0 ? 1.0f : 0.0f) << i << "," << j;
+    }
+  }
+  const auto refused = bake_with({"--maps", "normal,height", "--green", "directx"});
+  EXPECT_EQ(refused.exit_code, 2);
+  expect_one_error_line(refused, "", "--green directx: a glTF's normalTexture is OpenGL's convention");
+  const auto beside = bake_with({"--maps", "bent_normal", "--green", "directx", "--ao-samples", "4"});
+  EXPECT_EQ(beside.exit_code, 0) << beside.err;
 }
 
 // A bake removes what it leaves unused, as gltf-transform's prune would, and nothing else: the
@@ -509,7 +557,7 @@ TEST(CliBake, MatchByNameKeepsAPartsRaysOnItsOwnHighPolyPart) {
   fs::remove(out);
   auto r = bake_with({"--match", "by_name"});
   EXPECT_EQ(r.exit_code, 1);
-  EXPECT_NE(r.err.find("material 0 'plate': 100% of the rays (256 of 256) missed the high-poly, more than max_misses 0.5 "
+  EXPECT_NE(r.err.find("material 0 'plate': 100% of the rays (256 of 256) missed the high-poly, more than --max-misses 0.5 "
                        "allows: no high-poly part matches the low-poly parts 'washer_low' by name"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(out));
   r = bake_with({"--match", "by_name", "--max-misses", "1"});
@@ -567,15 +615,24 @@ TEST(CliBake, BadRequestsAreOneErrorLineAndWriteNothing) {
 TEST(CliBake, ABakedIcosphereRendersInThreeJsCloserToTheSphereThanItself) {
   TempDir dir;
   write_icosphere_pair(dir.path(), 4, 2);
-  for (const std::string green : {"opengl", "directx"}) {
-    const auto r = matbake({"bake", (dir / "low.gltf").string(), "--from", (dir / "high.gltf").string(), "-o",
-                            (dir / (green + ".glb")).string(), "--size", "512", "--front", "0.3", "--back", "0.3",
-                            "--absolute-cage", "--green", green});
-    ASSERT_EQ(r.exit_code, 0) << r.err;
-  }
+  const auto r = matbake({"--json", "bake", (dir / "low.gltf").string(), "--from", (dir / "high.gltf").string(), "-o",
+                          (dir / "opengl.gltf").string(), "--size", "512", "--front", "0.3", "--back", "0.3", "--absolute-cage"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  // The other convention (matbake refuses to write it into a glTF): the same file with the normal
+  // map's green flipped, 255 − code.
+  const std::string normal = nlohmann::json::parse(r.out)["textures"][0]["files"][0];
+  auto map = image::read_image(dir / normal, color::Transfer::linear);
+  ASSERT_TRUE(map) << map.error().to_string();
+  for (std::size_t i = 1; i < map->pixels.size(); i += std::size_t(map->channels)) map->pixels[i] = 1.0f - map->pixels[i];
+  image::WriteOptions png;
+  png.type = image::SampleType::u8;
+  ASSERT_TRUE(image::write_image(*map, dir / "flipped.png", png));
+  std::string text = read_bytes(dir / "opengl.gltf");
+  text.replace(text.find("\"" + normal + "\""), normal.size() + 2, "\"flipped.png\"");
+  write_bytes(dir / "directx.gltf", text);
   std::string why_not;
   const auto rendered = render_in_three(dir.path(), {{"high", dir / "high.gltf"}, {"low", dir / "low.gltf"},
-                                                     {"baked", dir / "opengl.glb"}, {"flipped", dir / "directx.glb"}},
+                                                     {"baked", dir / "opengl.gltf"}, {"flipped", dir / "directx.gltf"}},
                                         why_not);
   if (!rendered) GTEST_SKIP() << why_not;
   for (const auto& [name, model] : *rendered) EXPECT_TRUE(model.console.empty()) << name << ": " << model.console.front();

@@ -820,11 +820,12 @@ TEST(Bake, AveragedNormalsCastOneRayWhereAHardEdgesSplitVerticesMeet) {
 // bump wherever its surface is higher than 0.2, and finds nothing. Those texels, and no others,
 // miss (one position a texel: its centre); the probe's reach for them is the bump's height there,
 // whose 95th percentile is the front that would have met 95% of them (float64 reference over the
-// same texel centres; float32 distances of magnitude 3).
+// same texel centres; float32 distances of magnitude 3). The mask is (0, 1, 0) on exactly those
+// texels, (1, 0, 0) on the others: neither filled nor padded.
 TEST(BakeMisses, ACageBelowABumpMissesWhereTheBumpRisesAboveItAndSaysHowFarToReach) {
   const BumpPair pair = bump_pair(40, 0.5);
   Options options;
-  options.maps = {Map::height};
+  options.maps = {Map::height, Map::mask};
   options.front = 0.2, options.back = 0.25, options.absolute_distances = true;
   const ao::TextureOptions texture{.width = 64, .height = 64, .padding = 2, .texel_samples = 1};
   auto baked = bake(pair.low, pair.high, {ao::TextureTarget{{0}, 0}}, texture, options);
@@ -836,6 +837,8 @@ TEST(BakeMisses, ACageBelowABumpMissesWhereTheBumpRisesAboveItAndSaysHowFarToRea
       const double z = bump_surface(pair, 2 * (i + 0.5) / 64 - 1, 1 - 2 * (j + 0.5) / 64).z;
       ASSERT_GT(std::abs(z - 0.2), 1e-4) << "a texel on the boundary would make the count a coin toss";
       if (z > 0.2) above.push_back(z);
+      const dvec3 mask = texel3(map_of(baked->textures[0], Map::mask), std::size_t(j * 64 + i));
+      ASSERT_EQ(mask, z > 0.2 ? dvec3(0, 1, 0) : dvec3(1, 0, 0)) << i << "," << j;
     }
   }
   ASSERT_GT(above.size(), 100u);

@@ -52,8 +52,11 @@ enum class Map {
                 // is met), scene units; a slab of thickness t gives t for every ray
   transfer,     // the high-poly's base colour at the hit (BaseColor below), linear RGBA
   id,           // the material of the texel's first hit, as id_color's RGB (no blending: a mask)
+  mask,         // what the texel's rays did, as shares of them: hit (R), missed (G), started inside a
+                // closed part (B, counted among the hits); 0 where nothing is traced. Neither
+                // filled nor padded: it shows the misses the other maps hide
 };
-inline constexpr NameTable<Map, 9> kMapNames{{{Map::normal, "normal"},
+inline constexpr NameTable<Map, 10> kMapNames{{{Map::normal, "normal"},
                                               {Map::height, "height"},
                                               {Map::position, "position"},
                                               {Map::curvature, "curvature"},
@@ -61,7 +64,8 @@ inline constexpr NameTable<Map, 9> kMapNames{{{Map::normal, "normal"},
                                               {Map::bent_normal, "bent_normal"},
                                               {Map::thickness, "thickness"},
                                               {Map::transfer, "transfer"},
-                                              {Map::id, "id"}}};
+                                              {Map::id, "id"},
+                                              {Map::mask, "mask"}}};
 int channels(Map map);
 // The maps a low-poly vertex can take (one value each: ao, thickness, curvature, height).
 bool per_vertex(Map map);

@@ -13,6 +13,11 @@
 
 namespace matbake::bake {
 
+// How the maps that are not the material's own textures (all but normal, ao and transfer) are
+// written beside the output: float EXR, or PNG with each map's values mapped onto 0–1 (map_range).
+enum class MapFormat { exr, png };
+inline constexpr NameTable<MapFormat, 2> kMapFormatNames{{{MapFormat::exr, "exr"}, {MapFormat::png, "png"}}};
+
 struct Request {
   Options bake;
   ao::TextureOptions texture{.width = 1024, .height = 1024, .padding = -1, .texel_samples = 4};
@@ -25,7 +30,15 @@ struct Request {
   // bake fails: a units or placement mistake misses nearly all; a sound bake a few percent, and the
   // roughest pair the tests bake (a Khronos model onto its 10% simplification) 28%.
   double max_misses = 0.5;
+  int bits = 8;  // of every PNG the bake writes: the material's textures, and the maps beside with MapFormat::png
+  MapFormat map_format = MapFormat::exr;
 };
+
+// The values a PNG map's 0 and 1 stand for (MapFormat::png): the encoded maps (normal, bent
+// normal, ao, transfer, id, mask) as they are, 0 to 1; height and curvature symmetric about 0 (½ is
+// 0), to the largest magnitude baked; thickness 0 to its largest; position the smallest to the
+// largest coordinate of any axis (one scale for all three). A map of one value spans 1 around it.
+std::pair<double, double> map_range(const MapImage& image);
 
 struct FileOptions {
   std::filesystem::path high;    // .gltf or .glb: the surface the maps come from
@@ -48,6 +61,7 @@ struct TextureReport {
   double height_min = 0, height_max = 0;
   std::size_t from_inside = 0, overlapped = 0, outside_tile = 0;  // bake.hpp's TextureBake
   std::vector<std::string> files;  // per map, in the order asked: the image's URI or the file written
+  std::vector<std::pair<double, double>> ranges;  // per map: what its PNG's 0 and 1 stand for (EXR: the values themselves, {0, 0})
   std::string existing;            // what happened to the material's own normalTexture and occlusionTexture
                                    // ("", "normal replaced", "occlusion replaced", both)
 };

@@ -297,6 +297,18 @@ Param<T> integer(Spec spec, Field field) {
           [field](const T& t) { return nlohmann::json(field(t)); }};
 }
 
+// A PNG's bits a channel, 8 or 16, into an integer field.
+template <class T, class Field>
+Param<T> png_bits(Spec spec, Field field) {
+  spec.min = 8, spec.max = 16;
+  Param<T> p = integer<T>(std::move(spec), field);
+  p.set = [store = p.set](T& t, const Value& v) -> std::optional<std::string> {
+    if (std::get<std::int64_t>(v) != 8 && std::get<std::int64_t>(v) != 16) return "8 or 16";
+    return store(t, v);
+  };
+  return p;
+}
+
 template <class T, class Field>
 Param<T> number(Spec spec, Field field) {
   spec.kind = Kind::number;

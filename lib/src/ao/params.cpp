@@ -60,15 +60,9 @@ Param<Request> existing_occlusion() {
 }
 
 Param<Request> bits() {
-  auto p = params::integer<Request>(Spec{.name = "bits", .help = "Linear PNG bits of the texture: 8 or 16", .min = 8,
-                                         .max = 16, .example = "16", .needs = {{"texture"}}},
-                                    [](auto& r) -> auto& { return texture_of(r).bits; });
-  const auto store = p.set;
-  p.set = [store](Request& r, const Value& v) -> std::optional<std::string> {
-    if (std::get<std::int64_t>(v) != 8 && std::get<std::int64_t>(v) != 16) return "8 or 16";
-    return store(r, v);
-  };
-  return p;
+  return params::png_bits<Request>(Spec{.name = "bits", .help = "Linear PNG bits of the texture: 8 or 16", .example = "16",
+                                        .needs = {{"texture"}}},
+                                   [](auto& r) -> auto& { return texture_of(r).bits; });
 }
 
 params::Group<Request> make_group() {

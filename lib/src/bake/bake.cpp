@@ -326,7 +326,18 @@ void store(const TexelSum& sum, const Options& options, std::size_t texel, Textu
         for (int k = 0; k < 3; ++k) v[k] = rgb[k];
         break;
       }
+      case Map::mask: break;  // store_mask's, hit or not
     }
+  }
+}
+
+// The mask's texel (Map::mask), written for every traced texel, whether its rays hit or not.
+void store_mask(const TexelSum& sum, std::size_t texel, TextureBake& out) {
+  for (MapImage& image : out.maps) {
+    if (image.map != Map::mask || sum.rays == 0) continue;
+    float* v = &image.values[texel * 3];
+    v[0] = float(sum.hits) / float(sum.rays), v[1] = float(sum.rays - sum.hits) / float(sum.rays);
+    v[2] = float(sum.from_inside) / float(sum.rays);
   }
 }
 
@@ -469,7 +480,7 @@ bool per_vertex(Map map) { return map == Map::ao || map == Map::thickness || map
 
 int channels(Map map) {
   if (map == Map::transfer) return 4;
-  return map == Map::normal || map == Map::bent_normal || map == Map::position || map == Map::id ? 3 : 1;
+  return map == Map::normal || map == Map::bent_normal || map == Map::position || map == Map::id || map == Map::mask ? 3 : 1;
 }
 
 glm::vec3 id_color(int id) {
@@ -633,6 +644,7 @@ void trace_tile(const TraceContext& context, const Options& options, const ao::t
     tally.from_inside += std::size_t(sum.from_inside);
     tally.wanted_front.insert(tally.wanted_front.end(), sum.wanted_front.begin(), sum.wanted_front.end());
     tally.wanted_back.insert(tally.wanted_back.end(), sum.wanted_back.begin(), sum.wanted_back.end());
+    store_mask(sum, texel, out);
     if (sum.hits == 0) {
       ++tally.missed_texels;
       continue;
@@ -699,6 +711,7 @@ Result<TextureBake> trace_target(const TraceContext& context, const Options& opt
   const std::vector<std::int64_t> nearest_hit =
       out.missed_texels ? ao::texels::nearest_mapped(hit, texture.width, texture.height) : std::vector<std::int64_t>{};
   for (MapImage& image : out.maps) {
+    if (image.map == Map::mask) continue;  // the misses as they are
     fill_missed(image, nearest_hit, hit, was_traced);
     out.padded = ao::texels::pad_channels(image.values, image.channels, was_traced, texture.width, texture.height,
                                           ao::padding_for(texture));

@@ -53,7 +53,7 @@ std::string no_target_reason(const scene::Scene& low, bool no_material, const fs
   if (auto dense = scene::load_scene(high); dense && low_triangles > triangle_count(*dense)) {
     return "the low-poly's materials lack their UV sets, and it has " + std::to_string(low_triangles) +
            " triangles, more than the high-poly's " + std::to_string(triangle_count(*dense)) +
-           ": are the two swapped? (matbake bake LOW --from HIGH)";
+           ": are the two swapped? (the low-poly takes the maps, the high-poly gives them)";
   }
   return "no material of the low-poly can take baked maps: each needs its UV set (TEXCOORD_n of its normalTexture, else "
          "TEXCOORD_0) on all its primitives; unwrap the low-poly";
@@ -124,6 +124,16 @@ std::optional<Slot> material_slot(Map map) {
   }
 }
 
+// A DirectX-convention normal map in a glTF's normalTexture, which is OpenGL's: refused.
+Status check_green(const Options& bake) {
+  if (bake.green != Green::directx || std::ranges::find(bake.maps, Map::normal) == bake.maps.end()) return success();
+  return Error{"", mention("green", "directx") + ": a glTF's normalTexture is OpenGL's convention (green up the texture), and "
+                   "every glTF viewer would shade this normal map inverted; bake with " + mention("green", "opengl") +
+                   " (and flip green in the engine's import), or leave normal out of the maps (bent_normal, written "
+                   "beside the glTF, follows green)",
+               true};
+}
+
 // The high-poly's materials' base colours (transfer): factors, and textures decoded to linear
 // with their UV sets, transforms and wrap modes.
 Result<std::vector<BaseColor>> base_colors(const fs::path& high, const image::Encoding& encoding) {
@@ -159,8 +169,30 @@ Result<std::vector<BaseColor>> base_colors(const fs::path& high, const image::En
   return out;
 }
 
-fs::path float_map_file(const fs::path& output, const std::string& material_name, Map map) {
-  return output.parent_path() / (output.stem().string() + "_" + material_name + "_" + std::string(matbake::name_in(kMapNames, map)) + ".exr");
+// A map written beside the output (not one of the material's textures): EXR or PNG.
+fs::path beside_file(const fs::path& output, const std::string& material_name, Map map, MapFormat format) {
+  return output.parent_path() / (output.stem().string() + "_" + material_name + "_" + std::string(matbake::name_in(kMapNames, map)) +
+                                 (format == MapFormat::png ? ".png" : ".exr"));
+}
+
+image::SampleType png_type(const Request& request) { return request.bits == 16 ? image::SampleType::u16 : image::SampleType::u8; }
+
+// A map beside the output: float EXR, or a PNG of its values mapped onto 0–1 (map_range), which
+// `range` returns.
+Status write_beside(image::Image img, const fs::path& file, const FileOptions& options, const MapImage& map,
+                    std::pair<double, double>& range) {
+  image::WriteOptions write;
+  write.png_level = options.encoding.png_level;
+  if (options.request.map_format == MapFormat::exr) {
+    write.type = image::SampleType::f32;
+    range = {0, 0};
+    return image::write_image(img, file, write);
+  }
+  range = map_range(map);
+  const double scale = 1.0 / (range.second - range.first);
+  for (float& v : img.pixels) v = float(std::clamp((double(v) - range.first) * scale, 0.0, 1.0));
+  write.type = png_type(options.request);
+  return image::write_image(img, file, write);
 }
 
 // TANGENT (and NORMAL where missing) on each baked primitive, once per mesh primitive.
@@ -208,13 +240,12 @@ Result<TextureReport> write_maps(gltf::Document& doc, const gltf::ImageCache& ca
   const std::string file_name = gltf::material_file_name(material, m);
   for (MapImage& map : baked.maps) {
     image::Image img = gltf::blank(baked.width, baked.height, map.channels);
-    img.pixels = std::move(map.values);
+    img.pixels = map.values;
     const std::optional<Slot> slot = material_slot(map.map);
+    std::pair<double, double>& range = report.ranges.emplace_back(0.0, 1.0);
     if (!slot) {
-      const fs::path file = float_map_file(options.output, file_name, map.map);
-      image::WriteOptions exr;
-      exr.type = image::SampleType::f32;
-      if (Status s = image::write_image(img, file, exr); !s) return s.error();
+      const fs::path file = beside_file(options.output, file_name, map.map, options.request.map_format);
+      if (Status s = write_beside(std::move(img), file, options, map, range); !s) return s.error();
       report.files.push_back(file.string());
       continue;
     }
@@ -228,7 +259,7 @@ Result<TextureReport> write_maps(gltf::Document& doc, const gltf::ImageCache& ca
       report.existing += std::string(report.existing.empty() ? "" : ", ") + std::string(matbake::name_in(kMapNames, map.map)) + " replaced";
     }
     const std::string name = options.output.stem().string() + "_" + file_name + "_" + std::string(matbake::name_in(kMapNames, map.map));
-    auto made = cache.add_texture(doc, img, slot->colour, name, sampler_from);
+    auto made = cache.add_texture(doc, img, slot->colour, name, sampler_from, png_type(options.request));
     if (!made) return made.error();
     info["index"] = made->index;  // no transform: the bake is over raw UVs
     if (report.texcoord != 0) info["texCoord"] = report.texcoord;
@@ -411,7 +442,7 @@ Status judge_misses(const Bake& baked, const Targets& targets, const FileOptions
     if (double(misses) > limit * double(rays)) {
       char limit_text[32];
       std::snprintf(limit_text, sizeof limit_text, "%g", limit);
-      return Error{"", what + ": " + share + " missed the high-poly, more than max_misses " + limit_text + " allows: " + why};
+      return Error{"", what + ": " + share + " missed the high-poly, more than " + mention("max_misses", limit_text) + " allows: " + why};
     }
     report.warnings.push_back(what + ": " + share + " missed the high-poly (their texels take their neighbours' values): " + why);
     return success();
@@ -443,12 +474,30 @@ gltf::Reachable reach_before_bake(Json& json) {
 
 }  // namespace
 
+std::pair<double, double> map_range(const MapImage& image) {
+  double lo = 0, hi = 1, largest = 0;
+  const auto [smallest, biggest] = std::minmax_element(image.values.begin(), image.values.end());
+  for (float v : image.values) largest = std::max(largest, double(std::abs(v)));
+  switch (image.map) {
+    case Map::height:
+    case Map::curvature: lo = -largest, hi = largest; break;
+    case Map::thickness: lo = 0, hi = largest; break;
+    case Map::position:
+      if (smallest != image.values.end()) lo = *smallest, hi = *biggest;
+      break;
+    default: return {0.0, 1.0};  // encoded already
+  }
+  if (!(hi > lo)) lo -= 0.5, hi += 0.5;  // one value: 1 around it
+  return {lo, hi};
+}
+
 Result<FileReport> bake_file(const fs::path& low_path, const FileOptions& options) {
   return guarded(low_path.string(), [&]() -> Result<FileReport> {
     if (const fs::path ext = options.output.extension(); ext != ".gltf" && ext != ".glb") {
       return Error{options.output.string(), "the output is .gltf or .glb", true};
     }
     if (Status s = check(options.request.bake); !s) return s.error();
+    if (Status s = check_green(options.request.bake); !s) return s.error();
     const auto start = std::chrono::steady_clock::now();
     // The inputs' content before they are loaded: kept maps are keyed by what was read, at worst older.
     std::vector<fs::path> inputs = files_of(low_path);
@@ -481,7 +530,8 @@ Result<FileReport> bake_file(const fs::path& low_path, const FileOptions& option
     for (int m : into) {
       for (Map map : options.request.bake.maps) {
         if (material_slot(map)) continue;
-        outputs.push_back({float_map_file(options.output, gltf::material_file_name(materials[std::size_t(m)], m), map),
+        outputs.push_back({beside_file(options.output, gltf::material_file_name(materials[std::size_t(m)], m), map,
+                                       options.request.map_format),
                            std::string(matbake::name_in(kMapNames, map)) + " map"});
       }
     }

@@ -59,8 +59,10 @@ bool text_at(const nlohmann::json& j, const char* key, const std::string& expect
 nlohmann::json map_parameters(std::optional<Map> map, const Request& request) {
   nlohmann::json p = params::to_json(request_params(), request);
   // Another map asked or dropped changes none of the others; the vertex maps are never kept.
-  // max_misses judges a trace, it does not change one.
-  for (const char* unread : {"maps", "vertex_maps", "vertex_ao_into", "vertex_existing_colors", "max_misses"}) p.erase(unread);
+  // max_misses judges a trace, bits and map_format write it: none changes one.
+  for (const char* unread : {"maps", "vertex_maps", "vertex_ao_into", "vertex_existing_colors", "max_misses", "bits", "map_format"}) {
+    p.erase(unread);
+  }
   const bool tangent = map == Map::normal || map == Map::bent_normal;
   if (!tangent) p.erase("green");
   if (map != Map::id) p.erase("id_by");

@@ -149,6 +149,16 @@ params::Group<Request> make_group() {
                                            "misses are a warning",
                                    .min = 0, .max = 1, .example = "0.05"},
                               [](auto& r) -> auto& { return r.max_misses; }),
+      params::png_bits<Request>(Spec{.name = "bits",
+                                     .help = "Bits of every PNG the bake writes: 8 or 16 (the normal map's 16-bit step is "
+                                             "0.0017°)",
+                                     .example = "16"},
+                                [](auto& r) -> auto& { return r.bits; }),
+      params::choice<Request>(Spec{.name = "map_format",
+                                   .help = "The maps written beside the glTF (all but normal, ao and transfer): exr (float) "
+                                           "or png (bits deep, values mapped onto 0-1 as reported)",
+                                   .example = "png"},
+                              [](auto& r) -> auto& { return r.map_format; }, kMapFormatNames),
       params::integer<Request>(Spec{.name = "seed", .help = "Scrambling seed of the texel positions",
                                     .min = 0, .max = 9007199254740992.0, .example = "3"},
                                [](auto& r) -> auto& { return r.bake.seed; }),

@@ -17,11 +17,11 @@ std::vector<fs::path> bake_folders(const fs::path& state_folder, const Job& job)
 
 namespace {
 
-// A file a bake writes in its work folder (the baked glTF, its maps) or in kept/ (maps.json and
+// A file a bake writes in its work folder (the baked glTF, its maps: EXR or PNG) or in kept/ (maps.json and
 // "N_map.f32").
 bool made_by_a_bake(const fs::path& file, bool kept) {
   const std::string name = file.filename().string(), extension = file.extension().string();
-  if (!kept) return extension == ".glb" || extension == ".gltf" || extension == ".bin" || extension == ".exr";
+  if (!kept) return extension == ".glb" || extension == ".gltf" || extension == ".bin" || extension == ".exr" || extension == ".png";
   const std::size_t underscore = name.find('_');
   const bool numbered = underscore > 0 && underscore != std::string::npos &&
                         std::all_of(name.begin(), name.begin() + std::ptrdiff_t(underscore), [](char c) { return c >= '0' && c <= '9'; });
