@@ -161,6 +161,44 @@ TEST(Bake, ABumpOnAPlaneGivesTheHighPolysHeightAndNormalInThePlanesBasis) {
   }
 }
 
+// The high-poly: the low-poly's plane 0.05 below it, the same UVs (its tangent basis T = +x,
+// B = +y, N = +z), with a normal map of one code c = t/2 + ½, t = normalize(0.3, −0.2, 1). With
+// high_normal_maps every texel's normal is t decoded (scale 1), and normalize(0.5·t.x, 0.5·t.y, t.z)
+// at scale 0.5 (glTF's rule); without, the plane's own +z. Tolerance: float32 codes.
+TEST(Bake, TheHighPolysNormalMapIsAppliedInItsTangentBasis) {
+  const BumpPair pair = bump_pair(1, 0.5);
+  scene::Instance high = pair.low.instances[0];
+  for (auto* positions : {&high.positions, &high.object.positions}) {
+    for (auto& p : *positions) p.z -= 0.05f;
+  }
+  high.material = 0;
+  const dvec3 t = glm::normalize(dvec3(0.3, -0.2, 1));
+  NormalTexture normal;
+  normal.texture.image.width = normal.texture.image.height = 2, normal.texture.image.channels = 3;
+  for (int k = 0; k < 4; ++k) {
+    for (int c = 0; c < 3; ++c) normal.texture.image.pixels.push_back(float(t[c] * 0.5 + 0.5));
+  }
+  Options options;
+  options.maps = {Map::normal};
+  options.front = 0.1, options.back = 0.1, options.absolute_distances = true;
+  const ao::TextureOptions texture{.width = 16, .height = 16, .texel_samples = 1};
+  for (const double scale : {1.0, 0.5}) {
+    for (const bool apply : {true, false}) {
+      normal.scale = scale;
+      options.high_normal_maps = apply;
+      HighMaterials materials;
+      materials.normals = {normal};
+      auto baked = bake(pair.low, scene_of({high}), {ao::TextureTarget{{0}, 0}}, texture, options, {}, materials);
+      ASSERT_TRUE(baked) << baked.error().message;
+      const dvec3 want = apply ? glm::normalize(dvec3(scale * t.x, scale * t.y, t.z)) : dvec3(0, 0, 1);
+      const MapImage& map = map_of(baked->textures.at(0), Map::normal);
+      for (std::size_t texel = 0; texel < 16 * 16; ++texel) {
+        ASSERT_NEAR(glm::length(texel3(map, texel) * 2.0 - 1.0 - want), 0, 1e-6) << texel << " scale " << scale << " " << apply;
+      }
+    }
+  }
+}
+
 // A unit icosphere of 80 triangles placed by `world`, each triangle its own UV island (9 × 9 cells).
 constexpr int kCells = 9;
 scene::Instance icosphere_low(bool flat, const glm::dmat4& world) {
@@ -451,8 +489,9 @@ TEST(Bake, TransferGivesTheHighPolysBaseColourAtEachTexel) {
   high.material = 0;
   BaseColor color;
   color.factor = glm::vec4(0.5f, 1, 1, 0.8f);
-  color.wrap_s = color.wrap_t = Wrap::clamp_to_edge;
-  image::Image& ramp = color.texture.emplace();
+  MaterialTexture& texture = color.texture.emplace();
+  texture.wrap_s = texture.wrap_t = Wrap::clamp_to_edge;
+  image::Image& ramp = texture.image;
   ramp.width = ramp.height = 4, ramp.channels = 4;
   for (int y = 0; y < 4; ++y) {
     for (int x = 0; x < 4; ++x) ramp.pixels.insert(ramp.pixels.end(), {float(x) / 3, float(y) / 3, 1, 1});
@@ -462,7 +501,7 @@ TEST(Bake, TransferGivesTheHighPolysBaseColourAtEachTexel) {
   options.front = 0.05, options.back = 0.05, options.absolute_distances = true;
   constexpr int kSide = 16;
   auto baked = bake(pair.low, scene_of({high}), {ao::TextureTarget{{0}, 0}}, {.width = kSide, .height = kSide, .texel_samples = 1},
-                    options, {}, {color});
+                    options, {}, {{color}});
   ASSERT_TRUE(baked) << baked.error().message;
   const TextureBake& t = baked->textures.at(0);
   const auto ramped = [](double s) { return std::clamp((4 * s - 0.5) / 3, 0.0, 1.0); };

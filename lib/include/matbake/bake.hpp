@@ -121,6 +121,9 @@ struct Options {
   // two sides' rays then sweep the high-poly between them with neither gap nor overlap; where the
   // low-poly has no split normals the rays are the extrusion's.
   bool average_normals = true;
+  // The normal map's normal at a hit: the high-poly's own normal map applied there (HighMaterials::
+  // normals), as a runtime shades the high-poly, instead of its interpolated vertex normal.
+  bool high_normal_maps = false;
 };
 
 Status check(const Options& options);
@@ -138,13 +141,34 @@ std::string cage_mismatch(const scene::Scene& low, const scene::Scene& cage);
 // moved `front` along the mean of the distinct normals of the vertices at that position.
 scene::Scene averaged_normal_cage(const scene::Scene& low, double front);
 
-// A high-poly material's base colour as a runtime shades it: factor × texture × COLOR_0 (linear).
-struct BaseColor {
-  glm::vec4 factor{1.0f};
-  std::optional<image::Image> texture;  // linear RGBA floats (colour channels decoded from sRGB)
+// A high-poly material's texture as a runtime samples it: through its UV set and transform,
+// bilinear, with its sampler's wrap modes.
+struct MaterialTexture {
+  image::Image image;
   int texcoord = 0;
   std::function<glm::dvec2(glm::dvec2)> transform;  // the texture's UV transform; empty: none
   Wrap wrap_s = Wrap::repeat, wrap_t = Wrap::repeat;
+};
+
+// A high-poly material's base colour as a runtime shades it: factor × texture × COLOR_0 (linear).
+struct BaseColor {
+  glm::vec4 factor{1.0f};
+  std::optional<MaterialTexture> texture;  // linear RGBA floats (colour channels decoded from sRGB)
+};
+
+// A high-poly material's normalTexture (Options::high_normal_maps): its codes as stored (linear,
+// 0–1), decoded as glTF says: n = (2c − 1) with x and y times `scale`, in the high-poly's tangent
+// basis at the hit (its TANGENT, else MikkTSpace's), normalized.
+struct NormalTexture {
+  MaterialTexture texture;
+  double scale = 1;
+};
+
+// What the high-poly's materials give the maps, one entry per material index (an instance without
+// a material, or beyond them, has none): base colours for transfer, normal maps for the normal map.
+struct HighMaterials {
+  std::vector<BaseColor> base_colors;
+  std::vector<std::optional<NormalTexture>> normals;
 };
 
 struct MapImage {
@@ -225,13 +249,14 @@ struct Bake {
 // texel_samples positions as the AO texture bake shares them (position j casts rays j, j + K, ...);
 // its distances are of the high-poly's radius. The result is the same for any number of threads.
 // Errors: options out of range, a target without its UV set's data, Embree failing.
-// `base_colors` (the transfer map's) holds one per high-poly material index; an instance without a
-// material, or beyond them, is white. The high-poly then needs its texcoords loaded.
+// `materials` holds the high-poly's base colours (the transfer map's: an instance without one is
+// white) and, with Options::high_normal_maps, its normal maps; either needs the high-poly's
+// texcoords loaded, normal maps its object-space attributes too (SceneContent::object_space).
 // With a `cage` mesh (cage_mismatch empty), each ray starts at the cage's point with the low-poly
 // point's barycentric weights and heads for the low-poly point, reaching `back` beyond it; where
 // the two coincide, the ray is the extrusion's (Options::front along the low-poly's normal).
 Result<Bake> bake(const scene::Scene& low, const scene::Scene& high, const std::vector<ao::TextureTarget>& targets,
                   const ao::TextureOptions& texture, const Options& options, const ao::Options& occlusion = {},
-                  const std::vector<BaseColor>& base_colors = {}, const scene::Scene* cage = nullptr);
+                  const HighMaterials& materials = {}, const scene::Scene* cage = nullptr);
 
 }  // namespace matbake::bake

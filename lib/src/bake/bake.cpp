@@ -107,6 +107,10 @@ struct Rays {
   int occlusion_samples;
   std::uint64_t occlusion_seed;
   const std::vector<BaseColor>* base_colors;  // for transfer (null: not asked)
+  // With Options::high_normal_maps: the high-poly's normal maps and its corners' tangent frames
+  // (per instance; empty where it has no UV set for them). Null: its vertex normals.
+  const std::vector<std::optional<NormalTexture>>* normal_maps;
+  const std::vector<std::vector<CornerFrame>>* high_frames;
   const std::vector<int>* primitive_numbers;  // per high instance, for an id map by primitive (null: by material)
   const PartMatch* parts;                     // Match::by_name's parts (null: every ray meets every part)
   bool occluders_matched;                     // with parts: a hit's AO and thickness rays meet its part only
@@ -127,6 +131,21 @@ struct TraceContext {
   std::size_t target_index;
 };
 
+// A high-poly texture at a hit, bilinear through its UV set and transform, grey spread to RGB (and
+// grey-alpha's alpha kept); false where the instance lacks that UV set.
+bool sample_at(const MaterialTexture& m, const scene::Instance& inst, const Hit& hit, float (&texel)[4]) {
+  if (std::size_t(m.texcoord) >= inst.texcoords.size() || inst.texcoords[std::size_t(m.texcoord)].empty()) return false;
+  const auto& corners = inst.triangles[hit.triangle];
+  glm::dvec2 uv(0.0);
+  for (int k = 0; k < 3; ++k) uv += double(hit.weights[k]) * glm::dvec2(inst.texcoords[std::size_t(m.texcoord)][corners[std::size_t(k)]]);
+  if (m.transform) uv = m.transform(uv);
+  texel[0] = texel[1] = texel[2] = texel[3] = 1;
+  gltf::sample_bilinear(m.image, uv, m.wrap_s, m.wrap_t, texel);
+  const int channels = m.image.channels;
+  if (channels < 3) texel[3] = channels == 2 ? texel[1] : 1.0f, texel[1] = texel[2] = texel[0];
+  return true;
+}
+
 // The high-poly's base colour at a hit: COLOR_0 × the material's factor × its texture.
 glm::dvec4 base_color(const std::vector<BaseColor>& colors, const scene::Instance& inst, const Hit& hit) {
   const auto& corners = inst.triangles[hit.triangle];
@@ -138,15 +157,32 @@ glm::dvec4 base_color(const std::vector<BaseColor>& colors, const scene::Instanc
   if (inst.material < 0 || std::size_t(inst.material) >= colors.size()) return c;
   const BaseColor& m = colors[std::size_t(inst.material)];
   c *= glm::dvec4(m.factor);
-  if (!m.texture || std::size_t(m.texcoord) >= inst.texcoords.size()) return c;
-  glm::dvec2 uv(0.0);
-  for (int k = 0; k < 3; ++k) uv += double(hit.weights[k]) * glm::dvec2(inst.texcoords[std::size_t(m.texcoord)][corners[std::size_t(k)]]);
-  if (m.transform) uv = m.transform(uv);
-  float texel[4] = {1, 1, 1, 1};
-  gltf::sample_bilinear(*m.texture, uv, m.wrap_s, m.wrap_t, texel);
-  const int channels = m.texture->channels;
-  if (channels < 3) texel[3] = channels == 2 ? texel[1] : 1.0f, texel[1] = texel[2] = texel[0];  // grey (and alpha)
+  float texel[4];
+  if (!m.texture || !sample_at(*m.texture, inst, hit, texel)) return c;
   return c * glm::dvec4(texel[0], texel[1], texel[2], texel[3]);
+}
+
+// The high-poly's shading normal at a hit with its material's normal map applied (glTF's decoding,
+// in its tangent basis there: the corners' frames interpolated, each normalized); its
+// interpolated vertex normal where it has none.
+glm::dvec3 detailed_normal(const Rays& c, const Hit& hit) {
+  const scene::Instance& inst = c.high.instance(hit);
+  const auto& frames = (*c.high_frames)[hit.instance];
+  const int m = inst.material;
+  if (m < 0 || std::size_t(m) >= c.normal_maps->size() || !(*c.normal_maps)[std::size_t(m)] || frames.empty()) return glm::dvec3(hit.normal);
+  const NormalTexture& map = *(*c.normal_maps)[std::size_t(m)];
+  float texel[4];
+  if (!sample_at(map.texture, inst, hit, texel)) return glm::dvec3(hit.normal);
+  const glm::dvec3 n((2.0 * texel[0] - 1) * map.scale, (2.0 * texel[1] - 1) * map.scale, 2.0 * texel[2] - 1);
+  glm::dvec3 t(0), b(0), normal(0);
+  for (int k = 0; k < 3; ++k) {
+    const CornerFrame& f = frames[3 * hit.triangle + std::size_t(k)];
+    t += double(hit.weights[k]) * glm::dvec3(f.tangent), b += double(hit.weights[k]) * glm::dvec3(f.bitangent);
+    normal += double(hit.weights[k]) * glm::dvec3(f.normal);
+  }
+  const auto unit = [](const glm::dvec3& v) { return glm::length(v) > 0 ? glm::normalize(v) : v; };
+  const glm::dvec3 shaded = unit(t) * n.x + unit(b) * n.y + unit(normal) * n.z;
+  return glm::length(shaded) > 0 ? glm::normalize(shaded) : glm::dvec3(hit.normal);
 }
 
 // AO and bent normal from a hit, around the high-poly's normal there, and thickness, into it: the
@@ -233,7 +269,7 @@ void add_hit(const Rays& c, const CageHit& cage_hit, const LowPoint& low, TexelS
   const Hit& hit = cage_hit.hit;
   if (sum.hits == 0) sum.id = c.primitive_numbers ? (*c.primitive_numbers)[hit.instance] : c.high.instance(hit).material;
   ++sum.hits;
-  sum.normal += tangent_space(low.basis, glm::dvec3(hit.normal));
+  sum.normal += tangent_space(low.basis, c.normal_maps ? detailed_normal(c, hit) : glm::dvec3(hit.normal));
   sum.position += glm::dvec3(hit.position);
   sum.height += cage_hit.height;
   if (c.curvature) sum.curvature += c.high.mean_curvature(hit);
@@ -588,6 +624,23 @@ Result<std::vector<std::vector<CornerFrame>>> target_frames(const scene::Scene& 
   return frames;
 }
 
+// The tangent frames of each high-poly instance whose material has a normal map, through its UV
+// set (none for the others, or where the instance lacks that set).
+Result<std::vector<std::vector<CornerFrame>>> normal_map_frames(const scene::Scene& high,
+                                                                 const std::vector<std::optional<NormalTexture>>& normals) {
+  std::vector<std::vector<CornerFrame>> frames(high.instances.size());
+  for (std::size_t k = 0; k < high.instances.size(); ++k) {
+    const scene::Instance& inst = high.instances[k];
+    if (inst.material < 0 || std::size_t(inst.material) >= normals.size() || !normals[std::size_t(inst.material)]) continue;
+    const int texcoord = normals[std::size_t(inst.material)]->texture.texcoord;
+    if (std::size_t(texcoord) >= inst.texcoords.size() || inst.texcoords[std::size_t(texcoord)].empty()) continue;
+    auto made = corner_frames(inst, texcoord);
+    if (!made) return made.error();
+    frames[k] = std::move(*made);
+  }
+  return frames;
+}
+
 // The counts of one tile's texels for the report (summed over tiles, in any order).
 struct TileTally {
   std::size_t texels = 0, samples = 0, occlusion_rays = 0, misses = 0, missed_texels = 0, from_inside = 0, overlapped = 0;
@@ -723,7 +776,7 @@ Result<TextureBake> trace_target(const TraceContext& context, const Options& opt
 
 Result<Bake> bake(const scene::Scene& low, const scene::Scene& high, const std::vector<ao::TextureTarget>& targets,
                   const ao::TextureOptions& texture, const Options& options, const ao::Options& occlusion,
-                  const std::vector<BaseColor>& base_colors, const scene::Scene* cage) {
+                  const HighMaterials& materials, const scene::Scene* cage) {
   if (Status s = check(options); !s) return s.error();
   if (cage) {
     if (const std::string why = cage_mismatch(low, *cage); !why.empty()) return Error{"", "the cage " + why, true};
@@ -753,6 +806,14 @@ Result<Bake> bake(const scene::Scene& low, const scene::Scene& high, const std::
   result.setup_seconds = seconds_since(start);
 
   const std::vector<int> primitives = primitive_numbers(high);
+  // The high-poly's tangent frames, for its normal maps (each instance through its material's UV set).
+  const bool detail = options.high_normal_maps && asked(Map::normal) && !materials.normals.empty();
+  std::optional<std::vector<std::vector<CornerFrame>>> high_frames;
+  if (detail) {
+    auto frames_made = normal_map_frames(high, materials.normals);
+    if (!frames_made) return frames_made.error();
+    high_frames = std::move(*frames_made);
+  }
   const std::optional<PartMatch> parts = options.match == Match::by_name ? std::optional(match_parts(low, high)) : std::nullopt;
   if (parts) result.unmatched = parts->unmatched;
   const bool occluders_matched = options.occluders == Occluders::matched;
@@ -769,7 +830,9 @@ Result<Bake> bake(const scene::Scene& low, const scene::Scene& high, const std::
                         asked(Map::thickness) ? tracers->depths.get() : nullptr,
                         occlusion.samples,
                         occlusion.seed,
-                        asked(Map::transfer) ? &base_colors : nullptr,
+                        asked(Map::transfer) ? &materials.base_colors : nullptr,
+                        detail ? &materials.normals : nullptr,
+                        detail ? &*high_frames : nullptr,
                         options.id_by == IdSource::primitive ? &primitives : nullptr,
                         parts ? &*parts : nullptr,
                         occluders_matched,
@@ -795,6 +858,8 @@ Result<Bake> bake(const scene::Scene& low, const scene::Scene& high, const std::
                            asked_per_vertex(Map::thickness) ? tracers->depths.get() : nullptr,
                            occlusion.samples,
                            occlusion.seed,
+                           nullptr,
+                           nullptr,
                            nullptr,
                            nullptr,
                            parts ? &*parts : nullptr,

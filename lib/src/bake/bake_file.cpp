@@ -134,37 +134,57 @@ Status check_green(const Options& bake) {
                true};
 }
 
-// The high-poly's materials' base colours (transfer): factors, and textures decoded to linear
-// with their UV sets, transforms and wrap modes.
-Result<std::vector<BaseColor>> base_colors(const fs::path& high, const image::Encoding& encoding) {
+// A material's textureInfo `info` (at JSON pointer `where`) as the bake samples it: decoded with
+// `colour`, with its UV set, transform and sampler's wrap modes.
+Result<MaterialTexture> material_texture(const gltf::Document& doc, const gltf::ImageCache& cache, const Json& info,
+                                         color::Transfer colour, const std::string& where) {
+  const int index = gltf::integer_in<int>(info, "index", -1, -1);
+  auto decoded = cache.decode(index, colour);
+  if (!decoded) return decoded.error();
+  MaterialTexture out;
+  out.image = std::move(*decoded);
+  auto transform = gltf::uv_transform_of(info, doc.file, where);
+  if (!transform) return transform.error();
+  out.texcoord = transform->texcoord >= 0 ? transform->texcoord : gltf::integer_in<int>(info, "texCoord", 0, 0);
+  if (!transform->identity()) out.transform = [t = *transform](glm::dvec2 uv) { return t.apply(uv); };
+  const int sampler = gltf::integer_in<int>(doc.json["textures"][std::size_t(index)], "sampler", -1, -1);
+  if (sampler >= 0) {
+    const Json& s = doc.json["samplers"][std::size_t(sampler)];
+    out.wrap_s = gltf::wrap_of(s, "wrapS"), out.wrap_t = gltf::wrap_of(s, "wrapT");
+  }
+  return out;
+}
+
+// What the high-poly's materials give: base colours (factors, textures decoded to linear) when
+// `colours`, normal maps (codes as stored, with their scale) when `normals`.
+Result<HighMaterials> high_materials(const fs::path& high, const image::Encoding& encoding, bool colours, bool normals) {
   auto doc = gltf::read_document(high);
   if (!doc) return doc.error();
   gltf::ImageCache cache(*doc, encoding, gltf::MadeFormat::png);
-  std::vector<BaseColor> out;
+  HighMaterials out;
   const Json& materials = doc->json.value("materials", Json::array());
   for (std::size_t m = 0; m < materials.size(); ++m) {
-    BaseColor& color = out.emplace_back();
+    const std::string where = "/materials/" + std::to_string(m);
+    if (normals) {
+      std::optional<NormalTexture>& normal = out.normals.emplace_back();
+      if (materials[m].contains("normalTexture") && materials[m]["normalTexture"].is_object()) {
+        const Json& info = materials[m]["normalTexture"];
+        auto texture = material_texture(*doc, cache, info, color::Transfer::linear, where + "/normalTexture");
+        if (!texture) return texture.error();
+        normal = NormalTexture{std::move(*texture), info.value("scale", Json(1.0)).is_number() ? info["scale"].get<double>() : 1.0};
+      }
+    }
+    if (!colours) continue;
+    BaseColor& color = out.base_colors.emplace_back();
     const Json pbr = materials[m].value("pbrMetallicRoughness", Json::object());
     const Json factor = pbr.value("baseColorFactor", Json::array({1, 1, 1, 1}));
     if (factor.is_array() && factor.size() == 4) {
       for (int k = 0; k < 4; ++k) color.factor[k] = factor[std::size_t(k)].is_number() ? factor[std::size_t(k)].get<float>() : 1.0f;
     }
     if (!pbr.contains("baseColorTexture") || !pbr["baseColorTexture"].is_object()) continue;
-    const Json& info = pbr["baseColorTexture"];
-    const int index = gltf::integer_in<int>(info, "index", -1, -1);
-    auto decoded = cache.decode(index, color::Transfer::srgb);
-    if (!decoded) return decoded.error();
-    color.texture = std::move(*decoded);
-    auto transform = gltf::uv_transform_of(info, doc->file, "/materials/" + std::to_string(m) + "/pbrMetallicRoughness/baseColorTexture");
-    if (!transform) return transform.error();
-    color.texcoord = transform->texcoord >= 0 ? transform->texcoord : gltf::integer_in<int>(info, "texCoord", 0, 0);
-    if (!transform->identity()) color.transform = [t = *transform](glm::dvec2 uv) { return t.apply(uv); };
-    const std::size_t texture = std::size_t(index);
-    const int sampler = gltf::integer_in<int>(doc->json["textures"][texture], "sampler", -1, -1);
-    if (sampler >= 0) {
-      const Json& s = doc->json["samplers"][std::size_t(sampler)];
-      color.wrap_s = gltf::wrap_of(s, "wrapS"), color.wrap_t = gltf::wrap_of(s, "wrapT");
-    }
+    auto texture = material_texture(*doc, cache, pbr["baseColorTexture"], color::Transfer::srgb, where + "/pbrMetallicRoughness/baseColorTexture");
+    if (!texture) return texture.error();
+    color.texture = std::move(*texture);
   }
   return out;
 }
@@ -323,13 +343,14 @@ std::vector<fs::path> files_of(const fs::path& gltf) {
 // The bake of `maps` alone: the high-poly loaded (with its base colours only for transfer), traced.
 Result<Bake> trace_maps(const scene::Scene& low, const Targets& targets, const FileOptions& options, const std::vector<Map>& maps) {
   const bool transfer = std::find(maps.begin(), maps.end(), Map::transfer) != maps.end();
-  auto high = scene::load_scene(options.high, {.texcoords = transfer});
+  const bool detail = options.request.bake.high_normal_maps && std::find(maps.begin(), maps.end(), Map::normal) != maps.end();
+  auto high = scene::load_scene(options.high, {.texcoords = transfer || detail, .object_space = detail});
   if (!high) return high.error();
-  std::vector<BaseColor> colors;
-  if (transfer) {
-    auto read = base_colors(options.high, options.encoding);
+  HighMaterials materials;
+  if (transfer || detail) {
+    auto read = high_materials(options.high, options.encoding, transfer, detail);
     if (!read) return read.error();
-    colors = std::move(*read);
+    materials = std::move(*read);
   }
   std::optional<scene::Scene> cage;
   if (!options.cage.empty()) {
@@ -340,7 +361,7 @@ Result<Bake> trace_maps(const scene::Scene& low, const Targets& targets, const F
   }
   Options asked = options.request.bake;
   asked.maps = maps;
-  return bake(low, *high, targets.targets, options.request.texture, asked, options.request.occlusion.options, colors,
+  return bake(low, *high, targets.targets, options.request.texture, asked, options.request.occlusion.options, materials,
               cage ? &*cage : nullptr);
 }
 

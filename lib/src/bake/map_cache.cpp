@@ -66,6 +66,7 @@ nlohmann::json map_parameters(std::optional<Map> map, const Request& request) {
   const bool tangent = map == Map::normal || map == Map::bent_normal;
   if (!tangent) p.erase("green");
   if (map != Map::id) p.erase("id_by");
+  if (map != Map::normal) p.erase("high_normal_maps");
   const bool secondary = map == Map::ao || map == Map::bent_normal || map == Map::thickness;
   if (!secondary || request.bake.match != Match::by_name) p.erase("occluders");
   if (secondary) p["ao"] = params::to_json(ao::estimator_params(), request.occlusion);

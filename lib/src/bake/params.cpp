@@ -109,6 +109,11 @@ params::Group<Request> make_group() {
                                          "each face's own interpolated normal",
                                  .example = "false"},
                             [](auto& r) -> auto& { return r.bake.average_normals; }),
+      params::flag<Request>(Spec{.name = "high_normal_maps",
+                                 .help = "The normal map takes the high-poly's own normal maps at each hit (in its "
+                                         "tangent basis) over its vertex normals",
+                                 .example = "true"},
+                            [](auto& r) -> auto& { return r.bake.high_normal_maps; }),
       params::choice<Request>(Spec{.name = "green",
                                    .help = "The normal map's green: opengl (glTF's: up the texture) or directx",
                                    .example = "directx"},
