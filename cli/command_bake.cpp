@@ -49,8 +49,9 @@ int run_bake(const BakeSettings& s, const GlobalOptions& global) {
       if (t.height_max > t.height_min) std::printf(", height %.4g to %.4g", t.height_min, t.height_max);
       std::printf("\n");
       for (std::size_t i = 0; i < t.files.size() && i < t.ranges.size(); ++i) {  // PNG maps beside: what 0 and 1 stand for
-        const auto [lo, hi] = t.ranges[i];
-        if (t.files[i].ends_with(".png") && (lo != 0 || hi != 1)) {
+        if (!t.ranges[i]) continue;
+        const auto [lo, hi] = *t.ranges[i];
+        if (lo != 0 || hi != 1) {
           std::printf("    %s: 0 to 1 is %.6g to %.6g\n", escape_control(t.files[i]).c_str(), lo, hi);
         }
       }

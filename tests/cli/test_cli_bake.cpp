@@ -324,6 +324,104 @@ TEST(CliBake, SixteenBitNormalsAndPngMapsHoldTheTiltedPlaneWithinOneStep) {
   EXPECT_EQ(beside.exit_code, 0) << beside.err;
 }
 
+// A box of half-size `h` at the origin, 4 vertices a face (hard edges, face normals), each face's
+// UVs the whole tile.
+void write_box(const fs::path& path, double h) {
+  std::vector<glm::dvec3> positions, normals;
+  std::vector<glm::vec2> uvs;
+  std::vector<std::array<std::uint32_t, 3>> triangles;
+  for (int axis = 0; axis < 3; ++axis) {
+    for (const double sign : {1.0, -1.0}) {
+      glm::dvec3 n(0), u(0), v(0);
+      n[axis] = sign, u[(axis + 1) % 3] = 1, v[(axis + 2) % 3] = sign;  // u × v = n
+      const auto first = std::uint32_t(positions.size());
+      for (const auto& [a, b] : {std::pair{-1, -1}, {1, -1}, {1, 1}, {-1, 1}}) {
+        positions.push_back(h * (n + double(a) * u + double(b) * v));
+        normals.push_back(n);
+        uvs.emplace_back(float(a + 1) / 2, float(1 - b) / 2);
+      }
+      triangles.push_back({first, first + 1, first + 2});
+      triangles.push_back({first, first + 2, first + 3});
+    }
+  }
+  write_grey_mesh(path, positions, normals, uvs, triangles);
+}
+
+// The number after `key` in `text` ("front 0.0289 (" → 0.0289); NaN when absent.
+double number_after(const std::string& text, const std::string& key) {
+  const std::size_t at = text.find(key);
+  return at == std::string::npos ? std::nan("") : std::stod(text.substr(at + key.size()));
+}
+
+// What a stranger's bakes found (issue 70's attack), each now refused or named rightly:
+// - the front the error suggests for a hard-edged box (the averaged cage moves a face's middle
+//   only 1/√3 of front along its normal at the corners' mean) makes the bake pass;
+// - a flat low-poly under a plane 0.05 above: the cage, not "barely overlap";
+// - a high-poly facing away (its winding flipped): named so;
+// - UVs wholly outside the tile: a warning that the maps are fill values;
+// - a map beside the glTF named as an image the low-poly brings along: one error line, nothing
+//   written (it was overwritten by the copy, exit 0).
+TEST(CliBake, StrangersBakesAreRefusedOrNamedRightly) {
+  TempDir dir;
+  write_box(dir / "box.gltf", 0.5);
+  write_box(dir / "big_box.gltf", 0.55);
+  const auto bake = [&](const std::string& low, const std::string& high, const std::string& out, std::vector<std::string> extra = {}) {
+    std::vector<std::string> args{"bake", (dir / low).string(), "--from", (dir / high).string(), "-o", (dir / out).string(), "--size", "32"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return matbake(args);
+  };
+  auto r = bake("box.gltf", "big_box.gltf", "a.glb");
+  EXPECT_EQ(r.exit_code, 1);
+  const double front = number_after(r.err, "the cage is too small: front ");
+  ASSERT_TRUE(front > 0) << r.err;
+  r = bake("box.gltf", "big_box.gltf", "a.glb", {"--json", "--front", std::to_string(front * 1.01)});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto passed = nlohmann::json::parse(r.out)["textures"][0];
+  EXPECT_LE(passed["misses"].get<double>(), 0.06 * passed["rays"].get<double>()) << passed;
+
+  // A plane 0.05 under a plane: the cage, and the front it names works.
+  const std::vector<std::array<std::uint32_t, 3>> quad = {{0, 1, 2}, {0, 2, 3}};
+  const std::vector<glm::dvec3> up(4, {0, 0, 1});
+  const std::vector<glm::vec2> tile = {{0, 1}, {1, 1}, {1, 0}, {0, 0}};
+  write_grey_mesh(dir / "plane.gltf", {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}}, up, tile, quad);
+  write_grey_mesh(dir / "above.gltf", {{-1, -1, 0.05}, {1, -1, 0.05}, {1, 1, 0.05}, {-1, 1, 0.05}}, up, {}, quad);
+  r = bake("plane.gltf", "above.gltf", "b.glb");
+  EXPECT_EQ(r.exit_code, 1);
+  ASSERT_NE(r.err.find("the cage is too small: front 0.0"), std::string::npos) << r.err;
+  r = bake("plane.gltf", "above.gltf", "b.glb", {"--front", std::to_string(number_after(r.err, "front ") * 1.01)});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  write_grey_mesh(dir / "facing_down.gltf", {{-1, -1, -0.005}, {1, -1, -0.005}, {1, 1, -0.005}, {-1, 1, -0.005}}, {}, {},
+                  {{0, 2, 1}, {0, 3, 2}});
+  r = bake("plane.gltf", "facing_down.gltf", "c.glb");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("most missed rays met only the backs of high-poly faces"), std::string::npos) << r.err;
+
+  // UVs one tile to the right: nothing of the tile is covered, and the warning says so.
+  write_grey_mesh(dir / "moved.gltf", {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}}, up, {{1, 1}, {2, 1}, {2, 0}, {1, 0}}, quad);
+  r = bake("moved.gltf", "plane.gltf", "d.glb", {"--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(nlohmann::json::parse(r.out)["textures"][0]["rays"], 0);
+  EXPECT_NE(r.err.find("none of its UVs covers the 0–1 tile (2 triangles outside it"), std::string::npos) << r.err;
+
+  // An image of the low-poly, copied beside the output, named as a baked map: refused, nothing written.
+  fs::create_directories(dir / "in");
+  fs::create_directories(dir / "out");
+  write_grey_mesh(dir / "in/low.gltf", {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}}, up, tile, quad);
+  image::Image grey = gltf::blank(2, 2, 3);
+  image::WriteOptions png;
+  png.type = image::SampleType::u8;
+  ASSERT_TRUE(image::write_image(grey, dir / "in/a_grey_height.png", png));
+  edit_gltf(dir / "in", "low.gltf", "low.gltf", [](nlohmann::json& j) {
+    j["images"] = {{{"uri", "a_grey_height.png"}}};
+    j["textures"] = {{{"source", 0}}};
+    j["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"] = {{"index", 0}};
+  });
+  r = bake("in/low.gltf", "plane.gltf", "out/a.gltf", {"--maps", "normal,height", "--map-format", "png"});
+  EXPECT_EQ(r.exit_code, 2);
+  expect_one_error_line(r, (dir / "out/a_grey_height.png").string(), "is written twice");
+  EXPECT_TRUE(fs::is_empty(dir / "out"));
+}
+
 // A bake removes what it leaves unused, as gltf-transform's prune would, and nothing else: the
 // low-poly's material has a normal map and an occlusion map (one sampler each), and the file also
 // holds a texture no material uses (its image and sampler too). Baking normal and ao replaces the

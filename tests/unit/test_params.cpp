@@ -602,5 +602,17 @@ TEST(Sources, NoFlagIsSpeltInTheLibrarysMessages) {
   EXPECT_GT(files, 50u);
 }
 
+
+// A name read from a file is printed on one line and cannot steer the terminal: ASCII controls as
+// \n, \xNN; UTF-8's C1 controls (NEL breaks a line) and bidirectional overrides (U+202E reverses
+// what follows) as \uXXXX; other UTF-8 as it is.
+TEST(Messages, EscapeControlWritesTerminalControlsAsEscapes) {
+  EXPECT_EQ(escape_control("a\nb\x1b[31m"), "a\\nb\\x1b[31m");
+  EXPECT_EQ(escape_control("line\xc2\x85" "break"), "line\\u0085break");
+  EXPECT_EQ(escape_control("\xe2\x80\xaetxt.exe"), "\\u202etxt.exe");
+  EXPECT_EQ(escape_control("\xe2\x81\xa6x\xe2\x81\xa9"), "\\u2066x\\u2069");
+  EXPECT_EQ(escape_control("caf\xc3\xa9 \xe2\x80\x94 \xc2\xa0"), "caf\xc3\xa9 \xe2\x80\x94 \xc2\xa0");  // é, em dash, no-break space
+  EXPECT_EQ(escape_control("cut\xc2"), "cut\xc2");  // a truncated sequence: as it is
+}
 }  // namespace
 }  // namespace matbake::params

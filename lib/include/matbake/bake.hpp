@@ -202,9 +202,12 @@ struct TextureBake {
   std::size_t from_inside = 0;   // rays whose first surface was a high-poly face's back (a start inside a closed part)
   std::size_t overlapped = 0;    // texels whose centre several triangles cover (overlapping islands): their mean
   std::size_t outside_tile = 0;  // triangles whose UVs lie wholly outside the 0–1 tile: not baked
+  std::size_t degenerate_uv = 0, too_large = 0;  // triangles skipped: UVs of no area or not finite; spanning too far
+  std::size_t faced_away = 0;    // missed rays that met only the backs of high-poly faces (flipped winding)
   // The cage reach, scene units, that would have met 95% of the missed rays a probe along the
-  // low-poly's normal (the low-poly's diagonal either way) found the high-poly for: outside (front)
-  // and inside (back); 0 where none.
+  // low-poly's normal (the low-poly's diagonal either way) found the high-poly for: outside (front,
+  // as Options::front counts it: the averaged cage moves a point less far along its normal than
+  // front; with a cage mesh, how much farther out it must lie) and inside (back); 0 where none.
   double reach_front = 0, reach_back = 0;
 };
 
@@ -232,7 +235,9 @@ Boxes compare_boxes(const scene::Scene& low, const scene::Scene& high);
 // The likely cause of a texture's misses, a clause: the boxes' sizes differ by a power of ten
 // (units), they barely overlap (placement or the wrong file), or else the cage, with the front and
 // back that would have reached (in `options`'s terms: fractions of `diagonal`, or scene units).
-std::string miss_cause(const Boxes& boxes, const TextureBake& texture, const Options& options, double diagonal);
+// With a cage mesh (`cage_mesh`), the reach is how much farther out the mesh must lie.
+std::string miss_cause(const Boxes& boxes, const TextureBake& texture, const Options& options, double diagonal,
+                       bool cage_mesh = false);
 
 struct Bake {
   Boxes boxes;

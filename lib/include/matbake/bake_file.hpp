@@ -5,6 +5,7 @@
 // in the basis it was baked in), AO as its occlusionTexture, the other maps as float EXR files
 // beside the output.
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -40,6 +41,10 @@ struct Request {
 // largest coordinate of any axis (one scale for all three). A map of one value spans 1 around it.
 std::pair<double, double> map_range(const MapImage& image);
 
+// check(Options), and what a glTF cannot hold: green directx with the normal map (a glTF's
+// normalTexture is OpenGL's convention; every viewer would shade it inverted).
+Status check(const Request& request);
+
 struct FileOptions {
   std::filesystem::path high;    // .gltf or .glb: the surface the maps come from
   std::filesystem::path cage;    // .gltf or .glb: the low-poly with its vertices moved out (empty: extrusion)
@@ -59,9 +64,10 @@ struct TextureReport {
   int width = 0, height = 0, texcoord = 0;
   std::size_t texels = 0, samples = 0, misses = 0, missed_texels = 0, padded = 0, occlusion_rays = 0;
   double height_min = 0, height_max = 0;
-  std::size_t from_inside = 0, overlapped = 0, outside_tile = 0;  // bake.hpp's TextureBake
+  std::size_t from_inside = 0, overlapped = 0, outside_tile = 0, faced_away = 0;  // bake.hpp's TextureBake
+  std::size_t skipped_triangles = 0;  // UVs of no area, not finite, or spanning too far
   std::vector<std::string> files;  // per map, in the order asked: the image's URI or the file written
-  std::vector<std::pair<double, double>> ranges;  // per map: what its PNG's 0 and 1 stand for (EXR: the values themselves, {0, 0})
+  std::vector<std::optional<std::pair<double, double>>> ranges;  // per map: what its PNG's 0 and 1 stand for; none for EXR
   std::string existing;            // what happened to the material's own normalTexture and occlusionTexture
                                    // ("", "normal replaced", "occlusion replaced", both)
 };

@@ -16,8 +16,23 @@ namespace matbake {
 inline std::string escape_control(std::string_view text) {
   std::string out;
   out.reserve(text.size());
-  for (const char c : text) {
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
     const auto u = static_cast<unsigned char>(c);
+    const auto next = [&](std::size_t k) { return i + k < text.size() ? static_cast<unsigned char>(text[i + k]) : 0u; };
+    // UTF-8 controls a terminal acts on: C1 (U+0080–U+009F, NEL among them) and the bidirectional
+    // embeddings, overrides and isolates (U+202A–U+202E, U+2066–U+2069), written as \uXXXX.
+    const bool c1 = u == 0xc2 && next(1) >= 0x80 && next(1) <= 0x9f;
+    const bool bidi = u == 0xe2 && ((next(1) == 0x80 && next(2) >= 0xaa && next(2) <= 0xae) ||
+                                    (next(1) == 0x81 && next(2) >= 0xa6 && next(2) <= 0xa9));
+    if (c1 || bidi) {
+      const unsigned code = c1 ? next(1) : (next(1) == 0x80 ? 0x2000u : 0x2040u) + (next(2) & 0x3fu);
+      char hex[8];
+      std::snprintf(hex, sizeof hex, "\\u%04x", code);
+      out += hex;
+      i += c1 ? 1 : 2;
+      continue;
+    }
     if (u >= 0x20 && u != 0x7f) {
       out += c;
     } else if (c == '\n') {

@@ -268,8 +268,9 @@ Tiling tile(const scene::Scene& scene, const TextureTarget& target, int width, i
       CellRect cells{std::ceil(box.x0 - kReach), std::floor(box.x1 + kReach), std::ceil(box.y0 - kReach),
                      std::floor(box.y1 + kReach)};
       if (target.tile_only) {
+        // Wholly outside the tile: not even its edge texels are touched by it.
+        if (box.x0 >= width - 0.5 || box.x1 <= -0.5 || box.y0 >= height - 0.5 || box.y1 <= -0.5) continue;
         cells = {std::max(cells.i0, 0.0), std::min(cells.i1, width - 1.0), std::max(cells.j0, 0.0), std::min(cells.j1, height - 1.0)};
-        if (cells.i0 > cells.i1 || cells.j0 > cells.j1) continue;  // wholly outside the tile
       }
       if ((cells.i1 - cells.i0 + 1) * (cells.j1 - cells.j0 + 1) > max_cells ||
           std::max({std::abs(box.x0), std::abs(box.x1), std::abs(box.y0), std::abs(box.y1)}) > kFarthest) {

@@ -86,7 +86,8 @@ struct TexelSum {
   double height = 0, curvature = 0, occlusion = 0, thickness = 0;
   std::uint64_t occlusion_rays = 0, thickness_rays = 0;
   int hits = 0, rays = 0;
-  int from_inside = 0;  // rays whose first surface was a face's back
+  int from_inside = 0;  // rays that hit, whose first surface was a face's back
+  int faced_away = 0;   // rays that missed, having met a face's back
   // Of the rays that missed: how far out (front) or in (back) the high-poly lies along them, where
   // it does (the cage's reach that would have met it).
   std::vector<float> wanted_front, wanted_back;
@@ -115,6 +116,7 @@ struct Rays {
   const PartMatch* parts;                     // Match::by_name's parts (null: every ray meets every part)
   bool occluders_matched;                     // with parts: a hit's AO and thickness rays meet its part only
   float probe;                                // how far a missed ray's probe looks either way (0: no probe)
+  bool cage_mesh;                             // the cage is the caller's mesh (not the averaged one)
 };
 
 // The high-poly parts low instance `instance`'s cage rays meet.
@@ -244,16 +246,24 @@ std::optional<CageHit> cast(const Rays& c, const LowPoint& low, const std::optio
 }
 
 // A missed ray's probe: from c.probe outside the low-poly point along its normal to c.probe inside,
-// the high-poly's first front face gives the cage reach that would have met it (front where it lies
-// outside, back where inside), noted in `sum`.
-void probe_miss(const Rays& c, const LowPoint& low, ao::Parts parts, TexelSum& sum) {
-  const glm::vec3 n(low.basis[2]);
+// the high-poly's first front face gives the cage reach that would have met it, noted in `sum`:
+// where it lies outside, the front (the averaged cage's point lies less far out along the normal
+// than front: scaled by that; a cage mesh: how much farther out it must lie); inside, the back
+// (reached along the ray, at a slant to the normal).
+void probe_miss(const Rays& c, const LowPoint& low, const std::optional<glm::dvec3>& from_cage, ao::Parts parts, TexelSum& sum) {
+  const glm::dvec3 n = low.basis[2];
   if (!(c.probe > 0) || !(glm::length(n) > 0)) return;
-  const auto hit = c.high.first_hit(low.position + c.probe * n, -n, 2 * c.probe, parts);
+  const auto hit = c.high.first_hit(low.position + c.probe * glm::vec3(n), -glm::vec3(n), 2 * c.probe, parts);
   if (!hit) return;
-  const float height = c.probe - hit->distance;  // positive outside
-  if (height > c.front) sum.wanted_front.push_back(height);
-  if (-height > c.back) sum.wanted_back.push_back(-height);
+  const double height = double(c.probe) - double(hit->distance);  // positive outside
+  double out = c.front, cosine = 1;  // how far out along n the ray starts; its direction against −n
+  if (from_cage) {
+    const glm::dvec3 to_low = glm::dvec3(low.position) - *from_cage;
+    const double length = glm::length(to_low), along = -glm::dot(to_low, n);
+    if (length > 1e-6 * (1 + glm::length(glm::dvec3(low.position))) && along > 0) out = along, cosine = along / length;
+  }
+  if (height > out) sum.wanted_front.push_back(float(c.cage_mesh ? height - out : double(c.front) * height / out));
+  if (-height > c.back * cosine) sum.wanted_back.push_back(float(-height / cosine));
 }
 
 // The cage mesh's point of low instance `instance`'s triangle at weights `w` (none without a cage).
@@ -305,17 +315,20 @@ void trace_point(const TraceContext& t, const ao::texels::SurfacePoint& point, s
     LowPoint low = low_point(inst, t.frames[point.instance], point.triangle, w);
     ++sum.rays;
     bool from_inside = false;
-    auto cage_hit = cast(c, low, cage_point(c, point.instance, point.triangle, w), cage_parts(c, point.instance), &from_inside);
+    std::optional<glm::dvec3> from = cage_point(c, point.instance, point.triangle, w);
+    auto cage_hit = cast(c, low, from, cage_parts(c, point.instance), &from_inside);
     if (!cage_hit && on_edge(w)) {
       w = inside(w);
       low = low_point(inst, t.frames[point.instance], point.triangle, w);
-      cage_hit = cast(c, low, cage_point(c, point.instance, point.triangle, w), cage_parts(c, point.instance), &from_inside);
+      from = cage_point(c, point.instance, point.triangle, w);
+      cage_hit = cast(c, low, from, cage_parts(c, point.instance), &from_inside);
     }
-    sum.from_inside += from_inside;
     if (!cage_hit) {
-      probe_miss(c, low, cage_parts(c, point.instance), sum);
+      sum.faced_away += from_inside;  // met only the backs of faces: the high-poly faces away
+      probe_miss(c, low, from, cage_parts(c, point.instance), sum);
       continue;
     }
+    sum.from_inside += from_inside;
     add_hit(c, *cage_hit, low, sum);
     if (c.occlusion || c.thickness) trace_from_hit(c, cage_hit->hit, low, texel_size, j, positions, occlusion_key, sum);
   }
@@ -644,11 +657,12 @@ Result<std::vector<std::vector<CornerFrame>>> normal_map_frames(const scene::Sce
 // The counts of one tile's texels for the report (summed over tiles, in any order).
 struct TileTally {
   std::size_t texels = 0, samples = 0, occlusion_rays = 0, misses = 0, missed_texels = 0, from_inside = 0, overlapped = 0;
+  std::size_t faced_away = 0;
   double height_min = std::numeric_limits<double>::infinity(), height_max = -std::numeric_limits<double>::infinity();
   std::vector<float> wanted_front, wanted_back;  // TexelSum's, of every texel
   void add(const TileTally& o) {
     texels += o.texels, samples += o.samples, occlusion_rays += o.occlusion_rays, misses += o.misses;
-    missed_texels += o.missed_texels, from_inside += o.from_inside, overlapped += o.overlapped;
+    missed_texels += o.missed_texels, from_inside += o.from_inside, overlapped += o.overlapped, faced_away += o.faced_away;
     height_min = std::min(height_min, o.height_min), height_max = std::max(height_max, o.height_max);
     wanted_front.insert(wanted_front.end(), o.wanted_front.begin(), o.wanted_front.end());
     wanted_back.insert(wanted_back.end(), o.wanted_back.begin(), o.wanted_back.end());
@@ -694,7 +708,7 @@ void trace_tile(const TraceContext& context, const Options& options, const ao::t
     tally.samples += std::size_t(sum.rays);
     tally.occlusion_rays += sum.occlusion_rays + sum.thickness_rays;
     tally.misses += std::size_t(sum.rays - sum.hits);
-    tally.from_inside += std::size_t(sum.from_inside);
+    tally.from_inside += std::size_t(sum.from_inside), tally.faced_away += std::size_t(sum.faced_away);
     tally.wanted_front.insert(tally.wanted_front.end(), sum.wanted_front.begin(), sum.wanted_front.end());
     tally.wanted_back.insert(tally.wanted_back.end(), sum.wanted_back.begin(), sum.wanted_back.end());
     store_mask(sum, texel, out);
@@ -755,7 +769,8 @@ Result<TextureBake> trace_target(const TraceContext& context, const Options& opt
   for (const TileTally& t : tallies) total.add(t);
   out.texels = total.texels, out.samples = total.samples, out.occlusion_rays = total.occlusion_rays;
   out.misses = total.misses, out.missed_texels = total.missed_texels;
-  out.from_inside = total.from_inside, out.overlapped = total.overlapped;
+  out.from_inside = total.from_inside, out.overlapped = total.overlapped, out.faced_away = total.faced_away;
+  out.degenerate_uv = tiling.degenerate_uv, out.too_large = tiling.too_large;
   out.outside_tile = triangles_outside_tile(context.rays.low, context.target);
   out.reach_front = reach_for(total.wanted_front), out.reach_back = reach_for(total.wanted_back);
   if (total.height_min <= total.height_max) out.height_min = total.height_min, out.height_max = total.height_max;
@@ -798,6 +813,7 @@ Result<Bake> bake(const scene::Scene& low, const scene::Scene& high, const std::
   Bake result;
   result.boxes = compare_boxes(low, high);
   std::tie(result.front, result.back) = cage_distances(low, options, cage);  // an averaged cage's: front
+  const bool cage_mesh = cage != nullptr;
   std::optional<scene::Scene> averaged;
   if (options.average_normals && !cage) {
     averaged = averaged_normal_cage(low, result.front);
@@ -836,7 +852,8 @@ Result<Bake> bake(const scene::Scene& low, const scene::Scene& high, const std::
                         options.id_by == IdSource::primitive ? &primitives : nullptr,
                         parts ? &*parts : nullptr,
                         occluders_matched,
-                        2 * low.radius()};
+                        2 * low.radius(),
+                        cage_mesh};
   for (std::size_t index = 0; index < targets.size() && !options.maps.empty(); ++index) {
     // The 0–1 tile alone, as Substance, Marmoset and Blender bake: a shell moved out by whole tiles
     // (a mirrored half kept out of the bake) is not wrapped back into it.
@@ -864,7 +881,8 @@ Result<Bake> bake(const scene::Scene& low, const scene::Scene& high, const std::
                            nullptr,
                            parts ? &*parts : nullptr,
                            occluders_matched,
-                           0};
+                           0,
+                           cage_mesh};
     result.vertices = bake_vertices(vertex_rays, options.vertex_maps);
   }
   result.trace_seconds = seconds_since(trace_start);

@@ -48,13 +48,13 @@ std::size_t triangle_count(const scene::Scene& scene) {
 // Why no material of the low-poly can take maps: none has a material, the two files look swapped
 // (the "low-poly" denser than the high-poly: a sculpt seldom has UVs), or none has its UV set.
 std::string no_target_reason(const scene::Scene& low, bool no_material, const fs::path& high) {
-  if (no_material) return "no primitive of the low-poly has a material, and baked maps go into one: give its primitives a material";
   const std::size_t low_triangles = triangle_count(low);
   if (auto dense = scene::load_scene(high); dense && low_triangles > triangle_count(*dense)) {
-    return "the low-poly's materials lack their UV sets, and it has " + std::to_string(low_triangles) +
-           " triangles, more than the high-poly's " + std::to_string(triangle_count(*dense)) +
+    return std::string(no_material ? "the low-poly has no material" : "the low-poly's materials lack their UV sets") + ", and it has " +
+           std::to_string(low_triangles) + " triangles, more than the high-poly's " + std::to_string(triangle_count(*dense)) +
            ": are the two swapped? (the low-poly takes the maps, the high-poly gives them)";
   }
+  if (no_material) return "no primitive of the low-poly has a material, and baked maps go into one: give its primitives a material";
   return "no material of the low-poly can take baked maps: each needs its UV set (TEXCOORD_n of its normalTexture, else "
          "TEXCOORD_0) on all its primitives; unwrap the low-poly";
 }
@@ -124,16 +124,6 @@ std::optional<Slot> material_slot(Map map) {
   }
 }
 
-// A DirectX-convention normal map in a glTF's normalTexture, which is OpenGL's: refused.
-Status check_green(const Options& bake) {
-  if (bake.green != Green::directx || std::ranges::find(bake.maps, Map::normal) == bake.maps.end()) return success();
-  return Error{"", mention("green", "directx") + ": a glTF's normalTexture is OpenGL's convention (green up the texture), and "
-                   "every glTF viewer would shade this normal map inverted; bake with " + mention("green", "opengl") +
-                   " (and flip green in the engine's import), or leave normal out of the maps (bent_normal, written "
-                   "beside the glTF, follows green)",
-               true};
-}
-
 // A material's textureInfo `info` (at JSON pointer `where`) as the bake samples it: decoded with
 // `colour`, with its UV set, transform and sampler's wrap modes.
 Result<MaterialTexture> material_texture(const gltf::Document& doc, const gltf::ImageCache& cache, const Json& info,
@@ -197,22 +187,22 @@ fs::path beside_file(const fs::path& output, const std::string& material_name, M
 
 image::SampleType png_type(const Request& request) { return request.bits == 16 ? image::SampleType::u16 : image::SampleType::u8; }
 
-// A map beside the output: float EXR, or a PNG of its values mapped onto 0–1 (map_range), which
-// `range` returns.
-Status write_beside(image::Image img, const fs::path& file, const FileOptions& options, const MapImage& map,
-                    std::pair<double, double>& range) {
+// The bytes of a map beside the output: float EXR, or a PNG of its values mapped onto 0–1
+// (map_range), which `range` is set to.
+Result<std::string> encode_beside(image::Image img, const fs::path& file, const FileOptions& options, const MapImage& map,
+                                  std::optional<std::pair<double, double>>& range) {
   image::WriteOptions write;
   write.png_level = options.encoding.png_level;
   if (options.request.map_format == MapFormat::exr) {
     write.type = image::SampleType::f32;
-    range = {0, 0};
-    return image::write_image(img, file, write);
+    range.reset();
+    return image::encode_image(img, file, write);
   }
   range = map_range(map);
-  const double scale = 1.0 / (range.second - range.first);
-  for (float& v : img.pixels) v = float(std::clamp((double(v) - range.first) * scale, 0.0, 1.0));
+  const double scale = 1.0 / (range->second - range->first);
+  for (float& v : img.pixels) v = float(std::clamp((double(v) - range->first) * scale, 0.0, 1.0));
   write.type = png_type(options.request);
-  return image::write_image(img, file, write);
+  return image::encode_image(img, file, write);
 }
 
 // TANGENT (and NORMAL where missing) on each baked primitive, once per mesh primitive.
@@ -255,6 +245,7 @@ Result<TextureReport> write_maps(gltf::Document& doc, const gltf::ImageCache& ca
   report.texels = baked.texels, report.samples = baked.samples, report.misses = baked.misses;
   report.missed_texels = baked.missed_texels, report.padded = baked.padded;
   report.from_inside = baked.from_inside, report.overlapped = baked.overlapped, report.outside_tile = baked.outside_tile;
+  report.faced_away = baked.faced_away, report.skipped_triangles = baked.degenerate_uv + baked.too_large;
   report.height_min = baked.height_min, report.height_max = baked.height_max;
   report.occlusion_rays = baked.occlusion_rays;
   const std::string file_name = gltf::material_file_name(material, m);
@@ -262,10 +253,13 @@ Result<TextureReport> write_maps(gltf::Document& doc, const gltf::ImageCache& ca
     image::Image img = gltf::blank(baked.width, baked.height, map.channels);
     img.pixels = map.values;
     const std::optional<Slot> slot = material_slot(map.map);
-    std::pair<double, double>& range = report.ranges.emplace_back(0.0, 1.0);
+    std::optional<std::pair<double, double>>& range = report.ranges.emplace_back(std::pair(0.0, 1.0));
     if (!slot) {
+      // Written with the document, after every check of its files.
       const fs::path file = beside_file(options.output, file_name, map.map, options.request.map_format);
-      if (Status s = write_beside(std::move(img), file, options, map, range); !s) return s.error();
+      auto bytes = encode_beside(std::move(img), file, options, map, range);
+      if (!bytes) return bytes.error();
+      doc.beside[file.filename().string()] = std::move(*bytes);
       report.files.push_back(file.string());
       continue;
     }
@@ -458,11 +452,12 @@ Status judge_misses(const Bake& baked, const Targets& targets, const FileOptions
   const std::string cause = baked.unmatched.empty() ? "" : "no high-poly part matches the low-poly parts " + quoted(baked.unmatched) + " by name";
   const auto judge = [&](const std::string& what, std::size_t misses, std::size_t rays, const TextureBake* texture) -> Status {
     if (misses == 0 || rays == 0) return success();
-    const std::string why = !cause.empty() ? cause : miss_cause(baked.boxes, texture ? *texture : TextureBake{}, options.request.bake, diagonal);
+    const std::string why = !cause.empty() ? cause : miss_cause(baked.boxes, texture ? *texture : TextureBake{}, options.request.bake, diagonal,
+                                                                   !options.cage.empty());
     const std::string share = percent(misses, rays) + " of the rays (" + std::to_string(misses) + " of " + std::to_string(rays) + ")";
     if (double(misses) > limit * double(rays)) {
       char limit_text[32];
-      std::snprintf(limit_text, sizeof limit_text, "%g", limit);
+      std::snprintf(limit_text, sizeof limit_text, "%g", limit + 0.0);  // + 0.0: never "-0"
       return Error{"", what + ": " + share + " missed the high-poly, more than " + mention("max_misses", limit_text) + " allows: " + why};
     }
     report.warnings.push_back(what + ": " + share + " missed the high-poly (their texels take their neighbours' values): " + why);
@@ -472,6 +467,14 @@ Status judge_misses(const Bake& baked, const Targets& targets, const FileOptions
     const TextureBake& texture = baked.textures[t];
     const std::string& what = targets.targets[t].name;
     if (Status s = judge(what, texture.misses, texture.samples, &texture); !s) return s;
+    if (texture.texels == 0) {
+      report.warnings.push_back(what + ": none of its UVs covers the 0–1 tile (" + std::to_string(texture.outside_tile) +
+                                " triangles outside it, " + std::to_string(texture.degenerate_uv) + " of no area or not finite, " +
+                                std::to_string(texture.too_large) + " spanning too far): its maps hold only fill values");
+    } else if (texture.degenerate_uv + texture.too_large) {
+      report.warnings.push_back(what + ": " + std::to_string(texture.degenerate_uv + texture.too_large) +
+                                " triangles were not baked: their UVs have no area, are not finite or span too far");
+    }
     if (texture.from_inside) {
       report.warnings.push_back(what + ": " + percent(texture.from_inside, texture.samples) + " of the rays (" +
                                 std::to_string(texture.from_inside) + ") started inside a closed high-poly part (their first "
@@ -495,6 +498,17 @@ gltf::Reachable reach_before_bake(Json& json) {
 
 }  // namespace
 
+Status check(const Request& request) {
+  if (Status s = check(request.bake); !s) return s;
+  const Options& bake = request.bake;
+  if (bake.green != Green::directx || std::ranges::find(bake.maps, Map::normal) == bake.maps.end()) return success();
+  return Error{"", mention("green", "directx") + ": a glTF's normalTexture is OpenGL's convention (green up the texture), and "
+                   "every glTF viewer would shade this normal map inverted; bake with " + mention("green", "opengl") +
+                   " (and flip green in the engine's import), or leave normal out of the maps (bent_normal, written "
+                   "beside the glTF, follows green)",
+               true};
+}
+
 std::pair<double, double> map_range(const MapImage& image) {
   double lo = 0, hi = 1, largest = 0;
   const auto [smallest, biggest] = std::minmax_element(image.values.begin(), image.values.end());
@@ -517,8 +531,7 @@ Result<FileReport> bake_file(const fs::path& low_path, const FileOptions& option
     if (const fs::path ext = options.output.extension(); ext != ".gltf" && ext != ".glb") {
       return Error{options.output.string(), "the output is .gltf or .glb", true};
     }
-    if (Status s = check(options.request.bake); !s) return s.error();
-    if (Status s = check_green(options.request.bake); !s) return s.error();
+    if (Status s = check(options.request); !s) return s.error();
     const auto start = std::chrono::steady_clock::now();
     // The inputs' content before they are loaded: kept maps are keyed by what was read, at worst older.
     std::vector<fs::path> inputs = files_of(low_path);
@@ -553,7 +566,7 @@ Result<FileReport> bake_file(const fs::path& low_path, const FileOptions& option
         if (material_slot(map)) continue;
         outputs.push_back({beside_file(options.output, gltf::material_file_name(materials[std::size_t(m)], m), map,
                                        options.request.map_format),
-                           std::string(matbake::name_in(kMapNames, map)) + " map"});
+                           "material " + std::to_string(m) + "'s " + std::string(matbake::name_in(kMapNames, map)) + " map"});
       }
     }
     if (!options.keep.empty()) {
@@ -603,7 +616,6 @@ Result<FileReport> bake_file(const fs::path& low_path, const FileOptions& option
       }
       for (std::size_t i = 0; i < options.request.bake.maps.size(); ++i) {
         if (material_slot(options.request.bake.maps[i])) continue;
-        report.written.push_back(written->files[i]);
         report.beside.push_back(written->files[i]);
       }
       report.textures.push_back(std::move(*written));

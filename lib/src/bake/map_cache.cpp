@@ -135,6 +135,7 @@ std::optional<Bake> load_trace(const fs::path& folder, const std::string& key, s
     b.texels = count(t, "texels"), b.missed_texels = count(t, "missed_texels"), b.padded = count(t, "padded");
     b.samples = count(t, "rays"), b.misses = count(t, "misses"), b.occlusion_rays = count(t, "occlusion_rays");
     b.from_inside = count(t, "from_inside"), b.overlapped = count(t, "overlapped"), b.outside_tile = count(t, "outside_tile");
+    b.faced_away = count(t, "faced_away"), b.degenerate_uv = count(t, "degenerate_uv"), b.too_large = count(t, "too_large");
     b.height_min = number(t, "height_min"), b.height_max = number(t, "height_max");
     b.reach_front = number(t, "reach_front"), b.reach_back = number(t, "reach_back");
   }
@@ -159,7 +160,8 @@ Status store_maps(const fs::path& folder, const Bake& bake, const std::string& t
     stats.push_back({{"texels", t.texels}, {"missed_texels", t.missed_texels}, {"padded", t.padded},
                      {"height_min", t.height_min}, {"height_max", t.height_max}, {"rays", t.samples}, {"misses", t.misses},
                      {"occlusion_rays", t.occlusion_rays}, {"from_inside", t.from_inside}, {"overlapped", t.overlapped},
-                     {"outside_tile", t.outside_tile}, {"reach_front", t.reach_front}, {"reach_back", t.reach_back}});
+                     {"outside_tile", t.outside_tile}, {"reach_front", t.reach_front}, {"reach_back", t.reach_back},
+                     {"faced_away", t.faced_away}, {"degenerate_uv", t.degenerate_uv}, {"too_large", t.too_large}});
   }
   const nlohmann::json boxes = {{"low_diagonal", bake.boxes.low_diagonal}, {"high_diagonal", bake.boxes.high_diagonal},
                                 {"overlap", bake.boxes.overlap}};

@@ -13,13 +13,17 @@ Boxes compare_boxes(const scene::Scene& low, const scene::Scene& high) {
   Boxes out;
   const glm::dvec3 a0(low.bounds_min), a1(low.bounds_max), b0(high.bounds_min), b1(high.bounds_max);
   out.low_diagonal = glm::length(a1 - a0), out.high_diagonal = glm::length(b1 - b0);
-  // A flat low-poly has no extent along its normal: an axis counts at least 1% of the diagonal.
-  const double least = 0.01 * std::max(out.low_diagonal, out.high_diagonal);
   for (int k = 0; k < 3; ++k) {
-    const double pad = std::max(0.0, least - (a1[k] - a0[k])) / 2;
-    const double lo = a0[k] - pad, hi = a1[k] + pad;
-    const double shared = std::max(0.0, std::min(hi, b1[k] + pad) - std::max(lo, b0[k] - pad));
-    out.overlap = std::min(out.overlap, hi > lo ? shared / (hi - lo) : 1.0);
+    const double extent = a1[k] - a0[k];
+    const double shared = std::max(0.0, std::min(a1[k], b1[k]) - std::max(a0[k], b0[k]));
+    if (extent >= 0.1 * out.low_diagonal) {
+      out.overlap = std::min(out.overlap, shared / extent);
+      continue;
+    }
+    // Along an axis the low-poly hardly spans (a flat one's normal), the boxes overlap when their
+    // gap is within the low-poly's size: farther is placement, nearer the cage's business.
+    const double gap = std::max({0.0, b0[k] - a1[k], a0[k] - b1[k]});
+    if (gap > out.low_diagonal) out.overlap = 0;
   }
   return out;
 }
@@ -34,22 +38,34 @@ std::string number(double v) {
 
 }  // namespace
 
-std::string miss_cause(const Boxes& boxes, const TextureBake& texture, const Options& options, double diagonal) {
+std::string miss_cause(const Boxes& boxes, const TextureBake& texture, const Options& options, double diagonal, bool cage_mesh) {
   if (boxes.low_diagonal > 0 && boxes.high_diagonal > 0) {
     const double ratio = boxes.high_diagonal / boxes.low_diagonal;
     if (ratio >= 5 || ratio <= 0.2) {
-      const double power = std::pow(10.0, std::round(std::log10(ratio)));
+      const int power = int(std::lround(std::log10(ratio)));
+      const char* example = std::abs(power) == 2 ? ": centimetres against metres?" : std::abs(power) == 3 ? ": millimetres against metres?"
+                            : std::abs(power) == 1                                ? ": millimetres against centimetres?"
+                                                                                  : "";
       return "the high-poly's bounding box is " + number(ratio) + "× the low-poly's: the two are likely in different units (a "
-             "factor of " + number(power) + ": centimetres against metres?)";
+             "factor of " + number(std::pow(10.0, power)) + example + ")";
     }
   }
   if (boxes.overlap < 0.5) {
     return "the two meshes' bounding boxes barely overlap (" + number(100 * boxes.overlap) +
            "% of the low-poly's extent along one axis): one is misplaced, or it is the wrong file";
   }
+  if (2 * texture.faced_away > texture.misses) {
+    return "most missed rays met only the backs of high-poly faces: its winding (or the low-poly's side of it) is flipped "
+           "there";
+  }
   if (texture.reach_front > 0 || texture.reach_back > 0) {
     const double unit = options.absolute_distances || !(diagonal > 0) ? 1.0 : diagonal;
     std::string wider;
+    if (texture.reach_front > 0 && cage_mesh) {
+      wider = "the cage mesh " + number(texture.reach_front) + " (scene units) farther out";
+      if (texture.reach_back > 0) wider += " and back " + number(texture.reach_back / unit) + (unit == 1 ? " (scene units)" : " (of the diagonal)");
+      return "the cage is too small: " + wider + " would reach 95% of the missed rays that have the high-poly along them";
+    }
     if (texture.reach_front > 0) wider = "front " + number(texture.reach_front / unit);
     if (texture.reach_back > 0) wider += std::string(wider.empty() ? "" : " and ") + "back " + number(texture.reach_back / unit);
     return "the cage is too small: " + wider + (options.absolute_distances ? " (scene units)" : " (of the diagonal)") +

@@ -115,7 +115,8 @@ params::Group<Request> make_group() {
                                  .example = "true"},
                             [](auto& r) -> auto& { return r.bake.high_normal_maps; }),
       params::choice<Request>(Spec{.name = "green",
-                                   .help = "The normal map's green: opengl (glTF's: up the texture) or directx",
+                                   .help = "The normal map's green: opengl (glTF's: up the texture) or directx (refused "
+                                           "with the normal map: a glTF viewer shades it inverted; bent_normal follows it)",
                                    .example = "directx"},
                               [](auto& r) -> auto& { return r.bake.green; }, kGreenNames),
       params::choice<Request>(Spec{.name = "id_by",
@@ -168,7 +169,7 @@ params::Group<Request> make_group() {
                                     .min = 0, .max = 9007199254740992.0, .example = "3"},
                                [](auto& r) -> auto& { return r.bake.seed; }),
   };
-  g.check = [](const Request& r) -> Status { return check(r.bake); };
+  g.check = [](const Request& r) -> Status { return check(r); };
   return g;
 }
 

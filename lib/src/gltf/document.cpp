@@ -543,6 +543,18 @@ Result<std::vector<fs::path>> write_document(const Document& doc, const fs::path
         image["mimeType"] = mime;
       }
     }
+    for (const auto& [name, bytes] : doc.beside) {
+      const fs::path target = output.parent_path() / name;
+      if (!is_really_inside(out_folder, target)) {
+        return Error{target.string(), "leaves the output's folder (a link on the way); matbake writes only inside it", true};
+      }
+      files.emplace_back(target, bytes);
+    }
+    // No two of the files beside the output share a name (a map named as a copied image), nor any
+    // the output or its buffer.
+    std::vector<NamedOutput> beside_outputs(std::begin(files_out), std::end(files_out));
+    for (const auto& [target, bytes] : files) beside_outputs.push_back({target, "'" + target.filename().string() + "'"});
+    if (Status s = check_outputs(beside_outputs, inputs); !s) return s.error();
     if (bin.size == 0 && fallbacks.empty()) {
       json.erase("buffers");
     } else {

@@ -40,6 +40,10 @@ struct Document {
   // The files the command read besides this document (a bake's high-poly and cage, and what they
   // reference): write_document writes none of them, as none of the document's own.
   std::vector<std::filesystem::path> other_inputs;
+  // Files written beside the output whatever its kind, by name: a bake's maps that are not the
+  // materials' textures. Never embedded; checked with the document's own files (no name twice, no
+  // input, inside the output's folder) and written only when all of them pass.
+  std::map<std::string, std::string> beside;
   DecodedGeometry decoded;
 };
 

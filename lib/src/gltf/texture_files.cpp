@@ -220,6 +220,7 @@ std::string uri_safe(const std::string& name) {
 std::string free_uri(const Document& doc, const std::string& name, const std::string& extension) {
   std::set<std::string> taken;
   for (const auto& [uri, bytes] : doc.new_files) taken.insert(uri);
+  for (const auto& [file, bytes] : doc.beside) taken.insert(file);
   for (const Json& img : array_in(doc.json, "images")) {
     if (img.contains("uri") && img["uri"].is_string()) taken.insert(decode_uri(img["uri"].get<std::string>()));
   }

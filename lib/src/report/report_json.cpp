@@ -167,7 +167,11 @@ nlohmann::json to_json(const bake::FileReport& r) {
                         {"missed_texels", t.missed_texels}, {"padded", t.padded}, {"height_min", t.height_min},
                         {"height_max", t.height_max}, {"files", t.files}, {"existing", t.existing},
                         {"occlusion_rays", t.occlusion_rays}, {"from_inside", t.from_inside}, {"overlapped", t.overlapped},
-                        {"outside_tile", t.outside_tile}, {"ranges", t.ranges}});
+                        {"outside_tile", t.outside_tile}, {"faced_away", t.faced_away}, {"skipped_triangles", t.skipped_triangles},
+                        {"ranges", nlohmann::json::array()}});
+    for (const auto& range : t.ranges) {  // per map: what a PNG's 0 and 1 stand for; null for an EXR
+      textures.back()["ranges"].push_back(range ? nlohmann::json{range->first, range->second} : nlohmann::json());
+    }
     if (t.copy_of_material >= 0) textures.back()["copy_of"] = t.copy_of, textures.back()["copy_of_material"] = t.copy_of_material;
   }
   return {{"front", r.front}, {"back", r.back}, {"textures", textures}, {"tangent_primitives", r.tangent_primitives},
