@@ -405,7 +405,10 @@ TEST(RequestTree, BakesTreeTakesEveryParameterAtItsExample) {
   for (std::size_t b = 0; b < tree.size(); ++b) {
     for (const Spec* spec : tree[b].specs) {
       SCOPED_TRACE(spec->name);
-      auto cli = from_flags(tree, with_needs(tree, b, spec));
+      std::vector<Setting<bake::FileOptions>> settings = with_needs(tree, b, spec);
+      // green directx is refused with the normal map, which goes into the glTF: a map written beside it.
+      if (spec->name == "green") settings.push_back(find_setting(tree, b, "maps", "bent_normal"));
+      auto cli = from_flags(tree, settings);
       ASSERT_TRUE(cli) << cli.error().to_string();
       EXPECT_NE(tree[b].values(*cli).at(spec->name), tree[b].values(bake::FileOptions{}).at(spec->name));
     }

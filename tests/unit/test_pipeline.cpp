@@ -56,7 +56,7 @@ size = 256
 input = "low.glb"
 [scenes.hero.bake]
 from = "sculpt/high.glb"
-maps = ["normal", "thickness", "ao"]
+maps = ["bent_normal", "thickness", "ao"]
 front = 0.5
 back = 0.25
 absolute_cage = true
@@ -106,7 +106,7 @@ TEST(BuildManifest, EveryKeyReachesItsField) {
   EXPECT_EQ(hero.bake->from, "sculpt/high.glb");
   EXPECT_EQ(hero.bake->high, fs::path("/project/sculpt/high.glb"));
   const bake::Request& r = hero.bake->request;
-  EXPECT_EQ(r.bake.maps, (std::vector<bake::Map>{bake::Map::normal, bake::Map::thickness, bake::Map::ao}));
+  EXPECT_EQ(r.bake.maps, (std::vector<bake::Map>{bake::Map::bent_normal, bake::Map::thickness, bake::Map::ao}));
   EXPECT_DOUBLE_EQ(r.bake.front, 0.5);
   EXPECT_DOUBLE_EQ(r.bake.back, 0.25);
   EXPECT_TRUE(r.bake.absolute_distances);
