@@ -388,7 +388,7 @@ std::vector<int> brute_force_points(const Instance& g, const TextureTarget& targ
   std::vector<double> nearest(texels, 1e300);
   std::vector<bool> ambiguous(texels, false);
   for (std::size_t t = 0; t < g.triangles.size(); ++t) {
-    const texels::UvTriangle tri = texels::uv_triangle(g, 0, t, width, height);
+    const texels::UvTriangle tri = texels::uv_triangle(g, target, t, width, height);
     const glm::dvec2 ab = tri.b - tri.a, ac = tri.c - tri.a;
     const double sign = ab.x * ac.y - ab.y * ac.x > 0 ? 1 : -1;
     const double x0 = std::min({tri.a.x, tri.b.x, tri.c.x}), x1 = std::max({tri.a.x, tri.b.x, tri.c.x});

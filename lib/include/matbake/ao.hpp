@@ -6,6 +6,8 @@
 //   exponential: μ(x) = (1 − e^(−τx)) / (1 − e^(−τ d_max)) for x < d_max, 1 beyond;
 //   none (binary AO): μ = 0 for a hit within d_max, 1 beyond.
 // With cosine-weighted directions (pdf cos θ / π) the estimator is the mean of μ over the rays.
+#include <glm/vec2.hpp>
+
 #include <cstdint>
 #include <filesystem>
 #include <optional>
@@ -109,6 +111,9 @@ struct TextureTarget {
   int texcoord = 0;                    // TEXCOORD_n; an instance without it is skipped and counted
   Wrap wrap_s = Wrap::repeat, wrap_t = Wrap::repeat;  // how the texture will be sampled past [0, 1]
   bool tile_only = false;  // the 0–1 tile alone: what lies outside it is not wrapped in (a high-to-low bake)
+  // The UV tile the texture spans, by its corner: [u, u + 1] × [v, v + 1] of the UV set (a UDIM
+  // tile's); (0, 0) is the 0–1 tile. With tile_only, that tile alone is baked.
+  glm::ivec2 tile_origin{0, 0};
   std::string name = "";  // what errors call this texture ("material 2 'wood'"); empty: "texture N"
 };
 

@@ -8,7 +8,8 @@
 // sample, and every map is computed from it. A ray that finds nothing is a miss: counted, and the
 // texel takes its nearest hit neighbour's value.
 //
-// Only UVs in the 0–1 tile are baked (a shell moved out by whole tiles is not wrapped back in).
+// Only UVs in each target's tile are baked (TextureTarget::tile_origin: the 0–1 tile unless a UDIM
+// tile's); a shell moved out by whole tiles is not wrapped back in.
 //
 // The tangent-space normal map is made for the basis a runtime shades with, so that it gives back
 // the high-poly's normal: per vertex the low-poly's TANGENT (MikkTSpace where the file has none, in

@@ -256,7 +256,7 @@ Tiling tile(const scene::Scene& scene, const TextureTarget& target, int width, i
       continue;
     }
     for (std::size_t t = 0; t < inst.triangles.size(); ++t) {
-      const UvTriangle uv = uv_triangle(inst, target.texcoord, t, width, height);
+      const UvTriangle uv = uv_triangle(inst, target, t, width, height);
       const double area2 = cross(uv.b - uv.a, uv.c - uv.a);
       const double longest2 = std::max({glm::dot(uv.b - uv.a, uv.b - uv.a), glm::dot(uv.c - uv.a, uv.c - uv.a),
                                         glm::dot(uv.c - uv.b, uv.c - uv.b)});
@@ -303,7 +303,7 @@ void cover_tile(const scene::Scene& scene, const TextureTarget& target, const Ti
     return std::uint32_t(y * tiling.width + x);
   };
   const auto oriented = [&](const Fragment& f) {
-    const UvTriangle uv = uv_triangle(scene.instances[f.instance], target.texcoord, f.triangle, tiling.width, tiling.height);
+    const UvTriangle uv = uv_triangle(scene.instances[f.instance], target, f.triangle, tiling.width, tiling.height);
     return cross(uv.b - uv.a, uv.c - uv.a) > 0 ? uv : UvTriangle{uv.a, uv.c, uv.b};
   };
   out.found.clear();

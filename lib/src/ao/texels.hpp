@@ -83,11 +83,13 @@ Status cover_tiles(const scene::Scene& scene, const TextureTarget& target, const
 struct UvTriangle {
   glm::dvec2 a, b, c;
 };
-inline UvTriangle uv_triangle(const scene::Instance& inst, int texcoord, std::size_t triangle, int width, int height) {
-  const auto& uv = inst.texcoords[std::size_t(texcoord)];
+// (Texel space of target.tile_origin's tile: its corner at −½, −½.)
+inline UvTriangle uv_triangle(const scene::Instance& inst, const TextureTarget& target, std::size_t triangle, int width, int height) {
+  const auto& uv = inst.texcoords[std::size_t(target.texcoord)];
   const auto& t = inst.triangles[triangle];
+  const glm::dvec2 origin(target.tile_origin);
   const auto texel = [&](std::uint32_t v) {
-    return glm::dvec2(double(uv[v].x) * width - 0.5, double(uv[v].y) * height - 0.5);
+    return glm::dvec2((double(uv[v].x) - origin.x) * width - 0.5, (double(uv[v].y) - origin.y) * height - 0.5);
   };
   return {texel(t[0]), texel(t[1]), texel(t[2])};
 }

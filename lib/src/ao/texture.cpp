@@ -32,7 +32,7 @@ double point_occlusion(const Tracer& tracer, const scene::Scene& scene, const te
                        std::span<RTCRayHit16> rays, std::uint64_t& cast) {
   const scene::Instance& inst = scene.instances[point.instance];
   const auto& corners = inst.triangles[point.triangle];
-  const texels::UvTriangle uv = texels::uv_triangle(inst, target.texcoord, point.triangle, texture.width, texture.height);
+  const texels::UvTriangle uv = texels::uv_triangle(inst, target, point.triangle, texture.width, texture.height);
   const Mesh& mesh = tracer.mesh(point.instance);
   const Vec3& face = tracer.face_normals(point.instance)[point.triangle];
   const float texel_size = texels::texel_size(double(glm::length(face)), uv);

@@ -292,7 +292,7 @@ void trace_point(const TraceContext& t, const ao::texels::SurfacePoint& point, s
   const Rays& c = t.rays;
   const scene::Instance& inst = c.low.instances[point.instance];
   const ao::texels::UvTriangle uv =
-      ao::texels::uv_triangle(inst, t.target.texcoord, point.triangle, t.texture.width, t.texture.height);
+      ao::texels::uv_triangle(inst, t.target, point.triangle, t.texture.width, t.texture.height);
   const int positions = t.texture.texel_samples;
   float texel_size = 0;
   if (c.occlusion || c.thickness) {
@@ -723,17 +723,18 @@ void trace_tile(const TraceContext& context, const Options& options, const ao::t
   }
 }
 
-// The target's triangles whose UVs lie wholly outside the 0–1 tile (none of their texels baked).
+// The target's triangles whose UVs lie wholly outside its tile (none of their texels baked).
 std::size_t triangles_outside_tile(const scene::Scene& low, const ao::TextureTarget& target) {
   std::size_t outside = 0;
+  const glm::dvec2 tile(target.tile_origin);
   for (std::size_t k : target.instances) {
     const scene::Instance& inst = low.instances[k];
     if (std::size_t(target.texcoord) >= inst.texcoords.size()) continue;
     const auto& uv = inst.texcoords[std::size_t(target.texcoord)];
     for (const auto& corners : inst.triangles) {
-      glm::vec2 lo(uv[corners[0]]), hi = lo;
-      for (std::uint32_t v : corners) lo = glm::min(lo, uv[v]), hi = glm::max(hi, uv[v]);
-      outside += hi.x <= 0 || hi.y <= 0 || lo.x >= 1 || lo.y >= 1;
+      glm::dvec2 lo(uv[corners[0]]), hi = lo;
+      for (std::uint32_t v : corners) lo = glm::min(lo, glm::dvec2(uv[v])), hi = glm::max(hi, glm::dvec2(uv[v]));
+      outside += hi.x <= tile.x || hi.y <= tile.y || lo.x >= tile.x + 1 || lo.y >= tile.y + 1;
     }
   }
   return outside;
@@ -855,8 +856,9 @@ Result<Bake> bake(const scene::Scene& low, const scene::Scene& high, const std::
                         2 * low.radius(),
                         cage_mesh};
   for (std::size_t index = 0; index < targets.size() && !options.maps.empty(); ++index) {
-    // The 0–1 tile alone, as Substance, Marmoset and Blender bake: a shell moved out by whole tiles
-    // (a mirrored half kept out of the bake) is not wrapped back into it.
+    // The target's tile alone (the 0–1 tile unless a UDIM tile's), as Substance, Marmoset and
+    // Blender bake: a shell moved out by whole tiles (a mirrored half kept out of the bake) is not
+    // wrapped back into it.
     ao::TextureTarget in_tile = targets[index];
     in_tile.tile_only = true;
     auto traced = trace_target(TraceContext{texel_rays, *frames, in_tile, texture, index}, options);
