@@ -44,8 +44,9 @@ int run_bake(const BakeSettings& s, const GlobalOptions& global) {
   } else if (!global.quiet) {
     for (const std::string& note : report->notes) std::cout << "note: " << escape_control(note) << "\n";
     for (const bake::TextureReport& t : report->textures) {
-      std::printf("  material %d %s: %dx%d, %zu texels, %zu rays, %zu missed (%zu texels filled)", t.material,
-                  escape_control(t.name).c_str(), t.width, t.height, t.texels, t.samples, t.misses, t.missed_texels);
+      const std::string tile = t.tile ? " tile " + std::to_string(t.tile) : "";
+      std::printf("  material %d %s%s: %dx%d, %zu texels, %zu rays, %zu missed (%zu texels filled)", t.material,
+                  escape_control(t.name).c_str(), tile.c_str(), t.width, t.height, t.texels, t.samples, t.misses, t.missed_texels);
       if (t.height_max > t.height_min) std::printf(", height %.4g to %.4g", t.height_min, t.height_max);
       std::printf("\n");
       for (std::size_t i = 0; i < t.files.size() && i < t.ranges.size(); ++i) {  // PNG maps beside: what 0 and 1 stand for

@@ -619,6 +619,103 @@ TEST(CliBake, PerInstanceGivesEachPlacementItsOwnMapsAndVertexValues) {
   }
 }
 
+// --udim: one primitive of two quads with material "stone", A over x in [−1, 0] with its UVs in
+// tile 1001 and B over [0, 1] with its UVs in tile 1002 (u = x + 1 for both, v against y), over
+// the tilted plane z = 0.1x + 0.05y − 0.02. Each tile's height map is that plane over its own quad
+// (two different fields: tile 1001's x = u − 1, 1002's x = u), every texel within float rounding;
+// the files are named <stem>_<material>_<map>.<tile>. In the glTF each tile is a material of its
+// own ("stone", "stone (1002)"), the primitive split so that each holds its tile's triangles and
+// its material's normalTexture the tile's image: validator-clean. A triangle across the tiles'
+// border is one error line and writes nothing; without --udim, B is outside the 0–1 tile.
+void write_udim_low(const fs::path& path, double b_u0) {
+  GltfBuilder b;
+  const int positions = b.add_vec3({-1, -1, 0, 0, -1, 0, 0, 1, 0, -1, 1, 0, 0, -1, 0, 1, -1, 0, 1, 1, 0, 0, 1, 0});
+  std::vector<float> normals;
+  for (int v = 0; v < 8; ++v) normals.insert(normals.end(), {0, 0, 1});
+  const int mesh = b.add_mesh(positions, b.add_indices({0, 1, 2, 0, 2, 3, 4, 5, 6, 4, 6, 7}), 4, b.add_vec3(normals));
+  const auto u = [&](double x) { return float(x); };
+  auto& primitive = b.doc["meshes"][std::size_t(mesh)]["primitives"][0];
+  primitive["attributes"]["TEXCOORD_0"] =
+      b.add_floats({u(0), 1, u(1), 1, u(1), 0, u(0), 0, u(b_u0), 1, u(b_u0 + 1), 1, u(b_u0 + 1), 0, u(b_u0), 0}, "VEC2", 2);
+  primitive["material"] = 0;
+  b.doc["materials"] = {{{"name", "stone"}}};
+  b.write(path, {b.add_node({{"mesh", mesh}})});
+}
+
+TEST(CliBake, UdimTilesEachHoldTheirOwnFieldAndTheGltfTakesOneMaterialPerTile) {
+  TempDir dir;
+  write_udim_low(dir / "low.gltf", 1);
+  const auto plane = [](double x, double y) { return 0.1 * x + 0.05 * y - 0.02; };
+  const glm::dvec3 n = glm::normalize(glm::dvec3(-0.1, -0.05, 1));
+  std::vector<glm::dvec3> corners;
+  for (const auto& [x, y] : {std::pair{-2.0, -2.0}, {2.0, -2.0}, {2.0, 2.0}, {-2.0, 2.0}}) corners.emplace_back(x, y, plane(x, y));
+  write_grey_mesh(dir / "high.gltf", corners, std::vector<glm::dvec3>(4, n), {}, {{0, 1, 2}, {0, 2, 3}});
+  const auto bake_with = [&](const std::string& out, std::vector<std::string> extra) {
+    std::vector<std::string> args{"--json", "bake", (dir / "low.gltf").string(), "--from", (dir / "high.gltf").string(), "-o",
+                                  (dir / out).string(), "--maps", "normal,height", "--size", "16", "--texel-samples", "1",
+                                  "--front", "0.5", "--back", "0.5", "--absolute-cage"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return matbake(args);
+  };
+  const auto r = bake_with("out.gltf", {"--udim"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto report = nlohmann::json::parse(r.out);
+  ASSERT_EQ(report["textures"].size(), 2u) << report.dump(1);
+  const gltf::Document doc = read_output(dir / "out.gltf");
+  for (const auto& t : report["textures"]) {
+    const int tile = t.value("tile", 0);
+    ASSERT_TRUE(tile == 1001 || tile == 1002) << t.dump();
+    EXPECT_EQ(t["name"], tile == 1001 ? "stone" : "stone (1002)");
+    EXPECT_EQ(t["files"][0], "out_stone_normal." + std::to_string(tile) + ".png");
+    EXPECT_EQ(fs::path(t["files"][1].get<std::string>()), dir / ("out_stone_height." + std::to_string(tile) + ".exr"));
+    const auto height = image::read_image(t["files"][1].get<std::string>(), color::Transfer::linear);
+    ASSERT_TRUE(height);
+    for (int j = 0; j < 16; ++j) {
+      for (int i = 0; i < 16; ++i) {
+        const double u = (i + 0.5) / 16, x = tile == 1001 ? u - 1 : u, y = 1 - 2 * (j + 0.5) / 16;
+        ASSERT_NEAR(height->pixels[std::size_t(j * 16 + i)], plane(x, y), 1e-6) << tile << ": " << i << "," << j;
+      }
+    }
+    // The material of the tile: its normalTexture is the tile's image.
+    const auto& material = doc.json["materials"][t["material"].get<std::size_t>()];
+    const int texture = material["normalTexture"]["index"];
+    const int image = doc.json["textures"][std::size_t(texture)]["source"];
+    EXPECT_EQ(doc.json["images"][std::size_t(image)]["uri"], t["files"][0]);
+  }
+  // Each primitive's triangles lie in its material's tile: A's vertices (x ≤ 0) with "stone".
+  const auto& primitives = doc.json["meshes"][0]["primitives"];
+  ASSERT_EQ(primitives.size(), 2u);
+  for (const auto& primitive : primitives) {
+    const std::string material = doc.json["materials"][primitive["material"].get<std::size_t>()]["name"];
+    const std::vector<float> position = float_accessor(doc, primitive["attributes"]["POSITION"]);
+    auto indices = gltf::accessor_bytes(doc, primitive["indices"].get<std::size_t>());
+    ASSERT_TRUE(indices);
+    EXPECT_EQ(indices->count, 6u) << material;
+    for (std::size_t k = 0; k < indices->count; ++k) {
+      const std::uint32_t v = gltf::index_value(indices->first + k * indices->stride, indices->component_type);
+      const float x = position[3 * v], mid = material == "stone" ? -0.5f : 0.5f;
+      EXPECT_LE(std::abs(x - mid), 0.5f) << material << " vertex " << v;
+    }
+    EXPECT_TRUE(primitive["attributes"].contains("TANGENT"));
+  }
+  MATBAKE_VALIDATE_OR_SKIP(validated, dir / "out.gltf");
+  EXPECT_EQ(validated->errors, 0) << validated->summary;
+
+  write_udim_low(dir / "across.gltf", 0.5);  // B's UVs from u = 0.5 to 1.5
+  const auto across = matbake({"bake", (dir / "across.gltf").string(), "--from", (dir / "high.gltf").string(), "-o",
+                               (dir / "across_out.gltf").string(), "--size", "16", "--udim"});
+  EXPECT_EQ(across.exit_code, 1);
+  expect_one_error_line(across, (dir / "across.gltf").string(), "material 0 'stone': triangle 2 of mesh 0 primitive 0 lies across a UDIM tile's border");
+  EXPECT_FALSE(fs::exists(dir / "across_out.gltf"));
+
+  const auto one_tile = bake_with("plain.gltf", {});
+  ASSERT_EQ(one_tile.exit_code, 0) << one_tile.err;
+  const auto plain = nlohmann::json::parse(one_tile.out);
+  EXPECT_EQ(plain["textures"].size(), 1u);
+  EXPECT_FALSE(plain["textures"][0].contains("tile"));
+  EXPECT_EQ(plain["textures"][0]["outside_tile"], 2);
+}
+
 // Matching parts by name from the files' node names: the low-poly's quad (node "plate_low") under
 // two high-poly parts within its cage, its own 0.02 below it ("plate_high") and another's 0.02
 // above it ("bolt_high"). Every ray meets the bolt first; with --match by_name, only the plate.

@@ -33,7 +33,13 @@ struct Request {
   double max_misses = 0.5;
   int bits = 8;  // of every PNG the bake writes: the material's textures, and the maps beside with MapFormat::png
   MapFormat map_format = MapFormat::exr;
+  // Every UDIM tile a material's UVs touch baked into maps of its own, named
+  // <stem>_<material>_<map>.<tile> (tile 1001 + u + 10·v, v counted up the texture as Mari and
+  // Blender count it); in the glTF, one material per tile, each primitive split by tile, as
+  // Blender's glTF exporter writes UDIMs. A triangle across a tile's border is refused.
+  bool udim = false;
 };
+constexpr int kMaxUdimTiles = 100;  // in one bake: each tile's maps are held until written
 
 // The values a PNG map's 0 and 1 stand for (MapFormat::png): the encoded maps (normal, bent
 // normal, ao, transfer, id, mask) as they are, 0 to 1; height and curvature symmetric about 0 (½ is
@@ -59,9 +65,10 @@ struct FileOptions {
 struct TextureReport {
   int material = -1;
   std::string name;                // the material's
-  std::string copy_of;             // per_instance: the name of the material a placement's copy copies
+  std::string copy_of;             // per_instance, udim: the name of the material a placement's or tile's copy copies
   int copy_of_material = -1;       // and its index (−1: not a copy)
   int width = 0, height = 0, texcoord = 0;
+  int tile = 0;                    // with Request::udim, the UDIM tile (1001, ...); else 0
   std::size_t texels = 0, samples = 0, misses = 0, missed_texels = 0, padded = 0, occlusion_rays = 0;
   double height_min = 0, height_max = 0;
   std::size_t from_inside = 0, overlapped = 0, outside_tile = 0, faced_away = 0;  // bake.hpp's TextureBake

@@ -16,6 +16,7 @@
 #include "../scene/from_document.hpp"
 #include "frames.hpp"
 #include "map_cache.hpp"
+#include "udim.hpp"
 #include "matbake/bake_file.hpp"
 #include "matbake/join.hpp"
 #include "matbake/output_check.hpp"
@@ -30,6 +31,7 @@ struct Targets {
   std::vector<ao::TextureTarget> targets;
   std::vector<int> materials;  // each target's
   std::vector<int> nodes;      // with per_instance, the node placing each target's instances; else -1
+  std::vector<int> tiles;      // with Request::udim, each target's UDIM tile; else 0
   std::vector<std::string> notes;
 };
 
@@ -102,6 +104,7 @@ Result<Targets> material_targets(const gltf::Document& doc, const scene::Scene& 
     }
     out.materials.push_back(m);
     out.nodes.push_back(node);
+    out.tiles.push_back(0);
     out.targets.push_back(std::move(target));
   }
   if (out.targets.empty()) return Error{doc.file, no_target_reason(low, by_material.empty(), high)};
@@ -179,10 +182,15 @@ Result<HighMaterials> high_materials(const fs::path& high, const image::Encoding
   return out;
 }
 
+// What a map's files are named: <stem>_<material>_<map>, and .<tile> with a UDIM tile.
+std::string map_file_stem(const fs::path& output, const std::string& material_name, Map map, int tile) {
+  return output.stem().string() + "_" + material_name + "_" + std::string(matbake::name_in(kMapNames, map)) +
+         (tile ? "." + std::to_string(tile) : "");
+}
+
 // A map written beside the output (not one of the material's textures): EXR or PNG.
-fs::path beside_file(const fs::path& output, const std::string& material_name, Map map, MapFormat format) {
-  return output.parent_path() / (output.stem().string() + "_" + material_name + "_" + std::string(matbake::name_in(kMapNames, map)) +
-                                 (format == MapFormat::png ? ".png" : ".exr"));
+fs::path beside_file(const fs::path& output, const std::string& material_name, Map map, int tile, MapFormat format) {
+  return output.parent_path() / (map_file_stem(output, material_name, map, tile) + (format == MapFormat::png ? ".png" : ".exr"));
 }
 
 image::SampleType png_type(const Request& request) { return request.bits == 16 ? image::SampleType::u16 : image::SampleType::u8; }
@@ -205,8 +213,11 @@ Result<std::string> encode_beside(image::Image img, const fs::path& file, const 
   return image::encode_image(img, file, write);
 }
 
+// The triangles of each (mesh, primitive) whose vertices TANGENT renumbered, as written.
+using Renumbered = std::map<std::pair<int, int>, std::vector<std::uint32_t>>;
+
 // TANGENT (and NORMAL where missing) on each baked primitive, once per mesh primitive.
-Status write_tangents(gltf::Document& doc, const scene::Scene& low, const Targets& targets, FileReport& report) {
+Status write_tangents(gltf::Document& doc, const scene::Scene& low, const Targets& targets, FileReport& report, Renumbered& written) {
   std::set<std::pair<int, int>> done;
   for (const ao::TextureTarget& target : targets.targets) {
     for (std::size_t k : target.instances) {
@@ -228,19 +239,22 @@ Status write_tangents(gltf::Document& doc, const scene::Scene& low, const Target
       auto added = gltf::add_tangents(doc, p);
       if (!added) return added.error();
       ++report.tangent_primitives;
-      report.split_vertices += *added;
+      report.split_vertices += added->vertices;
+      if (added->vertices) written[{mesh, inst.primitive}] = std::move(added->triangles);
     }
   }
   return success();
 }
 
-// The texture target `t`'s maps into the document and beside the output.
+// The texture target `t`'s maps into material `m` of the document and beside the output, their
+// files named for `file_name` (its material's, or with a UDIM tile the material copied's).
 Result<TextureReport> write_maps(gltf::Document& doc, const gltf::ImageCache& cache, const FileOptions& options,
-                                 const Targets& targets, std::size_t t, int m, TextureBake& baked) {
+                                 const Targets& targets, std::size_t t, int m, const std::string& file_name, TextureBake& baked) {
   Json& material = doc.json["materials"][std::size_t(m)];
   TextureReport report;
   report.material = m;
   report.name = gltf::name_in(material, "");
+  report.tile = targets.tiles[t];
   report.width = baked.width, report.height = baked.height, report.texcoord = targets.targets[t].texcoord;
   report.texels = baked.texels, report.samples = baked.samples, report.misses = baked.misses;
   report.missed_texels = baked.missed_texels, report.padded = baked.padded;
@@ -248,7 +262,6 @@ Result<TextureReport> write_maps(gltf::Document& doc, const gltf::ImageCache& ca
   report.faced_away = baked.faced_away, report.skipped_triangles = baked.degenerate_uv + baked.too_large;
   report.height_min = baked.height_min, report.height_max = baked.height_max;
   report.occlusion_rays = baked.occlusion_rays;
-  const std::string file_name = gltf::material_file_name(material, m);
   for (MapImage& map : baked.maps) {
     image::Image img = gltf::blank(baked.width, baked.height, map.channels);
     img.pixels = map.values;
@@ -256,7 +269,7 @@ Result<TextureReport> write_maps(gltf::Document& doc, const gltf::ImageCache& ca
     std::optional<std::pair<double, double>>& range = report.ranges.emplace_back(std::pair(0.0, 1.0));
     if (!slot) {
       // Written with the document, after every check of its files.
-      const fs::path file = beside_file(options.output, file_name, map.map, options.request.map_format);
+      const fs::path file = beside_file(options.output, file_name, map.map, report.tile, options.request.map_format);
       auto bytes = encode_beside(std::move(img), file, options, map, range);
       if (!bytes) return bytes.error();
       doc.beside[file.filename().string()] = std::move(*bytes);
@@ -267,12 +280,14 @@ Result<TextureReport> write_maps(gltf::Document& doc, const gltf::ImageCache& ca
     int sampler_from = -1;
     Json info = Json::object();
     if (holder.contains(slot->key) && holder[slot->key].is_object()) {
-      sampler_from = gltf::integer_in<int>(holder[slot->key], "index", -1, -1);
+      // A UDIM tile's image is sampled at the file's own UVs, past 0–1: glTF's default sampler
+      // repeats it; the old texture's might clamp.
+      if (!report.tile) sampler_from = gltf::integer_in<int>(holder[slot->key], "index", -1, -1);
       // An occlusion's strength is the artist's; a normal map's scale was for the old map.
       if (map.map == Map::ao && holder[slot->key].contains("strength")) info["strength"] = holder[slot->key]["strength"];
       report.existing += std::string(report.existing.empty() ? "" : ", ") + std::string(matbake::name_in(kMapNames, map.map)) + " replaced";
     }
-    const std::string name = options.output.stem().string() + "_" + file_name + "_" + std::string(matbake::name_in(kMapNames, map.map));
+    const std::string name = map_file_stem(options.output, file_name, map.map, report.tile);
     auto made = cache.add_texture(doc, img, slot->colour, name, sampler_from, png_type(options.request));
     if (!made) return made.error();
     info["index"] = made->index;  // no transform: the bake is over raw UVs
@@ -368,7 +383,7 @@ Result<Bake> bake_or_reuse(const scene::Scene& low, const Targets& targets, cons
   std::string targets_text;
   for (std::size_t t = 0; t < targets.targets.size(); ++t) {
     targets_text += std::to_string(targets.materials[t]) + "@" + std::to_string(targets.nodes[t]) + ":" +
-                    std::to_string(targets.targets[t].texcoord) + " ";
+                    std::to_string(targets.targets[t].texcoord) + (targets.tiles[t] ? "#" + std::to_string(targets.tiles[t]) : "") + " ";
   }
   const bool keeping = !options.keep.empty() && !inputs.empty();
   const std::string trace_key = keeping ? map_key(inputs, std::nullopt, options.request, targets_text) : "";
@@ -468,7 +483,8 @@ Status judge_misses(const Bake& baked, const Targets& targets, const FileOptions
     const std::string& what = targets.targets[t].name;
     if (Status s = judge(what, texture.misses, texture.samples, &texture); !s) return s;
     if (texture.texels == 0) {
-      report.warnings.push_back(what + ": none of its UVs covers the 0–1 tile (" + std::to_string(texture.outside_tile) +
+      report.warnings.push_back(what + ": none of its UVs covers " + (targets.tiles[t] ? "its UDIM tile" : "the 0–1 tile") + " (" +
+                                std::to_string(texture.outside_tile) +
                                 " triangles outside it, " + std::to_string(texture.degenerate_uv) + " of no area or not finite, " +
                                 std::to_string(texture.too_large) + " spanning too far): its maps hold only fill values");
     } else if (texture.degenerate_uv + texture.too_large) {
@@ -483,6 +499,33 @@ Status judge_misses(const Bake& baked, const Targets& targets, const FileOptions
     }
   }
   return judge("the vertices", baked.vertices.misses, baked.vertices.vertices, nullptr);
+}
+
+// The targets split by UDIM tile (`split`, of `targets`): each tile after a material's first takes
+// a copy of its material, named "<name> (<tile>)"; `into` (each target's material) and
+// `file_names` (what its files are named for) follow the targets.
+void apply_tiles(gltf::Document& doc, Targets& targets, const TileTargets& split, std::vector<int>& into,
+                 std::vector<std::string>& file_names) {
+  Targets out;
+  out.notes = targets.notes;
+  out.notes.insert(out.notes.end(), split.notes.begin(), split.notes.end());
+  std::vector<int> tile_into;
+  std::vector<std::string> tile_names;
+  for (std::size_t i = 0; i < split.targets.size(); ++i) {
+    const std::size_t from = split.from[i];
+    out.targets.push_back(split.targets[i]);
+    out.materials.push_back(targets.materials[from]), out.nodes.push_back(targets.nodes[from]), out.tiles.push_back(split.tiles[i]);
+    tile_names.push_back(file_names[from]);
+    int m = into[from];
+    if (i > 0 && split.from[i - 1] == from) {
+      Json copy = doc.json["materials"][std::size_t(m)];
+      copy["name"] = gltf::name_in(copy, "material " + std::to_string(m)) + " (" + std::to_string(split.tiles[i]) + ")";
+      doc.json["materials"].push_back(std::move(copy));
+      m = int(doc.json["materials"].size()) - 1;
+    }
+    tile_into.push_back(m);
+  }
+  targets = std::move(out), into = std::move(tile_into), file_names = std::move(tile_names);
 }
 
 // What of a document a bake may remove once it has written its maps: what the scene reached as
@@ -555,18 +598,25 @@ Result<FileReport> bake_file(const fs::path& low_path, const FileOptions& option
     if (!targets) return targets.error();
 
     // Each target's material: with per_instance, a placement's own copy (and its mesh's).
-    const std::vector<int> into = gltf::split_placements(*doc, *low, targets->materials, targets->nodes);
+    std::vector<int> into = gltf::split_placements(*doc, *low, targets->materials, targets->nodes);
+    std::vector<std::string> file_names;
+    for (int m : into) file_names.push_back(gltf::material_file_name(doc->json["materials"][std::size_t(m)], m));
+    std::optional<TileTargets> tiles;  // with udim: a target per tile, and each tile after the first a material
+    if (options.request.udim && !targets->targets.empty()) {
+      auto split = udim_targets(*low, targets->targets);
+      if (!split) return Error{doc->file, split.error().message};
+      tiles = std::move(*split);
+      apply_tiles(*doc, *targets, *tiles, into, file_names);
+    }
     std::vector<NamedOutput> outputs = {{options.output, "glTF output"}};
     if (options.output.extension() == ".gltf") {
       outputs.push_back({options.output.parent_path() / (options.output.stem().string() + ".bin"), "its buffer"});
     }
-    const Json& materials = doc->json["materials"];
-    for (int m : into) {
+    for (std::size_t t = 0; t < into.size(); ++t) {
       for (Map map : options.request.bake.maps) {
         if (material_slot(map)) continue;
-        outputs.push_back({beside_file(options.output, gltf::material_file_name(materials[std::size_t(m)], m), map,
-                                       options.request.map_format),
-                           "material " + std::to_string(m) + "'s " + std::string(matbake::name_in(kMapNames, map)) + " map"});
+        outputs.push_back({beside_file(options.output, file_names[t], map, targets->tiles[t], options.request.map_format),
+                           "material " + std::to_string(into[t]) + "'s " + std::string(matbake::name_in(kMapNames, map)) + " map"});
       }
     }
     if (!options.keep.empty()) {
@@ -593,7 +643,7 @@ Result<FileReport> bake_file(const fs::path& low_path, const FileOptions& option
     for (std::size_t t = 0; t < baked->textures.size() && t < targets->targets.size(); ++t) {
       const TextureBake& b = baked->textures[t];
       const std::string& what = targets->targets[t].name;
-      if (b.outside_tile) {
+      if (b.outside_tile && !targets->tiles[t]) {  // a UDIM tile's: the other tiles' triangles
         report.notes.push_back(what + ": " + std::to_string(b.outside_tile) + " triangles have UVs wholly outside the 0–1 "
                                "tile (a shell moved out by whole tiles): not baked");
       }
@@ -608,7 +658,7 @@ Result<FileReport> bake_file(const fs::path& low_path, const FileOptions& option
     const bool tangent_basis = std::ranges::any_of(options.request.bake.maps, [](Map m) { return m == Map::normal || m == Map::bent_normal; });
     gltf::ImageCache cache(*doc, options.encoding, gltf::MadeFormat::png);
     for (std::size_t t = 0; t < targets->targets.size(); ++t) {
-      auto written = write_maps(*doc, cache, options, *targets, t, into[t], baked->textures[t]);
+      auto written = write_maps(*doc, cache, options, *targets, t, into[t], file_names[t], baked->textures[t]);
       if (!written) return written.error();
       if (into[t] != targets->materials[t]) {
         written->copy_of = gltf::name_in(doc->json["materials"][std::size_t(targets->materials[t])], "");
@@ -624,8 +674,12 @@ Result<FileReport> bake_file(const fs::path& low_path, const FileOptions& option
     if (!options.request.bake.vertex_maps.empty()) {
       write_vertex_maps(*doc, *low, baked->vertices, options.request.vertex_ao_into, options.request.per_instance, report);
     }
+    Renumbered renumbered;
     if (tangent_basis) {
-      if (Status s = write_tangents(*doc, *low, *targets, report); !s) return s.error();
+      if (Status s = write_tangents(*doc, *low, *targets, report, renumbered); !s) return s.error();
+    }
+    if (tiles) {  // after the tangents: the triangles as they are written
+      if (Status s = split_by_tile(*doc, *low, *tiles, into, renumbered); !s) return s.error();
     }
     if (const auto removed = gltf::prune_unreachable(*doc, nullptr, &as_read); !removed.empty()) {
       report.notes.push_back("removed what the bake left unused: " + join(removed, ", "));

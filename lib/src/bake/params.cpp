@@ -165,6 +165,11 @@ params::Group<Request> make_group() {
                                            "or png (bits deep, values mapped onto 0-1 as reported)",
                                    .example = "png"},
                               [](auto& r) -> auto& { return r.map_format; }, kMapFormatNames),
+      params::flag<Request>(Spec{.name = "udim",
+                                 .help = "Every UDIM tile the UVs touch baked into maps of its own "
+                                         "(<stem>_<material>_<map>.<tile>); in the glTF, one material per tile",
+                                 .example = "true"},
+                            [](auto& r) -> auto& { return r.udim; }),
       params::integer<Request>(Spec{.name = "seed", .help = "Scrambling seed of the texel positions",
                                     .min = 0, .max = 9007199254740992.0, .example = "3"},
                                [](auto& r) -> auto& { return r.bake.seed; }),

@@ -449,6 +449,19 @@ int add_view(Document& doc, std::span<const unsigned char> bytes, int target) {
   return int(doc.json["bufferViews"].size()) - 1;
 }
 
+int add_index_accessor(Document& doc, const std::vector<std::uint32_t>& indices, std::size_t vertices) {
+  std::vector<unsigned char> bytes;
+  const bool narrow = vertices <= 65535;
+  for (std::uint32_t i : indices) {
+    const unsigned char* p = reinterpret_cast<const unsigned char*>(&i);  // little-endian, as glTF
+    bytes.insert(bytes.end(), p, p + (narrow ? 2 : 4));
+  }
+  const int view = add_view(doc, bytes, kElementArrayBuffer);
+  doc.json["accessors"].push_back(
+      {{"bufferView", view}, {"componentType", narrow ? kUnsignedShort : kUnsignedInt}, {"count", indices.size()}, {"type", "SCALAR"}});
+  return int(doc.json["accessors"].size()) - 1;
+}
+
 int add_float_accessor(Document& doc, const std::vector<float>& values, std::size_t count, const char* type) {
   const std::span bytes(reinterpret_cast<const unsigned char*>(values.data()), values.size() * sizeof(float));
   const int view = add_view(doc, bytes, kArrayBuffer);

@@ -89,6 +89,10 @@ constexpr int kElementArrayBuffer = 34963;  // and of indices
 // Appends `bytes` (4-byte aligned) as a new buffer view; returns its index. target 0: none.
 int add_view(Document& doc, std::span<const unsigned char> bytes, int target);
 
+// A new index accessor over `indices` (unsigned short where `vertices` allows, else unsigned int);
+// returns its index.
+int add_index_accessor(Document& doc, const std::vector<std::uint32_t>& indices, std::size_t vertices);
+
 // A new float accessor of `count` elements of `type` ("SCALAR", "VEC3", "VEC4") over `values`
 // (count × components floats); returns its index.
 int add_float_accessor(Document& doc, const std::vector<float>& values, std::size_t count, const char* type);

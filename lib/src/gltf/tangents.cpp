@@ -49,22 +49,9 @@ Status gather_all(Document& doc, Json& attributes, const std::vector<std::uint32
   return success();
 }
 
-int index_accessor(Document& doc, const std::vector<std::uint32_t>& indices, std::size_t vertices) {
-  std::vector<unsigned char> bytes;
-  const bool narrow = vertices <= 65535;
-  for (std::uint32_t i : indices) {
-    const unsigned char* p = reinterpret_cast<const unsigned char*>(&i);  // little-endian, as glTF
-    bytes.insert(bytes.end(), p, p + (narrow ? 2 : 4));
-  }
-  const int view = add_view(doc, bytes, kElementArrayBuffer);
-  doc.json["accessors"].push_back(
-      {{"bufferView", view}, {"componentType", narrow ? kUnsignedShort : kUnsignedInt}, {"count", indices.size()}, {"type", "SCALAR"}});
-  return int(doc.json["accessors"].size()) - 1;
-}
-
 }  // namespace
 
-Result<std::size_t> add_tangents(Document& doc, const PrimitiveTangents& p) {
+Result<AddedTangents> add_tangents(Document& doc, const PrimitiveTangents& p) {
   // A Draco primitive changed is written uncompressed, as every primitive matbake changes.
   uncompress_draco_primitive(doc, std::size_t(p.mesh), std::size_t(p.primitive));
   for (const char* key : {"accessors", "bufferViews", "buffers"}) {  // present before references into the JSON are held
@@ -108,7 +95,7 @@ Result<std::size_t> add_tangents(Document& doc, const PrimitiveTangents& p) {
         if (Status s = gather_all(doc, target, source); !s) return s.error();
       }
     }
-    primitive["indices"] = index_accessor(doc, corners, source.size());
+    primitive["indices"] = add_index_accessor(doc, corners, source.size());
     primitive.erase("mode");  // now a triangle list
   }
   std::vector<float> tangent_values, normal_values;
@@ -116,7 +103,7 @@ Result<std::size_t> add_tangents(Document& doc, const PrimitiveTangents& p) {
   for (const glm::vec3& n : normals) normal_values.insert(normal_values.end(), {n.x, n.y, n.z});
   attributes["TANGENT"] = add_float_accessor(doc, tangent_values, source.size(), "VEC4");
   if (!has_normals) attributes["NORMAL"] = add_float_accessor(doc, normal_values, source.size(), "VEC3");
-  return added;
+  return AddedTangents{added, std::move(corners)};
 }
 
 }  // namespace matbake::gltf

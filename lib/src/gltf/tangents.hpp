@@ -23,7 +23,11 @@ struct PrimitiveTangents {
   std::vector<glm::vec3> normals;                       // per corner: written where NORMAL is missing
 };
 
-// Returns the vertices added. Errors: an attribute the document cannot read.
-Result<std::size_t> add_tangents(Document& doc, const PrimitiveTangents& primitive);
+struct AddedTangents {
+  std::size_t vertices = 0;              // added (copies of split vertices)
+  std::vector<std::uint32_t> triangles;  // the primitive's triangles as written: 3 vertex numbers each
+};
+// Errors: an attribute the document cannot read.
+Result<AddedTangents> add_tangents(Document& doc, const PrimitiveTangents& primitive);
 
 }  // namespace matbake::gltf

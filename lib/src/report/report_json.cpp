@@ -173,6 +173,7 @@ nlohmann::json to_json(const bake::FileReport& r) {
       textures.back()["ranges"].push_back(range ? nlohmann::json{range->first, range->second} : nlohmann::json());
     }
     if (t.copy_of_material >= 0) textures.back()["copy_of"] = t.copy_of, textures.back()["copy_of_material"] = t.copy_of_material;
+    if (t.tile) textures.back()["tile"] = t.tile;
   }
   return {{"front", r.front}, {"back", r.back}, {"textures", textures}, {"tangent_primitives", r.tangent_primitives},
           {"split_vertices", r.split_vertices}, {"seconds", r.seconds}, {"setup_seconds", r.setup_seconds},
