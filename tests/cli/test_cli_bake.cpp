@@ -763,6 +763,64 @@ TEST(CliBake, MatchByNameKeepsAPartsRaysOnItsOwnHighPolyPart) {
             std::string::npos) << report["notes"].dump();
 }
 
+// Cage distances per part (--front-by-part, --back-by-part; a manifest's tables): one quad placed
+// as "plate_low" at the origin and as "bolt_low" 10 along x, each its own maps (--per-instance);
+// plate_high lies 0.3 below the plate, bolt_high 0.4 above the bolt, the cage 0.1 either way. Each
+// part's own reach (the plate's back 0.5, the bolt's front 0.5) meets its surface at every texel
+// and vertex: heights −0.3 and 0.4 exactly (float32). Without them every ray misses (the error).
+// A part name no low part has is one error line listing the parts, and so is a table without
+// --match by_name.
+TEST(CliBake, CageDistancesPerPartReachEachPartsOwnSurface) {
+  TempDir dir;
+  write_quad_low(dir / "low.gltf", "quad", {{{"name", "plate_low"}}, {{"name", "bolt_low"}, {"translation", {10, 0, 0}}}});
+  {
+    GltfBuilder b;
+    const int plate = b.add_mesh(b.add_vec3({-2, -2, -0.3f, 2, -2, -0.3f, 2, 2, -0.3f, -2, 2, -0.3f}), b.add_indices({0, 1, 2, 0, 2, 3}));
+    const int bolt = b.add_mesh(b.add_vec3({8, -2, 0.4f, 12, -2, 0.4f, 12, 2, 0.4f, 8, 2, 0.4f}), b.add_indices({0, 1, 2, 0, 2, 3}));
+    b.write(dir / "high.gltf", {b.add_node({{"mesh", plate}, {"name", "plate_high"}}), b.add_node({{"mesh", bolt}, {"name", "bolt_high"}})});
+  }
+  const fs::path out = dir / "out.gltf";
+  const auto bake_with = [&](std::vector<std::string> extra) {
+    std::vector<std::string> args = {"--json", "bake", (dir / "low.gltf").string(), "--from", (dir / "high.gltf").string(),
+                                     "--maps", "height", "--vertex-maps", "height", "--front", "0.1", "--back", "0.1",
+                                     "--absolute-cage", "--size", "8", "--per-instance", "-o", out.string()};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return matbake(args);
+  };
+  const auto r = bake_with({"--match", "by_name", "--front-by-part", "bolt=0.5", "--back-by-part", "plate=0.5"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.err, "");
+  const auto report = nlohmann::json::parse(r.out);
+  ASSERT_EQ(report["textures"].size(), 2u);
+  for (const auto& t : report["textures"]) {
+    const double want = t["name"] == "quad" ? -0.3 : 0.4;  // the plate keeps the material, the bolt a copy
+    EXPECT_EQ(t["misses"], 0) << t["name"];
+    auto height = image::read_image(t["files"][0].get<std::string>(), color::Transfer::linear);
+    ASSERT_TRUE(height);
+    for (float v : height->pixels) ASSERT_NEAR(v, want, 1e-6) << t["name"];
+  }
+  const gltf::Document doc = read_output(out);
+  for (const auto& node : doc.json["nodes"]) {
+    const auto& attributes = doc.json["meshes"][node["mesh"].get<std::size_t>()]["primitives"][0]["attributes"];
+    for (float v : float_accessor(doc, attributes["_HEIGHT"])) EXPECT_NEAR(v, node["name"] == "plate_low" ? -0.3 : 0.4, 1e-6);
+  }
+  fs::remove(out);
+  auto failed = bake_with({"--match", "by_name"});
+  EXPECT_EQ(failed.exit_code, 1);
+  EXPECT_NE(failed.err.find("100% of the rays"), std::string::npos) << failed.err;
+  failed = bake_with({"--match", "by_name", "--front-by-part", "blot=0.5"});
+  EXPECT_EQ(failed.exit_code, 2);
+  expect_one_error_line(failed, "", "--front-by-part names part 'blot', which no low-poly part is called (its parts: 'bolt', 'plate')");
+  failed = bake_with({"--front-by-part", "bolt=0.5"});
+  EXPECT_EQ(failed.exit_code, 2);
+  EXPECT_NE(failed.err.find("--front-by-part"), std::string::npos) << failed.err;
+  EXPECT_NE(failed.err.find("--match by_name"), std::string::npos) << failed.err;
+  failed = bake_with({"--match", "by_name", "--back-by-part", "bolt=-1"});
+  EXPECT_EQ(failed.exit_code, 2);
+  expect_one_error_line(failed, "", "--back-by-part: 'bolt=-1': part=distance pairs");
+  EXPECT_FALSE(fs::exists(out));
+}
+
 TEST(CliBake, BadRequestsAreOneErrorLineAndWriteNothing) {
   TempDir dir;
   const fs::path scene = kExamples / "showroom.gltf";

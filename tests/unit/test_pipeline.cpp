@@ -64,6 +64,9 @@ green = "directx"
 padding = 3
 texel_samples = 9
 seed = 11
+match = "by_name"
+front_by_part = { bolt = 0.4, plate_2 = 3 }
+udim = true
 ao = { samples = 24, relative_distance = 0.5 }
 )";
 
@@ -116,6 +119,8 @@ TEST(BuildManifest, EveryKeyReachesItsField) {
   EXPECT_EQ(r.texture.padding, 3);
   EXPECT_EQ(r.texture.texel_samples, 9);
   EXPECT_EQ(r.bake.seed, 11u);
+  EXPECT_EQ(r.bake.front_by_part, (std::map<std::string, double, std::less<>>{{"bolt", 0.4}, {"plate_2", 3.0}}));
+  EXPECT_TRUE(r.udim);
   EXPECT_EQ(r.occlusion.options.samples, 24);
   EXPECT_DOUBLE_EQ(r.occlusion.options.relative_distance, 0.5);
   EXPECT_FALSE(m->scenes[1].bake);  // the top level's [bake] alone bakes nothing
@@ -205,7 +210,11 @@ TEST(BuildManifest, ErrorsSayWhereAndWhat) {
       {"[scenes.s]\ninput = \"a.gltf\"\nbake = { from = \"h.glb\", maps = [\"normal\", \"nromal\"] }\n", "m.toml:3:",
        "scenes.s.bake.maps: maps among"},
       {"[scenes.s]\ninput = \"a.gltf\"\nbake = { from = \"h.glb\", maps = [\"ao\", 3] }\n", "m.toml:3:",
-       "scenes.s.bake.maps: a number, a string, a list of names or true/false expected"},
+       "scenes.s.bake.maps: a number, a string, a list of names, a table of numbers or true/false expected"},
+      {"[scenes.s]\ninput = \"a.gltf\"\nbake = { from = \"h.glb\", match = \"by_name\", back_by_part = { bolt = \"x\" } }\n",
+       "m.toml:3:", "scenes.s.bake.back_by_part: a table of numbers by name expected"},
+      {"[scenes.s]\ninput = \"a.gltf\"\nbake = { from = \"h.glb\", back_by_part = { bolt = 0.5 } }\n", "m.toml:3:",
+       "scenes.s.bake.back_by_part"},
       {"[scenes.s]\ninput = \"a.gltf\"\nbake = { from = \"h.glb\", mpas = \"ao\" }\n", "m.toml:3:",
        "unknown key 'mpas' in scenes.s.bake"},
       {"[scenes.s]\ninput = \"a.gltf\"\nbake = { from = \"h.glb\", ao = { sample = 3 } }\n", "m.toml:3:",

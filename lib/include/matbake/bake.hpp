@@ -24,6 +24,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -110,6 +111,9 @@ struct Options {
   // The cage: how far outside (front) and inside (back) the low-poly the rays reach, as fractions
   // of the low-poly's bounding-box diagonal, or in scene units when absolute.
   double front = 0.01, back = 0.01;
+  // With Match::by_name, a part's own front and back (by its key, part_key(name, "_low")), as
+  // front and back count them: a bolt that stands far above its plate, a strap that hugs a sleeve.
+  std::map<std::string, double, std::less<>> front_by_part, back_by_part;
   bool absolute_distances = false;
   Green green = Green::opengl;
   IdSource id_by = IdSource::material;
@@ -138,9 +142,18 @@ std::pair<double, double> cage_distances(const scene::Scene& low, const Options&
 // primitives in the same order with the same vertex count and triangles (its positions moved).
 std::string cage_mismatch(const scene::Scene& low, const scene::Scene& cage);
 
-// The cage of Options::average_normals: per low instance, its positions (and nothing else) each
-// moved `front` along the mean of the distinct normals of the vertices at that position.
-scene::Scene averaged_normal_cage(const scene::Scene& low, double front);
+// The cage of Options::average_normals: per low instance k, its positions (and nothing else) each
+// moved front[k] along the mean of the distinct normals of the vertices at that position.
+scene::Scene averaged_normal_cage(const scene::Scene& low, const std::vector<double>& front);
+
+// Per low instance, its front and back in scene units (Options::front_by_part and back_by_part of
+// its part's key, else front and back; scaled as cage_distances scales them). `unknown`: why a
+// part named in those tables is none of the low-poly's (a misspelt name), else empty.
+struct CageReach {
+  std::vector<double> front, back;
+  std::string unknown;
+};
+CageReach part_distances(const scene::Scene& low, const Options& options);
 
 // A high-poly material's texture as a runtime samples it: through its UV set and transform,
 // bilinear, with its sampler's wrap modes.

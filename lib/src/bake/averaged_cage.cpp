@@ -37,14 +37,14 @@ std::vector<Vec3> averaged_normals(const scene::Instance& inst) {
 
 }  // namespace
 
-scene::Scene averaged_normal_cage(const scene::Scene& low, double front) {
+scene::Scene averaged_normal_cage(const scene::Scene& low, const std::vector<double>& front) {
   scene::Scene cage;
   cage.instances.resize(low.instances.size());
   for (std::size_t k = 0; k < low.instances.size(); ++k) {
     const scene::Instance& inst = low.instances[k];
     const std::vector<Vec3> normals = averaged_normals(inst);
     std::vector<Vec3>& positions = cage.instances[k].positions;
-    for (std::size_t v = 0; v < inst.positions.size(); ++v) positions.push_back(inst.positions[v] + float(front) * normals[v]);
+    for (std::size_t v = 0; v < inst.positions.size(); ++v) positions.push_back(inst.positions[v] + float(front[k]) * normals[v]);
   }
   return cage;
 }

@@ -13,6 +13,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <set>
 #include <tuple>
 
 #include "../ao/texels.hpp"
@@ -99,7 +100,9 @@ struct TexelSum {
 struct Rays {
   const scene::Scene& low;
   const HighPoly& high;
-  float front, back;
+  // Per low instance, scene units: how far out the extrusion's rays start (where a cage mesh
+  // touches the low-poly too) and how far beyond the low-poly every ray reaches.
+  std::vector<float> front, back;
   const scene::Scene* cage;      // the cage mesh (null: extrusion by front)
   bool curvature;                // asked for
   const ao::Tracer* occlusion;   // the high-poly, for ao and bent_normal (null: neither asked)
@@ -220,27 +223,29 @@ struct CageHit {
   double height;
 };
 
-// The cage ray at a low-poly point: from `from_cage` (the cage mesh's point with the same weights)
-// towards it, else (no cage mesh, or it touches the low-poly there) from the extrusion's `front`
-// outside along its normal; either reaching `back` beyond it, meeting the high-poly's `parts`.
-// `from_inside`, when given, is set to whether the ray's first surface was a face's back.
-std::optional<CageHit> cast(const Rays& c, const LowPoint& low, const std::optional<glm::dvec3>& from_cage, ao::Parts parts,
+// The cage ray at a point of low instance `instance`: from `from_cage` (the cage mesh's point with
+// the same weights) towards it, else (no cage mesh, or it touches the low-poly there) from the
+// extrusion's front outside along its normal; either reaching back beyond it (the instance's
+// distances), meeting the high-poly parts the instance's rays meet. `from_inside`, when given, is
+// set to whether the ray's first surface was a face's back.
+std::optional<CageHit> cast(const Rays& c, std::size_t instance, const LowPoint& low, const std::optional<glm::dvec3>& from_cage,
                             bool* from_inside = nullptr) {
-  const float front = c.front;
+  const float front = c.front[instance], back = c.back[instance];
+  const ao::Parts parts = cage_parts(c, instance);
   if (from_inside) *from_inside = false;
   if (from_cage) {
     const glm::dvec3 to_low = glm::dvec3(low.position) - *from_cage;
     const double distance = glm::length(to_low);
     // Below float32's resolution at the point the direction is noise: the cage touches the low-poly.
     if (distance > 1e-6 * (1 + glm::length(glm::dvec3(low.position)))) {
-      auto hit = c.high.first_hit(glm::vec3(*from_cage), glm::vec3(to_low / distance), float(distance) + c.back, parts, from_inside);
+      auto hit = c.high.first_hit(glm::vec3(*from_cage), glm::vec3(to_low / distance), float(distance) + back, parts, from_inside);
       if (!hit) return std::nullopt;
       return CageHit{*hit, distance - double(hit->distance)};
     }
   }
   const glm::vec3 n(low.basis[2]);
   if (!(glm::length(n) > 0)) return std::nullopt;
-  auto hit = c.high.first_hit(low.position + front * n, -n, front + c.back, parts, from_inside);
+  auto hit = c.high.first_hit(low.position + front * n, -n, front + back, parts, from_inside);
   if (!hit) return std::nullopt;
   return CageHit{*hit, double(front) - double(hit->distance)};
 }
@@ -250,20 +255,21 @@ std::optional<CageHit> cast(const Rays& c, const LowPoint& low, const std::optio
 // where it lies outside, the front (the averaged cage's point lies less far out along the normal
 // than front: scaled by that; a cage mesh: how much farther out it must lie); inside, the back
 // (reached along the ray, at a slant to the normal).
-void probe_miss(const Rays& c, const LowPoint& low, const std::optional<glm::dvec3>& from_cage, ao::Parts parts, TexelSum& sum) {
+void probe_miss(const Rays& c, std::size_t instance, const LowPoint& low, const std::optional<glm::dvec3>& from_cage, TexelSum& sum) {
   const glm::dvec3 n = low.basis[2];
   if (!(c.probe > 0) || !(glm::length(n) > 0)) return;
-  const auto hit = c.high.first_hit(low.position + c.probe * glm::vec3(n), -glm::vec3(n), 2 * c.probe, parts);
+  const auto hit = c.high.first_hit(low.position + c.probe * glm::vec3(n), -glm::vec3(n), 2 * c.probe, cage_parts(c, instance));
   if (!hit) return;
   const double height = double(c.probe) - double(hit->distance);  // positive outside
-  double out = c.front, cosine = 1;  // how far out along n the ray starts; its direction against −n
+  const double front = c.front[instance], back = c.back[instance];
+  double out = front, cosine = 1;  // how far out along n the ray starts; its direction against −n
   if (from_cage) {
     const glm::dvec3 to_low = glm::dvec3(low.position) - *from_cage;
     const double length = glm::length(to_low), along = -glm::dot(to_low, n);
     if (length > 1e-6 * (1 + glm::length(glm::dvec3(low.position))) && along > 0) out = along, cosine = along / length;
   }
-  if (height > out) sum.wanted_front.push_back(float(c.cage_mesh ? height - out : double(c.front) * height / out));
-  if (-height > c.back * cosine) sum.wanted_back.push_back(float(-height / cosine));
+  if (height > out) sum.wanted_front.push_back(float(c.cage_mesh ? height - out : front * height / out));
+  if (-height > back * cosine) sum.wanted_back.push_back(float(-height / cosine));
 }
 
 // The cage mesh's point of low instance `instance`'s triangle at weights `w` (none without a cage).
@@ -316,16 +322,16 @@ void trace_point(const TraceContext& t, const ao::texels::SurfacePoint& point, s
     ++sum.rays;
     bool from_inside = false;
     std::optional<glm::dvec3> from = cage_point(c, point.instance, point.triangle, w);
-    auto cage_hit = cast(c, low, from, cage_parts(c, point.instance), &from_inside);
+    auto cage_hit = cast(c, point.instance, low, from, &from_inside);
     if (!cage_hit && on_edge(w)) {
       w = inside(w);
       low = low_point(inst, t.frames[point.instance], point.triangle, w);
       from = cage_point(c, point.instance, point.triangle, w);
-      cage_hit = cast(c, low, from, cage_parts(c, point.instance), &from_inside);
+      cage_hit = cast(c, point.instance, low, from, &from_inside);
     }
     if (!cage_hit) {
       sum.faced_away += from_inside;  // met only the backs of faces: the high-poly faces away
-      probe_miss(c, low, from, cage_parts(c, point.instance), sum);
+      probe_miss(c, point.instance, low, from, sum);
       continue;
     }
     sum.from_inside += from_inside;
@@ -467,7 +473,7 @@ std::optional<CageHit> cast_at_vertex(const Rays& c, std::size_t instance, std::
   low = {inst.positions[vertex], glm::dmat3(glm::dvec3(0), glm::dvec3(0), glm::dvec3(normals[vertex]))};  // no tangents read
   const std::optional<glm::dvec3> from_cage =
       c.cage ? std::optional(glm::dvec3(c.cage->instances[instance].positions[vertex])) : std::nullopt;
-  if (auto hit = cast(c, low, from_cage, cage_parts(c, instance))) return hit;
+  if (auto hit = cast(c, instance, low, from_cage)) return hit;
   for (std::uint32_t t : triangles) {
     const auto& corners = inst.triangles[t];
     glm::dvec3 w(0);
@@ -476,7 +482,7 @@ std::optional<CageHit> cast_at_vertex(const Rays& c, std::size_t instance, std::
     glm::dvec3 p(0), n(0);
     for (int k = 0; k < 3; ++k) p += w[k] * glm::dvec3(inst.positions[corners[std::size_t(k)]]), n += w[k] * glm::dvec3(normals[corners[std::size_t(k)]]);
     low = {glm::vec3(p), glm::dmat3(glm::dvec3(0), glm::dvec3(0), glm::length(n) > 0 ? glm::normalize(n) : n)};
-    if (auto hit = cast(c, low, cage_point(c, instance, t, w), cage_parts(c, instance))) return hit;
+    if (auto hit = cast(c, instance, low, cage_point(c, instance, t, w))) return hit;
   }
   return std::nullopt;
 }
@@ -559,7 +565,48 @@ Status check(const Options& options) {
       options.front + options.back <= 0) {
     return Error{"", "the cage distances must be finite, 0 or more, and not both 0", true};
   }
+  for (const auto* by_part : {&options.front_by_part, &options.back_by_part}) {
+    if (by_part->empty()) continue;
+    const char* name = by_part == &options.front_by_part ? "front_by_part" : "back_by_part";
+    if (options.match != Match::by_name) return Error{"", mention(name) + " applies with " + mention("match", "by_name"), true};
+    for (const auto& [part, distance] : *by_part) {
+      if (part.empty() || !(distance >= 0) || !std::isfinite(distance)) {
+        return Error{"", mention(name) + ": each part's distance must be finite and 0 or more", true};
+      }
+    }
+  }
   return success();
+}
+
+CageReach part_distances(const scene::Scene& low, const Options& options) {
+  const double scale = options.absolute_distances ? 1.0 : 2.0 * double(low.radius());
+  CageReach out;
+  std::set<std::string_view> keys;
+  for (const scene::Instance& inst : low.instances) {
+    const std::string_view key = part_key(inst.name, "_low");
+    keys.insert(key);
+    const auto of = [&](const std::map<std::string, double, std::less<>>& by_part, double fallback) {
+      const auto found = by_part.find(key);
+      return (found == by_part.end() ? fallback : found->second) * scale;
+    };
+    out.front.push_back(of(options.front_by_part, options.front));
+    out.back.push_back(of(options.back_by_part, options.back));
+  }
+  for (const auto* by_part : {&options.front_by_part, &options.back_by_part}) {
+    for (const auto& [part, distance] : *by_part) {
+      if (keys.contains(part)) continue;
+      std::string known;
+      for (std::string_view k : keys) {  // appended: GCC 12 -O3 misreads `"'" + std::string`
+        known += known.empty() ? "'" : ", '";
+        known += escape_control(k);
+        known += '\'';
+      }
+      out.unknown = mention(by_part == &options.front_by_part ? "front_by_part" : "back_by_part") + " names part '" +
+                    escape_control(part) + "', which no low-poly part is called (its parts: " + known + ")";
+      return out;
+    }
+  }
+  return out;
 }
 
 std::pair<double, double> cage_distances(const scene::Scene& low, const Options& options, const scene::Scene* cage) {
@@ -811,15 +858,22 @@ Result<Bake> bake(const scene::Scene& low, const scene::Scene& high, const std::
   if (!frames) return frames.error();
   auto tracers = build_tracers(high, occluding, thickness, occlusion);
   if (!tracers) return tracers.error();
+  const CageReach reach = part_distances(low, options);
+  if (!reach.unknown.empty()) return Error{"", reach.unknown, true};
+  if (cage && !options.front_by_part.empty()) {
+    return Error{"", mention("front_by_part") + ": the cage mesh sets how far out each part's rays start (give " +
+                         mention("back_by_part") + " alone)", true};
+  }
   Bake result;
   result.boxes = compare_boxes(low, high);
   std::tie(result.front, result.back) = cage_distances(low, options, cage);  // an averaged cage's: front
   const bool cage_mesh = cage != nullptr;
   std::optional<scene::Scene> averaged;
   if (options.average_normals && !cage) {
-    averaged = averaged_normal_cage(low, result.front);
+    averaged = averaged_normal_cage(low, reach.front);
     cage = &*averaged;
   }
+  const auto floats = [](const std::vector<double>& v) { return std::vector<float>(v.begin(), v.end()); };
   result.setup_seconds = seconds_since(start);
 
   const std::vector<int> primitives = primitive_numbers(high);
@@ -838,8 +892,8 @@ Result<Bake> bake(const scene::Scene& low, const scene::Scene& high, const std::
   // Each pass's rays read only the tracers and inputs its maps need.
   const Rays texel_rays{low,
                         *tracers->high,
-                        float(cage_distances(low, options).first),  // the extrusion's, where a cage touches
-                        float(result.back),
+                        floats(reach.front),  // the extrusion's, where a cage mesh touches
+                        floats(reach.back),
                         cage,
                         asked(Map::curvature),
                         asked(Map::ao) || asked(Map::bent_normal) ? tracers->occluder.get() : nullptr,

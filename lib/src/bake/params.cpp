@@ -1,4 +1,5 @@
 // bake::Request's parameters: names, kinds, ranges, help and examples; defaults are the struct's.
+#include <charconv>
 #include <cmath>
 
 #include "matbake/ao_params.hpp"
@@ -36,6 +37,48 @@ std::string maps_text(const std::vector<Map>& maps) {
   return text.empty() ? "none" : text;
 }
 bool any_map(Map) { return true; }
+
+// "bolt=0.4,plate=0.02" (a manifest's table { bolt = 0.4, plate = 0.02 }, params/toml_value.cpp):
+// each part once, its distance a number 0 or more.
+using ByPart = std::map<std::string, double, std::less<>>;
+std::optional<std::string> read_by_part(const std::string& text, ByPart& out) {
+  ByPart parts;
+  for (std::size_t start = 0; start < text.size();) {
+    const std::size_t comma = std::min(text.find(',', start), text.size());
+    const std::string_view item = std::string_view(text).substr(start, comma - start);
+    const std::size_t equals = item.find('=');
+    double distance = 0;
+    const std::string_view number = equals == std::string_view::npos ? "" : item.substr(equals + 1);
+    const auto [end, error] = std::from_chars(number.data(), number.data() + number.size(), distance);
+    if (equals == 0 || number.empty() || error != std::errc() || end != number.data() + number.size() || !(distance >= 0) ||
+        !std::isfinite(distance)) {
+      return "part=distance pairs, comma-separated (bolt=0.4,plate=0.02), each distance 0 or more";
+    }
+    if (!parts.emplace(std::string(item.substr(0, equals)), distance).second) return "each part once";
+    start = comma + 1;
+  }
+  out = std::move(parts);
+  return std::nullopt;
+}
+std::string by_part_text(const ByPart& parts) {
+  std::string text;
+  for (const auto& [part, distance] : parts) {
+    char number[32];
+    const auto written = std::to_chars(number, number + sizeof number, distance);  // the shortest that reads back
+    if (!text.empty()) text += ',';
+    text += part;
+    text += '=';
+    text.append(number, written.ptr);
+  }
+  return text;
+}
+
+Param<Request> by_part(std::string name, ByPart Options::*field, std::string help) {
+  Spec spec{.name = std::move(name), .kind = params::Kind::text, .help = std::move(help), .example = "bolt=0.4,plate=0.02",
+            .needs = {{"match", "by_name"}}};
+  return {std::move(spec), [field](Request& r, const Value& v) { return read_by_part(std::get<std::string>(v), r.bake.*field); },
+          [field](const Request& r) { return nlohmann::json(by_part_text(r.bake.*field)); }};
+}
 
 Param<Request> maps() {
   Spec spec{.name = "maps",
@@ -101,6 +144,10 @@ params::Group<Request> make_group() {
                                    .help = "How far inside the low-poly the rays reach, as front",
                                    .min = 0, .max = kUnbounded, .example = "0.02"},
                               [](auto& r) -> auto& { return r.bake.back; }),
+      by_part("front_by_part", &Options::front_by_part,
+              "Parts' own front, by name as match by_name keys them (part=distance, comma-separated; a manifest "
+              "table { part = distance })"),
+      by_part("back_by_part", &Options::back_by_part, "Parts' own back, as front_by_part"),
       params::flag<Request>(Spec{.name = "absolute_cage", .help = "front and back in scene units", .example = "true"},
                             [](auto& r) -> auto& { return r.bake.absolute_distances; }),
       params::flag<Request>(Spec{.name = "average_normals",

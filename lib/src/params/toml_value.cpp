@@ -1,5 +1,7 @@
 #include "toml_value.hpp"
 
+#include <charconv>
+
 namespace matbake::params {
 
 Result<Value> toml_value(const toml::node& node) {
@@ -19,7 +21,26 @@ Result<Value> toml_value(const toml::node& node) {
       if (&item == &list->back()) return Value(joined);
     }
   }
-  return Error{"", "a number, a string, a list of names or true/false expected"};
+  // A table of numbers by name ({ bolt = 0.4, plate = 0.02 }) as the command line's
+  // "bolt=0.4,plate=0.02".
+  if (const toml::table* table = node.as_table(); table && !table->empty()) {
+    std::string joined;
+    for (const auto& [key, value] : *table) {
+      const std::string_view name = key.str();
+      const auto number = value.is_integer() ? std::optional<double>(double(*value.value<std::int64_t>())) : value.value_exact<double>();
+      if (!number || name.empty() || name.find_first_of(",=") != std::string_view::npos) {
+        return Error{"", "a table of numbers by name expected ({ name = 0.5 }; names without ',' or '=')"};
+      }
+      char text[32];
+      const auto written = std::to_chars(text, text + sizeof text, *number);
+      if (!joined.empty()) joined += ',';
+      joined += name;
+      joined += '=';
+      joined.append(text, written.ptr);
+    }
+    return Value(joined);
+  }
+  return Error{"", "a number, a string, a list of names, a table of numbers or true/false expected"};
 }
 
 }  // namespace matbake::params
