@@ -899,5 +899,47 @@ TEST(CliBake, ABakedIcosphereRendersInThreeJsCloserToTheSphereThanItself) {
   }
 }
 
+// A UDIM bake as a runtime shows it: the icosphere pair above with the islands of the triangles
+// on the +x side moved to tile 1002 (u + 1), baked with --udim, rendered by three.js beside the
+// sphere. Each tile's material samples its own image at the file's UVs past 0–1 (the default
+// sampler repeats), so the render must come closer to the sphere's than the bare icosphere in
+// every view, and closer than the same file with tile 1002's material reading tile 1001's image
+// (what a runtime shows where a tile takes the wrong image).
+TEST(CliBake, AUdimBakeRendersInThreeJsWithEachTilesOwnImage) {
+  TempDir dir;
+  const Icosphere high = icosphere(4);
+  write_grey_mesh(dir / "high.gltf", high.vertices, high.vertices, {}, high.triangles);
+  AtlasMesh low = icosphere_atlas(2, true);
+  for (std::size_t t = 0; t < low.triangles.size(); ++t) {
+    const auto& c = low.triangles[t];
+    if (low.positions[c[0]].x + low.positions[c[1]].x + low.positions[c[2]].x <= 0) continue;
+    for (std::uint32_t v : c) low.texcoords[v].x += 1;  // corners are not shared (one island a triangle)
+  }
+  write_grey_mesh(dir / "low.gltf", low.positions, low.normals, low.texcoords, low.triangles);
+  const auto r = matbake({"--json", "bake", (dir / "low.gltf").string(), "--from", (dir / "high.gltf").string(), "-o",
+                          (dir / "udim.gltf").string(), "--size", "512", "--front", "0.3", "--back", "0.3", "--absolute-cage", "--udim"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto textures = nlohmann::json::parse(r.out)["textures"];
+  ASSERT_EQ(textures.size(), 2u);
+  const std::string first = textures[0]["files"][0], second = textures[1]["files"][0];
+  std::string text = read_bytes(dir / "udim.gltf");
+  text.replace(text.find("\"" + second + "\""), second.size() + 2, "\"" + first + "\"");
+  write_bytes(dir / "wrong.gltf", text);
+  std::string why_not;
+  const auto rendered = render_in_three(dir.path(), {{"high", dir / "high.gltf"}, {"low", dir / "low.gltf"},
+                                                     {"udim", dir / "udim.gltf"}, {"wrong", dir / "wrong.gltf"}},
+                                        why_not);
+  if (!rendered) GTEST_SKIP() << why_not;
+  for (const auto& [name, model] : *rendered) EXPECT_TRUE(model.console.empty()) << name << ": " << model.console.front();
+  for (const std::string& view : kRuntimeViews) {
+    const auto psnr = [&](const char* name) { return render_psnr(rendered->at("high").renders.at(view), rendered->at(name).renders.at(view)); };
+    const double bare = psnr("low"), udim = psnr("udim"), wrong = psnr("wrong");
+    RecordProperty("psnr_" + view, std::to_string(bare) + " bare, " + std::to_string(udim) + " udim, " + std::to_string(wrong) + " wrong");
+    std::printf("%s: bare %.2f dB, udim %.2f dB, tile 1002 with 1001's image %.2f dB\n", view.c_str(), bare, udim, wrong);
+    EXPECT_GT(udim, bare) << view;
+    EXPECT_GT(udim, wrong) << view;
+  }
+}
+
 }  // namespace
 }  // namespace matbake::test
