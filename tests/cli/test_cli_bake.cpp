@@ -7,6 +7,7 @@
 
 #include <fstream>
 #include <functional>
+#include <limits>
 #include <set>
 
 #include "lib/src/bake/frames.hpp"
@@ -627,18 +628,25 @@ TEST(CliBake, PerInstanceGivesEachPlacementItsOwnMapsAndVertexValues) {
 // own ("stone", "stone (1002)"), the primitive split so that each holds its tile's triangles and
 // its material's normalTexture the tile's image: validator-clean. A triangle across the tiles'
 // border is one error line and writes nothing; without --udim, B is outside the 0–1 tile.
-void write_udim_low(const fs::path& path, double b_u0) {
+// `nan_triangle`: a third triangle (off to the side) whose UVs are NaN.
+void write_udim_low(const fs::path& path, double b_u0, const std::string& material = "stone", bool nan_triangle = false) {
   GltfBuilder b;
-  const int positions = b.add_vec3({-1, -1, 0, 0, -1, 0, 0, 1, 0, -1, 1, 0, 0, -1, 0, 1, -1, 0, 1, 1, 0, 0, 1, 0});
-  std::vector<float> normals;
-  for (int v = 0; v < 8; ++v) normals.insert(normals.end(), {0, 0, 1});
-  const int mesh = b.add_mesh(positions, b.add_indices({0, 1, 2, 0, 2, 3, 4, 5, 6, 4, 6, 7}), 4, b.add_vec3(normals));
+  std::vector<float> xyz = {-1, -1, 0, 0, -1, 0, 0, 1, 0, -1, 1, 0, 0, -1, 0, 1, -1, 0, 1, 1, 0, 0, 1, 0};
   const auto u = [&](double x) { return float(x); };
+  std::vector<float> uv = {u(0), 1, u(1), 1, u(1), 0, u(0), 0, u(b_u0), 1, u(b_u0 + 1), 1, u(b_u0 + 1), 0, u(b_u0), 0};
+  std::vector<std::uint32_t> indices = {0, 1, 2, 0, 2, 3, 4, 5, 6, 4, 6, 7};
+  if (nan_triangle) {
+    xyz.insert(xyz.end(), {1.5f, -1, 0, 1.9f, -1, 0, 1.5f, -0.5f, 0});
+    for (int k = 0; k < 6; ++k) uv.push_back(std::numeric_limits<float>::quiet_NaN());
+    indices.insert(indices.end(), {8, 9, 10});
+  }
+  std::vector<float> normals;
+  for (std::size_t v = 0; v < xyz.size() / 3; ++v) normals.insert(normals.end(), {0, 0, 1});
+  const int mesh = b.add_mesh(b.add_vec3(xyz), b.add_indices(indices), 4, b.add_vec3(normals));
   auto& primitive = b.doc["meshes"][std::size_t(mesh)]["primitives"][0];
-  primitive["attributes"]["TEXCOORD_0"] =
-      b.add_floats({u(0), 1, u(1), 1, u(1), 0, u(0), 0, u(b_u0), 1, u(b_u0 + 1), 1, u(b_u0 + 1), 0, u(b_u0), 0}, "VEC2", 2);
+  primitive["attributes"]["TEXCOORD_0"] = b.add_floats(uv, "VEC2", 2);
   primitive["material"] = 0;
-  b.doc["materials"] = {{{"name", "stone"}}};
+  b.doc["materials"] = {{{"name", material}}};
   b.write(path, {b.add_node({{"mesh", mesh}})});
 }
 
@@ -701,12 +709,34 @@ TEST(CliBake, UdimTilesEachHoldTheirOwnFieldAndTheGltfTakesOneMaterialPerTile) {
   MATBAKE_VALIDATE_OR_SKIP(validated, dir / "out.gltf");
   EXPECT_EQ(validated->errors, 0) << validated->summary;
 
-  write_udim_low(dir / "across.gltf", 0.5);  // B's UVs from u = 0.5 to 1.5
-  const auto across = matbake({"bake", (dir / "across.gltf").string(), "--from", (dir / "high.gltf").string(), "-o",
-                               (dir / "across_out.gltf").string(), "--size", "16", "--udim"});
-  EXPECT_EQ(across.exit_code, 1);
-  expect_one_error_line(across, (dir / "across.gltf").string(), "material 0 'stone': triangle 2 of mesh 0 primitive 0 lies across a UDIM tile's border");
-  EXPECT_FALSE(fs::exists(dir / "across_out.gltf"));
+  // Across an inner border (B's UVs from u = 0.5 to 1.5), and across the tiles' outer edge (from
+  // −0.8 to 0.2: triangle 2's centroid lies outside every tile, a corner inside tile 1001).
+  for (const double b_u0 : {0.5, -0.8}) {
+    write_udim_low(dir / "across.gltf", b_u0);
+    const auto across = matbake({"bake", (dir / "across.gltf").string(), "--from", (dir / "high.gltf").string(), "-o",
+                                 (dir / "across_out.gltf").string(), "--size", "16", "--udim"});
+    EXPECT_EQ(across.exit_code, 1) << b_u0;
+    expect_one_error_line(across, (dir / "across.gltf").string(),
+                          "material 0 'stone': triangle 2 of mesh 0 primitive 0 lies across a UDIM tile's border");
+    EXPECT_FALSE(fs::exists(dir / "across_out.gltf"));
+  }
+
+  // PNG maps beside: one range for a material's tiles (a UDIM set is read with one scale). A
+  // triangle with NaN UVs: one note, not a warning per tile. A material name of 300 characters:
+  // files named for its first 64.
+  write_udim_low(dir / "long.gltf", 1, std::string(300, 'x'), true);
+  const auto png = matbake({"--json", "bake", (dir / "long.gltf").string(), "--from", (dir / "high.gltf").string(), "-o",
+                            (dir / "png.gltf").string(), "--maps", "normal,height", "--size", "16", "--texel-samples", "1",
+                            "--front", "0.5", "--back", "0.5", "--absolute-cage", "--udim", "--map-format", "png"});
+  ASSERT_EQ(png.exit_code, 0) << png.err;
+  EXPECT_EQ(png.err, "");
+  const auto png_report = nlohmann::json::parse(png.out);
+  ASSERT_EQ(png_report["textures"].size(), 2u);
+  EXPECT_EQ(png_report["textures"][0]["ranges"][1], png_report["textures"][1]["ranges"][1]);
+  // The largest |height|: tile 1001's, near (−1, −1), where the plane is −0.17 (tile 1002's alone: 0.13).
+  EXPECT_NEAR(png_report["textures"][1]["ranges"][1][1].get<double>(), 0.17, 0.01);
+  EXPECT_EQ(png_report["textures"][0]["files"][0], "png_" + std::string(64, 'x') + "_normal.1001.png");
+  EXPECT_NE(png_report["notes"].dump().find("1 triangles lie outside the UDIM tiles"), std::string::npos) << png_report["notes"].dump();
 
   const auto one_tile = bake_with("plain.gltf", {});
   ASSERT_EQ(one_tile.exit_code, 0) << one_tile.err;
@@ -818,6 +848,15 @@ TEST(CliBake, CageDistancesPerPartReachEachPartsOwnSurface) {
   failed = bake_with({"--match", "by_name", "--back-by-part", "bolt=-1"});
   EXPECT_EQ(failed.exit_code, 2);
   expect_one_error_line(failed, "", "--back-by-part: 'bolt=-1': part=distance pairs");
+  // A cage far beyond the meshes (a part's, or the whole cage's): refused, where Embree aborted
+  // (exit 134) on rays starting 1e30 away.
+  const std::vector<std::string> whole = {"bake", (dir / "low.gltf").string(), "--from", (dir / "high.gltf").string(),
+                                          "-o", out.string(), "--front", "1e19", "--absolute-cage"};
+  for (const RunResult& deep : {bake_with({"--match", "by_name", "--front-by-part", "bolt=1e30"}), matbake(whole)}) {
+    failed = deep;
+    EXPECT_EQ(failed.exit_code, 2);
+    expect_one_error_line(failed, "", "the cage reaches ");
+  }
   EXPECT_FALSE(fs::exists(out));
 }
 

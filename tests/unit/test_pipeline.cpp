@@ -215,6 +215,8 @@ TEST(BuildManifest, ErrorsSayWhereAndWhat) {
        "m.toml:3:", "scenes.s.bake.back_by_part: a table of numbers by name expected"},
       {"[scenes.s]\ninput = \"a.gltf\"\nbake = { from = \"h.glb\", back_by_part = { bolt = 0.5 } }\n", "m.toml:3:",
        "scenes.s.bake.back_by_part"},
+      {"[scenes.s]\ninput = \"a.gltf\"\nbake = { from = \"h.glb\", match = \"by_name\", back_by_part = {} }\n", "m.toml:3:",
+       "scenes.s.bake.back_by_part: a table of numbers by name expected, not an empty one"},
       {"[scenes.s]\ninput = \"a.gltf\"\nbake = { from = \"h.glb\", mpas = \"ao\" }\n", "m.toml:3:",
        "unknown key 'mpas' in scenes.s.bake"},
       {"[scenes.s]\ninput = \"a.gltf\"\nbake = { from = \"h.glb\", ao = { sample = 3 } }\n", "m.toml:3:",

@@ -155,6 +155,14 @@ struct CageReach {
 };
 CageReach part_distances(const scene::Scene& low, const Options& options);
 
+struct Bake;
+// Whether the cage (bake.front and back as cage_distances gives them, and each part's `reach`)
+// stays within kDeepestCage times the larger of the two meshes' diagonals (bake.boxes): beyond it
+// a ray meets nothing a bake wants, its start loses float precision, and far enough Embree refuses
+// it (an abort). A usage error naming the options.
+constexpr double kDeepestCage = 100;
+Status check_depth(const Bake& bake, const CageReach& reach);
+
 // A high-poly material's texture as a runtime samples it: through its UV set and transform,
 // bilinear, with its sampler's wrap modes.
 struct MaterialTexture {
@@ -215,7 +223,7 @@ struct TextureBake {
   double height_min = 0, height_max = 0;  // over the hits
   std::size_t from_inside = 0;   // rays whose first surface was a high-poly face's back (a start inside a closed part)
   std::size_t overlapped = 0;    // texels whose centre several triangles cover (overlapping islands): their mean
-  std::size_t outside_tile = 0;  // triangles whose UVs lie wholly outside the 0–1 tile: not baked
+  std::size_t outside_tile = 0;  // triangles whose UVs lie wholly outside the target's tile (or are not finite): not baked
   std::size_t degenerate_uv = 0, too_large = 0;  // triangles skipped: UVs of no area or not finite; spanning too far
   std::size_t faced_away = 0;    // missed rays that met only the backs of high-poly faces (flipped winding)
   // The cage reach, scene units, that would have met 95% of the missed rays a probe along the

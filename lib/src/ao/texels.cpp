@@ -257,6 +257,10 @@ Tiling tile(const scene::Scene& scene, const TextureTarget& target, int width, i
     }
     for (std::size_t t = 0; t < inst.triangles.size(); ++t) {
       const UvTriangle uv = uv_triangle(inst, target, t, width, height);
+      const Box box = bounds(uv);
+      // The tile alone: a triangle wholly outside it (or not finite) is none of its business, not
+      // even its edge texels' (the bake counts such triangles once, not per tile).
+      if (target.tile_only && !(box.x0 < width - 0.5 && box.x1 > -0.5 && box.y0 < height - 0.5 && box.y1 > -0.5)) continue;
       const double area2 = cross(uv.b - uv.a, uv.c - uv.a);
       const double longest2 = std::max({glm::dot(uv.b - uv.a, uv.b - uv.a), glm::dot(uv.c - uv.a, uv.c - uv.a),
                                         glm::dot(uv.c - uv.b, uv.c - uv.b)});
@@ -264,12 +268,9 @@ Tiling tile(const scene::Scene& scene, const TextureTarget& target, int width, i
         ++out.degenerate_uv;
         continue;
       }
-      const Box box = bounds(uv);
       CellRect cells{std::ceil(box.x0 - kReach), std::floor(box.x1 + kReach), std::ceil(box.y0 - kReach),
                      std::floor(box.y1 + kReach)};
       if (target.tile_only) {
-        // Wholly outside the tile: not even its edge texels are touched by it.
-        if (box.x0 >= width - 0.5 || box.x1 <= -0.5 || box.y0 >= height - 0.5 || box.y1 <= -0.5) continue;
         cells = {std::max(cells.i0, 0.0), std::min(cells.i1, width - 1.0), std::max(cells.j0, 0.0), std::min(cells.j1, height - 1.0)};
       }
       if ((cells.i1 - cells.i0 + 1) * (cells.j1 - cells.j0 + 1) > max_cells ||

@@ -11,6 +11,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <memory>
 #include <set>
@@ -578,6 +579,20 @@ Status check(const Options& options) {
   return success();
 }
 
+Status check_depth(const Bake& bake, const CageReach& reach) {
+  double deepest = std::max(bake.front, bake.back);
+  for (const auto* distances : {&reach.front, &reach.back}) {
+    for (double d : *distances) deepest = std::max(deepest, d);
+  }
+  const double size = std::max(bake.boxes.low_diagonal, bake.boxes.high_diagonal);
+  if (deepest <= kDeepestCage * size) return success();
+  char text[96];
+  std::snprintf(text, sizeof text, "the cage reaches %g scene units, more than %g times the meshes' size (%g)", deepest, kDeepestCage, size);
+  return Error{"", std::string(text) + ": a ray that long meets nothing a bake wants and loses float precision; lower " +
+                       mention("front") + ", " + mention("back") + " or the parts' distances (or move the cage mesh closer)",
+               true};
+}
+
 CageReach part_distances(const scene::Scene& low, const Options& options) {
   const double scale = options.absolute_distances ? 1.0 : 2.0 * double(low.radius());
   CageReach out;
@@ -770,7 +785,8 @@ void trace_tile(const TraceContext& context, const Options& options, const ao::t
   }
 }
 
-// The target's triangles whose UVs lie wholly outside its tile (none of their texels baked).
+// The target's triangles whose UVs lie wholly outside its tile, or are not finite (none of their
+// texels baked).
 std::size_t triangles_outside_tile(const scene::Scene& low, const ao::TextureTarget& target) {
   std::size_t outside = 0;
   const glm::dvec2 tile(target.tile_origin);
@@ -781,7 +797,7 @@ std::size_t triangles_outside_tile(const scene::Scene& low, const ao::TextureTar
     for (const auto& corners : inst.triangles) {
       glm::dvec2 lo(uv[corners[0]]), hi = lo;
       for (std::uint32_t v : corners) lo = glm::min(lo, glm::dvec2(uv[v])), hi = glm::max(hi, glm::dvec2(uv[v]));
-      outside += hi.x <= tile.x || hi.y <= tile.y || lo.x >= tile.x + 1 || lo.y >= tile.y + 1;
+      outside += !(hi.x > tile.x && hi.y > tile.y && lo.x < tile.x + 1 && lo.y < tile.y + 1);  // not finite: outside too
     }
   }
   return outside;
@@ -867,6 +883,7 @@ Result<Bake> bake(const scene::Scene& low, const scene::Scene& high, const std::
   Bake result;
   result.boxes = compare_boxes(low, high);
   std::tie(result.front, result.back) = cage_distances(low, options, cage);  // an averaged cage's: front
+  if (Status s = check_depth(result, reach); !s) return s.error();
   const bool cage_mesh = cage != nullptr;
   std::optional<scene::Scene> averaged;
   if (options.average_normals && !cage) {

@@ -195,10 +195,10 @@ fs::path beside_file(const fs::path& output, const std::string& material_name, M
 
 image::SampleType png_type(const Request& request) { return request.bits == 16 ? image::SampleType::u16 : image::SampleType::u8; }
 
-// The bytes of a map beside the output: float EXR, or a PNG of its values mapped onto 0–1
-// (map_range), which `range` is set to.
-Result<std::string> encode_beside(image::Image img, const fs::path& file, const FileOptions& options, const MapImage& map,
-                                  std::optional<std::pair<double, double>>& range) {
+// The bytes of a map beside the output: float EXR, or a PNG of its values mapped onto 0–1 by
+// `png_range` (its map_range, or its material's tiles'), which `range` is set to.
+Result<std::string> encode_beside(image::Image img, const fs::path& file, const FileOptions& options,
+                                  std::pair<double, double> png_range, std::optional<std::pair<double, double>>& range) {
   image::WriteOptions write;
   write.png_level = options.encoding.png_level;
   if (options.request.map_format == MapFormat::exr) {
@@ -206,7 +206,7 @@ Result<std::string> encode_beside(image::Image img, const fs::path& file, const 
     range.reset();
     return image::encode_image(img, file, write);
   }
-  range = map_range(map);
+  range = png_range;
   const double scale = 1.0 / (range->second - range->first);
   for (float& v : img.pixels) v = float(std::clamp((double(v) - range->first) * scale, 0.0, 1.0));
   write.type = png_type(options.request);
@@ -246,10 +246,29 @@ Status write_tangents(gltf::Document& doc, const scene::Scene& low, const Target
   return success();
 }
 
+// Each map's range (map_range) over the texture targets of one material, as PNGs beside the
+// output map it (a UDIM set is read with one scale): per target, per map.
+std::vector<std::vector<std::pair<double, double>>> material_ranges(const Targets& targets, const Bake& baked) {
+  std::map<std::pair<int, int>, std::vector<std::pair<double, double>>> of;  // (material, node) → per map
+  for (std::size_t t = 0; t < baked.textures.size(); ++t) {
+    auto [it, first] = of.try_emplace({targets.materials[t], targets.nodes[t]});
+    for (std::size_t i = 0; i < baked.textures[t].maps.size(); ++i) {
+      const auto [lo, hi] = map_range(baked.textures[t].maps[i]);
+      if (first) it->second.emplace_back(lo, hi);
+      else it->second[i] = {std::min(it->second[i].first, lo), std::max(it->second[i].second, hi)};
+    }
+  }
+  std::vector<std::vector<std::pair<double, double>>> out;
+  for (std::size_t t = 0; t < baked.textures.size(); ++t) out.push_back(of.at({targets.materials[t], targets.nodes[t]}));
+  return out;
+}
+
 // The texture target `t`'s maps into material `m` of the document and beside the output, their
-// files named for `file_name` (its material's, or with a UDIM tile the material copied's).
+// files named for `file_name` (its material's, or with a UDIM tile the material copied's), PNGs
+// beside it mapped by `ranges` (per map).
 Result<TextureReport> write_maps(gltf::Document& doc, const gltf::ImageCache& cache, const FileOptions& options,
-                                 const Targets& targets, std::size_t t, int m, const std::string& file_name, TextureBake& baked) {
+                                 const Targets& targets, std::size_t t, int m, const std::string& file_name,
+                                 const std::vector<std::pair<double, double>>& ranges, TextureBake& baked) {
   Json& material = doc.json["materials"][std::size_t(m)];
   TextureReport report;
   report.material = m;
@@ -262,7 +281,8 @@ Result<TextureReport> write_maps(gltf::Document& doc, const gltf::ImageCache& ca
   report.faced_away = baked.faced_away, report.skipped_triangles = baked.degenerate_uv + baked.too_large;
   report.height_min = baked.height_min, report.height_max = baked.height_max;
   report.occlusion_rays = baked.occlusion_rays;
-  for (MapImage& map : baked.maps) {
+  for (std::size_t i = 0; i < baked.maps.size(); ++i) {
+    MapImage& map = baked.maps[i];
     image::Image img = gltf::blank(baked.width, baked.height, map.channels);
     img.pixels = map.values;
     const std::optional<Slot> slot = material_slot(map.map);
@@ -270,7 +290,7 @@ Result<TextureReport> write_maps(gltf::Document& doc, const gltf::ImageCache& ca
     if (!slot) {
       // Written with the document, after every check of its files.
       const fs::path file = beside_file(options.output, file_name, map.map, report.tile, options.request.map_format);
-      auto bytes = encode_beside(std::move(img), file, options, map, range);
+      auto bytes = encode_beside(std::move(img), file, options, ranges[i], range);
       if (!bytes) return bytes.error();
       doc.beside[file.filename().string()] = std::move(*bytes);
       report.files.push_back(file.string());
@@ -645,7 +665,7 @@ Result<FileReport> bake_file(const fs::path& low_path, const FileOptions& option
       const std::string& what = targets->targets[t].name;
       if (b.outside_tile && !targets->tiles[t]) {  // a UDIM tile's: the other tiles' triangles
         report.notes.push_back(what + ": " + std::to_string(b.outside_tile) + " triangles have UVs wholly outside the 0–1 "
-                               "tile (a shell moved out by whole tiles): not baked");
+                               "tile (a shell moved out by whole tiles) or not finite: not baked");
       }
       if (b.overlapped) {
         report.notes.push_back(what + ": " + std::to_string(b.overlapped) + " texels are covered by several triangles "
@@ -657,8 +677,9 @@ Result<FileReport> bake_file(const fs::path& low_path, const FileOptions& option
     // The maps stored in the low-poly's tangent basis: a runtime needs the basis they were baked in.
     const bool tangent_basis = std::ranges::any_of(options.request.bake.maps, [](Map m) { return m == Map::normal || m == Map::bent_normal; });
     gltf::ImageCache cache(*doc, options.encoding, gltf::MadeFormat::png);
+    const auto ranges = material_ranges(*targets, *baked);
     for (std::size_t t = 0; t < targets->targets.size(); ++t) {
-      auto written = write_maps(*doc, cache, options, *targets, t, into[t], file_names[t], baked->textures[t]);
+      auto written = write_maps(*doc, cache, options, *targets, t, into[t], file_names[t], ranges[t], baked->textures[t]);
       if (!written) return written.error();
       if (into[t] != targets->materials[t]) {
         written->copy_of = gltf::name_in(doc->json["materials"][std::size_t(targets->materials[t])], "");

@@ -17,11 +17,18 @@ int udim_of(glm::dvec2 uv) {
 
 glm::ivec2 udim_origin(int tile) { return {(tile - 1001) % 10, -((tile - 1001) / 10)}; }
 
+// A quarter of a texel at 2048: a corner on a border (an island's edge laid on it) is inside.
+constexpr double kSlack = 1e-4;
+
 int udim_of(const glm::vec2& a, const glm::vec2& b, const glm::vec2& c) {
   const int tile = udim_of((glm::dvec2(a) + glm::dvec2(b) + glm::dvec2(c)) / 3.0);
-  if (tile == 0) return 0;
-  // A quarter of a texel at 2048: a corner on the border (an island's edge laid on it) is inside.
-  constexpr double kSlack = 1e-4;
+  if (tile == 0) {  // outside every tile, unless a corner lies inside one: across the tiles' outer edge
+    for (const glm::vec2& corner : {a, b, c}) {
+      const double u = corner.x, up = 1.0 - double(corner.y);
+      if (u > kSlack && u < 10 - kSlack && up > kSlack && up < 100 - kSlack) return kAcrossTiles;
+    }
+    return 0;
+  }
   const glm::dvec2 low(udim_origin(tile));
   for (const glm::vec2& corner : {a, b, c}) {
     const glm::dvec2 p(corner);
@@ -65,8 +72,10 @@ Result<TileTargets> udim_targets(const scene::Scene& low, const std::vector<ao::
       out.tiles.push_back(tile);
     }
     if (out.targets.size() > std::size_t(kMaxUdimTiles)) {
-      return Error{"", "the low-poly's materials touch more than " + std::to_string(kMaxUdimTiles) +
-                           " UDIM tiles, each a set of maps held until written: bake fewer materials at a time"};
+      return Error{"", "the low-poly's materials touch " + std::to_string(out.targets.size()) + " UDIM tiles or more (" +
+                           target.name + ": " + std::to_string(tiles.size()) + "), more than the " +
+                           std::to_string(kMaxUdimTiles) + " one bake holds (each tile's maps are held until written): "
+                           "bake the materials one at a time, or move the UVs into fewer tiles"};
     }
   }
   return out;

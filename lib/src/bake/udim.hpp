@@ -21,7 +21,8 @@ namespace matbake::bake {
 // for u in [0, 10) and 1 − v in [0, 100); 0 outside them (or not finite).
 int udim_of(glm::dvec2 uv);
 // The tile of a triangle: its UV centroid's; kAcrossTiles where a corner lies beyond that tile by
-// more than 1e-4 (an island across a border).
+// more than 1e-4 (an island across a border), or where the centroid lies outside every tile and a
+// corner inside one by more than that (across the tiles' outer edge).
 constexpr int kAcrossTiles = -1;
 int udim_of(const glm::vec2& a, const glm::vec2& b, const glm::vec2& c);
 // TextureTarget::tile_origin of a tile: its corner of smallest u and v in glTF's UVs.

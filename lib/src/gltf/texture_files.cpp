@@ -230,7 +230,8 @@ std::string free_uri(const Document& doc, const std::string& name, const std::st
 }
 
 std::string material_file_name(const Json& material, int index) {
-  const std::string name = uri_safe(name_in(material, ""));
+  std::string name = uri_safe(name_in(material, "")).substr(0, kMaterialFileName);
+  while (!name.empty() && name.back() == '_') name.pop_back();
   return name.empty() ? "material" + std::to_string(index) : name;
 }
 

@@ -29,7 +29,10 @@ std::string uri_safe(const std::string& name);
 // `name` + `extension`, or name_2, name_3... when a file of the document already has that URI.
 std::string free_uri(const Document& doc, const std::string& name, const std::string& extension);
 
-// What names the files made for material `index`: its name made uri_safe, else "material<index>".
+// What names the files made for material `index`: its name made uri_safe and cut to
+// kMaterialFileName characters (a file name of a few of them and a map's stays within a file
+// system's 255 bytes), else "material<index>".
+constexpr std::size_t kMaterialFileName = 64;
 std::string material_file_name(const Json& material, int index);
 
 // The format of the images a cache makes: PNG, or lossless 8-bit WebP (the file then requires

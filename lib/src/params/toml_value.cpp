@@ -40,6 +40,7 @@ Result<Value> toml_value(const toml::node& node) {
     }
     return Value(joined);
   }
+  if (node.is_table()) return Error{"", "a table of numbers by name expected, not an empty one"};
   return Error{"", "a number, a string, a list of names, a table of numbers or true/false expected"};
 }
 
