@@ -86,17 +86,21 @@ run() {  # target, seconds, extra flags
   esac
   mkdir -p "$build/corpus/$target" "$build/artifacts/$target"
   local log=$build/fuzz-$target.log started=$SECONDS
+  rm -f "$build"/fuzz-[0-9]*.log  # the jobs' logs of an earlier run
   # -rss_limit_mb: a decoder's legitimate peak stays far below; -max_len: large seeds are kept whole
-  # (a -max_len among the target's flags, later on the line, overrides it).
-  if ! "$build/tests/fuzz/fuzz_$target" "$build/corpus/$target" "$seeds" -max_total_time="$seconds" \
+  # (a -max_len among the target's flags, later on the line, overrides it). Run from the build
+  # folder: with -jobs, libFuzzer writes each job's fuzz-N.log in the current one.
+  if ! (cd "$build" && exec "$build/tests/fuzz/fuzz_$target" "$build/corpus/$target" "$seeds" -max_total_time="$seconds" \
       -rss_limit_mb=4096 -max_len=1048576 -print_final_stats=1 -artifact_prefix="$build/artifacts/$target/" \
-      "$@" >"$log" 2>&1; then
+      "$@") >"$log" 2>&1; then
     tail -n 60 "$log" >&2
     echo "matbake: fuzz target $target failed; the input is in $build/artifacts/$target/" >&2
     return 1
   fi
+  # Runs: the one process's, or with -jobs the sum of its jobs'.
   printf "fuzz %-9s %10s runs in %4s s, corpus %s files\n" "$target" \
-    "$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$')" "$((SECONDS - started))" \
+    "$(cat "$log" "$build"/fuzz-[0-9]*.log 2>/dev/null | grep -o 'stat::number_of_executed_units: *[0-9]*' |
+      awk '{ runs += $NF } END { print runs + 0 }')" "$((SECONDS - started))" \
     "$(find "$build/corpus/$target" -type f | wc -l)"
 }
 
