@@ -164,7 +164,8 @@ Result<HighMaterials> high_materials(const fs::path& high, const image::Encoding
         const Json& info = materials[m]["normalTexture"];
         auto texture = material_texture(*doc, cache, info, color::Transfer::linear, where + "/normalTexture");
         if (!texture) return texture.error();
-        normal = NormalTexture{std::move(*texture), info.value("scale", Json(1.0)).is_number() ? info["scale"].get<double>() : 1.0};
+        const Json scale = info.value("scale", Json(1.0));  // absent (its default) in most files
+        normal = NormalTexture{std::move(*texture), scale.is_number() ? scale.get<double>() : 1.0};
       }
     }
     if (!colours) continue;
