@@ -566,6 +566,35 @@ TEST(TextureAo, NearestMappedTexelIsAtTheLeastDistance) {
   EXPECT_EQ(texels::nearest_mapped(std::vector<bool>(12, false), 4, 3), std::vector<std::int64_t>(12, -1));
 }
 
+// The same for a list of wanted texels: a few near mapped ones (searched ring by ring), many, or
+// one far from every mapped texel (the transform's answer), each at the brute force's least distance.
+TEST(TextureAo, NearestMappedToWantedTexelsIsAtTheLeastDistance) {
+  std::mt19937 random(7);
+  const int w = 97, h = 83;
+  const auto squared = [&](std::int64_t a, std::int64_t b) {
+    return long(a % w - b % w) * (a % w - b % w) + long(a / w - b / w) * (a / w - b / w);
+  };
+  for (const int sites : {1, 5, 300, 4000}) {
+    std::vector<bool> mapped(w * h, false);
+    for (int i = 0; i < sites; ++i) mapped[random() % std::size_t(w * h)] = true;
+    for (const std::size_t count : {std::size_t(1), std::size_t(10), std::size_t(w * h / 8)}) {
+      std::vector<std::size_t> wanted;
+      for (std::size_t i = 0; i < count; ++i) wanted.push_back(random() % std::size_t(w * h));
+      const std::vector<std::int64_t> nearest = texels::nearest_mapped_to(mapped, w, h, wanted);
+      ASSERT_EQ(nearest.size(), wanted.size());
+      for (std::size_t i = 0; i < wanted.size(); ++i) {
+        long best = std::numeric_limits<long>::max();
+        for (int s = 0; s < w * h; ++s) {
+          if (mapped[std::size_t(s)]) best = std::min(best, squared(s, std::int64_t(wanted[i])));
+        }
+        ASSERT_TRUE(nearest[i] >= 0 && mapped[std::size_t(nearest[i])]) << sites << " sites, texel " << wanted[i];
+        ASSERT_EQ(squared(nearest[i], std::int64_t(wanted[i])), best) << sites << " sites, " << count << " wanted, texel " << wanted[i];
+      }
+    }
+  }
+  EXPECT_EQ(texels::nearest_mapped_to(std::vector<bool>(12, false), 4, 3, {0, 5, 11}), std::vector<std::int64_t>(3, -1));
+}
+
 TEST(TextureAo, PaddingDefaultsAndBadOptions) {
   EXPECT_EQ(padding_for(size(1024, 1024, -1)), 16);
   EXPECT_EQ(padding_for(size(4096, 512, -1)), 64);

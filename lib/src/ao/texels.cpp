@@ -460,6 +460,49 @@ std::vector<std::int64_t> nearest_mapped(const std::vector<bool>& mapped, int wi
   return nearest;
 }
 
+namespace {
+
+// The nearest mapped texel to (x, y), −1 when none is found before `budget` (texels looked at,
+// counted down) runs out. Ring r (the square at that Chebyshev distance) lies at least r away, so
+// the search stops at the first ring beyond the best distance found.
+std::int64_t nearest_by_rings(const std::vector<bool>& mapped, long w, long h, long x, long y, std::int64_t& budget) {
+  std::int64_t best = -1;
+  long best_d2 = std::numeric_limits<long>::max();
+  const auto consider = [&](long xx, long yy) {
+    if (xx < 0 || yy < 0 || xx >= w || yy >= h || !mapped[std::size_t(yy * w + xx)]) return;
+    const long d2 = (xx - x) * (xx - x) + (yy - y) * (yy - y);
+    if (d2 < best_d2) best_d2 = d2, best = yy * w + xx;
+  };
+  consider(x, y);
+  for (long r = 1; r * r <= best_d2 && r <= std::max(w, h); ++r) {
+    if ((budget -= 8 * r) < 0) return -1;
+    for (long d = -r; d <= r; ++d) {
+      consider(x + d, y - r), consider(x + d, y + r);
+      if (d > -r && d < r) consider(x - r, y + d), consider(x + r, y + d);
+    }
+  }
+  return best;
+}
+
+}  // namespace
+
+std::vector<std::int64_t> nearest_mapped_to(const std::vector<bool>& mapped, int width, int height,
+                                            const std::vector<std::size_t>& wanted) {
+  // The searches may look at as many texels as the texture holds (the transform's passes look at
+  // each several times): beyond that, the transform.
+  auto budget = std::int64_t(width) * std::int64_t(height);
+  std::vector<std::int64_t> out(wanted.size(), -1);
+  bool searched = true;
+  for (std::size_t i = 0; searched && i < wanted.size(); ++i) {
+    out[i] = nearest_by_rings(mapped, width, height, long(wanted[i] % std::size_t(width)), long(wanted[i] / std::size_t(width)), budget);
+    searched = out[i] >= 0;
+  }
+  if (searched) return out;
+  const std::vector<std::int64_t> all = nearest_mapped(mapped, width, height);
+  for (std::size_t i = 0; i < wanted.size(); ++i) out[i] = all[wanted[i]];
+  return out;
+}
+
 std::size_t pad_channels(std::vector<float>& values, int channels, const std::vector<bool>& mapped, int width,
                          int height, int padding) {
   if (padding <= 0) return 0;

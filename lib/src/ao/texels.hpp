@@ -117,4 +117,11 @@ inline std::size_t pad(std::vector<float>& values, const std::vector<bool>& mapp
 // the transform meets first), −1 when none is mapped. Linear in the texels, however far.
 std::vector<std::int64_t> nearest_mapped(const std::vector<bool>& mapped, int width, int height);
 
+// Of each texel in `wanted` (indices j × width + i), one mapped texel nearest to it (Euclidean), −1
+// when none is mapped. A few wanted texels near mapped ones are each searched ring by ring around
+// it; else the transform over the whole texture answers (nearest_mapped), which costs more than a
+// few hundred searches.
+std::vector<std::int64_t> nearest_mapped_to(const std::vector<bool>& mapped, int width, int height,
+                                            const std::vector<std::size_t>& wanted);
+
 }  // namespace matbake::ao::texels

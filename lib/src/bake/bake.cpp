@@ -410,14 +410,13 @@ void background(MapImage& image) {
   }
 }
 
-// Texels all of whose rays missed take their nearest hit texel's value (however far); `nearest_hit`
-// is empty when none missed.
-void fill_missed(MapImage& image, const std::vector<std::int64_t>& nearest_hit, const std::vector<bool>& hit,
-                 const std::vector<bool>& traced) {
+// Texels all of whose rays missed (`missed`) take their nearest hit texel's value (`nearest_hit`,
+// however far; none when nothing was hit).
+void fill_missed(MapImage& image, const std::vector<std::size_t>& missed, const std::vector<std::int64_t>& nearest_hit) {
   const std::size_t channels = std::size_t(image.channels);
-  for (std::size_t t = 0; t < nearest_hit.size(); ++t) {
-    if (!traced[t] || hit[t] || nearest_hit[t] < 0) continue;
-    for (std::size_t k = 0; k < channels; ++k) image.values[t * channels + k] = image.values[std::size_t(nearest_hit[t]) * channels + k];
+  for (std::size_t i = 0; i < missed.size(); ++i) {
+    if (nearest_hit[i] < 0) continue;
+    for (std::size_t k = 0; k < channels; ++k) image.values[missed[i] * channels + k] = image.values[std::size_t(nearest_hit[i]) * channels + k];
   }
 }
 
@@ -839,12 +838,14 @@ Result<TextureBake> trace_target(const TraceContext& context, const Options& opt
   out.reach_front = reach_for(total.wanted_front), out.reach_back = reach_for(total.wanted_back);
   if (total.height_min <= total.height_max) out.height_min = total.height_min, out.height_max = total.height_max;
   const std::vector<bool> hit(out.hit.begin(), out.hit.end()), was_traced(traced.begin(), traced.end());
-  // Only where a texel missed every ray: the nearest-hit transform is over the whole texture.
-  const std::vector<std::int64_t> nearest_hit =
-      out.missed_texels ? ao::texels::nearest_mapped(hit, texture.width, texture.height) : std::vector<std::int64_t>{};
+  std::vector<std::size_t> missed;  // traced texels that missed every ray
+  for (std::size_t t = 0; out.missed_texels && t < texel_count; ++t) {
+    if (traced[t] && !out.hit[t]) missed.push_back(t);
+  }
+  const std::vector<std::int64_t> nearest_hit = ao::texels::nearest_mapped_to(hit, texture.width, texture.height, missed);
   for (MapImage& image : out.maps) {
     if (image.map == Map::mask) continue;  // the misses as they are
-    fill_missed(image, nearest_hit, hit, was_traced);
+    fill_missed(image, missed, nearest_hit);
     out.padded = ao::texels::pad_channels(image.values, image.channels, was_traced, texture.width, texture.height,
                                           ao::padding_for(texture));
   }
