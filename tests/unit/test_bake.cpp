@@ -945,7 +945,7 @@ TEST(BakeTiles, AShellMovedOutByWholeTilesIsNotBakedIntoTheTile) {
 }
 
 // What the two meshes' boxes say: a high-poly 100× the low-poly (centimetres against metres), one
-// moved away, and one in place over a small cage.
+// moved away, and one in place over a small cage (or wanting so far that a hole is the cause).
 TEST(BakeMisses, TheCauseNamedIsUnitsPlacementOrTheCage) {
   const scene::Scene low = scene_of({hard_box(1)});
   const scene::Scene in_cm = scene_of({hard_box(100)});
@@ -964,6 +964,11 @@ TEST(BakeMisses, TheCauseNamedIsUnitsPlacementOrTheCage) {
   EXPECT_EQ(miss_cause(cage, t, options, diagonal),
             "the cage is too small: front 0.2 (of the diagonal) would reach 95% of the missed rays that have the high-poly along them");
   EXPECT_EQ(miss_cause(cage, TextureBake{}, options, diagonal).rfind("no high-poly surface lies along the missed rays", 0), 0u);
+  // Wanting 0.4 of the diagonal is the far side of the model seen through a hole, not a small cage.
+  t.reach_front = 0.4 * 2 * std::sqrt(3.0);
+  EXPECT_EQ(miss_cause(cage, t, options, diagonal),
+            "the high-poly surface along the missed rays lies 0.4 of the low-poly's diagonal away, farther than any cage "
+            "reaches: holes in the high-poly, or parts of the low-poly it does not have");
 }
 
 }  // namespace

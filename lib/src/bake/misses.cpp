@@ -2,6 +2,7 @@
 // warnings name as the likely cause.
 #include <glm/geometric.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -30,6 +31,9 @@ Boxes compare_boxes(const scene::Scene& low, const scene::Scene& high) {
 
 namespace {
 
+// The reach (of the low-poly's diagonal) past which a miss is put down to holes, not the cage.
+constexpr double kHoleReach = 0.25;
+
 std::string number(double v) {
   char text[32];
   std::snprintf(text, sizeof text, "%.3g", v);
@@ -57,6 +61,14 @@ std::string miss_cause(const Boxes& boxes, const TextureBake& texture, const Opt
   if (2 * texture.faced_away > texture.misses) {
     return "most missed rays met only the backs of high-poly faces: its winding (or the low-poly's side of it) is flipped "
            "there";
+  }
+  // A cage reaching a quarter of the model's size would meet the far side of the model: the surface
+  // those rays want is across a hole (an open base, a missing part), not beyond a small cage.
+  if (const double farthest = std::max(texture.reach_front, texture.reach_back);
+      boxes.low_diagonal > 0 && farthest > kHoleReach * boxes.low_diagonal) {
+    return "the high-poly surface along the missed rays lies " + number(farthest / boxes.low_diagonal) +
+           " of the low-poly's diagonal away, farther than any cage reaches: holes in the high-poly, or parts of the "
+           "low-poly it does not have";
   }
   if (texture.reach_front > 0 || texture.reach_back > 0) {
     const double unit = options.absolute_distances || !(diagonal > 0) ? 1.0 : diagonal;
