@@ -1,6 +1,6 @@
 # Blender's "selected to active" bake of one pair, for scripts/bench-bake-blender.sh:
 #   blender -b --factory-startup --python scripts/bench-bake-blender.py -- \
-#     LOW.gltf HIGH.gltf OUT.exr normal|ao|position|transfer SIZE SAMPLES EXTRUSION MAX_RAY_DISTANCE AO_DISTANCE THREADS [REPEATS]
+#     LOW.gltf HIGH.gltf OUT.exr normal|ao|position|transfer SIZE SAMPLES EXTRUSION MAX_RAY_DISTANCE AO_DISTANCE THREADS [REPEATS [by_name]]
 # Cycles on the CPU; the cage is the low-poly extruded by EXTRUSION along its normals, rays reach
 # MAX_RAY_DISTANCE inward (scene units). The low-poly is invisible to every ray (it is the surface
 # being replaced: it must not occlude the high-poly's AO). Bakes REPEATS times (default 1) and prints
@@ -9,6 +9,9 @@
 # Blender's are Z up: its importer turns the coordinates, not the objects). Kind transfer: the
 # high-poly's base colour (Cycles' diffuse colour pass alone; its importer multiplies COLOR_0 in),
 # linear.
+# With by_name, parts are matched by name as a Blender artist bakes such a set: each low-poly object
+# (NAME_low...) with the high-poly objects of its key (NAME_high...) selected, one bake call each into
+# the one image, not cleared between them; the time is the calls' sum.
 # Kind ao_self (scripts/bench-ao-blender.sh): a scene's AO onto its own UVs, as `matbake bake-ao
 # --texture`: LOW.gltf is the scene, HIGH.gltf is ignored, every mesh object is baked, each material
 # into its own SIZE² image; OUT.exr is the first material's (EXTRUSION and MAX_RAY_DISTANCE unused).
@@ -30,15 +33,21 @@ low_path, high_path, out_path, kind = args[0], args[1], args[2], args[3]
 size, samples = int(args[4]), int(args[5])
 extrusion, max_ray, ao_distance, threads = float(args[6]), float(args[7]), float(args[8]), int(args[9])
 repeats = int(args[10]) if len(args) > 10 else 1
+by_name = len(args) > 11 and args[11] == "by_name"
 
 bpy.ops.wm.read_factory_settings(use_empty=True)
 
 
-def import_mesh(path):
-    """The file's mesh objects joined into one; returns it."""
+def import_meshes(path):
+    """The file's mesh objects."""
     bpy.ops.object.select_all(action="DESELECT")
     bpy.ops.import_scene.gltf(filepath=path)
-    meshes = [o for o in bpy.context.selected_objects if o.type == "MESH"]
+    return [o for o in bpy.context.selected_objects if o.type == "MESH"]
+
+
+def import_mesh(path):
+    """The file's mesh objects joined into one; returns it."""
+    meshes = import_meshes(path)
     bpy.ops.object.select_all(action="DESELECT")
     for o in meshes:
         o.select_set(True)
@@ -62,6 +71,11 @@ def new_image(name):
     return image
 
 
+def key(name, suffix):
+    """A part's name up to its first suffix (_low or _high), as matbake's --match by_name reads it."""
+    return name.split(suffix)[0]
+
+
 if kind == "ao_self":
     bpy.ops.import_scene.gltf(filepath=low_path)
     baked = [o for o in bpy.context.scene.objects if o.type == "MESH"]
@@ -73,16 +87,20 @@ if kind == "ao_self":
         for link in [link for link in tree.links if link.to_socket.name == "Normal"]:
             tree.links.remove(link)
     image = images[0]
+    calls = [(baked[:-1], baked[-1])]  # every object baked onto itself at once
 else:
-    high = import_mesh(high_path)
-    low = import_mesh(low_path)
-    for attribute in ("visible_camera", "visible_diffuse", "visible_glossy", "visible_transmission",
-                      "visible_volume_scatter", "visible_shadow"):
-        setattr(low, attribute, False)
+    highs = import_meshes(high_path) if by_name else [import_mesh(high_path)]
+    lows = import_meshes(low_path) if by_name else [import_mesh(low_path)]
     image = new_image("bake")
-    for slot in low.material_slots:
-        bake_into(slot.material, image)
-    baked = [high, low]
+    for low in lows:
+        for attribute in ("visible_camera", "visible_diffuse", "visible_glossy", "visible_transmission",
+                          "visible_volume_scatter", "visible_shadow"):
+            setattr(low, attribute, False)
+        for slot in low.material_slots:
+            bake_into(slot.material, image)
+    # Each bake call: the high-poly objects selected, the low-poly one active.
+    calls = [([h for h in highs if key(h.name, "_high") == key(low.name, "_low")], low) for low in lows] if by_name \
+        else [(highs, lows[0])]
 
 scene = bpy.context.scene
 scene.render.engine = "CYCLES"
@@ -96,6 +114,7 @@ scene.world = bpy.data.worlds.new("world")
 scene.world.light_settings.distance = ao_distance
 bake = scene.render.bake
 bake.use_selected_to_active = kind != "ao_self"
+bake.use_clear = not by_name  # one image for every part's call
 bake.use_cage = False
 bake.cage_extrusion = extrusion
 bake.max_ray_distance = max_ray
@@ -105,15 +124,18 @@ bake.normal_r, bake.normal_g, bake.normal_b = "POS_X", "POS_Y", "POS_Z"
 bake.use_pass_direct = bake.use_pass_indirect = False  # the diffuse pass's colour alone (transfer)
 bake.use_pass_color = True
 
-bpy.ops.object.select_all(action="DESELECT")
-for o in baked:
-    o.select_set(True)
-bpy.context.view_layer.objects.active = baked[-1]
 seconds = float("inf")
 for _ in range(repeats):
-    started = time.perf_counter()
-    bpy.ops.object.bake(type={"normal": "NORMAL", "ao": "AO", "ao_self": "AO", "position": "POSITION", "transfer": "DIFFUSE"}[kind])
-    seconds = min(seconds, time.perf_counter() - started)
+    total = 0.0
+    for selected, active in calls:
+        bpy.ops.object.select_all(action="DESELECT")
+        for o in selected + [active]:
+            o.select_set(True)
+        bpy.context.view_layer.objects.active = active
+        started = time.perf_counter()
+        bpy.ops.object.bake(type={"normal": "NORMAL", "ao": "AO", "ao_self": "AO", "position": "POSITION", "transfer": "DIFFUSE"}[kind])
+        total += time.perf_counter() - started
+    seconds = min(seconds, total)
 
 if kind == "position":  # Blender's (x, y, z) is glTF's (x, -z, y)
     pixels = numpy.array(image.pixels[:], dtype=numpy.float32).reshape(-1, 4)
