@@ -178,10 +178,12 @@ TEST(CliBuildBake, ACageMeshIsAnInputOfTheBake) {
 TEST(CliBuildBake, VertexMapsReachTheExportedSceneAndAChangeToThemReadsTheTexturesBack) {
   TempDir dir;
   for (const char* f : {"showroom.gltf", "showroom.bin"}) fs::copy_file(kExamples / f, dir / f);
+  // vertex_ao_into with AO among the vertex maps only (it is refused without: it would do nothing).
   const auto run = [&](const std::string& vertex_maps) {
+    const std::string into = vertex_maps.find("ao") != std::string::npos ? ", vertex_ao_into = \"COLOR_0\"" : "";
     write_bytes(dir / "m.toml", "output = \"out\"\n[scenes.s]\ninput = \"showroom.gltf\"\noutput = \"s.glb\"\n"
                                 "bake = { from = \"showroom.gltf\", maps = [\"normal\", \"ao\"], size = 16, vertex_maps = \"" +
-                                    vertex_maps + "\", vertex_ao_into = \"COLOR_0\", ao = { samples = 4 } }\n");
+                                    vertex_maps + "\"" + into + ", ao = { samples = 4 } }\n");
     const RunResult r = matbake({"--json", "build", (dir / "m.toml").string()});
     EXPECT_EQ(r.exit_code, 0) << r.err;
     return json::parse(r.out, nullptr, false)["jobs"][0];

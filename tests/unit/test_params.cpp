@@ -19,6 +19,7 @@
 #include "matbake/encoding_params.hpp"
 #include "matbake/export_params.hpp"
 #include "matbake/material_params.hpp"
+#include "matbake/join.hpp"
 #include "matbake/params.hpp"
 #include "matbake/preview_params.hpp"
 #include "matbake/validate_params.hpp"
@@ -108,15 +109,29 @@ Setting<Root> find_setting(const Tree<Root>& tree, std::size_t own, const std::s
   return {own, nullptr, value};
 }
 
-// The parameter at its example and what it needs that the defaults do not give (each at the value
-// it needs, or its example).
+// What `spec` needs that the defaults do not give (each at the value it needs, or its example), and
+// what those need in turn (vertex_existing_colors: vertex_ao_into = COLOR_0, which needs ao among
+// vertex_maps), onto `out`, each once.
+template <class Root>
+void add_needs(const Tree<Root>& tree, std::size_t b, const Spec* spec, std::vector<Setting<Root>>& out) {
+  for (const Condition& c : spec->needs) {
+    // A list rule: the list holding its last name alone (green's bent_normal: the normal map with
+    // green directx is refused for the glTF it goes into).
+    const std::string value = c.among ? split(c.value, ',').back() : c.value;
+    const Setting<Root> needed = find_setting(tree, b, c.name, value);
+    const bool listed = std::ranges::any_of(out, [&](const Setting<Root>& s) { return s.spec == needed.spec; });
+    if (!listed && (c.value.empty() || value_text(tree[needed.branch].values(Root{}).at(c.name)) != value)) {
+      out.push_back(needed);
+      add_needs(tree, needed.branch, needed.spec, out);
+    }
+  }
+}
+
+// The parameter at its example and all it needs (add_needs).
 template <class Root>
 std::vector<Setting<Root>> with_needs(const Tree<Root>& tree, std::size_t b, const Spec* spec) {
   std::vector<Setting<Root>> out{{b, spec, spec->example}};
-  for (const Condition& c : spec->needs) {
-    const Setting<Root> needed = find_setting(tree, b, c.name, c.value);
-    if (c.value.empty() || value_text(tree[needed.branch].values(Root{}).at(c.name)) != c.value) out.push_back(needed);
-  }
+  add_needs(tree, b, spec, out);
   return out;
 }
 
@@ -406,13 +421,43 @@ TEST(RequestTree, BakesTreeTakesEveryParameterAtItsExample) {
     for (const Spec* spec : tree[b].specs) {
       SCOPED_TRACE(spec->name);
       std::vector<Setting<bake::FileOptions>> settings = with_needs(tree, b, spec);
-      // green directx is refused with the normal map, which goes into the glTF: a map written beside it.
-      if (spec->name == "green") settings.push_back(find_setting(tree, b, "maps", "bent_normal"));
       auto cli = from_flags(tree, settings);
       ASSERT_TRUE(cli) << cli.error().to_string();
       EXPECT_NE(tree[b].values(*cli).at(spec->name), tree[b].values(bake::FileOptions{}).at(spec->name));
     }
   }
+}
+
+// The parameters that act only on some maps say so (a rule on a list's values), and both doors
+// refuse them with a list that lacks those maps, in one line each in their own spelling; with one
+// of the maps among the list, the rule holds.
+TEST(RequestTree, BakesListRulesAreEnforcedAtBothDoors) {
+  const Tree<bake::FileOptions>& tree = bake::request_tree();
+  std::size_t rules = 0;
+  for (std::size_t b = 0; b < tree.size(); ++b) {
+    for (const Spec* spec : tree[b].specs) {
+      for (const Condition& c : spec->needs) {
+        if (!c.among) continue;
+        SCOPED_TRACE(spec->name + " needs " + c.value + " among " + c.name);
+        const Setting<bake::FileOptions> self{b, spec, spec->example}, without = find_setting(tree, b, c.name, "height");
+        const std::string alternatives = join(split(c.value, ','), " or ");
+        auto cli = from_flags(tree, {self, without});
+        ASSERT_FALSE(cli);
+        EXPECT_EQ(cli.error().message, flag_of(tree, self) + " applies only with " + alternatives + " among " + flag_of(tree, without));
+        const std::string table = "bake = { from = \"h.glb\", " + spec->name + " = " + toml_value_text(*spec, spec->example) + ", " +
+                                  c.name + " = \"height\" }";
+        auto manifest = pipeline::parse_manifest("[scenes.s]\ninput = \"a.gltf\"\n" + table + "\n", "/p/assets.toml");
+        ASSERT_FALSE(manifest);
+        // Placed at the value, as every manifest error is.
+        const std::size_t column = table.find(spec->name + " = ") + spec->name.size() + 4;
+        EXPECT_EQ(manifest.error().to_string(), "/p/assets.toml:3:" + std::to_string(column) + ": scenes.s.bake." +
+                                                    spec->name + " applies only with " + alternatives + " among scenes.s.bake." + c.name);
+        EXPECT_TRUE(from_flags(tree, with_needs(tree, b, spec)));
+        ++rules;
+      }
+    }
+  }
+  EXPECT_EQ(rules, 4u);  // green, id_by, high_normal_maps, vertex_ao_into; a new one is walked here too
 }
 
 // A request made by the command line from one parameter at its example (a flag on by default

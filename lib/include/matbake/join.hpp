@@ -1,5 +1,6 @@
 #pragma once
-// The one way matbake joins words into a message or a list: "a, b, c".
+// The one way matbake joins words into a message or a list ("a, b, c"), and splits a list.
+#include <algorithm>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -15,6 +16,17 @@ inline std::string join(const std::vector<std::string>& parts, std::string_view 
     out.append(parts[i]);
   }
   return out;
+}
+
+// The parts of `text` between each `separator` ("a,,b" has three; "" has one, empty).
+inline std::vector<std::string> split(std::string_view text, char separator) {
+  std::vector<std::string> parts;
+  for (std::size_t start = 0;;) {
+    const std::size_t end = std::min(text.find(separator, start), text.size());
+    parts.emplace_back(text.substr(start, end - start));
+    if (end == text.size()) return parts;
+    start = end + 1;
+  }
 }
 
 }  // namespace matbake

@@ -23,10 +23,13 @@
 
 namespace matbake::params {
 
-// A parameter another one applies with, and (when not empty) the value it must have.
+// A parameter another one applies with, and (when not empty) the value it must have; with `among`,
+// `value` is names (comma-separated) one of which the parameter's list (comma-separated: a bake's
+// maps) must hold: green acts only on the normal or bent-normal map.
 struct Condition {
   std::string name;
   std::string value;
+  bool among = false;
 };
 
 // A value as a door gives it: the command line's text is turned into one by from_text, a
@@ -54,8 +57,9 @@ struct Spec {
   std::vector<std::string> aliases;  // older manifest keys, still read, with a note
   // Rules across parameters, run at both doors by check_rules with one message each (a door only
   // spells the names): `needs` are the parameters this one applies with, in its own group or
-  // another of the request: given (texcoord: texture), or set to a value (colour_quality:
-  // texture_format = ktx2, colour_codec = etc1s). `excludes`: parameters it cannot be given with.
+  // another of the request: given (texcoord: texture), set to a value (colour_quality:
+  // texture_format = ktx2, colour_codec = etc1s), or a list holding a value (green: normal or
+  // bent_normal among maps). `excludes`: parameters it cannot be given with.
   std::vector<Condition> needs;
   std::vector<std::string> excludes;
   bool manifest_only = false;        // a manifest key with no flag (a build's own setting)

@@ -128,7 +128,8 @@ params::Group<Request> make_group() {
       ao::into_attribute<Request>(Spec{.name = "vertex_ao_into",
                                        .help = "Per-vertex AO as _AO (a float attribute) or COLOR_0 (multiplies the "
                                                "base colour in any viewer)",
-                                       .example = "COLOR_0"},
+                                       .example = "COLOR_0",
+                                       .needs = {{"vertex_maps", "ao", true}}},
                                   &Request::vertex_ao_into),
       ao::into_existing<Request>(Spec{.name = "vertex_existing_colors",
                                       .help = "With COLOR_0, a primitive's own COLOR_0: multiply (kept, times AO; alpha "
@@ -159,16 +160,19 @@ params::Group<Request> make_group() {
       params::flag<Request>(Spec{.name = "high_normal_maps",
                                  .help = "The normal map takes the high-poly's own normal maps at each hit (in its "
                                          "tangent basis) over its vertex normals",
-                                 .example = "true"},
+                                 .example = "true",
+                                 .needs = {{"maps", "normal", true}}},
                             [](auto& r) -> auto& { return r.bake.high_normal_maps; }),
       params::choice<Request>(Spec{.name = "green",
                                    .help = "The normal map's green: opengl (glTF's: up the texture) or directx (refused "
                                            "with the normal map: a glTF viewer shades it inverted; bent_normal follows it)",
-                                   .example = "directx"},
+                                   .example = "directx",
+                                   .needs = {{"maps", "normal,bent_normal", true}}},
                               [](auto& r) -> auto& { return r.bake.green; }, kGreenNames),
       params::choice<Request>(Spec{.name = "id_by",
                                    .help = "What the id map colours: the hit's material or its glTF primitive",
-                                   .example = "primitive"},
+                                   .example = "primitive",
+                                   .needs = {{"maps", "id", true}}},
                               [](auto& r) -> auto& { return r.bake.id_by; }, kIdSourceNames),
       params::choice<Request>(Spec{.name = "match",
                                    .help = "Which high-poly parts a low-poly part's rays meet: always (every one) or "

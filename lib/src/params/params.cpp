@@ -50,6 +50,19 @@ std::optional<std::int64_t> integer_from(std::string_view text) {
 
 }  // namespace
 
+namespace {
+
+// Whether the comma-separated `list` holds one of the comma-separated `names`.
+bool holds_any(const std::string& list, const std::string& names) {
+  const std::vector<std::string> items = split(list, ',');
+  return std::ranges::any_of(split(names, ','), [&](const std::string& n) { return std::ranges::find(items, n) != items.end(); });
+}
+
+// "normal or bent_normal" for "normal,bent_normal".
+std::string alternatives(const std::string& names) { return join(split(names, ','), " or "); }
+
+}  // namespace
+
 std::optional<RuleBreak> check_rules(const std::vector<GroupState>& groups, const Spelling& spell) {
   struct Found {
     std::size_t group;
@@ -78,7 +91,14 @@ std::optional<RuleBreak> check_rules(const std::vector<GroupState>& groups, cons
         const auto needed = find(g, c.name);
         if (!needed) continue;
         const GroupState& in = groups[needed->group];
-        if (c.value.empty() ? !in.given.count(c.name) : value_text(in.values.value(c.name, nlohmann::json())) != c.value) {
+        const std::string value = value_text(in.values.value(c.name, nlohmann::json()));
+        if (c.among) {
+          if (!holds_any(value, c.value)) {
+            return RuleBreak{g, spec->name, self + " applies only with " + alternatives(c.value) + " among " + spell(needed->group, *needed->spec, nullptr)};
+          }
+          continue;
+        }
+        if (c.value.empty() ? !in.given.count(c.name) : value != c.value) {
           return RuleBreak{g, spec->name, self + " applies only with " + spell(needed->group, *needed->spec, c.value.empty() ? nullptr : &c.value) +
                                               (c.value.empty() ? " as well" : "")};
         }
@@ -183,7 +203,10 @@ std::string value_text(const nlohmann::json& value) {
 // The docs' words for a parameter's rules: " (with `texture`; not with `into`)".
 std::string rules_text(const Spec& spec) {
   std::vector<std::string> parts;
-  for (const Condition& c : spec.needs) parts.push_back("with `" + c.name + (c.value.empty() ? "" : " = " + c.value) + "`");
+  for (const Condition& c : spec.needs) {
+    parts.push_back(c.among ? "with " + alternatives(c.value) + " among `" + c.name + "`"
+                            : "with `" + c.name + (c.value.empty() ? "" : " = " + c.value) + "`");
+  }
   for (const std::string& other : spec.excludes) parts.push_back("not with `" + other + "`");
   return parts.empty() ? "" : " (" + join(parts, "; ") + ")";
 }
