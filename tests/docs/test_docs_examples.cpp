@@ -35,7 +35,7 @@ struct Block {
 
 std::vector<fs::path> markdown_files() {
   const fs::path root(MATBAKE_SOURCE_DIR);
-  std::vector<fs::path> files = {root / "README.md"};
+  std::vector<fs::path> files = {root / "README.md", root / "CONTRIBUTING.md"};
   for (const auto& entry : fs::directory_iterator(root / "docs")) {
     if (entry.path().extension() == ".md") files.push_back(entry.path());
   }
