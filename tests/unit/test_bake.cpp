@@ -968,7 +968,13 @@ TEST(BakeMisses, TheCauseNamedIsUnitsPlacementOrTheCage) {
   t.reach_front = 0.4 * 2 * std::sqrt(3.0);
   EXPECT_EQ(miss_cause(cage, t, options, diagonal),
             "the high-poly surface along the missed rays lies 0.4 of the low-poly's diagonal away, farther than any cage "
-            "reaches: holes in the high-poly, or parts of the low-poly it does not have");
+            "reaches: holes in the high-poly (the rays see its far side), parts of the low-poly it does not have, or "
+            "high-poly parts standing that far off the low-poly (give them low-poly parts, or their own cage with match "
+            "by_name)");
+  // A suggestion is rounded up: 0.07071 (front 0.0707 would fall short) is 0.0708.
+  t.reach_front = 0.07071 * 2 * std::sqrt(3.0);
+  EXPECT_EQ(miss_cause(cage, t, options, diagonal),
+            "the cage is too small: front 0.0708 (of the diagonal) would reach 95% of the missed rays that have the high-poly along them");
 }
 
 }  // namespace

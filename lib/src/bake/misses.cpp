@@ -40,6 +40,14 @@ std::string number(double v) {
   return text;
 }
 
+// A distance to suggest, rounded up to three significant digits: rounded down, the cage it names
+// falls just short of the surfaces it was measured to reach.
+std::string number_up(double v) {
+  if (!(v > 0) || !std::isfinite(v)) return number(v);
+  const double step = std::pow(10.0, std::floor(std::log10(v)) - 2);
+  return number(std::ceil(v / step - 1e-6) * step);  // a float a hair above 0.2 is still 0.2
+}
+
 }  // namespace
 
 std::string miss_cause(const Boxes& boxes, const TextureBake& texture, const Options& options, double diagonal, bool cage_mesh) {
@@ -67,19 +75,20 @@ std::string miss_cause(const Boxes& boxes, const TextureBake& texture, const Opt
   if (const double farthest = std::max(texture.reach_front, texture.reach_back);
       boxes.low_diagonal > 0 && farthest > kHoleReach * boxes.low_diagonal) {
     return "the high-poly surface along the missed rays lies " + number(farthest / boxes.low_diagonal) +
-           " of the low-poly's diagonal away, farther than any cage reaches: holes in the high-poly, or parts of the "
-           "low-poly it does not have";
+           " of the low-poly's diagonal away, farther than any cage reaches: holes in the high-poly (the rays see "
+           "its far side), parts of the low-poly it does not have, or high-poly parts standing that far off the "
+           "low-poly (give them low-poly parts, or their own cage with match by_name)";
   }
   if (texture.reach_front > 0 || texture.reach_back > 0) {
     const double unit = options.absolute_distances || !(diagonal > 0) ? 1.0 : diagonal;
     std::string wider;
     if (texture.reach_front > 0 && cage_mesh) {
-      wider = "the cage mesh " + number(texture.reach_front) + " (scene units) farther out";
-      if (texture.reach_back > 0) wider += " and back " + number(texture.reach_back / unit) + (unit == 1 ? " (scene units)" : " (of the diagonal)");
+      wider = "the cage mesh " + number_up(texture.reach_front) + " (scene units) farther out";
+      if (texture.reach_back > 0) wider += " and back " + number_up(texture.reach_back / unit) + (unit == 1 ? " (scene units)" : " (of the diagonal)");
       return "the cage is too small: " + wider + " would reach 95% of the missed rays that have the high-poly along them";
     }
-    if (texture.reach_front > 0) wider = "front " + number(texture.reach_front / unit);
-    if (texture.reach_back > 0) wider += std::string(wider.empty() ? "" : " and ") + "back " + number(texture.reach_back / unit);
+    if (texture.reach_front > 0) wider = "front " + number_up(texture.reach_front / unit);
+    if (texture.reach_back > 0) wider += std::string(wider.empty() ? "" : " and ") + "back " + number_up(texture.reach_back / unit);
     return "the cage is too small: " + wider + (options.absolute_distances ? " (scene units)" : " (of the diagonal)") +
            " would reach 95% of the missed rays that have the high-poly along them";
   }
