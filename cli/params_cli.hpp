@@ -11,6 +11,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "matbake/join.hpp"
 #include "matbake/params.hpp"
 
 namespace matbake::cli {
@@ -42,7 +43,9 @@ inline void add_specs(CLI::App& cmd, const std::vector<const params::Spec*>& spe
     std::string help = p.help;
     if (p.kind == params::Kind::choice) help += ": " + params::type_text(p);
     for (const params::Condition& c : p.needs) {
-      help += " (with " + params::flag_name(params::Spec{.name = c.name}, prefix) + (c.value.empty() ? "" : " " + c.value) + ")";
+      const std::string needed = params::flag_name(params::Spec{.name = c.name}, prefix);
+      help += c.among ? " (with " + join(split(c.value, ','), " or ") + " among " + needed + ")"
+                      : " (with " + needed + (c.value.empty() ? "" : " " + c.value) + ")";
     }
     if (p.kind == params::Kind::flag) {  // on by default: --no-NAME turns it off
       const bool on = defaults.at(p.name) == true;

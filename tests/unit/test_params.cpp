@@ -458,6 +458,16 @@ TEST(RequestTree, BakesListRulesAreEnforcedAtBothDoors) {
     }
   }
   EXPECT_EQ(rules, 4u);  // green, id_by, high_normal_maps, vertex_ao_into; a new one is walked here too
+  // A project-wide default at the manifest's top level applies where it can: the scene baking AO
+  // alone is not refused for it; given by that scene itself, it is.
+  const std::string scenes = "[scenes.s]\ninput = \"a.gltf\"\nbake = { from = \"h.glb\", maps = [\"normal\"] }\n"
+                             "[scenes.t]\ninput = \"b.gltf\"\nbake = { from = \"h.glb\", maps = [\"ao\"] }\n";
+  auto inherited = pipeline::parse_manifest("[bake]\nhigh_normal_maps = true\nid_by = \"primitive\"\n" + scenes, "/p/assets.toml");
+  EXPECT_TRUE(inherited) << inherited.error().to_string();
+  auto own = pipeline::parse_manifest(scenes + "[scenes.u]\ninput = \"c.gltf\"\nbake = { from = \"h.glb\", maps = [\"ao\"], "
+                                               "high_normal_maps = true }\n", "/p/assets.toml");
+  ASSERT_FALSE(own);
+  EXPECT_EQ(own.error().to_string(), "/p/assets.toml:9:60: scenes.u.bake.high_normal_maps applies only with normal among scenes.u.bake.maps");
 }
 
 // A request made by the command line from one parameter at its example (a flag on by default

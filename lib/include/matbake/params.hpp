@@ -129,6 +129,10 @@ struct GroupState {
   std::vector<const Spec*> specs;
   nlohmann::json values;
   std::set<std::string> given;
+  // Of `given`, those a manifest's top level gave for every entry, not the entry itself: a rule on
+  // a list's values (green with normal among maps) lets them be where the list lacks the values,
+  // as a project-wide default that applies where it can.
+  std::set<std::string> inherited;
 };
 
 // How a door writes a parameter of group `group`, alone (`value` null) or set to a value:

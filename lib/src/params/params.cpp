@@ -93,7 +93,7 @@ std::optional<RuleBreak> check_rules(const std::vector<GroupState>& groups, cons
         const GroupState& in = groups[needed->group];
         const std::string value = value_text(in.values.value(c.name, nlohmann::json()));
         if (c.among) {
-          if (!holds_any(value, c.value)) {
+          if (!groups[g].inherited.count(spec->name) && !holds_any(value, c.value)) {
             return RuleBreak{g, spec->name, self + " applies only with " + alternatives(c.value) + " among " + spell(needed->group, *needed->spec, nullptr)};
           }
           continue;

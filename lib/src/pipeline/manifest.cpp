@@ -2,6 +2,7 @@
 // does not silently fall back to a default.
 #include <toml++/toml.h>
 
+#include <algorithm>
 #include <fstream>
 #include <initializer_list>
 #include <set>
@@ -245,7 +246,16 @@ Status check_tree(const Reader& r, const toml::table& t, const toml::table& top,
                   const params::Tree<Root>& tree, const Entry<Root>& entry) {
   std::vector<std::string> wheres;
   for (const params::Branch<Root>& b : tree) wheres.push_back(where_of(b, where));
-  if (auto broken = params::check_rules(params::states_of(tree, entry.request, entry.given), key_spelling(wheres))) {
+  std::vector<params::GroupState> states = params::states_of(tree, entry.request, entry.given);
+  for (std::size_t i = 0; i < tree.size(); ++i) {
+    const toml::table* own = tree[i].table.empty() ? &t : sub_table(t, tree[i].table);
+    for (const params::Spec* spec : tree[i].specs) {
+      const bool in_entry = own && (own->contains(spec->name) ||
+                                    std::ranges::any_of(spec->aliases, [&](const std::string& a) { return own->contains(a); }));
+      if (entry.given[i].count(spec->name) && !in_entry) states[i].inherited.insert(spec->name);
+    }
+  }
+  if (auto broken = params::check_rules(states, key_spelling(wheres))) {
     return r.at(key_node(tree[broken->group], broken->name, t, top), broken->message);
   }
   for (std::size_t i = 0; i < tree.size(); ++i) {
