@@ -197,6 +197,16 @@ TEST(Bake, TheHighPolysNormalMapIsAppliedInItsTangentBasis) {
       }
     }
   }
+  // A normal map on a UV set the high-poly lacks is refused, not left out without a word.
+  normal.texture.texcoord = 1;
+  options.high_normal_maps = true;
+  HighMaterials materials;
+  materials.normals = {normal};
+  auto baked = bake(pair.low, scene_of({high}), {ao::TextureTarget{{0}, 0}}, texture, options, {}, materials);
+  ASSERT_FALSE(baked);
+  EXPECT_EQ(baked.error().message, "the high-poly's material 0 has a normal map on TEXCOORD_1, which a primitive using it "
+                                   "lacks: high_normal_maps cannot apply it (give the primitive that UV set, or the "
+                                   "normalTexture the texCoord it has)");
 }
 
 // A unit icosphere of 80 triangles placed by `world`, each triangle its own UV island (9 × 9 cells).

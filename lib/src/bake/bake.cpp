@@ -699,7 +699,8 @@ Result<std::vector<std::vector<CornerFrame>>> target_frames(const scene::Scene& 
 }
 
 // The tangent frames of each high-poly instance whose material has a normal map, through its UV
-// set (none for the others, or where the instance lacks that set).
+// set (none for the others). An instance without that set is an error: the map asked for would be
+// left out without a word.
 Result<std::vector<std::vector<CornerFrame>>> normal_map_frames(const scene::Scene& high,
                                                                  const std::vector<std::optional<NormalTexture>>& normals) {
   std::vector<std::vector<CornerFrame>> frames(high.instances.size());
@@ -707,7 +708,11 @@ Result<std::vector<std::vector<CornerFrame>>> normal_map_frames(const scene::Sce
     const scene::Instance& inst = high.instances[k];
     if (inst.material < 0 || std::size_t(inst.material) >= normals.size() || !normals[std::size_t(inst.material)]) continue;
     const int texcoord = normals[std::size_t(inst.material)]->texture.texcoord;
-    if (std::size_t(texcoord) >= inst.texcoords.size() || inst.texcoords[std::size_t(texcoord)].empty()) continue;
+    if (std::size_t(texcoord) >= inst.texcoords.size() || inst.texcoords[std::size_t(texcoord)].empty()) {
+      return Error{"", "the high-poly's material " + std::to_string(inst.material) + " has a normal map on TEXCOORD_" +
+                           std::to_string(texcoord) + ", which a primitive using it lacks: high_normal_maps cannot apply it "
+                           "(give the primitive that UV set, or the normalTexture the texCoord it has)"};
+    }
     auto made = corner_frames(inst, texcoord);
     if (!made) return made.error();
     frames[k] = std::move(*made);

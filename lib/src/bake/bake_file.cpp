@@ -148,6 +148,25 @@ Result<MaterialTexture> material_texture(const gltf::Document& doc, const gltf::
   return out;
 }
 
+// Every primitive of material `m` has the UV set `texcoord` its normal map reads: else that map
+// would be left out of the bake without a word. The error names the file and the primitive.
+Status check_normal_uvs(const gltf::Document& doc, int m, int texcoord) {
+  const Json& meshes = doc.json.value("meshes", Json::array());
+  const std::string set = "TEXCOORD_" + std::to_string(texcoord);
+  for (std::size_t i = 0; i < meshes.size(); ++i) {
+    const Json& primitives = meshes[i].is_object() ? meshes[i].value("primitives", Json::array()) : Json::array();
+    for (std::size_t j = 0; j < primitives.size(); ++j) {
+      const Json& p = primitives[j];
+      if (!p.is_object() || p.value("material", Json(-1)) != Json(m)) continue;
+      if (p.contains("attributes") && p["attributes"].is_object() && p["attributes"].contains(set)) continue;
+      return Error{doc.file, "/meshes/" + std::to_string(i) + "/primitives/" + std::to_string(j) + ": its material " +
+                                          std::to_string(m) + "'s normal map reads " + set + ", which it lacks: "
+                                          "--high-normal-maps cannot apply it"};
+    }
+  }
+  return success();
+}
+
 // What the high-poly's materials give: base colours (factors, textures decoded to linear) when
 // `colours`, normal maps (codes as stored, with their scale) when `normals`.
 Result<HighMaterials> high_materials(const fs::path& high, const image::Encoding& encoding, bool colours, bool normals) {
@@ -167,6 +186,9 @@ Result<HighMaterials> high_materials(const fs::path& high, const image::Encoding
         const Json scale = info.value("scale", Json(1.0));  // absent (its default) in most files
         normal = NormalTexture{std::move(*texture), scale.is_number() ? scale.get<double>() : 1.0};
       }
+    }
+    if (normals && out.normals.back()) {
+      if (Status s = check_normal_uvs(*doc, int(m), out.normals.back()->texture.texcoord); !s) return s.error();
     }
     if (!colours) continue;
     BaseColor& color = out.base_colors.emplace_back();
