@@ -160,8 +160,8 @@ Status check_normal_uvs(const gltf::Document& doc, int m, int texcoord) {
       if (!p.is_object() || p.value("material", Json(-1)) != Json(m)) continue;
       if (p.contains("attributes") && p["attributes"].is_object() && p["attributes"].contains(set)) continue;
       return Error{doc.file, "/meshes/" + std::to_string(i) + "/primitives/" + std::to_string(j) + ": its material " +
-                                          std::to_string(m) + "'s normal map reads " + set + ", which it lacks: "
-                                          "--high-normal-maps cannot apply it"};
+                                          std::to_string(m) + "'s normal map reads " + set + ", which it lacks: " +
+                                          mention("high_normal_maps") + " cannot apply it"};
     }
   }
   return success();
